@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// The one exception type the library throws for bad input.
+
+#include <stdexcept>
+#include <string>
+
+namespace caliber {
+
+/// What kind of bad input an Error reports.
+enum class ErrorCode {
+  file_not_found,   ///< the path does not exist or is not a regular file
+  unreadable,       ///< the file exists but could not be read or parsed
+  bad_value,        ///< a value is out of range or not finite (coordinate, pose, option)
+  bad_index,        ///< a face refers to a vertex that does not exist
+  empty_mesh,       ///< the input holds no triangle at all
+  bad_argument,     ///< an API argument is invalid (for example a null model)
+};
+
+/// Thrown for every bad input: missing or malformed files, non-finite values, bad options.
+/// `what()` is a complete message that names the source (file path or option) and the problem.
+/// Nothing in the library crashes or returns a silent wrong answer on such input instead.
+class Error : public std::runtime_error {
+ public:
+  /// `source` names where the problem is (a file path, an option name); may be empty.
+  Error(ErrorCode code, std::string source, const std::string& problem)
+      : std::runtime_error(source.empty() ? problem : source + ": " + problem),
+        mCode(code),
+        mSource(std::move(source)) {}
+
+  /// The kind of problem.
+  [[nodiscard]] ErrorCode code() const noexcept { return mCode; }
+  /// The file path or option the problem is in.
+  [[nodiscard]] const std::string& source() const noexcept { return mSource; }
+
+ private:
+  ErrorCode mCode;
+  std::string mSource;
+};
+
+}  // namespace caliber

@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// Triangle meshes: the geometry of one rigid object, in its own (object) frame.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace caliber {
+
+/// A triangle mesh in object space. Triangle ids are indices into `triangles`; loaders keep the
+/// file's face order so that users and tests can refer to triangles by id.
+struct Mesh {
+  /// Vertex positions (object space). All finite once validated.
+  std::vector<Eigen::Vector3d> vertices;
+  /// Triangles as three vertex indices. Degenerate (zero-area) triangles are allowed.
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  /// Optional primitive group of each triangle (0..63), used by the group-compatibility test.
+  /// Empty means every triangle is in group 0.
+  std::vector<std::uint8_t> groups;
+  /// Where the mesh came from (a file path or a generator name), used in error messages.
+  std::string source;
+};
+
+/// Largest number of primitive groups (one bit each in a BVH node's mask).
+inline constexpr int kMaxGroups = 64;
+
+/// Loads OFF, OBJ, STL (ascii and binary) or PLY through assimp.
+/// Triangle ids follow the file's face order; a polygon with n > 3 corners becomes n-2 triangles
+/// fanned from its first corner, in place. Vertices are not merged or reordered.
+/// Throws caliber::Error naming the file on a missing file, a parse error, a non-finite coordinate,
+/// an index out of range, a face with fewer than 3 corners, or a mesh without triangles.
+[[nodiscard]] Mesh load_mesh(const std::filesystem::path& path);
+
+/// Checks the invariants every routine relies on: at least one triangle, finite coordinates,
+/// indices in range, groups (if any) one per triangle and below kMaxGroups.
+/// Throws caliber::Error naming `mesh.source` and the first problem found.
+void validate_mesh(const Mesh& mesh);
+
+/// Applies a uniform scale to every vertex (scene files scale meshes). `factor` must be finite and > 0.
+void scale_mesh(Mesh& mesh, double factor);
+
+}  // namespace caliber

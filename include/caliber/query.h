@@ -1,0 +1,97 @@
+#pragma once
+/// \file
+/// The narrow-phase query between two posed models: interference, proximity and contact.
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "caliber/model.h"
+#include "caliber/pose.h"
+
+namespace caliber {
+
+/// What a query reports.
+enum class QueryKind : std::uint8_t {
+  interference,  ///< every intersecting triangle pair (exact predicates)
+  proximity,     ///< every triangle pair at distance <= tolerance, with closest points
+  contact,       ///< quasi-LMD: proximity pairs whose normals face each other, reduced to local minima
+};
+
+/// "interference", "proximity" or "contact".
+[[nodiscard]] std::string_view to_string(QueryKind kind);
+/// Parses a kind name; throws caliber::Error on an unknown name.
+[[nodiscard]] QueryKind parse_query_kind(std::string_view name);
+
+/// Which primitive groups may touch: group g may touch group h iff bit h of compatible[g] is set.
+/// The matrix should be symmetric; the default lets every group touch every group.
+struct GroupCompatibility {
+  /// Row g: the groups that g may touch.
+  std::array<std::uint64_t, 64> compatible;
+  /// All groups compatible with all.
+  GroupCompatibility() { compatible.fill(~std::uint64_t{0}); }
+  /// Whether groups a and b may touch.
+  [[nodiscard]] bool allows(unsigned a, unsigned b) const { return (compatible[a] >> b) & 1u; }
+};
+
+/// Every option of a query, with defaults.
+struct QueryRequest {
+  /// What to report.
+  QueryKind kind = QueryKind::interference;
+  /// Distance d (world units) for proximity and contact; must be finite and >= 0. Ignored by interference.
+  double tolerance = 0.0;
+  /// Angle theta in degrees, [0, 180], for contact: normals must face each other within it.
+  double angle_deg = 30.0;
+  /// Group compatibility; null means every group may touch every group. Not owned.
+  const GroupCompatibility* groups = nullptr;
+};
+
+/// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or an angle outside [0, 180].
+void validate_request(const QueryRequest& request);
+
+/// A triangle pair: triangle of A, triangle of B.
+struct TrianglePair {
+  std::uint32_t tri_a;  ///< triangle id in model A
+  std::uint32_t tri_b;  ///< triangle id in model B
+  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
+  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
+};
+
+/// One reported contact (proximity and contact queries), in world coordinates.
+struct Contact {
+  std::uint32_t tri_a = 0;             ///< triangle id in model A
+  std::uint32_t tri_b = 0;             ///< triangle id in model B
+  Eigen::Vector3d point_a;             ///< closest point on triangle A
+  Eigen::Vector3d point_b;             ///< closest point on triangle B
+  Eigen::Vector3d normal;              ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
+  double distance = 0.0;               ///< triangle distance; exactly 0 when the triangles intersect
+};
+
+/// Work counters: the parallel engine weighs tasks by them.
+struct QueryStats {
+  std::uint64_t node_tests = 0;  ///< node-node tests (BVH node pairs examined)
+  std::uint64_t leaf_tests = 0;  ///< triangle-pair tests
+};
+
+/// The result of a query. `pairs` is sorted and holds every reported triangle pair; `contacts`
+/// (proximity and contact only; empty for interference) holds one entry per pair, same order.
+struct QueryResult {
+  QueryKind kind = QueryKind::interference;  ///< the kind that produced it
+  std::vector<TrianglePair> pairs;           ///< sorted by (tri_a, tri_b)
+  std::vector<Contact> contacts;             ///< sorted like pairs
+  QueryStats stats;                          ///< work done
+};
+
+/// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
+/// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.
+[[nodiscard]] QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+                                const QueryRequest& request);
+
+/// The O(n*m) oracle: runs the leaf test on every triangle pair. For tests.
+[[nodiscard]] QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b,
+                                            const Pose& pose_b, const QueryRequest& request);
+
+}  // namespace caliber

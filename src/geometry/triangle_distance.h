@@ -1,0 +1,34 @@
+#pragma once
+/// \file
+/// Closest points between triangles, segments and points (floating point, robust to degeneracy).
+/// Every point returned is a convex combination of the input vertices (weights clamped to [0, 1]),
+/// so a reported distance is never below the true distance by more than rounding: the BVH prune
+/// (which bounds the true distance with a safety margin) stays conservative against it.
+
+#include <Eigen/Core>
+
+namespace caliber::geometry {
+
+/// Closest point to x on the closed segment pq (pq may be a point).
+Eigen::Vector3d closest_point_on_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& p, const Eigen::Vector3d& q);
+
+/// Closest point to x on the closed triangle abc (which may be degenerate).
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c);
+
+/// Closest points c1 on p1q1 and c2 on p2q2 (segments may be points).
+void closest_points_segments(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1, const Eigen::Vector3d& p2,
+                             const Eigen::Vector3d& q2, Eigen::Vector3d& c1, Eigen::Vector3d& c2);
+
+/// A pair of points, one on each triangle, and their distance.
+struct ClosestPoints {
+  Eigen::Vector3d on_a;  ///< point on triangle A
+  Eigen::Vector3d on_b;  ///< point on triangle B
+  double distance;       ///< |on_b - on_a|
+};
+
+/// Closest points between triangles A and B: the nearest of the edge-edge, vertex-face and
+/// edge-through-face candidates (the last ones find the crossing point of intersecting triangles).
+ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
+
+}  // namespace caliber::geometry

@@ -1,0 +1,142 @@
+#include "geometry/triangle_intersect.h"
+
+#include <algorithm>
+
+#include "geometry/predicates.h"
+
+namespace caliber::geometry {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+struct P2 {
+  double v[2];
+};
+
+/// Given x collinear with a and b, whether x lies within the closed segment ab (coordinate bounds).
+bool within_bounds(const P2& x, const P2& a, const P2& b) {
+  for (int k = 0; k < 2; ++k) {
+    if (x.v[k] < std::min(a.v[k], b.v[k]) || x.v[k] > std::max(a.v[k], b.v[k])) return false;
+  }
+  return true;
+}
+
+/// Closed 2-D segments pq and rs meet; exact, degenerate segments (points) included.
+bool segments_intersect_2d(const P2& p, const P2& q, const P2& r, const P2& s) {
+  const int o1 = orient2d(p.v, q.v, r.v);
+  const int o2 = orient2d(p.v, q.v, s.v);
+  const int o3 = orient2d(r.v, s.v, p.v);
+  const int o4 = orient2d(r.v, s.v, q.v);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  if (o1 == 0 && within_bounds(r, p, q)) return true;
+  if (o2 == 0 && within_bounds(s, p, q)) return true;
+  if (o3 == 0 && within_bounds(p, r, s)) return true;
+  if (o4 == 0 && within_bounds(q, r, s)) return true;
+  return false;
+}
+
+/// Point p lies in the closed 2-D triangle t (which may be degenerate).
+bool point_in_triangle_2d(const P2& p, const P2 t[3]) {
+  if (orient2d(t[0].v, t[1].v, t[2].v) != 0) {
+    const int o1 = orient2d(t[0].v, t[1].v, p.v);
+    const int o2 = orient2d(t[1].v, t[2].v, p.v);
+    const int o3 = orient2d(t[2].v, t[0].v, p.v);
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const P2& a = t[i];
+    const P2& b = t[(i + 1) % 3];
+    if (orient2d(a.v, b.v, p.v) == 0 && within_bounds(p, a, b)) return true;
+  }
+  return false;
+}
+
+/// Closed 2-D triangles (possibly degenerate) meet: some edges cross, or one holds the other.
+bool triangles_intersect_2d(const P2 a[3], const P2 b[3]) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (segments_intersect_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3])) return true;
+    }
+  }
+  return point_in_triangle_2d(a[0], b) || point_in_triangle_2d(b[0], a);
+}
+
+/// For point sets that lie in one common plane: their convex hulls meet iff they meet in all three
+/// axis projections (one projection is injective on that plane, and projections keep meetings).
+bool coplanar_hulls_intersect(const Vec3 a[3], const Vec3 b[3]) {
+  for (int drop = 0; drop < 3; ++drop) {
+    const int u = (drop + 1) % 3, v = (drop + 2) % 3;
+    P2 pa[3], pb[3];
+    for (int i = 0; i < 3; ++i) {
+      pa[i] = P2{{a[i][u], a[i][v]}};
+      pb[i] = P2{{b[i][u], b[i][v]}};
+    }
+    if (!triangles_intersect_2d(pa, pb)) return false;
+  }
+  return true;
+}
+
+/// a, b, c lie on one line (or coincide), exactly.
+bool collinear(const Vec3& a, const Vec3& b, const Vec3& c) {
+  for (int drop = 0; drop < 3; ++drop) {
+    const int u = (drop + 1) % 3, v = (drop + 2) % 3;
+    const double pa[2] = {a[u], a[v]}, pb[2] = {b[u], b[v]}, pc[2] = {c[u], c[v]};
+    if (orient2d(pa, pb, pc) != 0) return false;
+  }
+  return true;
+}
+
+/// Segment pq against triangle abc, given sp = orient3d(a,b,c,p) and sq = orient3d(a,b,c,q).
+bool segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c, int sp, int sq) {
+  if (sp * sq > 0) return false;
+  const int o1 = orient3d(p.data(), q.data(), a.data(), b.data());
+  const int o2 = orient3d(p.data(), q.data(), b.data(), c.data());
+  const int o3 = orient3d(p.data(), q.data(), c.data(), a.data());
+  if (sp != 0 || sq != 0) {
+    // The line pq crosses the plane of a non-degenerate triangle at one point of the segment;
+    // that point is in the closed triangle iff pq turns the same way around all three edges.
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+  }
+  // Here the segment lies in the triangle's plane, or the triangle is degenerate (a segment or a
+  // point). In the latter case the five points are coplanar only if all three orientations vanish.
+  if (collinear(a, b, c) && (o1 != 0 || o2 != 0 || o3 != 0)) return false;
+  const Vec3 seg[3] = {p, q, q};
+  const Vec3 tri[3] = {a, b, c};
+  return coplanar_hulls_intersect(seg, tri);
+}
+
+}  // namespace
+
+bool segment_intersects_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return segment_triangle(p, q, a, b, c, orient3d(a.data(), b.data(), c.data(), p.data()),
+                          orient3d(a.data(), b.data(), c.data(), q.data()));
+}
+
+bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                         const Vec3& b2) {
+  const Vec3 a[3] = {a0, a1, a2};
+  const Vec3 b[3] = {b0, b1, b2};
+  int sa[3], sb[3];
+  for (int i = 0; i < 3; ++i) sa[i] = orient3d(b0.data(), b1.data(), b2.data(), a[i].data());
+  if ((sa[0] > 0 && sa[1] > 0 && sa[2] > 0) || (sa[0] < 0 && sa[1] < 0 && sa[2] < 0)) return false;
+  for (int i = 0; i < 3; ++i) sb[i] = orient3d(a0.data(), a1.data(), a2.data(), b[i].data());
+  if ((sb[0] > 0 && sb[1] > 0 && sb[2] > 0) || (sb[0] < 0 && sb[1] < 0 && sb[2] < 0)) return false;
+
+  // Coplanar, non-degenerate triangles: one 2-D test instead of six edge tests.
+  const bool a_in_plane_of_b = sa[0] == 0 && sa[1] == 0 && sa[2] == 0;
+  if (a_in_plane_of_b && !collinear(b0, b1, b2)) return coplanar_hulls_intersect(a, b);
+
+  // Two closed triangles meet iff an edge of one meets the other: the intersection is convex, and
+  // its boundary points lie on an edge of one triangle (or one triangle holds the other whole).
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (segment_triangle(a[i], a[j], b0, b1, b2, sa[i], sa[j])) return true;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (segment_triangle(b[i], b[j], a0, a1, a2, sb[i], sb[j])) return true;
+  }
+  return false;
+}
+
+}  // namespace caliber::geometry

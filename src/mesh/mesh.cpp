@@ -1,0 +1,48 @@
+#include <cmath>
+#include <string>
+
+#include "caliber/error.h"
+#include "caliber/mesh.h"
+
+namespace caliber {
+
+void validate_mesh(const Mesh& mesh) {
+  const std::string& src = mesh.source.empty() ? std::string("mesh") : mesh.source;
+  if (mesh.triangles.empty()) throw Error(ErrorCode::empty_mesh, src, "mesh has no triangles");
+  if (mesh.triangles.size() >= 0x7fffffffu) throw Error(ErrorCode::bad_value, src, "too many triangles");
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (!mesh.vertices[v].allFinite()) {
+      throw Error(ErrorCode::bad_value, src, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (const std::uint32_t index : mesh.triangles[t]) {
+      if (index >= mesh.vertices.size()) {
+        throw Error(ErrorCode::bad_index, src,
+                    "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(index) +
+                        " but there are only " + std::to_string(mesh.vertices.size()));
+      }
+    }
+  }
+  if (!mesh.groups.empty()) {
+    if (mesh.groups.size() != mesh.triangles.size()) {
+      throw Error(ErrorCode::bad_value, src, "groups must hold one entry per triangle");
+    }
+    for (std::size_t t = 0; t < mesh.groups.size(); ++t) {
+      if (mesh.groups[t] >= kMaxGroups) {
+        throw Error(ErrorCode::bad_value, src,
+                    "triangle " + std::to_string(t) + " is in group " + std::to_string(mesh.groups[t]) +
+                        "; groups are 0.." + std::to_string(kMaxGroups - 1));
+      }
+    }
+  }
+}
+
+void scale_mesh(Mesh& mesh, double factor) {
+  if (!std::isfinite(factor) || factor <= 0.0) {
+    throw Error(ErrorCode::bad_value, mesh.source, "scale must be a finite number > 0");
+  }
+  for (auto& v : mesh.vertices) v *= factor;
+}
+
+}  // namespace caliber

@@ -1,0 +1,83 @@
+#include "narrow/pair_context.h"
+
+#include <cmath>
+
+#include "geometry/triangle_distance.h"
+#include "geometry/triangle_intersect.h"
+
+namespace caliber::narrow {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+/// Relative safety margin on sphere tests. Rounding in the transformed centers and vertices is a few
+/// ulps (~1e-16 relative) of the coordinates' magnitude; 1e-9 of it is far above that and far below
+/// any size that changes how much the prune prunes.
+constexpr double kRelativeMargin = 1e-9;
+/// Margin on the cosine in the cone test: covers float-rounded cone axes (|axis| = 1 +- 2e-7).
+constexpr double kConeCosMargin = 1e-6;
+}  // namespace
+
+PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+                         const QueryRequest& request)
+    : mA(a), mB(b), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
+  validate_request(request);
+  validate_pose(pose_a, "pose of A");
+  validate_pose(pose_b, "pose of B");
+  const Eigen::Matrix3d ra = pose_a.rotation_matrix();
+  const Eigen::Matrix3d rb = pose_b.rotation_matrix();
+  mRot = ra.transpose() * rb;
+  mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
+  const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
+  mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
+  mTheta = request.angle_deg * kPi / 180.0;
+  mCosTheta = std::cos(mTheta);
+}
+
+bool PairContext::cones_can_face(const BvhNode& na, const BvhNode& nb) const {
+  // Leaf normals n_a, n_b lie within their cones; a leaf passes when angle(n_a, -n_b) <= theta, so by
+  // the triangle inequality angle(axis_a, -axis_b) <= alpha_a + alpha_b + theta for any passing leaf.
+  if (na.cone_angle < 0.0f || nb.cone_angle < 0.0f) return false;  // only degenerate triangles below
+  const double total = static_cast<double>(na.cone_angle) + static_cast<double>(nb.cone_angle) + mTheta;
+  if (total >= kPi) return true;
+  const Eigen::Vector3d axis_a(na.cone_axis[0], na.cone_axis[1], na.cone_axis[2]);
+  const Eigen::Vector3d axis_b(nb.cone_axis[0], nb.cone_axis[1], nb.cone_axis[2]);
+  const double facing = -axis_a.dot(mRot * axis_b);
+  return facing >= std::cos(total) - kConeCosMargin;
+}
+
+bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {
+  while (ga != 0) {
+    const int g = __builtin_ctzll(ga);
+    if (mGroups->compatible[g] & gb) return true;
+    ga &= ga - 1;
+  }
+  return false;
+}
+
+bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const {
+  if (mGroups != nullptr) {
+    const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
+    const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
+    if (!mGroups->allows(ga, gb)) return false;
+  }
+  if (mKind == QueryKind::contact) {
+    const Eigen::Vector3d& na = mA.normals[ta];
+    const Eigen::Vector3d& nb = mB.normals[tb];
+    if (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0) return false;  // degenerate: no normal
+    if (na.dot(mRot * nb) > -mCosTheta) return false;
+  }
+  const auto& tri_a = mA.mesh.triangles[ta];
+  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
+  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
+  if (mKind == QueryKind::interference) {
+    if (intersecting) out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+    return intersecting;
+  }
+  const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
+  const double distance = intersecting ? 0.0 : closest.distance;
+  if (!(distance <= mRequest.tolerance)) return false;
+  out.push_back(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
+  return true;
+}
+
+}  // namespace caliber::narrow

@@ -1,0 +1,150 @@
+// The query front-end: one object pair, one traversal, and the brute-force oracle beside it.
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "caliber/error.h"
+#include "caliber/query.h"
+#include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+
+namespace caliber {
+
+std::string_view to_string(QueryKind kind) {
+  switch (kind) {
+    case QueryKind::interference: return "interference";
+    case QueryKind::proximity: return "proximity";
+    case QueryKind::contact: return "contact";
+  }
+  return "unknown";
+}
+
+QueryKind parse_query_kind(std::string_view name) {
+  if (name == "interference") return QueryKind::interference;
+  if (name == "proximity") return QueryKind::proximity;
+  if (name == "contact") return QueryKind::contact;
+  throw Error(ErrorCode::bad_value, "kind",
+              "unknown query kind '" + std::string(name) + "' (expected interference, proximity or contact)");
+}
+
+void validate_request(const QueryRequest& request) {
+  if (!std::isfinite(request.tolerance) || request.tolerance < 0.0) {
+    throw Error(ErrorCode::bad_value, "tolerance", "must be a finite number >= 0");
+  }
+  if (!std::isfinite(request.angle_deg) || request.angle_deg < 0.0 || request.angle_deg > 180.0) {
+    throw Error(ErrorCode::bad_value, "angle", "must be a number of degrees in [0, 180]");
+  }
+}
+
+namespace narrow {
+namespace {
+
+/// Strict total order used by the local-minimum reduction: closer first, then lower ids.
+bool closer(const Candidate& x, const Candidate& y) {
+  if (x.distance != y.distance) return x.distance < y.distance;
+  if (x.tri_a != y.tri_a) return x.tri_a < y.tri_a;
+  return x.tri_b < y.tri_b;
+}
+
+bool by_ids(const Candidate& x, const Candidate& y) {
+  return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
+}
+
+/// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
+/// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win).
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted) {
+  const auto find = [&](std::uint32_t ta, std::uint32_t tb) -> const Candidate* {
+    const Candidate key{ta, tb, 0.0, {}, {}};
+    const auto it = std::lower_bound(sorted.begin(), sorted.end(), key, by_ids);
+    return (it != sorted.end() && it->tri_a == ta && it->tri_b == tb) ? &*it : nullptr;
+  };
+  const Model& ma = ctx.a();
+  const Model& mb = ctx.b();
+  std::vector<Candidate> kept;
+  for (const Candidate& c : sorted) {
+    bool dominated = false;
+    for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
+      const Candidate* other = find(ma.adjacency[k], c.tri_b);
+      dominated = other != nullptr && closer(*other, c);
+    }
+    for (std::uint32_t k = mb.adjacency_offsets[c.tri_b]; !dominated && k < mb.adjacency_offsets[c.tri_b + 1]; ++k) {
+      const Candidate* other = find(c.tri_a, mb.adjacency[k]);
+      dominated = other != nullptr && closer(*other, c);
+    }
+    if (!dominated) kept.push_back(c);
+  }
+  return kept;
+}
+
+}  // namespace
+
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats) {
+  QueryResult result;
+  result.kind = ctx.request().kind;
+  result.stats = stats;
+  std::sort(candidates.begin(), candidates.end(), by_ids);
+  if (result.kind == QueryKind::contact) {
+    if (ctx.a().adjacency_offsets.empty() || ctx.b().adjacency_offsets.empty()) {
+      throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
+    }
+    candidates = local_minima(ctx, candidates);
+  }
+  result.pairs.reserve(candidates.size());
+  for (const Candidate& c : candidates) result.pairs.push_back(TrianglePair{c.tri_a, c.tri_b});
+  if (result.kind == QueryKind::interference) return result;
+
+  const Pose& pose = ctx.pose_a();
+  const Eigen::Matrix3d ra = pose.rotation_matrix();
+  result.contacts.reserve(candidates.size());
+  for (const Candidate& c : candidates) {
+    Contact contact;
+    contact.tri_a = c.tri_a;
+    contact.tri_b = c.tri_b;
+    contact.distance = c.distance;
+    contact.point_a = ra * c.point_a + pose.translation;
+    contact.point_b = ra * c.point_b + pose.translation;
+    const Eigen::Vector3d gap = c.point_b - c.point_a;
+    const double gap_norm = gap.norm();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    if (c.distance > 0.0 && gap_norm > 0.0) {
+      normal = gap / gap_norm;
+    } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
+      normal = ctx.a().normals[c.tri_a];
+    } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
+      normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
+    }
+    contact.normal = ra * normal;
+    result.contacts.push_back(contact);
+  }
+  return result;
+}
+
+}  // namespace narrow
+
+QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {
+  const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
+  narrow::TraversalScratch scratch;
+  std::vector<narrow::Candidate> candidates;
+  QueryStats stats;
+  narrow::traverse_depth_first(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats);
+  return narrow::finalize(ctx, candidates, stats);
+}
+
+QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+                              const QueryRequest& request) {
+  const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
+  std::vector<narrow::Candidate> candidates;
+  QueryStats stats;
+  const auto na = static_cast<std::uint32_t>(a.mesh.triangles.size());
+  const auto nb = static_cast<std::uint32_t>(b.mesh.triangles.size());
+  for (std::uint32_t ta = 0; ta < na; ++ta) {
+    for (std::uint32_t tb = 0; tb < nb; ++tb) {
+      ++stats.leaf_tests;
+      ctx.leaf_test(ta, tb, candidates);
+    }
+  }
+  return narrow::finalize(ctx, candidates, stats);
+}
+
+}  // namespace caliber
