@@ -2,7 +2,9 @@
 /// \file
 /// Exact geometric predicates on double coordinates: a floating-point filter, then exact expansion
 /// arithmetic (Shewchuk's error-free transformations) when the filter cannot decide the sign.
-/// The sign returned is the sign of the exact determinant of the given doubles.
+/// The sign returned is the sign of the exact determinant of the given doubles, provided no
+/// intermediate product underflows (coordinates, and differences of coordinates, either zero or
+/// above about 1e-140 in magnitude) or overflows (below about 1e100): far beyond any mesh's range.
 
 namespace caliber::geometry {
 

@@ -1,0 +1,125 @@
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/error.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+
+namespace caliber {
+namespace {
+
+/// Checks every invariant of the BVH; returns the triangles below `index`.
+std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
+  const BvhNode& node = m.nodes[index];
+  std::vector<std::uint32_t> below;
+  if (node.is_leaf()) {
+    below.push_back(node.index);
+  } else {
+    EXPECT_GT(node.index, index + 1) << "right child after the left subtree";
+    auto left = check_subtree(m, index + 1);
+    auto right = check_subtree(m, node.index);
+    EXPECT_EQ(m.nodes[index + 1].count + m.nodes[node.index].count, node.count);
+    EXPECT_EQ(m.nodes[index + 1].groups | m.nodes[node.index].groups, node.groups);
+    below = std::move(left);
+    below.insert(below.end(), right.begin(), right.end());
+  }
+  EXPECT_EQ(below.size(), node.count);
+  const Eigen::Vector3d c(node.center[0], node.center[1], node.center[2]);
+  const Eigen::Vector3d axis = Eigen::Vector3d(node.cone_axis[0], node.cone_axis[1], node.cone_axis[2]).normalized();
+  bool any_normal = false;
+  for (const std::uint32_t t : below) {
+    for (const std::uint32_t v : m.mesh.triangles[t]) {
+      EXPECT_LE((m.mesh.vertices[v] - c).norm(), node.radius) << "node " << index << " must cover its vertices";
+    }
+    if (m.normals[t].squaredNorm() > 0.0) {
+      any_normal = true;
+      const double angle = std::acos(std::clamp(axis.dot(m.normals[t]), -1.0, 1.0));
+      EXPECT_LE(angle, node.cone_angle) << "node " << index << " cone must hold the normal of triangle " << t;
+    }
+  }
+  EXPECT_EQ(any_normal, node.cone_angle >= 0.0f) << "node " << index;
+  return below;
+}
+
+void check_model(const Model& m) {
+  ASSERT_EQ(m.nodes.size(), 2 * m.mesh.triangles.size() - 1);
+  auto all = check_subtree(m, 0);
+  std::sort(all.begin(), all.end());
+  for (std::uint32_t t = 0; t < all.size(); ++t) ASSERT_EQ(all[t], t) << "each triangle in exactly one leaf";
+}
+
+TEST(BuildModel, InvariantsOnProceduralMeshes) {
+  check_model(*build_model(make_sphere(1.0, 12, 16)));
+  check_model(*build_model(make_torus(2.0, 0.5, 16, 10)));
+  check_model(*build_model(make_box(1.0, 2.0, 0.5, 3)));
+  check_model(*build_model(make_plate(1.0, 0.02, 5)));
+}
+
+TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-10, 10);
+  Mesh mesh;
+  mesh.source = "soup";
+  for (int t = 0; t < 500; ++t) {
+    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+    const Eigen::Vector3d p(u(rng), u(rng), u(rng));
+    mesh.vertices.push_back(p);
+    mesh.vertices.push_back(t % 7 == 0 ? p : Eigen::Vector3d(p + Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.1));
+    mesh.vertices.push_back(p + Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.1);
+    mesh.triangles.push_back({base, base + 1, base + 2});
+    mesh.groups.push_back(static_cast<std::uint8_t>(t % 5));
+  }
+  const auto model = build_model(mesh);
+  check_model(*model);
+  EXPECT_EQ(model->nodes[0].groups, 0b11111u);
+  EXPECT_LE(model->height, 12);  // median split: ceil(log2(500)) + 1 = 10
+}
+
+TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
+  Mesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+  mesh.triangles = {{0, 1, 2}};
+  const auto model = build_model(mesh);
+  ASSERT_EQ(model->nodes.size(), 1u);
+  EXPECT_TRUE(model->nodes[0].is_leaf());
+  EXPECT_LT(model->nodes[0].cone_angle, 0.0f) << "a degenerate triangle has no normal";
+  EXPECT_EQ(model->normals[0], Eigen::Vector3d::Zero());
+  check_model(*model);
+}
+
+TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
+  // Two triangles sharing an edge, with the shared vertices repeated (as STL stores them),
+  // and a third far away.
+  Mesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
+  mesh.triangles = {{0, 1, 2}, {3, 5, 4}, {6, 7, 8}};
+  const auto model = build_model(mesh);
+  const auto neighbors = [&](std::uint32_t t) {
+    return std::vector<std::uint32_t>(model->adjacency.begin() + model->adjacency_offsets[t],
+                                      model->adjacency.begin() + model->adjacency_offsets[t + 1]);
+  };
+  EXPECT_EQ(neighbors(0), std::vector<std::uint32_t>{1});
+  EXPECT_EQ(neighbors(1), std::vector<std::uint32_t>{0});
+  EXPECT_TRUE(neighbors(2).empty());
+}
+
+TEST(BuildModel, RejectsBadMesh) {
+  Mesh mesh;
+  mesh.source = "empty";
+  EXPECT_THROW((void)build_model(mesh), Error);
+}
+
+TEST(BuildModel, BoxAdjacencyIsVertexAdjacency) {
+  const auto model = build_model(make_box(1, 1, 1, 1));
+  // A cube of 12 triangles: faces are separate grids, so adjacency comes from welding positions.
+  for (std::uint32_t t = 0; t < 12; ++t) {
+    const auto count = model->adjacency_offsets[t + 1] - model->adjacency_offsets[t];
+    EXPECT_GE(count, 5u) << "triangle " << t;
+  }
+}
+
+}  // namespace
+}  // namespace caliber

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# End-to-end checks of the caliber command line: output shape and exit codes.
+set -u
+cli="$1"
+data="$2"
+failures=0
+passes=0
+check() {  # check NAME EXPECTED_RC COMMAND... ; stderr/stdout kept in $out
+  local name="$1" want="$2"
+  shift 2
+  out=$("$@" 2>&1)
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then
+    echo "FAIL $name: exit $rc, wanted $want; output: $out"
+    failures=$((failures + 1))
+    return 1
+  fi
+  passes=$((passes + 1))
+  return 0
+}
+contains() {  # contains NAME TEXT
+  if ! grep -qF -- "$2" <<<"$out"; then
+    echo "FAIL $1: output lacks '$2': $out"
+    failures=$((failures + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+check help 0 "$cli" --help
+check query-help 0 "$cli" query --help
+check summary 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.5 0.5 0.5 1 0 0 0"
+contains summary "intersecting triangle pairs"
+check json 0 "$cli" query "$data/tetra.off" "$data/tetra_binary.stl" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind proximity --tolerance 0.1 --json
+contains json '"kind":"proximity"'
+contains json '"stats":{'
+contains json '"build_ms"'
+python3 - "$out" <<'PY' || { echo "FAIL json-shape"; failures=$((failures + 1)); }
+import json, sys
+r = json.loads(sys.argv[1])
+assert r["kind"] == "proximity"
+assert r["pairs"] == sorted(r["pairs"]) and len(r["pairs"]) > 0
+assert len(r["contacts"]) == len(r["pairs"])
+for c, p in zip(r["contacts"], r["pairs"]):
+    assert [c["tri_a"], c["tri_b"]] == p
+    assert len(c["point_a"]) == 3 and len(c["normal"]) == 3 and c["distance"] <= 0.1
+assert r["stats"]["node_tests"] >= r["stats"]["leaf_tests"] > 0
+PY
+check missing 2 "$cli" query "$data/nope.off" "$data/tetra.off"
+contains missing "nope.off: no such file"
+check bad-index 2 "$cli" query "$data/bad/index_range.off" "$data/tetra.off"
+contains bad-index "index_range.off"
+check nan 2 "$cli" query "$data/bad/nan.off" "$data/tetra.off"
+contains nan "non-finite"
+check empty 2 "$cli" query "$data/bad/empty.off" "$data/tetra.off"
+check directory 2 "$cli" query "$data/bad" "$data/tetra.off"
+check bad-pose 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-a "1 2 3"
+contains bad-pose "--pose-a"
+check zero-quat 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0 0 0 0 0 0 0"
+check bad-kind 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind collide
+contains bad-kind "unknown query kind"
+check neg-tol 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind proximity --tolerance -1
+check bad-angle 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind contact --angle 200
+check no-args 2 "$cli"
+check unknown-flag 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --frobnicate
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]

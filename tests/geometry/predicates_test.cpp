@@ -1,0 +1,116 @@
+#include "geometry/predicates.h"
+
+#include <cmath>
+#include <array>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace caliber::geometry {
+namespace {
+
+using i128 = __int128;
+
+/// Exact orient3d on integer coordinates (|x| < 2^26 keeps every product inside 128 bits).
+int orient3d_int(const std::int64_t* a, const std::int64_t* b, const std::int64_t* c, const std::int64_t* d) {
+  const i128 adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
+  const i128 bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
+  const i128 cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
+  const i128 det = adz * (bdx * cdy - cdx * bdy) + bdz * (cdx * ady - adx * cdy) + cdz * (adx * bdy - bdx * ady);
+  return det > 0 ? 1 : (det < 0 ? -1 : 0);
+}
+
+TEST(Predicates, Orient3dBasicSigns) {
+  const double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0, 1, 0};
+  const double above[3] = {0, 0, 1}, below[3] = {0, 0, -1}, on[3] = {0.3, 0.3, 0};
+  // Shewchuk's convention: positive when d lies below the plane of counter-clockwise a, b, c.
+  EXPECT_EQ(orient3d(a, b, c, below), 1);
+  EXPECT_EQ(orient3d(a, b, c, above), -1);
+  EXPECT_EQ(orient3d(a, b, c, on), 0);
+}
+
+TEST(Predicates, Orient2dBasicSigns) {
+  const double a[2] = {0, 0}, b[2] = {1, 0}, left[2] = {0.5, 1}, right[2] = {0.5, -1}, on[2] = {3, 0};
+  EXPECT_EQ(orient2d(a, b, left), 1);
+  EXPECT_EQ(orient2d(a, b, right), -1);
+  EXPECT_EQ(orient2d(a, b, on), 0);
+}
+
+TEST(Predicates, Orient3dDetectsOneUlpOffThePlane) {
+  // The plane x + y + z = 1; the origin is on one side.
+  const double p[3] = {1.0, 0.0, 0.0}, q[3] = {0.0, 1.0, 0.0}, r[3] = {0.0, 0.0, 1.0};
+  const double origin[3] = {0.0, 0.0, 0.0};
+  const int origin_side = orient3d(p, q, r, origin);
+  ASSERT_NE(origin_side, 0);
+  const double on[3] = {0.5, 0.5, 0.0};
+  EXPECT_EQ(orient3d(p, q, r, on), 0);
+  // A tiny positive z puts the point strictly beyond the plane (exactness holds while no product
+  // underflows: see predicates.h).
+  const double beyond[3] = {0.5, 0.5, 1e-200};
+  EXPECT_EQ(orient3d(p, q, r, beyond), -origin_side);
+  // One ulp less in y puts it strictly on the origin's side.
+  const double before[3] = {0.5, std::nextafter(0.5, 0.0), 0.0};
+  EXPECT_EQ(orient3d(p, q, r, before), origin_side);
+}
+
+TEST(Predicates, Orient3dMatchesIntegerArithmeticOnNearlyCoplanarPoints) {
+  std::mt19937_64 rng(42);
+  std::uniform_int_distribution<std::int64_t> coord(-(1 << 20), 1 << 20);
+  std::uniform_int_distribution<std::int64_t> small(-3, 3);
+  std::uniform_int_distribution<int> scale_exp(-40, 40);
+  int zeros = 0, nonzeros = 0;
+  for (int iter = 0; iter < 20000; ++iter) {
+    std::int64_t a[3], b[3], c[3], d[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = coord(rng);
+      b[k] = coord(rng);
+      c[k] = coord(rng);
+    }
+    // d = a + (b - a) + (c - a) + tiny perturbation: on or one unit off the plane.
+    for (int k = 0; k < 3; ++k) d[k] = b[k] + c[k] - a[k] + (iter % 2 == 0 ? 0 : small(rng));
+    const int want = orient3d_int(a, b, c, d);
+    // Scale by a power of two: exact in floating point, sign unchanged.
+    const double s = std::ldexp(1.0, scale_exp(rng));
+    double fa[3], fb[3], fc[3], fd[3];
+    for (int k = 0; k < 3; ++k) {
+      fa[k] = static_cast<double>(a[k]) * s;
+      fb[k] = static_cast<double>(b[k]) * s;
+      fc[k] = static_cast<double>(c[k]) * s;
+      fd[k] = static_cast<double>(d[k]) * s;
+    }
+    ASSERT_EQ(orient3d(fa, fb, fc, fd), want) << "iteration " << iter;
+    (want == 0 ? zeros : nonzeros)++;
+  }
+  EXPECT_GT(zeros, 5000);
+  EXPECT_GT(nonzeros, 5000);
+}
+
+TEST(Predicates, Orient2dMatchesIntegerArithmetic) {
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<std::int64_t> coord(-(1 << 25), 1 << 25);
+  std::uniform_int_distribution<std::int64_t> small(-2, 2);
+  for (int iter = 0; iter < 20000; ++iter) {
+    std::int64_t a[2], b[2], c[2];
+    for (int k = 0; k < 2; ++k) {
+      a[k] = coord(rng);
+      b[k] = coord(rng);
+    }
+    for (int k = 0; k < 2; ++k) c[k] = 2 * b[k] - a[k] + small(rng);
+    const i128 det = static_cast<i128>(a[0] - c[0]) * (b[1] - c[1]) - static_cast<i128>(a[1] - c[1]) * (b[0] - c[0]);
+    const int want = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    const double fa[2] = {static_cast<double>(a[0]) * 0.125, static_cast<double>(a[1]) * 0.125};
+    const double fb[2] = {static_cast<double>(b[0]) * 0.125, static_cast<double>(b[1]) * 0.125};
+    const double fc[2] = {static_cast<double>(c[0]) * 0.125, static_cast<double>(c[1]) * 0.125};
+    ASSERT_EQ(orient2d(fa, fb, fc), want) << "iteration " << iter;
+  }
+}
+
+TEST(Predicates, ExactWhereDifferencesAreInexact) {
+  // Coordinates whose differences are not representable: 1 and 1e-20 apart (the difference rounds).
+  const double a[3] = {1.0, 0.0, 0.0}, b[3] = {0.0, 1.0, 0.0}, c[3] = {0.0, 0.0, 1.0};
+  const double d[3] = {1.0 - 1e-20, 1e-20, 0.0};  // rounds to (1, 1e-20, 0): off the plane x+y+z=1 by 1e-20
+  EXPECT_EQ(orient3d(a, b, c, d), -orient3d(a, b, c, std::array<double, 3>{0.0, 0.0, 0.0}.data()));
+}
+
+}  // namespace
+}  // namespace caliber::geometry

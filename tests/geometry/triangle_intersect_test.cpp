@@ -1,0 +1,160 @@
+#include "geometry/triangle_intersect.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "geometry/triangle_distance.h"
+
+namespace caliber::geometry {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+bool tri_tri(const Vec3 a[3], const Vec3 b[3]) { return triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]); }
+
+/// The answer must not depend on argument order or vertex order: checks all 2 x 6 x 6 orders.
+bool consistent_answer(const Vec3 a[3], const Vec3 b[3]) {
+  const int perms[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+  const bool want = tri_tri(a, b);
+  for (const auto& pa : perms) {
+    for (const auto& pb : perms) {
+      const Vec3 ra[3] = {a[pa[0]], a[pa[1]], a[pa[2]]};
+      const Vec3 rb[3] = {b[pb[0]], b[pb[1]], b[pb[2]]};
+      EXPECT_EQ(tri_tri(ra, rb), want);
+      EXPECT_EQ(tri_tri(rb, ra), want);
+    }
+  }
+  return want;
+}
+
+TEST(TriangleIntersect, SeparatedByPlane) {
+  const Vec3 a[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Vec3 b[3] = {{0, 0, 1}, {1, 0, 1}, {0, 1, 1}};
+  EXPECT_FALSE(consistent_answer(a, b));
+}
+
+TEST(TriangleIntersect, Piercing) {
+  const Vec3 a[3] = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+  const Vec3 b[3] = {{1, 1, -1}, {1, 1, 1}, {2, 0.5, 1}};
+  EXPECT_TRUE(consistent_answer(a, b));
+}
+
+TEST(TriangleIntersect, CrossingWithoutVertexInside) {
+  // Two triangles that cross like links of a chain: each pierces the other through an edge.
+  const Vec3 a[3] = {{-2, 0, 0}, {2, 0, 0}, {0, 0, 3}};
+  const Vec3 b[3] = {{0, -2, 1}, {0, 2, 1}, {0, 0, -2}};
+  EXPECT_TRUE(consistent_answer(a, b));
+}
+
+TEST(TriangleIntersect, TouchingAtOneVertex) {
+  const Vec3 a[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Vec3 b[3] = {{0, 0, 0}, {-1, 0, 1}, {0, -1, 1}};
+  EXPECT_TRUE(consistent_answer(a, b));
+}
+
+TEST(TriangleIntersect, VertexTouchingFaceInterior) {
+  const Vec3 a[3] = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+  const Vec3 b[3] = {{1, 1, 0}, {1, 2, 3}, {2, 1, 3}};
+  EXPECT_TRUE(consistent_answer(a, b));
+  const Vec3 lifted[3] = {{1, 1, 1e-300}, {1, 2, 3}, {2, 1, 3}};  // a hair above: no contact
+  EXPECT_FALSE(consistent_answer(a, lifted));
+}
+
+TEST(TriangleIntersect, EdgeOnEdge) {
+  const Vec3 a[3] = {{0, 0, 0}, {2, 0, 0}, {1, 1, 0}};
+  const Vec3 b[3] = {{1, 0, 0}, {3, 0, 0}, {2, 0, 1}};  // shares a stretch of the x axis, other plane
+  EXPECT_TRUE(consistent_answer(a, b));
+  const Vec3 c[3] = {{2.5, 0, 0}, {3, 0, 0}, {2.7, 0, 1}};  // same line, disjoint stretch
+  EXPECT_FALSE(consistent_answer(a, c));
+}
+
+TEST(TriangleIntersect, CoplanarOverlapping) {
+  const Vec3 a[3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+  const Vec3 b[3] = {{1, 1, 0}, {3, 1, 0}, {1, 3, 0}};  // touches a's hypotenuse at (1, 1)
+  EXPECT_TRUE(consistent_answer(a, b));
+  const Vec3 c[3] = {{0.5, 0.5, 0}, {1.5, 0.5, 0}, {0.5, 1.5, 0}};  // overlaps
+  EXPECT_TRUE(consistent_answer(a, c));
+  const Vec3 inside[3] = {{0.1, 0.1, 0}, {0.2, 0.1, 0}, {0.1, 0.2, 0}};  // held whole, no edge crossing
+  EXPECT_TRUE(consistent_answer(a, inside));
+}
+
+TEST(TriangleIntersect, CoplanarDisjoint) {
+  const Vec3 a[3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+  const Vec3 b[3] = {{1.01, 1.01, 0}, {3, 1, 0}, {1, 3, 0}};
+  EXPECT_FALSE(consistent_answer(a, b));
+}
+
+TEST(TriangleIntersect, CoplanarInTiltedPlane) {
+  // Plane x + y + z = 1 with coordinates that are exact binary fractions.
+  const Vec3 a[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const Vec3 b[3] = {{0.5, 0.5, 0}, {0.5, 0, 0.5}, {0.75, 0.125, 0.125}};
+  EXPECT_TRUE(consistent_answer(a, b));
+  const Vec3 c[3] = {{1.5, -0.25, -0.25}, {1.25, 0, -0.25}, {1.25, -0.25, 0}};  // same plane, outside
+  EXPECT_FALSE(consistent_answer(a, c));
+}
+
+TEST(TriangleIntersect, DegenerateSegmentTriangle) {
+  const Vec3 a[3] = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+  const Vec3 seg[3] = {{1, 1, -1}, {1, 1, 1}, {1, 1, 0.5}};  // collinear: a segment through a's face
+  EXPECT_TRUE(consistent_answer(a, seg));
+  const Vec3 seg_off[3] = {{5, 5, -1}, {5, 5, 1}, {5, 5, 0}};
+  EXPECT_FALSE(consistent_answer(a, seg_off));
+  const Vec3 seg_in_plane[3] = {{-1, 1, 0}, {1, 1, 0}, {0, 1, 0}};  // crosses a's edge in a's plane
+  EXPECT_TRUE(consistent_answer(a, seg_in_plane));
+  const Vec3 skew[3] = {{-1, -1, 1}, {1, 1, 1}, {0, 0, 1}};
+  EXPECT_FALSE(consistent_answer(a, skew));
+}
+
+TEST(TriangleIntersect, DegeneratePointTriangle) {
+  const Vec3 a[3] = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+  const Vec3 on[3] = {{1, 1, 0}, {1, 1, 0}, {1, 1, 0}};
+  const Vec3 off[3] = {{1, 1, 1e-9}, {1, 1, 1e-9}, {1, 1, 1e-9}};
+  EXPECT_TRUE(consistent_answer(a, on));
+  EXPECT_FALSE(consistent_answer(a, off));
+}
+
+TEST(TriangleIntersect, BothDegenerate) {
+  const Vec3 s1[3] = {{0, 0, 0}, {2, 2, 2}, {1, 1, 1}};
+  const Vec3 s2[3] = {{0, 2, 0}, {2, 0, 2}, {2, 0, 2}};  // crosses s1 at (1, 1, 1)
+  EXPECT_TRUE(consistent_answer(s1, s2));
+  const Vec3 s3[3] = {{0, 2, 0.001}, {2, 0, 2}, {2, 0, 2}};  // skew
+  EXPECT_FALSE(consistent_answer(s1, s3));
+  const Vec3 p1[3] = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
+  EXPECT_TRUE(consistent_answer(s1, p1));
+  const Vec3 p2[3] = {{1, 1, 1.5}, {1, 1, 1.5}, {1, 1, 1.5}};
+  EXPECT_FALSE(consistent_answer(s1, p2));
+  EXPECT_TRUE(consistent_answer(p1, p1));
+}
+
+TEST(TriangleIntersect, IdenticalTriangles) {
+  const Vec3 a[3] = {{0.1, 0.2, 0.3}, {1.7, -0.2, 0.9}, {0.4, 1.1, -0.6}};
+  EXPECT_TRUE(consistent_answer(a, a));
+}
+
+TEST(TriangleIntersect, RandomAgreesWithDistanceWherePlain) {
+  // Away from touching configurations, "intersect" and "distance is 0" must agree.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int yes = 0, no = 0;
+  for (int iter = 0; iter < 20000; ++iter) {
+    Vec3 a[3], b[3];
+    for (auto& v : a) v = Vec3(u(rng), u(rng), u(rng));
+    for (auto& v : b) v = Vec3(u(rng), u(rng), u(rng)) + Vec3(0.5, 0, 0);
+    const bool hit = tri_tri(a, b);
+    const double d = closest_points_triangles(a, b).distance;
+    if (hit) {
+      ++yes;
+      EXPECT_LT(d, 1e-9) << "iteration " << iter;
+    } else {
+      ++no;
+      EXPECT_GT(d, 0.0) << "iteration " << iter;
+    }
+    EXPECT_EQ(tri_tri(b, a), hit);
+  }
+  EXPECT_GT(yes, 1000);
+  EXPECT_GT(no, 1000);
+}
+
+}  // namespace
+}  // namespace caliber::geometry
