@@ -1,0 +1,208 @@
+// Peer comparison: caliber's sequential interference query against FCL 0.7's BVHModel<OBBRSS>
+// collide with every contact, on CGAL meshes (rotated, overlapping copies). Reports the BVH build
+// and query times (medians), their ratios, and whether the triangle-pair sets are identical.
+//
+//   bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/narrowphase/collision.h>
+
+#include "caliber/mesh.h"
+#include "caliber/model.h"
+#include "caliber/query.h"
+#include "machine.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using FclModel = fcl::BVHModel<fcl::OBBRSSd>;
+
+/// Median wall time of `repeat` runs of f, in milliseconds.
+double median_ms(int repeat, const std::function<void()>& f) {
+  std::vector<double> times;
+  for (int i = 0; i < repeat; ++i) {
+    const auto start = Clock::now();
+    f();
+    times.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+std::shared_ptr<FclModel> build_fcl(const caliber::Mesh& mesh) {
+  auto model = std::make_shared<FclModel>();
+  std::vector<fcl::Vector3d> vertices(mesh.vertices.begin(), mesh.vertices.end());
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size()));
+  model->addSubModel(vertices, triangles);
+  model->endModel();
+  return model;
+}
+
+fcl::Transform3d to_fcl(const caliber::Pose& pose) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.linear() = pose.rotation_matrix();
+  tf.translation() = pose.translation;
+  return tf;
+}
+
+/// Rotation of B about its own box center, and where that center goes, as a fraction of A's box
+/// diagonal away from A's box center. A stays at the identity.
+struct Case {
+  std::string name;
+  std::string mesh_a, mesh_b;
+  double angle_deg;
+  Eigen::Vector3d axis;
+  Eigen::Vector3d offset;
+};
+
+void box(const caliber::Mesh& m, Eigen::Vector3d& center, double& diagonal) {
+  Eigen::Vector3d lo = m.vertices[0], hi = lo;
+  for (const auto& v : m.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  center = 0.5 * (lo + hi);
+  diagonal = (hi - lo).norm();
+}
+
+caliber::Pose place(const Case& c, const caliber::Mesh& a, const caliber::Mesh& b) {
+  Eigen::Vector3d ca, cb;
+  double da, db;
+  box(a, ca, da);
+  box(b, cb, db);
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(c.angle_deg * 3.14159265358979323846 / 180.0, c.axis.normalized()));
+  const Eigen::Vector3d t = ca + c.offset * da - q * cb;
+  return caliber::Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
+}
+
+struct Row {
+  std::string name;
+  std::size_t tris_a, tris_b;
+  double build_ours, build_fcl, query_ours, query_fcl;
+  std::size_t pairs_ours, pairs_fcl, only_ours, only_fcl;
+  std::uint64_t node_tests;
+};
+
+Row run_case(const Case& c, const std::filesystem::path& dir, int repeat) {
+  const caliber::Mesh mesh_a = caliber::load_mesh(dir / c.mesh_a);
+  const caliber::Mesh mesh_b = caliber::load_mesh(dir / c.mesh_b);
+  const caliber::Pose pose_b = place(c, mesh_a, mesh_b);
+  Row row{};
+  row.name = c.name;
+  row.tris_a = mesh_a.triangles.size();
+  row.tris_b = mesh_b.triangles.size();
+
+  caliber::BuildOptions bvh_only;
+  bvh_only.adjacency = false;  // FCL builds no adjacency either
+  std::shared_ptr<const caliber::Model> ours_a, ours_b;
+  row.build_ours = median_ms(repeat, [&] { ours_a = caliber::build_model(mesh_a, bvh_only); });
+  ours_b = caliber::build_model(mesh_b, bvh_only);
+  std::shared_ptr<FclModel> fcl_a, fcl_b;
+  row.build_fcl = median_ms(repeat, [&] { fcl_a = build_fcl(mesh_a); });
+  fcl_b = build_fcl(mesh_b);
+
+  caliber::QueryResult ours;
+  const caliber::Pose pose_a;
+  row.query_ours = median_ms(repeat, [&] { ours = caliber::query(*ours_a, pose_a, *ours_b, pose_b, {}); });
+
+  fcl::CollisionObjectd obj_a(fcl_a, to_fcl(pose_a));
+  fcl::CollisionObjectd obj_b(fcl_b, to_fcl(pose_b));
+  fcl::CollisionRequestd request(100000000, false);  // every contact, no contact geometry
+  fcl::CollisionResultd fcl_result;
+  row.query_fcl = median_ms(repeat, [&] {
+    fcl_result.clear();
+    fcl::collide(&obj_a, &obj_b, request, fcl_result);
+  });
+
+  std::vector<caliber::TrianglePair> theirs;
+  for (std::size_t i = 0; i < fcl_result.numContacts(); ++i) {
+    const auto& contact = fcl_result.getContact(i);
+    theirs.push_back({static_cast<std::uint32_t>(contact.b1), static_cast<std::uint32_t>(contact.b2)});
+  }
+  std::sort(theirs.begin(), theirs.end());
+  std::vector<caliber::TrianglePair> only_ours, only_fcl;
+  std::set_difference(ours.pairs.begin(), ours.pairs.end(), theirs.begin(), theirs.end(), std::back_inserter(only_ours));
+  std::set_difference(theirs.begin(), theirs.end(), ours.pairs.begin(), ours.pairs.end(), std::back_inserter(only_fcl));
+  row.pairs_ours = ours.pairs.size();
+  row.pairs_fcl = theirs.size();
+  row.only_ours = only_ours.size();
+  row.only_fcl = only_fcl.size();
+  row.node_tests = ours.stats.node_tests;
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path dir = "data/meshes";
+  std::string out;
+  int repeat = 5;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md]\n");
+      return 2;
+    }
+  }
+  // Rotated, overlapping copies: the meshes' sizes differ, so offsets are in each mesh's units.
+  const std::vector<Case> cases = {
+      {"armadillo x armadillo", "armadillo.off", "armadillo.off", 30, {1, 2, 0.5}, {0.05, 0.03, -0.02}},
+      {"bunny x bunny", "bunny00.off", "bunny00.off", 25, {0, 1, 1}, {0.06, 0.02, 0.0}},
+      {"dragon x dragon", "ChineseDragon-10kv.off", "ChineseDragon-10kv.off", 20, {1, 0, 1}, {0.04, 0.03, 0.0}},
+      {"elephant x elephant (refined)", "refined_elephant.off", "refined_elephant.off", 35, {1, 1, 0}, {0.05, 0.02, 0.01}},
+      {"turbine x blade", "turbine.off", "blade.off", 10, {0, 0, 1}, {0.0, 0.05, 0.0}},
+      {"fandisk x rotor", "fandisk_large.off", "rotor_small.off", 15, {1, 0, 0}, {0.02, 0.02, 0.0}},
+  };
+  std::string table;
+  table += "| case | triangles A / B | build ours (ms) | build FCL (ms) | build ratio | query ours (ms) | query FCL (ms) | "
+           "query ratio | pairs ours / FCL | identical | our node tests |\n";
+  table += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
+  for (const Case& c : cases) {
+    if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {
+      std::fprintf(stderr, "skipping %s: meshes missing in %s (run scripts/fetch_meshes.sh)\n", c.name.c_str(),
+                   dir.c_str());
+      continue;
+    }
+    const Row r = run_case(c, dir, repeat);
+    char line[1024];
+    std::snprintf(line, sizeof line,
+                  "| %s | %zu / %zu | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu |\n", r.name.c_str(),
+                  r.tris_a, r.tris_b, r.build_ours, r.build_fcl, r.build_ours / r.build_fcl, r.query_ours, r.query_fcl,
+                  r.query_ours / r.query_fcl, r.pairs_ours, r.pairs_fcl,
+                  (r.only_ours == 0 && r.only_fcl == 0)
+                      ? "yes"
+                      : ("no: " + std::to_string(r.only_ours) + " only ours, " + std::to_string(r.only_fcl) + " only FCL")
+                            .c_str(),
+                  static_cast<unsigned long long>(r.node_tests));
+    std::fputs(line, stdout);
+    std::fflush(stdout);
+    table += line;
+  }
+  if (!out.empty()) {
+    std::ofstream file(out);
+    file << "# caliber vs FCL 0.7 (BVHModel<OBBRSS>), sequential interference, all contacts\n\n"
+         << "Machine: " << caliber::bench::machine_description() << "\n\n"
+         << "Medians of " << repeat << " runs. Ratios are ours / FCL (lower is better for us). "
+         << "Build: caliber's sphere tree without adjacency vs FCL's OBBRSS build.\n\n"
+         << table;
+  }
+  return 0;
+}

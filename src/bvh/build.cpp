@@ -46,12 +46,14 @@ class Builder {
       mCentroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
     }
     mNodes.reserve(2 * n - 1);
+    mBoxes.reserve(2 * n - 1);
     mNormalSums.reserve(2 * n - 1);
   }
 
-  std::vector<BvhNode> build(int& height) {
+  void build(std::vector<BvhNode>& nodes, std::vector<BvhBox>& boxes, int& height) {
     height = build_range(0, static_cast<std::uint32_t>(mOrder.size()));
-    return std::move(mNodes);
+    nodes = std::move(mNodes);
+    boxes = std::move(mBoxes);
   }
 
  private:
@@ -59,6 +61,7 @@ class Builder {
   int build_range(std::uint32_t begin, std::uint32_t end) {
     const auto self = static_cast<std::uint32_t>(mNodes.size());
     mNodes.emplace_back();
+    mBoxes.emplace_back();
     mNormalSums.emplace_back(Vec3::Zero());
     if (end - begin == 1) {
       make_leaf(self, mOrder[begin]);
@@ -101,6 +104,17 @@ class Builder {
     return std::sqrt(r2) * (1.0 + 1e-14);
   }
 
+  /// The box of the vertices below, grown by a relative hair so rounding never leaves one outside.
+  void set_box(std::uint32_t self, const Vec3& lo, const Vec3& hi) {
+    const Vec3 c = 0.5 * (lo + hi);
+    const Vec3 h = 0.5 * (hi - lo);
+    const double pad = 1e-14 * (c.cwiseAbs().maxCoeff() + h.maxCoeff());
+    for (int k = 0; k < 3; ++k) {
+      mBoxes[self].center[k] = c[k];
+      mBoxes[self].half[k] = h[k] + pad;
+    }
+  }
+
   void set_sphere(BvhNode& node, const Vec3& c, double r) {
     node.center[0] = c.x();
     node.center[1] = c.y();
@@ -115,6 +129,7 @@ class Builder {
     const Vec3& c = mMesh.vertices[t[2]];
     // Candidate centers: the smallest enclosing sphere (circumcenter or midpoint of the longest
     // edge) and the box center; keep whichever covers with the smaller radius.
+    set_box(self, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c));
     Vec3 best = 0.5 * (a.cwiseMin(b).cwiseMin(c) + a.cwiseMax(b).cwiseMax(c));
     double best_r = std::max({(a - best).norm(), (b - best).norm(), (c - best).norm()});
     const Vec3 ab = b - a, ac = c - a;
@@ -178,6 +193,7 @@ class Builder {
         hi = hi.cwiseMax(mMesh.vertices[v]);
       }
     }
+    set_box(self, lo, hi);
     const Vec3 box = 0.5 * (lo + hi);
     const double r_merged = covering_radius(merged, begin, end);
     const double r_box = covering_radius(box, begin, end);
@@ -219,6 +235,7 @@ class Builder {
   std::vector<std::uint32_t> mOrder;
   std::vector<Vec3> mCentroids;
   std::vector<BvhNode> mNodes;
+  std::vector<BvhBox> mBoxes;
   std::vector<Vec3> mNormalSums;
 };
 
@@ -291,7 +308,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   auto model = std::make_shared<Model>();
   model->normals = face_normals(mesh);
   Builder builder(mesh, model->normals);
-  model->nodes = builder.build(model->height);
+  builder.build(model->nodes, model->boxes, model->height);
   double extent = 0.0;
   for (const auto& tri : mesh.triangles) {
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].norm());

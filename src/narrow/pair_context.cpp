@@ -26,6 +26,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
+  mAbsRot = mRot.cwiseAbs().array() + 1e-12;
   const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
   mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
   mTheta = request.angle_deg * kPi / 180.0;

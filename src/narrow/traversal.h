@@ -67,7 +67,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     const BvhNode& a = ma.nodes[n.a];
     const BvhNode& b = mb.nodes[n.b];
     ++node_tests;
-    if (!ctx.node_test(a, b)) continue;
+    if (!ctx.node_test(n.a, n.b)) continue;
     if (a.is_leaf() && b.is_leaf()) {
       ++leaf_tests;
       ctx.leaf_test(a.index, b.index, out);
