@@ -14,42 +14,45 @@
 
 namespace caliber {
 
-/// One node of the sphere-tree BVH: 64 bytes, one cache line. Nodes are stored depth-first:
-/// the left child of an internal node `i` is `i + 1`, the right child is `right`.
+/// One node of the BVH, as the node-node test reads it: 48 bytes. Two bounding volumes per node:
+/// the paper's sphere, tested first, and the node's axis-aligned box in the mesh's own frame, which
+/// sharpens what the sphere lets through (thin and elongated parts, where spheres are loose). All
+/// boxes of one mesh share that frame, so the rotation between two meshes' boxes is one matrix per
+/// query and the box test is a separating-axis test on six face axes.
+///
+/// Values are stored as floats, rounded outward at build time (the radius and half-extents cover
+/// the rounding of the centers), so every vertex below lies inside both volumes exactly as stored.
+/// The children of an internal node are adjacent: `index` and `index + 1`.
 struct BvhNode {
   /// Bounding-sphere center (object space).
-  double center[3];
-  /// Bounding-sphere radius: every vertex of every triangle below lies within it.
-  double radius;
-  /// Normal-cone axis (unit, rounded to float; the half-angle is measured from this rounded axis).
-  float cone_axis[3];
-  /// Normal-cone half-angle in radians, rounded up; negative when every triangle below is
-  /// degenerate (no normal, so no contact can come from this node).
-  float cone_angle;
-  /// Internal node: index of the right child. Leaf: the triangle id.
+  float center[3];
+  /// Bounding-sphere radius.
+  float radius;
+  /// Box center (object space).
+  float box_center[3];
+  /// Box half-extents along the object axes.
+  float box_half[3];
+  /// Internal node: index of the first child (the second is index + 1). Leaf: the triangle id.
   std::uint32_t index;
   /// Number of triangles below (the paper's P); 1 for a leaf.
   std::uint32_t count;
-  /// Bit g set when some triangle below is in primitive group g.
-  std::uint64_t groups;
 
   /// True for a leaf (one triangle).
   [[nodiscard]] bool is_leaf() const { return count == 1; }
 };
-static_assert(sizeof(BvhNode) == 64, "BvhNode is meant to fill one cache line");
+static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
 
-/// A second bounding volume per node, beside the sphere: the node's axis-aligned box in the mesh's
-/// own frame. All boxes of one mesh share that frame, so the rotation between two meshes' boxes is
-/// one matrix per query and the box test costs a few multiply-adds (a separating-axis test on the
-/// six face axes). The sphere test runs first; the box only sharpens what the sphere lets through
-/// (thin and elongated parts, where spheres are loose).
-struct BvhBox {
-  /// Box center (object space).
-  double center[3];
-  /// Half-extents along the object axes: every vertex below lies within center +- half.
-  double half[3];
+/// What only the contact query and the group filter read of a node, kept apart so that the
+/// interference and proximity traversals do not carry it through the cache.
+struct BvhNodeFilter {
+  /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
+  float cone_axis[3];
+  /// Normal-cone half-angle in radians, rounded up; negative when every triangle below is
+  /// degenerate (no normal, so no contact can come from this node).
+  float cone_angle;
+  /// Bit g set when some triangle below is in primitive group g.
+  std::uint64_t groups;
 };
-static_assert(sizeof(BvhBox) == 48);
 
 /// Options of the BVH build.
 struct BuildOptions {
@@ -61,10 +64,10 @@ struct BuildOptions {
 struct Model {
   /// The mesh, as loaded (triangle ids unchanged).
   Mesh mesh;
-  /// BVH nodes, root first, depth-first order.
+  /// BVH nodes, root first; siblings adjacent.
   std::vector<BvhNode> nodes;
-  /// boxes[i] is the object-space box of nodes[i].
-  std::vector<BvhBox> boxes;
+  /// filters[i]: normal cone and group mask of nodes[i].
+  std::vector<BvhNodeFilter> filters;
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
   std::vector<Eigen::Vector3d> normals;
   /// Triangles sharing a vertex position with triangle t are

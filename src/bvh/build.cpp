@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <Eigen/Geometry>
@@ -15,6 +16,9 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 
 constexpr double kPi = 3.14159265358979323846;
+/// Nodes with at most this many triangles get the exact covering radius (a pass over their vertices);
+/// larger ones bound it from their children's spheres.
+constexpr std::uint32_t kExactRadiusCount = 256;
 /// Added to every cone half-angle: covers rounding in the angles and in the rotated normals.
 constexpr double kConeSlack = 1e-6;
 
@@ -25,7 +29,7 @@ double angle_between(const Vec3& u, const Vec3& v) {
 /// A float that is >= x (x >= 0), so that a stored half-angle never shrinks.
 float round_up(double x) {
   auto f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = std::nextafter(f, 4.0f);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
   return f;
 }
 
@@ -33,6 +37,19 @@ Vec3 to_float_axis(const Vec3& axis) {
   Vec3 rounded(static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z()));
   return rounded;
 }
+
+/// A node while it is built, in double precision; converted to BvhNode / BvhNodeFilter at the end.
+struct WorkNode {
+  Vec3 center;
+  double radius = 0.0;
+  Vec3 lo, hi;           ///< box of the vertices below
+  Vec3 normal_sum;       ///< sum of the unit normals below (cone axis direction)
+  Vec3 axis;             ///< cone axis, already rounded to float
+  double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
+  std::uint64_t groups = 0;
+  std::uint32_t index = 0;
+  std::uint32_t count = 0;
+};
 
 class Builder {
  public:
@@ -45,34 +62,31 @@ class Builder {
       const auto& tri = mesh.triangles[t];
       mCentroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
     }
-    mNodes.reserve(2 * n - 1);
-    mBoxes.reserve(2 * n - 1);
-    mNormalSums.reserve(2 * n - 1);
+    mWork.reserve(2 * n - 1);
   }
 
-  void build(std::vector<BvhNode>& nodes, std::vector<BvhBox>& boxes, int& height) {
-    height = build_range(0, static_cast<std::uint32_t>(mOrder.size()));
-    nodes = std::move(mNodes);
-    boxes = std::move(mBoxes);
+  void build(std::vector<BvhNode>& nodes, std::vector<BvhNodeFilter>& filters, int& height) {
+    mWork.emplace_back();
+    height = build_range(0, 0, static_cast<std::uint32_t>(mOrder.size()));
+    nodes.resize(mWork.size());
+    filters.resize(mWork.size());
+    for (std::size_t i = 0; i < mWork.size(); ++i) convert(mWork[i], nodes[i], filters[i]);
   }
 
  private:
-  /// Builds the subtree over mOrder[begin, end) at index mNodes.size(); returns its height.
-  int build_range(std::uint32_t begin, std::uint32_t end) {
-    const auto self = static_cast<std::uint32_t>(mNodes.size());
-    mNodes.emplace_back();
-    mBoxes.emplace_back();
-    mNormalSums.emplace_back(Vec3::Zero());
+  /// Builds the subtree over mOrder[begin, end) into mWork[slot]; returns its height.
+  int build_range(std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
     if (end - begin == 1) {
-      make_leaf(self, mOrder[begin]);
+      make_leaf(slot, mOrder[begin]);
       return 1;
     }
     const std::uint32_t mid = split(begin, end);
-    const std::uint32_t left = self + 1;
-    const int hl = build_range(begin, mid);
-    const auto right = static_cast<std::uint32_t>(mNodes.size());
-    const int hr = build_range(mid, end);
-    make_internal(self, left, right, begin, end);
+    const auto first = static_cast<std::uint32_t>(mWork.size());
+    mWork.emplace_back();
+    mWork.emplace_back();
+    const int hl = build_range(first, begin, mid);
+    const int hr = build_range(first + 1, mid, end);
+    make_internal(slot, first, begin, end);
     return 1 + std::max(hl, hr);
   }
 
@@ -94,149 +108,137 @@ class Builder {
     return mid;
   }
 
-  /// Largest distance from c to a vertex of a triangle in mOrder[begin, end).
-  double covering_radius(const Vec3& c, std::uint32_t begin, std::uint32_t end) const {
-    double r2 = 0.0;
+  /// Largest distances from c1 and from c2 to a vertex of a triangle in mOrder[begin, end), rounded
+  /// up a little so that they cover every vertex despite rounding in the norms.
+  void covering_radii(const Vec3& c1, const Vec3& c2, std::uint32_t begin, std::uint32_t end, double& r1,
+                      double& r2) const {
+    double d1 = 0.0, d2 = 0.0;
     for (std::uint32_t i = begin; i < end; ++i) {
-      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) r2 = std::max(r2, (mMesh.vertices[v] - c).squaredNorm());
+      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
+        const Vec3& p = mMesh.vertices[v];
+        d1 = std::max(d1, (p - c1).squaredNorm());
+        d2 = std::max(d2, (p - c2).squaredNorm());
+      }
     }
-    // Rounded up a little: the radius must cover every vertex despite rounding in the norm.
-    return std::sqrt(r2) * (1.0 + 1e-14);
+    r1 = std::sqrt(d1) * (1.0 + 1e-14);
+    r2 = std::sqrt(d2) * (1.0 + 1e-14);
   }
 
-  /// The box of the vertices below, grown by a relative hair so rounding never leaves one outside.
-  void set_box(std::uint32_t self, const Vec3& lo, const Vec3& hi) {
-    const Vec3 c = 0.5 * (lo + hi);
-    const Vec3 h = 0.5 * (hi - lo);
-    const double pad = 1e-14 * (c.cwiseAbs().maxCoeff() + h.maxCoeff());
-    for (int k = 0; k < 3; ++k) {
-      mBoxes[self].center[k] = c[k];
-      mBoxes[self].half[k] = h[k] + pad;
-    }
-  }
-
-  void set_sphere(BvhNode& node, const Vec3& c, double r) {
-    node.center[0] = c.x();
-    node.center[1] = c.y();
-    node.center[2] = c.z();
-    node.radius = r;
-  }
-
-  void make_leaf(std::uint32_t self, std::uint32_t tri) {
+  void make_leaf(std::uint32_t slot, std::uint32_t tri) {
     const auto& t = mMesh.triangles[tri];
     const Vec3& a = mMesh.vertices[t[0]];
     const Vec3& b = mMesh.vertices[t[1]];
     const Vec3& c = mMesh.vertices[t[2]];
-    // Candidate centers: the smallest enclosing sphere (circumcenter or midpoint of the longest
-    // edge) and the box center; keep whichever covers with the smaller radius.
-    set_box(self, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c));
-    Vec3 best = 0.5 * (a.cwiseMin(b).cwiseMin(c) + a.cwiseMax(b).cwiseMax(c));
-    double best_r = std::max({(a - best).norm(), (b - best).norm(), (c - best).norm()});
-    const Vec3 ab = b - a, ac = c - a;
-    const Vec3 n = ab.cross(ac);
+    WorkNode& node = mWork[slot];
+    node.lo = a.cwiseMin(b).cwiseMin(c);
+    node.hi = a.cwiseMax(b).cwiseMax(c);
+    // Candidate centers: the box center, the circumcenter and the edge midpoints (the smallest
+    // enclosing sphere is one of the last four); keep whichever covers with the smallest radius.
+    const Vec3 ab = b - a, ac = c - a, n = ab.cross(ac);
     const double n2 = n.squaredNorm();
-    if (n2 > 0.0) {
-      const Vec3 cc = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
-      const Vec3 candidates[4] = {cc, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)};
-      for (const Vec3& cand : candidates) {
-        if (!cand.allFinite()) continue;
-        const double r = std::max({(a - cand).norm(), (b - cand).norm(), (c - cand).norm()});
-        if (r < best_r) {
-          best = cand;
-          best_r = r;
-        }
+    Vec3 candidates[5] = {0.5 * (node.lo + node.hi), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), a};
+    int count = 4;
+    if (n2 > 0.0) candidates[count++] = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
+    node.radius = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < count; ++i) {
+      if (!candidates[i].allFinite()) continue;
+      const double r = std::max({(a - candidates[i]).norm(), (b - candidates[i]).norm(), (c - candidates[i]).norm()});
+      if (r < node.radius) {
+        node.radius = r;
+        node.center = candidates[i];
       }
     }
-    BvhNode& node = mNodes[self];
-    set_sphere(node, best, best_r * (1.0 + 1e-14));
+    node.radius *= 1.0 + 1e-14;
     node.index = tri;
     node.count = 1;
     node.groups = std::uint64_t{1} << (mMesh.groups.empty() ? 0 : mMesh.groups[tri]);
     const Vec3& normal = mNormals[tri];
-    mNormalSums[self] = normal;
+    node.normal_sum = normal;
     if (normal.squaredNorm() > 0.0) {
-      const Vec3 axis = to_float_axis(normal);
-      const Vec3 unit = axis.normalized();
-      for (int k = 0; k < 3; ++k) node.cone_axis[k] = static_cast<float>(axis[k]);
-      node.cone_angle = round_up(angle_between(unit, normal) + kConeSlack);
-    } else {
-      for (float& k : node.cone_axis) k = 0.0f;
-      node.cone_angle = -1.0f;
+      node.axis = to_float_axis(normal);
+      node.cone = angle_between(node.axis.normalized(), normal) + kConeSlack;
     }
   }
 
-  void make_internal(std::uint32_t self, std::uint32_t left, std::uint32_t right, std::uint32_t begin,
-                     std::uint32_t end) {
-    const BvhNode& l = mNodes[left];
-    const BvhNode& r = mNodes[right];
-    BvhNode node{};
-    node.index = right;
+  void make_internal(std::uint32_t slot, std::uint32_t first, std::uint32_t begin, std::uint32_t end) {
+    const WorkNode& l = mWork[first];
+    const WorkNode& r = mWork[first + 1];
+    WorkNode node;
+    node.index = first;
     node.count = l.count + r.count;
     node.groups = l.groups | r.groups;
+    node.lo = l.lo.cwiseMin(r.lo);
+    node.hi = l.hi.cwiseMax(r.hi);
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.
-    const Vec3 cl(l.center[0], l.center[1], l.center[2]), cr(r.center[0], r.center[1], r.center[2]);
-    Vec3 merged = cl;
-    const double d = (cr - cl).norm();
+    Vec3 merged = l.center;
+    const double d = (r.center - l.center).norm();
     if (d > 0.0 && d + r.radius > l.radius) {
       if (d + l.radius <= r.radius) {
-        merged = cr;
+        merged = r.center;
       } else {
-        const double radius = 0.5 * (d + l.radius + r.radius);
-        merged = cl + ((radius - l.radius) / d) * (cr - cl);
+        merged = l.center + ((0.5 * (d + l.radius + r.radius) - l.radius) / d) * (r.center - l.center);
       }
     }
-    Vec3 lo = mMesh.vertices[mMesh.triangles[mOrder[begin]][0]], hi = lo;
-    for (std::uint32_t i = begin; i < end; ++i) {
-      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
-        lo = lo.cwiseMin(mMesh.vertices[v]);
-        hi = hi.cwiseMax(mMesh.vertices[v]);
-      }
-    }
-    set_box(self, lo, hi);
-    const Vec3 box = 0.5 * (lo + hi);
-    const double r_merged = covering_radius(merged, begin, end);
-    const double r_box = covering_radius(box, begin, end);
-    if (r_box < r_merged) {
-      set_sphere(node, box, r_box);
+    const Vec3 box = 0.5 * (node.lo + node.hi);
+    double r_merged, r_box;
+    if (node.count <= kExactRadiusCount) {
+      covering_radii(merged, box, begin, end, r_merged, r_box);
     } else {
-      set_sphere(node, merged, r_merged);
+      // Near the root, the children's spheres bound the radius: O(1) instead of a pass over every
+      // vertex below, which keeps the build O(n log n) with a small constant. These few large
+      // nodes are also pruned by their boxes.
+      const auto bound = [&](const Vec3& c) {
+        return std::max((c - l.center).norm() + l.radius, (c - r.center).norm() + r.radius) * (1.0 + 1e-14);
+      };
+      r_merged = bound(merged);
+      r_box = bound(box);
     }
+    node.center = r_box < r_merged ? box : merged;
+    node.radius = std::min(r_box, r_merged);
 
     // Normal cone: axis along the sum of the unit normals below; half-angle from the children's
     // cones by the triangle inequality (angle to a child's axis + that child's half-angle).
-    mNormalSums[self] = mNormalSums[left] + mNormalSums[right];
-    const BvhNode* kids[2] = {&l, &r};
-    const bool has_l = l.cone_angle >= 0.0f, has_r = r.cone_angle >= 0.0f;
-    if (!has_l && !has_r) {
-      for (float& k : node.cone_axis) k = 0.0f;
-      node.cone_angle = -1.0f;
-    } else {
-      const Vec3& sum = mNormalSums[self];
-      const double sum_norm = sum.norm();
-      Vec3 axis = sum_norm > 1e-9 * node.count ? Vec3(sum / sum_norm) : Vec3(1.0, 0.0, 0.0);
-      axis = to_float_axis(axis);
-      const Vec3 unit = axis.normalized();
+    node.normal_sum = l.normal_sum + r.normal_sum;
+    if (l.cone >= 0.0 || r.cone >= 0.0) {
+      const double sum_norm = node.normal_sum.norm();
+      node.axis = to_float_axis(sum_norm > 1e-9 * node.count ? Vec3(node.normal_sum / sum_norm) : Vec3(1.0, 0.0, 0.0));
+      const Vec3 unit = node.axis.normalized();
       double angle = 0.0;
-      for (const BvhNode* kid : kids) {
-        if (kid->cone_angle < 0.0f) continue;
-        const Vec3 kid_axis = Vec3(kid->cone_axis[0], kid->cone_axis[1], kid->cone_axis[2]).normalized();
-        angle = std::max(angle, angle_between(unit, kid_axis) + kid->cone_angle);
+      for (const WorkNode* kid : {&l, &r}) {
+        if (kid->cone >= 0.0) angle = std::max(angle, angle_between(unit, kid->axis.normalized()) + kid->cone);
       }
-      angle = std::min(angle + kConeSlack, 2.0 * kPi);
-      for (int k = 0; k < 3; ++k) node.cone_axis[k] = static_cast<float>(axis[k]);
-      node.cone_angle = round_up(angle);
+      node.cone = std::min(angle + kConeSlack, 2.0 * kPi);
     }
-    mNodes[self] = node;
+    mWork[slot] = node;
+  }
+
+  /// Rounds the volumes outward to floats: the stored radius and half-extents also cover the
+  /// distance the center moved when it was rounded.
+  static void convert(const WorkNode& w, BvhNode& node, BvhNodeFilter& filter) {
+    const Vec3 box_center = 0.5 * (w.lo + w.hi);
+    const Vec3 box_half = 0.5 * (w.hi - w.lo);
+    const double pad = 1e-14 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
+    for (int k = 0; k < 3; ++k) {
+      node.center[k] = static_cast<float>(w.center[k]);
+      node.box_center[k] = static_cast<float>(box_center[k]);
+      const double moved = std::abs(static_cast<double>(node.box_center[k]) - box_center[k]);
+      node.box_half[k] = round_up(box_half[k] + moved + pad);
+    }
+    const Vec3 stored(node.center[0], node.center[1], node.center[2]);
+    node.radius = round_up((w.radius + (stored - w.center).norm()) * (1.0 + 1e-14));
+    node.index = w.index;
+    node.count = w.count;
+    for (int k = 0; k < 3; ++k) filter.cone_axis[k] = w.cone >= 0.0 ? static_cast<float>(w.axis[k]) : 0.0f;
+    filter.cone_angle = w.cone >= 0.0 ? round_up(w.cone) : -1.0f;
+    filter.groups = w.groups;
   }
 
   const Mesh& mMesh;
   const std::vector<Vec3>& mNormals;
   std::vector<std::uint32_t> mOrder;
   std::vector<Vec3> mCentroids;
-  std::vector<BvhNode> mNodes;
-  std::vector<BvhBox> mBoxes;
-  std::vector<Vec3> mNormalSums;
+  std::vector<WorkNode> mWork;
 };
 
 std::vector<Vec3> face_normals(const Mesh& mesh) {
@@ -308,7 +310,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   auto model = std::make_shared<Model>();
   model->normals = face_normals(mesh);
   Builder builder(mesh, model->normals);
-  builder.build(model->nodes, model->boxes, model->height);
+  builder.build(model->nodes, model->filters, model->height);
   double extent = 0.0;
   for (const auto& tri : mesh.triangles) {
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].norm());

@@ -1,6 +1,9 @@
 #include "geometry/triangle_intersect.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
 
 #include "geometry/predicates.h"
 
@@ -105,6 +108,27 @@ bool segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b
   return coplanar_hulls_intersect(seg, tri);
 }
 
+/// Signs of orient3d(p0, p1, p2, q[i]) for three points, mostly without calling orient3d: the
+/// float value s = ((p1 - p0) x (p2 - p0)) . (p0 - q) is trusted when |s| > 1e-13 |u| |v| |w|
+/// (u, v the edge vectors, w = q - p0), about 45 times the worst-case rounding of these few
+/// operations; otherwise the exact predicate decides. So the signs are always exact.
+void plane_signs(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3 q[3], int out[3]) {
+  const Vec3 u = p1 - p0, v = p2 - p0;
+  const Vec3 n = u.cross(v);
+  const double uv2 = u.squaredNorm() * v.squaredNorm();
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 w = p0 - q[i];
+    const double s = n.dot(w);
+    if (s * s > 1e-26 * uv2 * w.squaredNorm()) {
+      out[i] = s > 0.0 ? 1 : -1;
+    } else {
+      out[i] = orient3d(p0.data(), p1.data(), p2.data(), q[i].data());
+    }
+  }
+}
+
+bool same_strict_side(const int s[3]) { return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0); }
+
 }  // namespace
 
 bool segment_intersects_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -116,11 +140,12 @@ bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
                          const Vec3& b2) {
   const Vec3 a[3] = {a0, a1, a2};
   const Vec3 b[3] = {b0, b1, b2};
+  // Most pairs that reach here are apart: one plane leaves the other triangle on one side.
   int sa[3], sb[3];
-  for (int i = 0; i < 3; ++i) sa[i] = orient3d(b0.data(), b1.data(), b2.data(), a[i].data());
-  if ((sa[0] > 0 && sa[1] > 0 && sa[2] > 0) || (sa[0] < 0 && sa[1] < 0 && sa[2] < 0)) return false;
-  for (int i = 0; i < 3; ++i) sb[i] = orient3d(a0.data(), a1.data(), a2.data(), b[i].data());
-  if ((sb[0] > 0 && sb[1] > 0 && sb[2] > 0) || (sb[0] < 0 && sb[1] < 0 && sb[2] < 0)) return false;
+  plane_signs(b0, b1, b2, a, sa);
+  if (same_strict_side(sa)) return false;
+  plane_signs(a0, a1, a2, b, sb);
+  if (same_strict_side(sb)) return false;
 
   // Coplanar, non-degenerate triangles: one 2-D test instead of six edge tests.
   const bool a_in_plane_of_b = sa[0] == 0 && sa[1] == 0 && sa[2] == 0;

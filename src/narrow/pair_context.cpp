@@ -33,7 +33,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mCosTheta = std::cos(mTheta);
 }
 
-bool PairContext::cones_can_face(const BvhNode& na, const BvhNode& nb) const {
+bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const {
   // Leaf normals n_a, n_b lie within their cones; a leaf passes when angle(n_a, -n_b) <= theta, so by
   // the triangle inequality angle(axis_a, -axis_b) <= alpha_a + alpha_b + theta for any passing leaf.
   if (na.cone_angle < 0.0f || nb.cone_angle < 0.0f) return false;  // only degenerate triangles below

@@ -32,45 +32,92 @@ class PairContext {
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
 
-  /// The node-node test: spheres within the tolerance, normal cones able to face each other
-  /// (contact only), some compatible groups. Conservative: see the margins in the definition.
-  [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const {
-    const BvhNode& na = mA.nodes[ia];
-    const BvhNode& nb = mB.nodes[ib];
-    const double* cb = nb.center;
-    const double* ca = na.center;
-    const double dx = ca[0] - (mRot(0, 0) * cb[0] + mRot(0, 1) * cb[1] + mRot(0, 2) * cb[2] + mTrans[0]);
-    const double dy = ca[1] - (mRot(1, 0) * cb[0] + mRot(1, 1) * cb[1] + mRot(1, 2) * cb[2] + mTrans[1]);
-    const double dz = ca[2] - (mRot(2, 0) * cb[0] + mRot(2, 1) * cb[1] + mRot(2, 2) * cb[2] + mTrans[2]);
-    const double reach = na.radius + nb.radius + mReach;
-    if (dx * dx + dy * dy + dz * dz > reach * reach) return false;
-    if (!boxes_overlap(mA.boxes[ia], mB.boxes[ib])) return false;
-    if (mKind == QueryKind::contact && !cones_can_face(na, nb)) return false;
-    if (mGroups != nullptr && !groups_can_touch(na.groups, nb.groups)) return false;
+  /// A node of A with what the node-node test needs of it precomputed: its box center seen from
+  /// B's frame and its box's extent along each of B's axes. Prepared once per node and reused
+  /// against every node of B it meets (the traversal tests two children of A against two of B).
+  struct SideA {
+    std::uint32_t index;   ///< node index in A
+    double center[3];      ///< sphere center (A's frame)
+    double radius;         ///< sphere radius
+    double box[3];         ///< box center (A's frame)
+    double half[3];        ///< box half-extents (A's axes)
+    double box_in_b[3];    ///< box center in B's frame
+    double reach_on_b[3];  ///< half-extent of A's box along each of B's axes
+  };
+  /// A node of B, prepared the same way: centers brought into A's frame.
+  struct SideB {
+    std::uint32_t index;   ///< node index in B
+    double center[3];      ///< sphere center in A's frame
+    double radius;         ///< sphere radius
+    double box[3];         ///< box center (B's own frame)
+    double half[3];        ///< box half-extents (B's axes)
+    double box_in_a[3];    ///< box center in A's frame
+    double reach_on_a[3];  ///< half-extent of B's box along each of A's axes
+  };
+
+  /// Prepares node ia of A for node tests.
+  [[nodiscard]] SideA prepare_a(std::uint32_t ia) const {
+    const BvhNode& n = mA.nodes[ia];
+    SideA s;
+    s.index = ia;
+    s.radius = n.radius;
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = n.center[i];
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    // B's frame: x_b = R^T (x_a - T).
+    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
+    for (int j = 0; j < 3; ++j) {
+      s.box_in_b[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
+      s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
+    }
+    return s;
+  }
+
+  /// Prepares node ib of B for node tests.
+  [[nodiscard]] SideB prepare_b(std::uint32_t ib) const {
+    const BvhNode& n = mB.nodes[ib];
+    SideB s;
+    s.index = ib;
+    s.radius = n.radius;
+    const double c[3] = {n.center[0], n.center[1], n.center[2]};
+    for (int i = 0; i < 3; ++i) {
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
+      s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
+      s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
+    }
+    return s;
+  }
+
+  /// The node-node test on prepared nodes: spheres within the tolerance, boxes not separated by a
+  /// face axis, normal cones able to face each other (contact only), some compatible groups.
+  /// Conservative: every bound carries the safety margin (see the constructor).
+  [[nodiscard]] bool node_test(const SideA& a, const SideB& b) const {
+    double dist2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = a.center[i] - b.center[i];
+      dist2 += d * d;
+    }
+    const double reach = a.radius + b.radius + mReach;
+    if (dist2 > reach * reach) return false;
+    for (int i = 0; i < 3; ++i) {  // A's axes
+      if (std::abs(b.box_in_a[i] - a.box[i]) > a.half[i] + b.reach_on_a[i] + mReach) return false;
+    }
+    for (int j = 0; j < 3; ++j) {  // B's axes
+      if (std::abs(b.box[j] - a.box_in_b[j]) > b.half[j] + a.reach_on_b[j] + mReach) return false;
+    }
+    if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
+    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
     return true;
   }
 
-  /// Separating-axis test of A's box against B's box (in B's frame) on the six face axes, with the
-  /// tolerance and safety margin added: false only if some face axis separates them by more.
-  [[nodiscard]] bool boxes_overlap(const BvhBox& ba, const BvhBox& bb) const {
-    const double* cb = bb.center;
-    const double* hb = bb.half;
-    const double* ha = ba.half;
-    double t[3];
-    for (int i = 0; i < 3; ++i) {
-      t[i] = mRot(i, 0) * cb[0] + mRot(i, 1) * cb[1] + mRot(i, 2) * cb[2] + mTrans[i] - ba.center[i];
-    }
-    for (int i = 0; i < 3; ++i) {  // A's axes
-      const double rb = mAbsRot(i, 0) * hb[0] + mAbsRot(i, 1) * hb[1] + mAbsRot(i, 2) * hb[2];
-      if (std::abs(t[i]) > ha[i] + rb + mReach) return false;
-    }
-    for (int j = 0; j < 3; ++j) {  // B's axes
-      const double tj = mRot(0, j) * t[0] + mRot(1, j) * t[1] + mRot(2, j) * t[2];
-      const double ra = mAbsRot(0, j) * ha[0] + mAbsRot(1, j) * ha[1] + mAbsRot(2, j) * ha[2];
-      if (std::abs(tj) > hb[j] + ra + mReach) return false;
-    }
-    return true;
-  }
+  /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
+  [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
@@ -92,7 +139,7 @@ class PairContext {
   }
 
  private:
-  bool cones_can_face(const BvhNode& na, const BvhNode& nb) const;
+  bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
 
   const Model& mA;

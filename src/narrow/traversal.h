@@ -20,26 +20,25 @@ struct NodePair {
 /// A node whose sphere is more than this many times larger than its partner's descends alone.
 inline constexpr double kDescendAloneRatio = 2.0;
 
-/// The children of CD-tree node n (which must not be a leaf pair): both nodes split (up to 4
-/// children) unless one is a leaf or much larger than the other, in which case only the larger
-/// one splits. Depends only on object-space radii, so the CD tree's shape is pose-independent.
-/// Writes them to out and returns how many.
+/// Which sides of CD-tree node n split: both (up to 4 children) unless one is a leaf or much larger
+/// than the other, in which case only the larger one splits. Depends only on object-space radii,
+/// so the CD tree's shape does not depend on the poses. n must not be a pair of leaves.
+inline void cd_split(const BvhNode& a, const BvhNode& b, bool& split_a, bool& split_b) {
+  split_a = !a.is_leaf() && (b.is_leaf() || double(a.radius) * kDescendAloneRatio >= double(b.radius));
+  split_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * kDescendAloneRatio >= double(a.radius));
+}
+
+/// The children of CD-tree node n (not a pair of leaves), written to out; returns how many.
 inline int cd_children(const Model& ma, const Model& mb, NodePair n, NodePair out[4]) {
   const BvhNode& a = ma.nodes[n.a];
   const BvhNode& b = mb.nodes[n.b];
-  const bool split_a = !a.is_leaf() && (b.is_leaf() || a.radius * kDescendAloneRatio >= b.radius);
-  const bool split_b = !b.is_leaf() && (a.is_leaf() || b.radius * kDescendAloneRatio >= a.radius);
-  const std::uint32_t as[2] = {n.a + 1, a.index};
-  const std::uint32_t bs[2] = {n.b + 1, b.index};
+  bool split_a, split_b;
+  cd_split(a, b, split_a, split_b);
   int count = 0;
-  if (split_a && split_b) {
-    for (const std::uint32_t ca : as) {
-      for (const std::uint32_t cb : bs) out[count++] = NodePair{ca, cb};
+  for (std::uint32_t i = 0; i < (split_a ? 2u : 1u); ++i) {
+    for (std::uint32_t j = 0; j < (split_b ? 2u : 1u); ++j) {
+      out[count++] = NodePair{split_a ? a.index + i : n.a, split_b ? b.index + j : n.b};
     }
-  } else if (split_a) {
-    for (const std::uint32_t ca : as) out[count++] = NodePair{ca, n.b};
-  } else {
-    for (const std::uint32_t cb : bs) out[count++] = NodePair{n.a, cb};
   }
   return count;
 }
@@ -50,31 +49,46 @@ struct TraversalScratch {
 };
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root and every node below it
-/// that survives its parent's test; runs the leaf test on surviving leaf pairs; appends the kept
-/// pairs to `out` and counts the work in `stats`.
+/// whose parent passed; runs the leaf test on passing leaf pairs; appends the kept pairs to `out`
+/// and counts the work in `stats` (every node test, every leaf test).
+/// Children are tested when their parent is expanded, so each child node of A and of B is
+/// prepared once for the (up to) four pairs it takes part in; only passing children are pushed.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
                                  std::vector<Candidate>& out, QueryStats& stats) {
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
+  // Each expansion pops one node and pushes at most four, one level deeper: the stack never holds
+  // more than 3 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
-  stack.clear();
-  stack.push_back(root);
-  std::uint64_t node_tests = 0, leaf_tests = 0;
-  NodePair kids[4];
-  while (!stack.empty()) {
-    const NodePair n = stack.back();
-    stack.pop_back();
+  const auto bound = static_cast<std::size_t>(3 * (ma.height + mb.height) + 4);
+  if (stack.size() < bound) stack.resize(bound);
+  NodePair* const base = stack.data();
+  NodePair* top = base;
+  std::uint64_t node_tests = 1, leaf_tests = 0;
+  if (ctx.node_test(root.a, root.b)) *top++ = root;
+  while (top != base) {
+    const NodePair n = *--top;
     const BvhNode& a = ma.nodes[n.a];
     const BvhNode& b = mb.nodes[n.b];
-    ++node_tests;
-    if (!ctx.node_test(n.a, n.b)) continue;
     if (a.is_leaf() && b.is_leaf()) {
       ++leaf_tests;
       ctx.leaf_test(a.index, b.index, out);
       continue;
     }
-    const int count = cd_children(ma, mb, n, kids);
-    for (int i = count - 1; i >= 0; --i) stack.push_back(kids[i]);
+    bool split_a, split_b;
+    cd_split(a, b, split_a, split_b);
+    PairContext::SideA sa[2];
+    PairContext::SideB sb[2];
+    const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
+    for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
+    for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
+    // Pushed in reverse so that the first child is popped first (the same order as cd_children).
+    for (int i = na - 1; i >= 0; --i) {
+      for (int j = nb - 1; j >= 0; --j) {
+        ++node_tests;
+        if (ctx.node_test(sa[i], sb[j])) *top++ = NodePair{sa[i].index, sb[j].index};
+      }
+    }
   }
   stats.node_tests += node_tests;
   stats.leaf_tests += leaf_tests;

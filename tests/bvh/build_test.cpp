@@ -14,33 +14,38 @@ namespace {
 /// Checks every invariant of the BVH; returns the triangles below `index`.
 std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const BvhNode& node = m.nodes[index];
+  const BvhNodeFilter& filter = m.filters[index];
   std::vector<std::uint32_t> below;
   if (node.is_leaf()) {
     below.push_back(node.index);
   } else {
-    EXPECT_GT(node.index, index + 1) << "right child after the left subtree";
-    auto left = check_subtree(m, index + 1);
-    auto right = check_subtree(m, node.index);
-    EXPECT_EQ(m.nodes[index + 1].count + m.nodes[node.index].count, node.count);
-    EXPECT_EQ(m.nodes[index + 1].groups | m.nodes[node.index].groups, node.groups);
+    EXPECT_GT(node.index, index) << "children after their parent";
+    auto left = check_subtree(m, node.index);
+    auto right = check_subtree(m, node.index + 1);
+    EXPECT_EQ(m.nodes[node.index].count + m.nodes[node.index + 1].count, node.count);
+    EXPECT_EQ(m.filters[node.index].groups | m.filters[node.index + 1].groups, filter.groups);
     below = std::move(left);
     below.insert(below.end(), right.begin(), right.end());
   }
   EXPECT_EQ(below.size(), node.count);
   const Eigen::Vector3d c(node.center[0], node.center[1], node.center[2]);
-  const Eigen::Vector3d axis = Eigen::Vector3d(node.cone_axis[0], node.cone_axis[1], node.cone_axis[2]).normalized();
+  const Eigen::Vector3d bc(node.box_center[0], node.box_center[1], node.box_center[2]);
+  const Eigen::Vector3d bh(node.box_half[0], node.box_half[1], node.box_half[2]);
+  const Eigen::Vector3d axis = Eigen::Vector3d(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]).normalized();
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh.triangles[t]) {
-      EXPECT_LE((m.mesh.vertices[v] - c).norm(), node.radius) << "node " << index << " must cover its vertices";
+      const Eigen::Vector3d& p = m.mesh.vertices[v];
+      EXPECT_LE((p - c).norm(), node.radius) << "node " << index << " sphere must cover its vertices";
+      EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
     }
     if (m.normals[t].squaredNorm() > 0.0) {
       any_normal = true;
       const double angle = std::acos(std::clamp(axis.dot(m.normals[t]), -1.0, 1.0));
-      EXPECT_LE(angle, node.cone_angle) << "node " << index << " cone must hold the normal of triangle " << t;
+      EXPECT_LE(angle, filter.cone_angle) << "node " << index << " cone must hold the normal of triangle " << t;
     }
   }
-  EXPECT_EQ(any_normal, node.cone_angle >= 0.0f) << "node " << index;
+  EXPECT_EQ(any_normal, filter.cone_angle >= 0.0f) << "node " << index;
   return below;
 }
 
@@ -74,8 +79,15 @@ TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
   }
   const auto model = build_model(mesh);
   check_model(*model);
-  EXPECT_EQ(model->nodes[0].groups, 0b11111u);
+  EXPECT_EQ(model->filters[0].groups, 0b11111u);
   EXPECT_LE(model->height, 12);  // median split: ceil(log2(500)) + 1 = 10
+}
+
+TEST(BuildModel, FarFromTheOriginVolumesStillCover) {
+  // Float storage must not lose a vertex: coordinates around 1e6 with millimetre triangles.
+  Mesh mesh = make_sphere(0.001, 6, 8);
+  for (auto& v : mesh.vertices) v += Eigen::Vector3d(1e6, -2e6, 3e5);
+  check_model(*build_model(mesh));
 }
 
 TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
@@ -85,7 +97,7 @@ TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
   const auto model = build_model(mesh);
   ASSERT_EQ(model->nodes.size(), 1u);
   EXPECT_TRUE(model->nodes[0].is_leaf());
-  EXPECT_LT(model->nodes[0].cone_angle, 0.0f) << "a degenerate triangle has no normal";
+  EXPECT_LT(model->filters[0].cone_angle, 0.0f) << "a degenerate triangle has no normal";
   EXPECT_EQ(model->normals[0], Eigen::Vector3d::Zero());
   check_model(*model);
 }
