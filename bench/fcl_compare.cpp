@@ -18,6 +18,8 @@
 #include <Eigen/Geometry>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/detail/traversal/collision/mesh_collision_traversal_node.h>
+#include <fcl/narrowphase/detail/traversal/collision_node.h>
 
 #include "caliber/mesh.h"
 #include "caliber/model.h"
@@ -95,7 +97,8 @@ struct Row {
   std::size_t tris_a, tris_b;
   double build_ours, build_fcl, query_ours, query_fcl;
   std::size_t pairs_ours, pairs_fcl, only_ours, only_fcl;
-  std::uint64_t node_tests;
+  std::uint64_t node_tests, leaf_tests;
+  long fcl_bv_tests, fcl_leaf_tests;
 };
 
 Row run_case(const Case& c, const std::filesystem::path& dir, int repeat) {
@@ -143,6 +146,15 @@ Row run_case(const Case& c, const std::filesystem::path& dir, int repeat) {
   row.only_ours = only_ours.size();
   row.only_fcl = only_fcl.size();
   row.node_tests = ours.stats.node_tests;
+  row.leaf_tests = ours.stats.leaf_tests;
+  // FCL's own work counters, from one untimed run of the same traversal with statistics on.
+  fcl::detail::MeshCollisionTraversalNodeOBBRSS<double> node;
+  fcl::CollisionResultd counted;
+  fcl::detail::initialize(node, *fcl_a, to_fcl(pose_a), *fcl_b, to_fcl(pose_b), request, counted);
+  node.enable_statistics = true;
+  fcl::detail::collide(&node);
+  row.fcl_bv_tests = node.num_bv_tests;
+  row.fcl_leaf_tests = node.num_leaf_tests;
   return row;
 }
 
@@ -172,8 +184,8 @@ int main(int argc, char** argv) {
   };
   std::string table;
   table += "| case | triangles A / B | build ours (ms) | build FCL (ms) | build ratio | query ours (ms) | query FCL (ms) | "
-           "query ratio | pairs ours / FCL | identical | our node tests |\n";
-  table += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "query ratio | pairs ours / FCL | identical | node tests ours / FCL | leaf tests ours / FCL |\n";
+  table += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
   for (const Case& c : cases) {
     if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {
@@ -184,14 +196,15 @@ int main(int argc, char** argv) {
     const Row r = run_case(c, dir, repeat);
     char line[1024];
     std::snprintf(line, sizeof line,
-                  "| %s | %zu / %zu | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu |\n", r.name.c_str(),
+                  "| %s | %zu / %zu | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu / %ld | %llu / %ld |\n", r.name.c_str(),
                   r.tris_a, r.tris_b, r.build_ours, r.build_fcl, r.build_ours / r.build_fcl, r.query_ours, r.query_fcl,
                   r.query_ours / r.query_fcl, r.pairs_ours, r.pairs_fcl,
                   (r.only_ours == 0 && r.only_fcl == 0)
                       ? "yes"
                       : ("no: " + std::to_string(r.only_ours) + " only ours, " + std::to_string(r.only_fcl) + " only FCL")
                             .c_str(),
-                  static_cast<unsigned long long>(r.node_tests));
+                  static_cast<unsigned long long>(r.node_tests), r.fcl_bv_tests,
+                  static_cast<unsigned long long>(r.leaf_tests), r.fcl_leaf_tests);
     std::fputs(line, stdout);
     std::fflush(stdout);
     table += line;
