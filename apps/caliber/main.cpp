@@ -1,108 +1,24 @@
 // caliber: command-line front-end of the library.
-//   caliber query A B [--pose-a ...] [--pose-b ...] --kind K [--tolerance D] [--angle DEG] [--json]
+//   caliber query A B [...]      two meshes, one query
+//   caliber run SCENE [...]      a scene over its time steps
+//   caliber refine IN OUT -l K   1-to-4 subdivision
 // Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
 
-#include <chrono>
-#include <cstdio>
 #include <iostream>
-#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "caliber/error.h"
-#include "caliber/mesh.h"
-#include "caliber/model.h"
-#include "caliber/pose.h"
-#include "caliber/query.h"
-#include "json_output.h"
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-struct QueryOptions {
-  std::string mesh_a, mesh_b;
-  std::string pose_a = "0 0 0 1 0 0 0", pose_b = "0 0 0 1 0 0 0";
-  std::string kind = "interference";
-  double tolerance = 0.0;
-  double angle = 30.0;
-  bool json = false;
-  int show = 10;
-};
-
-int run_query(const QueryOptions& opt) {
-  caliber::QueryRequest request;
-  request.kind = caliber::parse_query_kind(opt.kind);
-  request.tolerance = opt.tolerance;
-  request.angle_deg = opt.angle;
-  caliber::validate_request(request);
-  const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
-  const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
-
-  const auto build_start = Clock::now();
-  const auto model_a = caliber::build_model(caliber::load_mesh(opt.mesh_a));
-  const auto model_b = opt.mesh_b == opt.mesh_a ? model_a : caliber::build_model(caliber::load_mesh(opt.mesh_b));
-  const double build_ms = ms_since(build_start);
-
-  const auto query_start = Clock::now();
-  const caliber::QueryResult result = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
-  const double query_ms = ms_since(query_start);
-
-  if (opt.json) {
-    nlohmann::json out = caliber::cli::to_json(result);
-    out["stats"]["build_ms"] = build_ms;
-    out["stats"]["query_ms"] = query_ms;
-    std::cout << out.dump() << "\n";
-    return 0;
-  }
-  const char* what = request.kind == caliber::QueryKind::interference ? "intersecting triangle pairs"
-                     : request.kind == caliber::QueryKind::proximity  ? "triangle pairs within the tolerance"
-                                                                       : "contacts (local minima)";
-  std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.pairs.size(), what);
-  std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), model_a->mesh.triangles.size(),
-              model_a->height);
-  std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), model_b->mesh.triangles.size(),
-              model_b->height);
-  std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms\n",
-              static_cast<unsigned long long>(result.stats.node_tests),
-              static_cast<unsigned long long>(result.stats.leaf_tests), build_ms, query_ms);
-  const std::size_t shown = std::min<std::size_t>(result.pairs.size(), static_cast<std::size_t>(std::max(opt.show, 0)));
-  for (std::size_t i = 0; i < shown; ++i) {
-    if (result.contacts.empty()) {
-      std::printf("  pair %u %u\n", result.pairs[i].tri_a, result.pairs[i].tri_b);
-    } else {
-      const auto& c = result.contacts[i];
-      std::printf("  pair %u %u  distance %.6g  normal (%.4f %.4f %.4f)\n", c.tri_a, c.tri_b, c.distance, c.normal.x(),
-                  c.normal.y(), c.normal.z());
-    }
-  }
-  if (shown < result.pairs.size()) std::printf("  ... %zu more (use --json for all)\n", result.pairs.size() - shown);
-  return 0;
-}
-
-}  // namespace
+#include "commands.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"caliber: exact collision detection between rigid triangle meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "caliber 0.1.0");
-
-  QueryOptions query;
-  CLI::App* cmd = app.add_subcommand("query", "Query two meshes: interference, proximity or contact");
-  cmd->add_option("A", query.mesh_a, "Mesh A (OFF, OBJ, STL or PLY)")->required();
-  cmd->add_option("B", query.mesh_b, "Mesh B (OFF, OBJ, STL or PLY)")->required();
-  cmd->add_option("--pose-a", query.pose_a, "Pose of A: \"tx ty tz qw qx qy qz\"")->capture_default_str();
-  cmd->add_option("--pose-b", query.pose_b, "Pose of B: \"tx ty tz qw qx qy qz\"")->capture_default_str();
-  cmd->add_option("--kind", query.kind, "interference | proximity | contact")->capture_default_str();
-  cmd->add_option("--tolerance", query.tolerance, "Distance d for proximity and contact (>= 0)")->capture_default_str();
-  cmd->add_option("--angle", query.angle, "Contact angle theta in degrees, [0, 180]")->capture_default_str();
-  cmd->add_flag("--json", query.json, "Print one JSON object with every pair and contact");
-  cmd->add_option("--show", query.show, "How many pairs the summary lists")->capture_default_str();
-
+  const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app),
+                                                      caliber::cli::add_run_command(app),
+                                                      caliber::cli::add_refine_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -116,7 +32,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    if (cmd->parsed()) return run_query(query);
+    for (const auto& command : commands) {
+      const int rc = command();
+      if (rc >= 0) return rc;
+    }
   } catch (const caliber::Error& e) {
     std::cerr << "caliber: " << e.what() << "\n";
     return 2;

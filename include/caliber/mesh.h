@@ -41,6 +41,14 @@ inline constexpr int kMaxGroups = 64;
 /// Throws caliber::Error naming `mesh.source` and the first problem found.
 void validate_mesh(const Mesh& mesh);
 
+/// 1-to-4 midpoint subdivision, `levels` times: triangle t becomes triangles 4t .. 4t+3 (corner at
+/// vertex 0, at vertex 1, at vertex 2, then the middle one), so ids stay predictable. The surface
+/// does not change, only its triangle count; groups are inherited.
+[[nodiscard]] Mesh refine_mesh(const Mesh& mesh, int levels);
+
+/// Writes the mesh as an OFF file. Throws caliber::Error if the file cannot be written.
+void save_off(const Mesh& mesh, const std::filesystem::path& path);
+
 /// Applies a uniform scale to every vertex (scene files scale meshes). `factor` must be finite and > 0.
 void scale_mesh(Mesh& mesh, double factor);
 

@@ -40,11 +40,11 @@ Vec3 to_float_axis(const Vec3& axis) {
 
 /// A node while it is built, in double precision; converted to BvhNode / BvhNodeFilter at the end.
 struct WorkNode {
-  Vec3 center;
+  Vec3 center = Vec3::Zero();
   double radius = 0.0;
-  Vec3 lo, hi;           ///< box of the vertices below
-  Vec3 normal_sum;       ///< sum of the unit normals below (cone axis direction)
-  Vec3 axis;             ///< cone axis, already rounded to float
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  ///< box of the vertices below
+  Vec3 normal_sum = Vec3::Zero();             ///< sum of the unit normals below (cone axis direction)
+  Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
   std::uint64_t groups = 0;
   std::uint32_t index = 0;

@@ -1,0 +1,64 @@
+// Midpoint subdivision and OFF output.
+
+#include <fstream>
+#include <map>
+#include <utility>
+
+#include "caliber/error.h"
+#include "caliber/mesh.h"
+
+namespace caliber {
+namespace {
+
+Mesh refine_once(const Mesh& in) {
+  Mesh out;
+  out.source = in.source;
+  out.vertices = in.vertices;
+  out.triangles.reserve(4 * in.triangles.size());
+  if (!in.groups.empty()) out.groups.reserve(4 * in.groups.size());
+  // One midpoint per edge (by vertex indices), so shared edges stay shared.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
+  const auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
+    const auto key = std::minmax(a, b);
+    const auto [it, inserted] = midpoints.try_emplace({key.first, key.second}, 0u);
+    if (inserted) {
+      it->second = static_cast<std::uint32_t>(out.vertices.size());
+      out.vertices.push_back(0.5 * (in.vertices[key.first] + in.vertices[key.second]));
+    }
+    return it->second;
+  };
+  for (std::size_t t = 0; t < in.triangles.size(); ++t) {
+    const auto [a, b, c] = in.triangles[t];
+    const std::uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+    out.triangles.push_back({a, ab, ca});
+    out.triangles.push_back({ab, b, bc});
+    out.triangles.push_back({ca, bc, c});
+    out.triangles.push_back({ab, bc, ca});
+    if (!in.groups.empty()) out.groups.insert(out.groups.end(), 4, in.groups[t]);
+  }
+  return out;
+}
+
+}  // namespace
+
+Mesh refine_mesh(const Mesh& mesh, int levels) {
+  if (levels < 0 || levels > 8) throw Error(ErrorCode::bad_value, "refine", "levels must be in [0, 8]");
+  if (mesh.triangles.size() << (2 * levels) >= 0x7fffffffu) {
+    throw Error(ErrorCode::bad_value, mesh.source, "refining this mesh " + std::to_string(levels) + " times makes too many triangles");
+  }
+  Mesh out = mesh;
+  for (int i = 0; i < levels; ++i) out = refine_once(out);
+  return out;
+}
+
+void save_off(const Mesh& mesh, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(ErrorCode::unreadable, path.string(), "cannot be opened for writing");
+  out.precision(17);
+  out << "OFF\n" << mesh.vertices.size() << ' ' << mesh.triangles.size() << " 0\n";
+  for (const auto& v : mesh.vertices) out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+  for (const auto& t : mesh.triangles) out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  if (!out) throw Error(ErrorCode::unreadable, path.string(), "write failed");
+}
+
+}  // namespace caliber
