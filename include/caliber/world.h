@@ -108,6 +108,9 @@ class World {
 
   /// The poses of all objects at step k.
   [[nodiscard]] std::vector<Pose> poses_at(int step) const;
+  /// World-space box of object i at `pose` (its root box moved by the pose, grown by `grow` and a
+  /// rounding margin), as the broad phase uses it: low corner, high corner.
+  [[nodiscard]] std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds(std::size_t i, const Pose& pose, double grow) const;
   /// The broad phase: object pairs whose world boxes, grown by the tolerance, overlap; pairs of two
   /// static objects and ignored pairs are skipped. Sorted. Sweep and prune along x.
   [[nodiscard]] std::vector<Task> broad_phase(const std::vector<Pose>& poses) const;

@@ -91,6 +91,11 @@ std::vector<Pose> World::poses_at(int step) const {
   return poses;
 }
 
+std::pair<Eigen::Vector3d, Eigen::Vector3d> World::bounds(std::size_t i, const Pose& pose, double grow) const {
+  const WorldBox b = world_box(*mModels[i], pose, grow);
+  return {b.lo, b.hi};
+}
+
 std::vector<Task> World::broad_phase(const std::vector<Pose>& poses) const {
   const std::size_t n = mScene.objects.size();
   const double grow = mRequest.kind == QueryKind::interference ? 0.0 : 0.5 * mRequest.tolerance;

@@ -64,5 +64,40 @@ check bad-angle 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind contac
 check no-args 2 "$cli"
 check unknown-flag 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --frobnicate
 
+# caliber run
+tmp=$(mktemp -d)
+check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
+contains run "summary over 12 steps"
+contains run "heaviest pair"
+python3 - "$tmp/report.json" "$tmp/contacts.jsonl" <<'PY' || { echo "FAIL run-files"; failures=$((failures + 1)); }
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["scene"] == "tetras" and len(r["steps"]) == 12
+s = r["steps"][0]
+for key in ("broad_ms", "narrow_ms", "reduce_ms", "node_tests", "contacts", "tasks"):
+    assert key in s, key
+assert r["summary"]["steps_with_contacts"] > 0
+lines = open(sys.argv[2]).read().splitlines()
+assert len(lines) == 12
+counts = [len(json.loads(l)["contacts"]) for l in lines]
+assert counts == [st["contacts"] for st in r["steps"]]
+PY
+check run-steps 0 "$cli" run "$data/scenes/tetras.json" --steps 3
+contains run-steps "summary over 3 steps"
+check run-zero-steps 2 "$cli" run "$data/scenes/tetras.json" --steps 0
+check run-missing 2 "$cli" run "$data/scenes/nope.json"
+contains run-missing "no such scene file"
+check run-bad-key 2 "$cli" run "$data/scenes/bad_key.json"
+contains run-bad-key "'objects[0].wobble': unknown key"
+check run-directory 2 "$cli" run "$data/scenes"
+# caliber refine
+check refine 0 "$cli" refine "$data/tetra.off" "$tmp/fine.off" --levels 2
+contains refine "4 triangles"
+contains refine "64 triangles"
+check refine-query 0 "$cli" query "$tmp/fine.off" "$data/tetra.off" --show 0
+check refine-bad-levels 2 "$cli" refine "$data/tetra.off" "$tmp/x.off" --levels 12
+check refine-missing 2 "$cli" refine "$data/nope.off" "$tmp/x.off"
+rm -rf "$tmp"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -1,0 +1,204 @@
+// The world: shared models, broad phase against the all-pairs check, steps against the oracle.
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/error.h"
+#include "caliber/procedural.h"
+#include "caliber/world.h"
+#include "support/random_poses.h"
+
+namespace caliber {
+namespace {
+
+/// A temporary folder with a cube, a sphere and a torus saved as OFF files.
+class WorldFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() / ("caliber_world_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    save_off(make_box(0.5, 0.5, 0.5, 2), dir / "cube.off");
+    save_off(make_box(0.5, 0.5, 0.5, 2), dir / "cube_copy.off");
+    save_off(make_sphere(0.6, 8, 12), dir / "sphere.off");
+    save_off(make_torus(0.8, 0.25, 12, 8), dir / "torus.off");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+
+  Scene scene(const std::string& json) const { return parse_scene(json, dir, "world_test.json"); }
+
+  std::filesystem::path dir;
+};
+
+/// Each step's contacts must equal, bit for bit, the oracle run on every object pair.
+void expect_steps_match_oracle(const World& world, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    const StepResult s = world.step(k);
+    const std::vector<Pose> poses = world.poses_at(k);
+    std::vector<SceneContact> want;
+    for (std::uint32_t a = 0; a < world.object_count(); ++a) {
+      for (std::uint32_t b = a + 1; b < world.object_count(); ++b) {
+        if (world.scene().objects[a].motion.type == Motion::Type::fixed &&
+            world.scene().objects[b].motion.type == Motion::Type::fixed) {
+          continue;
+        }
+        const QueryResult r = query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request());
+        for (std::size_t i = 0; i < r.pairs.size(); ++i) {
+          SceneContact c{a, b, {}};
+          if (r.contacts.empty()) {
+            c.contact.tri_a = r.pairs[i].tri_a;
+            c.contact.tri_b = r.pairs[i].tri_b;
+            c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
+          } else {
+            c.contact = r.contacts[i];
+          }
+          want.push_back(c);
+        }
+      }
+    }
+    ASSERT_EQ(s.contacts.size(), want.size()) << "step " << k;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      ASSERT_EQ(s.contacts[i].object_a, want[i].object_a) << "step " << k;
+      ASSERT_EQ(s.contacts[i].object_b, want[i].object_b) << "step " << k;
+      ASSERT_EQ(s.contacts[i].contact.tri_a, want[i].contact.tri_a) << "step " << k;
+      ASSERT_EQ(s.contacts[i].contact.tri_b, want[i].contact.tri_b) << "step " << k;
+      ASSERT_EQ(s.contacts[i].contact.distance, want[i].contact.distance) << "step " << k;
+      ASSERT_EQ(s.contacts[i].contact.point_a, want[i].contact.point_a) << "step " << k;
+      ASSERT_EQ(s.contacts[i].contact.normal, want[i].contact.normal) << "step " << k;
+    }
+  }
+}
+
+TEST_F(WorldFiles, CubeSlidingIntoCubeHasContactsExactlyWhenTheyOverlap) {
+  // B moves along x from a gap of 0.5 into A at 0.1 per step: faces meet at step 5.
+  const World world(scene(R"({"steps": 10, "dt": 1, "objects": [
+      {"name": "a", "mesh": "cube.off"},
+      {"name": "b", "mesh": "cube.off", "position": [1.5, 0.25, 0.125], "motion": {"type": "velocity", "linear": [-0.125, 0, 0]}}]})"));
+  EXPECT_EQ(world.distinct_models(), 1u);
+  for (int k = 0; k < 10; ++k) {
+    const StepResult s = world.step(k);
+    const double gap = 1.5 - 0.125 * k - 1.0;  // exact in binary
+    EXPECT_EQ(s.contacts.empty(), gap > 0.0) << "step " << k << " gap " << gap;
+  }
+  expect_steps_match_oracle(world, 10);
+}
+
+TEST_F(WorldFiles, ProximityAndContactStepsMatchTheOracle) {
+  for (const char* kind : {"proximity", "contact"}) {
+    const World world(scene(std::string(R"({"steps": 12, "dt": 0.1, "query": {"kind": ")") + kind +
+                            R"(", "tolerance": 0.15, "angle": 40}, "objects": [
+      {"name": "ring", "mesh": "torus.off", "motion": {"type": "velocity", "angular": [0, 0.5, 0]}},
+      {"name": "ball", "mesh": "sphere.off", "position": [0.9, 0, 0.3], "motion": {"type": "velocity", "linear": [-0.2, 0, -0.1]}},
+      {"name": "box", "mesh": "cube.off", "position": [-0.2, 1.0, 0], "motion": {"type": "keyframes", "keys": [
+        {"time": 0, "position": [-0.2, 1.0, 0]}, {"time": 1.2, "position": [0.1, 0.4, 0.2], "orientation": [0.9, 0.1, 0.3, 0.2]}]}}]})"));
+    expect_steps_match_oracle(world, 12);
+    int with_contacts = 0;
+    for (int k = 0; k < 12; ++k) with_contacts += world.step(k).contacts.empty() ? 0 : 1;
+    EXPECT_GT(with_contacts, 6) << kind;
+  }
+}
+
+TEST_F(WorldFiles, SharedModelsGiveTheSameContactsAsSeparateOnes) {
+  const std::string shared = R"({"steps": 8, "dt": 0.1, "query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "cube.off"},
+      {"name": "b", "mesh": "cube.off", "position": [0.8, 0.3, 0], "orientation": [0.95, 0.1, 0.2, 0.1], "motion": {"type": "velocity", "linear": [0.05, 0, 0]}},
+      {"name": "c", "mesh": "cube.off", "position": [-0.7, -0.2, 0.4], "motion": {"type": "velocity", "angular": [0, 0, 1]}}]})";
+  std::string separate = shared;
+  separate.replace(separate.find("cube.off", separate.find("\"b\"")), 8, "cube_copy.off");
+  const World one(scene(shared));
+  const World two(scene(separate));
+  EXPECT_EQ(one.distinct_models(), 1u);
+  EXPECT_EQ(two.distinct_models(), 2u);
+  int total = 0;
+  for (int k = 0; k < 8; ++k) {
+    const StepResult x = one.step(k), y = two.step(k);
+    ASSERT_EQ(x.contacts.size(), y.contacts.size());
+    for (std::size_t i = 0; i < x.contacts.size(); ++i) {
+      EXPECT_EQ(x.contacts[i].contact.tri_a, y.contacts[i].contact.tri_a);
+      EXPECT_EQ(x.contacts[i].contact.point_b, y.contacts[i].contact.point_b);
+    }
+    total += static_cast<int>(x.contacts.size());
+  }
+  EXPECT_GT(total, 0);
+}
+
+TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
+  std::mt19937_64 rng(9);
+  const char* meshes[3] = {"cube.off", "sphere.off", "torus.off"};
+  for (int trial = 0; trial < 8; ++trial) {
+    std::string json = R"({"query": {"kind": "proximity", "tolerance": 0.1}, "ignore": [["o0", "o1"]], "objects": [)";
+    const int n = 12;
+    for (int i = 0; i < n; ++i) {
+      const Pose p = test::random_pose(rng, 2.0);
+      const bool fixed = i % 4 == 0;
+      char buf[512];
+      std::snprintf(buf, sizeof buf,
+                    R"(%s{"name": "o%d", "mesh": "%s", "position": [%.17g, %.17g, %.17g], "orientation": [%.17g, %.17g, %.17g, %.17g]%s})",
+                    i ? "," : "", i, meshes[i % 3], p.translation.x(), p.translation.y(), p.translation.z(), p.rotation.w(),
+                    p.rotation.x(), p.rotation.y(), p.rotation.z(), fixed ? "" : R"(, "motion": {"type": "velocity", "linear": [0, 0, 1]})");
+      json += buf;
+    }
+    json += "]}";
+    const World world(scene(json));
+    const std::vector<Pose> poses = world.poses_at(0);
+    const std::vector<Task> tasks = world.broad_phase(poses);
+    std::vector<Task> want;
+    for (std::uint32_t a = 0; a < n; ++a) {
+      for (std::uint32_t b = a + 1; b < n; ++b) {
+        const auto [alo, ahi] = world.bounds(a, poses[a], 0.05);
+        const auto [blo, bhi] = world.bounds(b, poses[b], 0.05);
+        const bool overlap = (alo.array() <= bhi.array()).all() && (blo.array() <= ahi.array()).all();
+        const bool both_fixed = a % 4 == 0 && b % 4 == 0;
+        const bool ignored = a == 0 && b == 1;
+        if (overlap && !both_fixed && !ignored) want.push_back(Task{a, b});
+        if (!both_fixed && !ignored && !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).pairs.empty()) {
+          EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), Task{a, b}) != tasks.end()) << "touching pair dropped";
+        }
+      }
+    }
+    EXPECT_EQ(tasks, want) << "trial " << trial;
+  }
+}
+
+TEST_F(WorldFiles, GroupsInScenesFilterContacts) {
+  const std::string base = R"({"query": {"kind": "interference"}, %s "objects": [
+      {"name": "a", "mesh": "cube.off", "group": 1},
+      {"name": "b", "mesh": "cube.off", "position": [0.6, 0.2, 0.1], "group": 2, "motion": {"type": "velocity"}}]})";
+  char with[1024], without[1024];
+  std::snprintf(with, sizeof with, base.c_str(), R"("groups": {"compatible": [[1, 1], [2, 2]]},)");
+  std::snprintf(without, sizeof without, base.c_str(), "");
+  EXPECT_TRUE(World(scene(with)).step(0).contacts.empty());
+  EXPECT_FALSE(World(scene(without)).step(0).contacts.empty());
+}
+
+TEST_F(WorldFiles, AMeshThatIsNotAMeshFailsClearly) {
+  std::ofstream(dir / "self.json") << R"({"objects": [{"mesh": "self.json"}]})";
+  try {
+    const World world(load_scene(dir / "self.json"));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("self.json"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RefineMesh, SplitsEachTriangleIntoFourInPlace) {
+  const Mesh box = make_box(1, 1, 1, 1);
+  const Mesh fine = refine_mesh(box, 2);
+  ASSERT_EQ(fine.triangles.size(), box.triangles.size() * 16);
+  const auto area = [](const Mesh& m, std::size_t t) {
+    const auto& tri = m.triangles[t];
+    return 0.5 * (m.vertices[tri[1]] - m.vertices[tri[0]]).cross(m.vertices[tri[2]] - m.vertices[tri[0]]).norm();
+  };
+  for (std::size_t t = 0; t < box.triangles.size(); ++t) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < 16; ++k) sum += area(fine, 16 * t + k);
+    EXPECT_NEAR(sum, area(box, t), 1e-12) << "triangle " << t << " becomes triangles 16t .. 16t+15";
+  }
+  EXPECT_EQ(fine.vertices[fine.triangles[0][0]], box.vertices[box.triangles[0][0]]) << "corner triangle first";
+  EXPECT_THROW((void)refine_mesh(box, -1), Error);
+}
+
+}  // namespace
+}  // namespace caliber
