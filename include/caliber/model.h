@@ -50,6 +50,8 @@ struct BvhNodeFilter {
   /// Normal-cone half-angle in radians, rounded up; negative when every triangle below is
   /// degenerate (no normal, so no contact can come from this node).
   float cone_angle;
+  /// cos(cone_angle) and sin(cone_angle), so the cone test needs no trigonometric call.
+  float cone_cos, cone_sin;
   /// Bit g set when some triangle below is in primitive group g.
   std::uint64_t groups;
 };

@@ -231,6 +231,8 @@ class Builder {
     node.count = w.count;
     for (int k = 0; k < 3; ++k) filter.cone_axis[k] = w.cone >= 0.0 ? static_cast<float>(w.axis[k]) : 0.0f;
     filter.cone_angle = w.cone >= 0.0 ? round_up(w.cone) : -1.0f;
+    filter.cone_cos = static_cast<float>(std::cos(static_cast<double>(filter.cone_angle)));
+    filter.cone_sin = static_cast<float>(std::sin(static_cast<double>(filter.cone_angle)));
     filter.groups = w.groups;
   }
 

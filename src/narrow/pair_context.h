@@ -154,6 +154,7 @@ class PairContext {
   double mReach;       ///< tolerance + safety margin added to the sum of radii
   double mTheta;       ///< contact angle, radians
   double mCosTheta;    ///< cos(theta)
+  double mSinTheta;    ///< sin(theta)
 };
 
 }  // namespace caliber::narrow
