@@ -75,6 +75,14 @@ TEST(LoadMeshErrors, IndexOutOfRange) { expect_error(kData / "bad/index_range.of
 TEST(LoadMeshErrors, FaceWithTwoCorners) { expect_error(kData / "bad/two_corners.off", ErrorCode::bad_index, "2 corner"); }
 TEST(LoadMeshErrors, NoTriangles) { expect_error(kData / "bad/no_faces.off", ErrorCode::unreadable, "no valid faces"); }
 
+TEST(LoadMeshErrors, OtherFormats) {
+  expect_error(kData / "bad/index_range.obj", ErrorCode::unreadable, "out of range");
+  expect_error(kData / "bad/index_range.ply", ErrorCode::bad_index, "refers to vertex 9");
+  expect_error(kData / "bad/nan.obj", ErrorCode::bad_value, "non-finite");
+  expect_error(kData / "bad/no_faces.obj", ErrorCode::empty_mesh, "no triangles");
+  expect_error(kData / "bad/truncated_ascii.stl", ErrorCode::unreadable, "cannot parse");
+}
+
 TEST(LoadMeshErrors, TruncatedOff) {
   // assimp reads the missing face as one with no corners; either way it must be an error, not a mesh.
   EXPECT_THROW((void)load_mesh(kData / "bad/truncated.off"), Error);
