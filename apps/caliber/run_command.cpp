@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "caliber/engine.h"
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
@@ -20,6 +21,9 @@ namespace {
 
 struct RunOptions {
   std::string scene;
+  std::string method = "sequential";
+  int threads = 0;
+  int stealing_depth = 10;
   int steps = -1;
   std::string json;
   std::string contacts;
@@ -71,12 +75,18 @@ int run_scene(const RunOptions& opt) {
   if (opt.steps > 0) scene.steps = opt.steps;
   const auto load_start = std::chrono::steady_clock::now();
   const World world(std::move(scene));
+  EngineOptions engine_options;
+  engine_options.method = parse_method(opt.method);
+  engine_options.threads = opt.threads;
+  engine_options.stealing_depth = opt.stealing_depth;
+  Engine engine(world, engine_options);
   const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count();
   const Scene& sc = world.scene();
   std::printf("scene %s: %zu objects (%zu distinct models), %zu triangles, %d steps of %g s, %s query (d = %g, angle %g)\n",
               sc.name.c_str(), world.object_count(), world.distinct_models(), world.triangle_count(), sc.steps, sc.dt,
               std::string(to_string(sc.query.kind)).c_str(), sc.query.tolerance, sc.query.angle_deg);
-  std::printf("loaded and built in %.1f ms\n", load_ms);
+  std::printf("loaded and built in %.1f ms; method %s on %d thread(s)\n", load_ms,
+              std::string(to_string(engine.options().method)).c_str(), engine.threads());
   std::fflush(stdout);
 
   std::unique_ptr<std::ofstream> contacts_out;
@@ -88,7 +98,7 @@ int run_scene(const RunOptions& opt) {
   RunStats stats;
   const Progress progress(static_cast<std::size_t>(sc.steps));
   for (int k = 0; k < sc.steps; ++k) {
-    const StepResult s = world.step(k);
+    const StepResult s = engine.step(k);
     stats.add(s);
     if (!opt.json.empty()) steps.push_back(step_record(s));
     if (contacts_out) *contacts_out << contacts_line(world, s).dump() << '\n';
@@ -120,6 +130,8 @@ int run_scene(const RunOptions& opt) {
         {"file", sc.file.string()},
         {"query", {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}}},
         {"dt", sc.dt},
+        {"method", std::string(to_string(engine.options().method))},
+        {"threads", engine.threads()},
         {"summary",
          {{"steps", stats.steps()},
           {"objects", world.object_count()},
@@ -149,6 +161,10 @@ Runner add_run_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene over its time steps");
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--steps", opt->steps, "Run this many steps instead of the scene's");
+  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--stealing-depth", opt->stealing_depth, "Stealing: CD-tree depth below which a subtree runs serially")
+      ->capture_default_str();
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");
   cmd->add_option("--contacts", opt->contacts, "Write each step's contacts, one JSON line per step, to this file");
   return [cmd, opt]() { return cmd->parsed() ? run_scene(*opt) : -1; };

@@ -50,6 +50,11 @@ struct StepResult {
   QueryStats stats;                     ///< totals over the tasks
 };
 
+/// The reduction of a step: per-task records and the contacts of every task, in task order (tasks
+/// are sorted and each result is sorted, so the concatenation is canonical). Fills out.tasks,
+/// out.contacts and out.stats; every method of the engine ends its step with it.
+void gather_step(const std::vector<Task>& tasks, const std::vector<QueryResult>& results, StepResult& out);
+
 /// The paper's Table 1 for a run, and its timing summary, accumulated step by step (no step is kept).
 class RunStats {
  public:

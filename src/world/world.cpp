@@ -141,6 +141,18 @@ StepResult World::step(int step) const {
   out.narrow_ms = ms_since(start);
 
   start = Clock::now();
+  gather_step(tasks, results, out);
+  out.reduce_ms = ms_since(start);
+  return out;
+}
+
+void gather_step(const std::vector<Task>& tasks, const std::vector<QueryResult>& results, StepResult& out) {
+  out.tasks.clear();
+  out.contacts.clear();
+  out.stats = QueryStats{};
+  std::size_t total = 0;
+  for (const QueryResult& r : results) total += r.pairs.size();
+  out.contacts.reserve(total);
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const QueryResult& r = results[i];
     out.tasks.push_back(TaskRecord{tasks[i], r.stats, r.pairs.size()});
@@ -158,9 +170,6 @@ StepResult World::step(int step) const {
       out.contacts.push_back(c);
     }
   }
-  // Tasks are sorted and each result is sorted: the concatenation is already canonical.
-  out.reduce_ms = ms_since(start);
-  return out;
 }
 
 }  // namespace caliber

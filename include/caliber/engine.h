@@ -1,0 +1,61 @@
+#pragma once
+/// \file
+/// The parallel engine: how a step's work is cut into tasks and scheduled on threads. Every method
+/// runs the same traversal and returns byte-identical contacts; they differ only in the task list
+/// and the schedule.
+
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include "caliber/world.h"
+
+namespace caliber {
+
+/// How a step's narrow phase is cut and scheduled.
+enum class Method : std::uint8_t {
+  sequential,    ///< one thread, the initial tasks one after another
+  exploitation,  ///< a parallel loop over the initial tasks (the paper's "parallelism exploitation")
+  stealing,      ///< recursive parallel traversal on oneTBB's work stealing, serial below a depth cut-off
+};
+
+/// "sequential", "exploitation" or "stealing".
+[[nodiscard]] std::string_view to_string(Method method);
+/// Parses a method name; throws caliber::Error on an unknown one.
+[[nodiscard]] Method parse_method(std::string_view name);
+
+/// Options of the engine.
+struct EngineOptions {
+  /// The method.
+  Method method = Method::sequential;
+  /// Worker threads (1..1024); 0 means the machine's hardware threads. `sequential` always uses one.
+  int threads = 0;
+  /// Stealing: CD-tree depth from which a subtree is traversed serially by one task.
+  int stealing_depth = 10;
+};
+
+/// Runs a world's steps with a method on a fixed number of threads (a oneTBB task arena of exactly
+/// that many). Not thread-safe itself: one step at a time.
+class Engine {
+ public:
+  /// Throws caliber::Error on a thread count outside 0..1024 or a negative stealing depth.
+  Engine(const World& world, const EngineOptions& options);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  /// Runs step k. The contacts are identical to World::step(k), whatever the method or threads.
+  [[nodiscard]] StepResult step(int k);
+  /// The number of worker threads.
+  [[nodiscard]] int threads() const;
+  /// The options in force (threads resolved).
+  [[nodiscard]] const EngineOptions& options() const { return mOptions; }
+
+ private:
+  struct Impl;
+  const World& mWorld;
+  EngineOptions mOptions;
+  std::unique_ptr<Impl> mImpl;
+};
+
+}  // namespace caliber

@@ -1,0 +1,198 @@
+// The engine: one traversal (narrow/traversal.h), several ways to cut and schedule it.
+//   sequential    the initial tasks one after another on the calling thread
+//   exploitation  tbb::parallel_for over the initial tasks, one task per pair
+//   stealing      every pair's CD tree split recursively into tbb tasks down to a depth, then
+//                 traversed depth first; oneTBB's scheduler steals the pieces
+// All of them end with the same per-pair finalization and the same reduction, so the contacts
+// do not depend on the method or the thread count.
+
+#include "caliber/engine.h"
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
+#include "caliber/error.h"
+#include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+
+namespace caliber {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
+
+/// One worker's output for a step: candidates and work per pair, and its traversal stack.
+struct WorkerSlots {
+  narrow::TraversalScratch scratch;
+  std::vector<std::vector<narrow::Candidate>> candidates;  ///< per pair
+  std::vector<QueryStats> stats;                           ///< per pair
+
+  void reset(std::size_t pairs) {
+    candidates.resize(pairs);
+    stats.assign(pairs, QueryStats{});
+    for (auto& c : candidates) c.clear();
+  }
+};
+
+using Workers = tbb::enumerable_thread_specific<WorkerSlots>;
+
+/// This thread's slots, sized for `pairs` (a thread that joins mid-step starts with empty slots).
+WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
+  WorkerSlots& w = workers.local();
+  if (w.stats.size() != pairs) w.reset(pairs);
+  return w;
+}
+
+}  // namespace
+
+std::string_view to_string(Method method) {
+  switch (method) {
+    case Method::sequential: return "sequential";
+    case Method::exploitation: return "exploitation";
+    case Method::stealing: return "stealing";
+  }
+  return "unknown";
+}
+
+Method parse_method(std::string_view name) {
+  if (name == "sequential") return Method::sequential;
+  if (name == "exploitation") return Method::exploitation;
+  if (name == "stealing") return Method::stealing;
+  throw Error(ErrorCode::bad_value, "method",
+              "unknown method '" + std::string(name) + "' (expected sequential, exploitation or stealing)");
+}
+
+struct Engine::Impl {
+  explicit Impl(int threads) : arena(threads) {}
+  tbb::task_arena arena;
+  Workers workers;
+};
+
+Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world), mOptions(options) {
+  if (mOptions.threads < 0 || mOptions.threads > 1024) {
+    throw Error(ErrorCode::bad_value, "threads", "must be between 1 and 1024 (0: one per hardware thread)");
+  }
+  if (mOptions.stealing_depth < 0) throw Error(ErrorCode::bad_value, "stealing depth", "must be >= 0");
+  if (mOptions.threads == 0) mOptions.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (mOptions.method == Method::sequential) mOptions.threads = 1;
+  mImpl = std::make_unique<Impl>(mOptions.threads);
+}
+
+Engine::~Engine() = default;
+
+int Engine::threads() const { return mOptions.threads; }
+
+namespace {
+
+/// Stealing: tests CD-tree node n of pair `pair` and, above the cut-off depth, spawns one task per
+/// child; from the cut-off down, one depth-first traversal. The node tests made are exactly those
+/// of a single depth-first traversal of the whole tree.
+void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, narrow::NodePair n, int depth, int cutoff,
+           Workers& workers) {
+  {
+    WorkerSlots& w = local_slots(workers, pairs);
+    if (depth >= cutoff) {
+      narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair]);
+      return;
+    }
+    ++w.stats[pair].node_tests;
+    if (!ctx.node_test(n.a, n.b)) return;
+    const BvhNode& a = ctx.a().nodes[n.a];
+    const BvhNode& b = ctx.b().nodes[n.b];
+    if (a.is_leaf() && b.is_leaf()) {
+      ++w.stats[pair].leaf_tests;
+      ctx.leaf_test(a.index, b.index, w.candidates[pair]);
+      return;
+    }
+  }
+  narrow::NodePair kids[4];
+  const int count = narrow::cd_children(ctx.a(), ctx.b(), n, kids);
+  tbb::task_group group;
+  for (int i = 1; i < count; ++i) {
+    const narrow::NodePair kid = kids[i];
+    group.run([&ctx, pair, pairs, kid, depth, cutoff, &workers] { steal(ctx, pair, pairs, kid, depth + 1, cutoff, workers); });
+  }
+  steal(ctx, pair, pairs, kids[0], depth + 1, cutoff, workers);
+  group.wait();
+}
+
+}  // namespace
+
+StepResult Engine::step(int k) {
+  StepResult out;
+  out.step = k;
+  out.time = k * mWorld.scene().dt;
+  auto start = Clock::now();
+  const std::vector<Pose> poses = mWorld.poses_at(k);
+  const std::vector<Task> tasks = mWorld.broad_phase(poses);
+  out.broad_ms = ms_since(start);
+
+  start = Clock::now();
+  std::vector<narrow::PairContext> contexts;
+  contexts.reserve(tasks.size());
+  for (const Task& t : tasks) {
+    contexts.emplace_back(mWorld.model(t.a), poses[t.a], mWorld.model(t.b), poses[t.b], mWorld.request());
+  }
+  std::vector<QueryResult> results(tasks.size());
+  const auto n = tasks.size();
+  auto& workers = mImpl->workers;
+  for (WorkerSlots& w : workers) w.reset(n);
+  const auto run_pair = [&](std::size_t i) {
+    WorkerSlots& w = local_slots(workers, n);
+    QueryStats stats;
+    narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], stats);
+    results[i] = narrow::finalize(contexts[i], w.candidates[i], stats);
+  };
+
+  switch (mOptions.method) {
+    case Method::sequential:
+      for (std::size_t i = 0; i < n; ++i) run_pair(i);
+      break;
+    case Method::exploitation:
+      mImpl->arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) run_pair(i);
+        });
+      });
+      break;
+    case Method::stealing: {
+      mImpl->arena.execute([&] {
+        tbb::task_group group;
+        for (std::size_t i = 0; i < n; ++i) {
+          group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers); });
+        }
+        group.wait();
+        // Per pair: every worker's candidates and counts, then the same finalization.
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::vector<narrow::Candidate> all;
+            QueryStats stats;
+            for (WorkerSlots& w : workers) {
+              if (w.stats.size() != n) continue;
+              all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
+              stats.node_tests += w.stats[i].node_tests;
+              stats.leaf_tests += w.stats[i].leaf_tests;
+            }
+            results[i] = narrow::finalize(contexts[i], all, stats);
+          }
+        });
+      });
+      break;
+    }
+  }
+  out.narrow_ms = ms_since(start);
+
+  start = Clock::now();
+  gather_step(tasks, results, out);
+  out.reduce_ms = ms_since(start);
+  return out;
+}
+
+}  // namespace caliber

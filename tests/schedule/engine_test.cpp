@@ -1,0 +1,116 @@
+// Every method, every thread count, every step: the same contacts as the sequential reference, to
+// the bit, and (for these methods, which cut the same tree) the same node tests per pair.
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "caliber/engine.h"
+#include "caliber/error.h"
+#include "caliber/procedural.h"
+#include "caliber/world.h"
+
+namespace caliber {
+namespace {
+
+void expect_same_step(const StepResult& got, const StepResult& want, const std::string& what) {
+  ASSERT_EQ(got.tasks.size(), want.tasks.size()) << what;
+  for (std::size_t i = 0; i < want.tasks.size(); ++i) {
+    ASSERT_EQ(got.tasks[i].task, want.tasks[i].task) << what;
+    EXPECT_EQ(got.tasks[i].stats.node_tests, want.tasks[i].stats.node_tests) << what << " task " << i;
+    EXPECT_EQ(got.tasks[i].stats.leaf_tests, want.tasks[i].stats.leaf_tests) << what << " task " << i;
+  }
+  ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
+  for (std::size_t i = 0; i < want.contacts.size(); ++i) {
+    const SceneContact& g = got.contacts[i];
+    const SceneContact& w = want.contacts[i];
+    ASSERT_EQ(g.object_a, w.object_a) << what;
+    ASSERT_EQ(g.object_b, w.object_b) << what;
+    ASSERT_EQ(g.contact.tri_a, w.contact.tri_a) << what;
+    ASSERT_EQ(g.contact.tri_b, w.contact.tri_b) << what;
+    ASSERT_EQ(g.contact.distance, w.contact.distance) << what;
+    ASSERT_EQ(g.contact.point_a, w.contact.point_a) << what;
+    ASSERT_EQ(g.contact.point_b, w.contact.point_b) << what;
+    ASSERT_EQ(g.contact.normal, w.contact.normal) << what;
+  }
+}
+
+/// Runs `steps` steps of the world with every method and thread count against World::step.
+void expect_all_methods_identical(const World& world, int steps) {
+  std::vector<StepResult> reference;
+  for (int k = 0; k < steps; ++k) reference.push_back(world.step(k));
+  std::size_t contacts = 0;
+  for (const auto& r : reference) contacts += r.contacts.size();
+  EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing}) {
+    for (const int threads : {1, 2, 3, 4, 8}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      options.stealing_depth = 3;  // shallow: many tasks, much stealing
+      Engine engine(world, options);
+      for (int k = 0; k < steps; ++k) {
+        expect_same_step(engine.step(k), reference[k],
+                         std::string(to_string(method)) + " x" + std::to_string(threads) + " step " + std::to_string(k));
+        if (::testing::Test::HasFatalFailure()) return;
+      }
+    }
+  }
+}
+
+class EngineScenes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() / ("caliber_engine_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    save_off(make_box(0.5, 0.5, 0.5, 3), dir / "cube.off");
+    save_off(make_sphere(0.6, 10, 14), dir / "sphere.off");
+    save_off(make_torus(0.8, 0.25, 16, 10), dir / "torus.off");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+  std::filesystem::path dir;
+};
+
+TEST_F(EngineScenes, SmallSceneEveryKind) {
+  for (const char* kind : {"interference", "proximity", "contact"}) {
+    const World world(parse_scene(std::string(R"({"steps": 6, "dt": 0.1, "query": {"kind": ")") + kind +
+                                      R"(", "tolerance": 0.1, "angle": 40}, "objects": [
+      {"name": "ring", "mesh": "torus.off", "motion": {"type": "velocity", "angular": [0, 0.5, 0]}},
+      {"name": "ball", "mesh": "sphere.off", "position": [0.9, 0, 0.3], "motion": {"type": "velocity", "linear": [-0.2, 0, -0.1]}},
+      {"name": "box", "mesh": "cube.off", "position": [-0.2, 0.8, 0], "motion": {"type": "velocity", "linear": [0.05, -0.1, 0]}},
+      {"name": "box2", "mesh": "cube.off", "position": [0.3, -0.7, 0.1], "orientation": [0.9, 0.3, 0.1, 0.2]}]})",
+                                  dir, "engine_test.json"));
+    expect_all_methods_identical(world, 6);
+  }
+}
+
+TEST(EngineRealScenes, PaperScenesFirstSteps) {
+  const std::filesystem::path scenes = CALIBER_SCENES;
+  if (!std::filesystem::exists(std::filesystem::path(CALIBER_MESH_DATA) / "dragknob.off")) {
+    GTEST_SKIP() << "run scripts/fetch_meshes.sh first";
+  }
+  for (const char* name : {"two_small.json", "funnel.json", "front_car.json"}) {
+    Scene scene = load_scene(scenes / name);
+    const World world(std::move(scene));
+    expect_all_methods_identical(world, 3);
+  }
+}
+
+TEST(EngineOptionsValidation, RejectsBadValues) {
+  const World world(parse_scene(R"({"objects": [{"mesh": "tetra.off"}]})", CALIBER_TEST_DATA, "x.json"));
+  EngineOptions options;
+  options.threads = -1;
+  EXPECT_THROW(Engine(world, options), Error);
+  options.threads = 5000;
+  EXPECT_THROW(Engine(world, options), Error);
+  options.threads = 0;
+  EXPECT_GE(Engine(world, options).threads(), 1);
+  options.method = Method::sequential;
+  options.threads = 4;
+  EXPECT_EQ(Engine(world, options).threads(), 1) << "sequential runs on one thread";
+  EXPECT_THROW((void)parse_method("calibrated"), Error);
+  EXPECT_EQ(parse_method("stealing"), Method::stealing);
+}
+
+}  // namespace
+}  // namespace caliber
