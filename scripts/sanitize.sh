@@ -14,6 +14,7 @@ if [ "$kind" = thread ]; then
   ctest --output-on-failure -j "${JOBS:-2}" -R "Engine|World|QueryOracle"
 else
   export ASAN_OPTIONS="detect_leaks=1 halt_on_error=1"
+  export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp"
   export UBSAN_OPTIONS="halt_on_error=1 print_stacktrace=1"
   ctest --output-on-failure -j "${JOBS:-2}"
 fi

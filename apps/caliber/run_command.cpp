@@ -24,6 +24,8 @@ struct RunOptions {
   std::string method = "sequential";
   int threads = 0;
   int stealing_depth = 10;
+  double beta = 2.0;
+  double epsilon = 0.25;
   int steps = -1;
   std::string json;
   std::string contacts;
@@ -37,8 +39,19 @@ nlohmann::json step_record(const StepResult& s) {
     tasks.push_back({{"a", t.task.a}, {"b", t.task.b}, {"node_tests", t.stats.node_tests},
                      {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}});
   }
+  const CalibrationRecord& c = s.calibration;
+  nlohmann::json calibration = {{"omega", c.omega},
+                                {"kept", c.kept},
+                                {"split", c.split},
+                                {"carted", c.carted},
+                                {"generated", c.generated},
+                                {"stage_node_tests", c.stage_node_tests},
+                                {"queue_peak", c.queue_peak},
+                                {"task_node_tests", c.task_node_tests},
+                                {"task_weights", c.task_weights}};
   return {{"step", s.step},
           {"time", s.time},
+          {"calibration", calibration},
           {"broad_ms", s.broad_ms},
           {"narrow_ms", s.narrow_ms},
           {"reduce_ms", s.reduce_ms},
@@ -79,6 +92,8 @@ int run_scene(const RunOptions& opt) {
   engine_options.method = parse_method(opt.method);
   engine_options.threads = opt.threads;
   engine_options.stealing_depth = opt.stealing_depth;
+  engine_options.beta = opt.beta;
+  engine_options.epsilon = opt.epsilon;
   Engine engine(world, engine_options);
   const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count();
   const Scene& sc = world.scene();
@@ -161,7 +176,10 @@ Runner add_run_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene over its time steps");
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--steps", opt->steps, "Run this many steps instead of the scene's");
-  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing")->capture_default_str();
+  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | apriori | hybrid")->capture_default_str();
+  cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
+      ->capture_default_str();
+  cmd->add_option("--epsilon", opt->epsilon, "Calibration: tolerance on Omega, as a fraction of Omega")->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();
   cmd->add_option("--stealing-depth", opt->stealing_depth, "Stealing: CD-tree depth below which a subtree runs serially")
       ->capture_default_str();

@@ -11,15 +11,20 @@
 #include "caliber/world.h"
 
 namespace caliber {
+namespace narrow {
+class PairContext;
+}
 
 /// How a step's narrow phase is cut and scheduled.
 enum class Method : std::uint8_t {
   sequential,    ///< one thread, the initial tasks one after another
   exploitation,  ///< a parallel loop over the initial tasks (the paper's "parallelism exploitation")
   stealing,      ///< recursive parallel traversal on oneTBB's work stealing, serial below a depth cut-off
+  apriori,       ///< task calibration with geometric weights (the weight-driven stage splits heavy pairs)
+  hybrid,        ///< task calibration with geometric weights rescaled by the previous step's node tests
 };
 
-/// "sequential", "exploitation" or "stealing".
+/// "sequential", "exploitation", "stealing", "apriori" or "hybrid".
 [[nodiscard]] std::string_view to_string(Method method);
 /// Parses a method name; throws caliber::Error on an unknown one.
 [[nodiscard]] Method parse_method(std::string_view name);
@@ -32,6 +37,10 @@ struct EngineOptions {
   int threads = 0;
   /// Stealing: CD-tree depth from which a subtree is traversed serially by one task.
   int stealing_depth = 10;
+  /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
+  double beta = 2.0;
+  /// Calibration: tolerance on Omega, as a fraction of Omega (>= 0).
+  double epsilon = 0.25;
 };
 
 /// Runs a world's steps with a method on a fixed number of threads (a oneTBB task arena of exactly
@@ -53,6 +62,8 @@ class Engine {
 
  private:
   struct Impl;
+  void run_calibrated(const std::vector<Task>& tasks, const std::vector<narrow::PairContext>& contexts,
+                      std::vector<QueryResult>& results, CalibrationRecord& record);
   const World& mWorld;
   EngineOptions mOptions;
   std::unique_ptr<Impl> mImpl;

@@ -38,6 +38,19 @@ struct TaskRecord {
   std::size_t pairs = 0;  ///< triangle pairs reported
 };
 
+/// How the engine cut a step's work (calibrated methods; zero otherwise).
+struct CalibrationRecord {
+  double omega = 0.0;                          ///< the caliber Omega (in weight units)
+  std::size_t kept = 0;                        ///< initial tasks run as they are
+  std::size_t split = 0;                       ///< initial tasks split by the weight-driven stage
+  std::size_t carted = 0;                      ///< items merged in the cart (light tasks and light nodes)
+  std::size_t generated = 0;                   ///< run-time tasks
+  std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
+  std::size_t queue_peak = 0;                  ///< longest priority queue of the weight-driven stage
+  std::vector<std::uint64_t> task_node_tests;  ///< node tests of each run-time task
+  std::vector<double> task_weights;            ///< estimated weight of each run-time task
+};
+
 /// Everything one step produced.
 struct StepResult {
   int step = 0;                         ///< step index
@@ -48,6 +61,7 @@ struct StepResult {
   std::vector<TaskRecord> tasks;        ///< one per initial task, in task order
   std::vector<SceneContact> contacts;   ///< sorted by (object a, object b, tri a, tri b)
   QueryStats stats;                     ///< totals over the tasks
+  CalibrationRecord calibration;        ///< how the work was cut (calibrated methods)
 };
 
 /// The reduction of a step: per-task records and the contacts of every task, in task order (tasks

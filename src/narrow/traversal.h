@@ -48,13 +48,14 @@ struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
 };
 
-/// Depth-first traversal of the CD subtree rooted at `root`: tests root and every node below it
-/// whose parent passed; runs the leaf test on passing leaf pairs; appends the kept pairs to `out`
-/// and counts the work in `stats` (every node test, every leaf test).
+/// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
+/// was tested, and passed, earlier) and every node below it whose parent passed; runs the leaf
+/// test on passing leaf pairs; appends the kept pairs to `out` and counts the work in `stats`
+/// (every node test, every leaf test).
 /// Children are tested when their parent is expanded, so each child node of A and of B is
 /// prepared once for the (up to) four pairs it takes part in; only passing children are pushed.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
-                                 std::vector<Candidate>& out, QueryStats& stats) {
+                                 std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false) {
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
   // Each expansion pops one node and pushes at most four, one level deeper: the stack never holds
@@ -64,8 +65,8 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   if (stack.size() < bound) stack.resize(bound);
   NodePair* const base = stack.data();
   NodePair* top = base;
-  std::uint64_t node_tests = 1, leaf_tests = 0;
-  if (ctx.node_test(root.a, root.b)) *top++ = root;
+  std::uint64_t node_tests = root_tested ? 0 : 1, leaf_tests = 0;
+  if (root_tested || ctx.node_test(root.a, root.b)) *top++ = root;
   while (top != base) {
     const NodePair n = *--top;
     const BvhNode& a = ma.nodes[n.a];

@@ -8,7 +8,10 @@
 
 #include "caliber/engine.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <map>
 #include <string>
 #include <thread>
 
@@ -20,6 +23,8 @@
 #include "caliber/error.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
+#include "tasks/calibration.h"
+#include "tasks/weights.h"
 
 namespace caliber {
 namespace {
@@ -57,6 +62,8 @@ std::string_view to_string(Method method) {
     case Method::sequential: return "sequential";
     case Method::exploitation: return "exploitation";
     case Method::stealing: return "stealing";
+    case Method::apriori: return "apriori";
+    case Method::hybrid: return "hybrid";
   }
   return "unknown";
 }
@@ -65,14 +72,18 @@ Method parse_method(std::string_view name) {
   if (name == "sequential") return Method::sequential;
   if (name == "exploitation") return Method::exploitation;
   if (name == "stealing") return Method::stealing;
+  if (name == "apriori") return Method::apriori;
+  if (name == "hybrid") return Method::hybrid;
   throw Error(ErrorCode::bad_value, "method",
-              "unknown method '" + std::string(name) + "' (expected sequential, exploitation or stealing)");
+              "unknown method '" + std::string(name) + "' (expected sequential, exploitation, stealing, apriori or hybrid)");
 }
 
 struct Engine::Impl {
   explicit Impl(int threads) : arena(threads) {}
   tbb::task_arena arena;
   Workers workers;
+  /// Temporal state: node tests of each object pair at its last step. Changes only how work is cut.
+  std::map<Task, std::uint64_t> history;
 };
 
 Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world), mOptions(options) {
@@ -80,6 +91,10 @@ Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world)
     throw Error(ErrorCode::bad_value, "threads", "must be between 1 and 1024 (0: one per hardware thread)");
   }
   if (mOptions.stealing_depth < 0) throw Error(ErrorCode::bad_value, "stealing depth", "must be >= 0");
+  if (!(mOptions.beta > 0.0) || !std::isfinite(mOptions.beta)) throw Error(ErrorCode::bad_value, "beta", "must be a finite number > 0");
+  if (!(mOptions.epsilon >= 0.0) || !std::isfinite(mOptions.epsilon)) {
+    throw Error(ErrorCode::bad_value, "epsilon", "must be a finite number >= 0");
+  }
   if (mOptions.threads == 0) mOptions.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   if (mOptions.method == Method::sequential) mOptions.threads = 1;
   mImpl = std::make_unique<Impl>(mOptions.threads);
@@ -124,6 +139,112 @@ void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, 
 }
 
 }  // namespace
+
+void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<narrow::PairContext>& contexts,
+                            std::vector<QueryResult>& results, CalibrationRecord& record) {
+  const std::size_t n = tasks.size();
+  const int threads = mOptions.threads;
+  auto& workers = mImpl->workers;
+  for (WorkerSlots& w : workers) w.reset(n);
+
+  // 1. Weights of the initial tasks. A priori: the root's geometric estimate. Hybrid: the pair's node
+  //    tests at the previous step, and node weights rescaled by N(t-1) / w~root(t); a pair with no
+  //    history is rescaled by the ratio measured over the pairs that have one (1 if none has).
+  std::vector<double> root(n), weight(n), scale(n, 1.0);
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { root[i] = tasks::apriori_weight(contexts[i], {0, 0}); });
+  if (mOptions.method == Method::hybrid) {
+    double measured = 0.0, estimated = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto it = mImpl->history.find(tasks[i]);
+      if (it != mImpl->history.end() && it->second > 0) {
+        measured += static_cast<double>(it->second);
+        estimated += root[i];
+      }
+    }
+    const double fallback = estimated > 0.0 ? measured / estimated : 1.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto it = mImpl->history.find(tasks[i]);
+      scale[i] = (it != mImpl->history.end() && it->second > 0) ? static_cast<double>(it->second) / root[i] : fallback;
+    }
+  }
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    weight[i] = scale[i] * root[i];
+    total += weight[i];
+  }
+  const double omega = tasks::caliber_threshold(total, mOptions.beta, threads);
+  const double eps = mOptions.epsilon * omega;
+  record.omega = omega;
+
+  // 2. Keep, split or cart each initial task; the weight-driven stage of the split ones in parallel.
+  std::vector<tasks::RunTask> run;
+  std::vector<tasks::Root> cart;
+  std::vector<std::size_t> to_split;
+  for (std::size_t i = 0; i < n; ++i) {
+    const tasks::Root whole{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, weight[i]};
+    switch (tasks::classify(weight[i], omega, eps)) {
+      case tasks::Verdict::keep: run.push_back(tasks::RunTask{{whole}, weight[i]}); ++record.kept; break;
+      case tasks::Verdict::cart: cart.push_back(whole); break;
+      case tasks::Verdict::split: to_split.push_back(i); break;
+    }
+  }
+  record.split = to_split.size();
+  std::vector<tasks::SplitResult> splits(to_split.size());
+  tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
+    const std::size_t i = to_split[s];
+    splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps);
+  });
+  for (tasks::SplitResult& s : splits) {
+    for (const tasks::Root& r : s.roots) run.push_back(tasks::RunTask{{r}, r.weight});
+    cart.insert(cart.end(), s.cart.begin(), s.cart.end());
+    record.stage_node_tests += s.stats.node_tests;
+    record.queue_peak = std::max(record.queue_peak, s.queue_peak);
+  }
+  record.carted = cart.size();
+  for (tasks::RunTask& t : tasks::merge_cart(std::move(cart), omega)) run.push_back(std::move(t));
+  // Heaviest first, so that the parallel loop does not end on a heavy straggler.
+  std::stable_sort(run.begin(), run.end(), [](const tasks::RunTask& x, const tasks::RunTask& y) { return x.weight > y.weight; });
+  record.generated = run.size();
+
+  // 3. Every run-time task depth first, by one thread; then per pair, the same finalization.
+  record.task_node_tests.assign(run.size(), 0);
+  record.task_weights.resize(run.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, run.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+      WorkerSlots& w = local_slots(workers, n);
+      std::uint64_t tests = 0;
+      for (const tasks::Root& root_ref : run[t].roots) {
+        QueryStats& stats = w.stats[root_ref.pair];
+        const std::uint64_t before = stats.node_tests;
+        narrow::traverse_depth_first(contexts[root_ref.pair], root_ref.node, w.scratch, w.candidates[root_ref.pair], stats,
+                                     root_ref.tested);
+        tests += stats.node_tests - before;
+      }
+      record.task_node_tests[t] = tests;
+      record.task_weights[t] = run[t].weight;
+    }
+  });
+  std::vector<std::size_t> split_of(n, SIZE_MAX);
+  for (std::size_t s = 0; s < to_split.size(); ++s) split_of[to_split[s]] = s;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      std::vector<narrow::Candidate> all;
+      QueryStats stats;
+      if (split_of[i] != SIZE_MAX) {
+        const tasks::SplitResult& s = splits[split_of[i]];
+        all = s.candidates;
+        stats = s.stats;
+      }
+      for (WorkerSlots& w : workers) {
+        if (w.stats.size() != n) continue;
+        all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
+        stats.node_tests += w.stats[i].node_tests;
+        stats.leaf_tests += w.stats[i].leaf_tests;
+      }
+      results[i] = narrow::finalize(contexts[i], all, stats);
+    }
+  });
+}
 
 StepResult Engine::step(int k) {
   StepResult out;
@@ -186,7 +307,12 @@ StepResult Engine::step(int k) {
       });
       break;
     }
+    case Method::apriori:
+    case Method::hybrid:
+      mImpl->arena.execute([&] { run_calibrated(tasks, contexts, results, out.calibration); });
+      break;
   }
+  for (std::size_t i = 0; i < n; ++i) mImpl->history[tasks[i]] = results[i].stats.node_tests;
   out.narrow_ms = ms_since(start);
 
   start = Clock::now();

@@ -42,7 +42,7 @@ void expect_all_methods_identical(const World& world, int steps) {
   std::size_t contacts = 0;
   for (const auto& r : reference) contacts += r.contacts.size();
   EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing}) {
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::apriori, Method::hybrid}) {
     for (const int threads : {1, 2, 3, 4, 8}) {
       EngineOptions options;
       options.method = method;
@@ -50,9 +50,18 @@ void expect_all_methods_identical(const World& world, int steps) {
       options.stealing_depth = 3;  // shallow: many tasks, much stealing
       Engine engine(world, options);
       for (int k = 0; k < steps; ++k) {
-        expect_same_step(engine.step(k), reference[k],
-                         std::string(to_string(method)) + " x" + std::to_string(threads) + " step " + std::to_string(k));
+        const StepResult got = engine.step(k);
+        const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads) + " step " + std::to_string(k);
+        expect_same_step(got, reference[k], what);
         if (::testing::Test::HasFatalFailure()) return;
+        if (method == Method::apriori || method == Method::hybrid) {
+          // Conservation: the weight-driven stage and the run-time tasks test every node once.
+          std::uint64_t cut = got.calibration.stage_node_tests;
+          for (const std::uint64_t t : got.calibration.task_node_tests) cut += t;
+          EXPECT_EQ(cut, reference[k].stats.node_tests) << what;
+          for (const std::uint64_t t : got.calibration.task_node_tests) EXPECT_GT(t, 0u) << what << ": an empty run-time task";
+          EXPECT_EQ(got.calibration.generated, got.calibration.task_node_tests.size()) << what;
+        }
       }
     }
   }
@@ -96,6 +105,34 @@ TEST(EngineRealScenes, PaperScenesFirstSteps) {
   }
 }
 
+TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
+  // 25 tetrahedra (4 triangles each) crowded together: 300 candidate pairs, all light.
+  const std::string tetra = (std::filesystem::path(CALIBER_TEST_DATA) / "tetra.off").string();
+  std::string json = R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [)";
+  for (int i = 0; i < 25; ++i) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf, R"(%s{"name": "t%d", "mesh": "%s", "position": [%g, %g, 0], "motion": {"type": "velocity"}})",
+                  i ? "," : "", i, tetra.c_str(), 0.03 * (i % 5), 0.03 * (i / 5));
+    json += buf;
+  }
+  json += "]}";
+  const World crowd(parse_scene(json, dir, "crowd.json"));
+  EXPECT_EQ(crowd.broad_phase(crowd.poses_at(0)).size(), 300u);
+  expect_all_methods_identical(crowd, 1);
+  const World single(parse_scene(R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}}]})",
+                                 dir, "single.json"));
+  expect_all_methods_identical(single, 2);
+  // One heavy pair on two threads is split: more than one run-time task.
+  EngineOptions options;
+  options.method = Method::apriori;
+  options.threads = 2;
+  Engine engine(single, options);
+  const StepResult s = engine.step(0);
+  EXPECT_EQ(s.calibration.split, 1u);
+  EXPECT_GT(s.calibration.generated, 1u);
+}
+
 TEST(EngineOptionsValidation, RejectsBadValues) {
   const World world(parse_scene(R"({"objects": [{"mesh": "tetra.off"}]})", CALIBER_TEST_DATA, "x.json"));
   EngineOptions options;
@@ -108,6 +145,12 @@ TEST(EngineOptionsValidation, RejectsBadValues) {
   options.method = Method::sequential;
   options.threads = 4;
   EXPECT_EQ(Engine(world, options).threads(), 1) << "sequential runs on one thread";
+  options.method = Method::hybrid;
+  options.beta = 0;
+  EXPECT_THROW(Engine(world, options), Error);
+  options.beta = 2;
+  options.epsilon = -0.1;
+  EXPECT_THROW(Engine(world, options), Error);
   EXPECT_THROW((void)parse_method("calibrated"), Error);
   EXPECT_EQ(parse_method("stealing"), Method::stealing);
 }

@@ -1,0 +1,62 @@
+// Calibration rules in isolation: Omega, keep / split / cart at the epsilon boundaries, cart merging.
+
+#include <gtest/gtest.h>
+
+#include "tasks/calibration.h"
+
+namespace caliber::tasks {
+namespace {
+
+Root item(std::uint32_t pair, double weight) { return Root{pair, narrow::NodePair{0, 0}, false, weight}; }
+
+TEST(Calibration, ThresholdIsTotalOverBetaThreads) {
+  EXPECT_DOUBLE_EQ(caliber_threshold(1200.0, 2.0, 4), 150.0);
+  EXPECT_DOUBLE_EQ(caliber_threshold(1200.0, 1.0, 1), 1200.0);
+  EXPECT_GT(caliber_threshold(0.0, 2.0, 4), 0.0) << "a step without work still has a positive caliber";
+}
+
+TEST(Calibration, ClassifyAtTheEpsilonBoundaries) {
+  EXPECT_EQ(classify(100.0, 100.0, 10.0), Verdict::keep);
+  EXPECT_EQ(classify(110.0, 100.0, 10.0), Verdict::keep) << "Omega + eps is kept";
+  EXPECT_EQ(classify(90.0, 100.0, 10.0), Verdict::keep) << "Omega - eps is kept";
+  EXPECT_EQ(classify(110.000001, 100.0, 10.0), Verdict::split);
+  EXPECT_EQ(classify(89.999999, 100.0, 10.0), Verdict::cart);
+  EXPECT_EQ(classify(100.0, 100.0, 0.0), Verdict::keep);
+}
+
+TEST(Calibration, CartMergesHeaviestWithLightestUntilOmega) {
+  // Omega 10: 9 takes 1 (=10); 8 takes 1, 2 (=11); 7 takes 3 (=10); 6 alone is left with nothing? No:
+  // 6 takes 4 (=10); 5 is last and alone.
+  std::vector<Root> cart = {item(0, 5), item(1, 1), item(2, 9), item(3, 2), item(4, 8), item(5, 1),
+                            item(6, 7), item(7, 3), item(8, 6), item(9, 4)};
+  const std::vector<RunTask> tasks = merge_cart(cart, 10.0);
+  ASSERT_EQ(tasks.size(), 5u);
+  const std::vector<std::vector<double>> want = {{9, 1}, {8, 1, 2}, {7, 3}, {6, 4}, {5}};
+  for (std::size_t t = 0; t < tasks.size(); ++t) {
+    std::vector<double> got;
+    for (const Root& r : tasks[t].roots) got.push_back(r.weight);
+    EXPECT_EQ(got, want[t]) << "task " << t;
+  }
+  std::size_t roots = 0;
+  for (const RunTask& t : tasks) {
+    EXPECT_FALSE(t.roots.empty());
+    roots += t.roots.size();
+  }
+  EXPECT_EQ(roots, cart.size()) << "every item in exactly one task";
+}
+
+TEST(Calibration, CartEdgeCases) {
+  EXPECT_TRUE(merge_cart({}, 10.0).empty());
+  const auto one = merge_cart({item(0, 3)}, 10.0);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].roots.size(), 1u);
+  // 300 tiny items of weight 1 with Omega 25: 12 tasks of 25 (the heaviest-first rule, all equal).
+  std::vector<Root> tiny;
+  for (std::uint32_t i = 0; i < 300; ++i) tiny.push_back(item(i, 1.0));
+  const auto tasks = merge_cart(tiny, 25.0);
+  EXPECT_EQ(tasks.size(), 12u);
+  for (const RunTask& t : tasks) EXPECT_EQ(t.weight, 25.0);
+}
+
+}  // namespace
+}  // namespace caliber::tasks
