@@ -55,6 +55,28 @@ WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
   return w;
 }
 
+/// Per pair, in parallel: `start` seeds the pair's candidates and counts (work done outside the
+/// workers' slots), every worker's slots are added, and the pair goes through the one finalization.
+template <class Start>
+void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& workers, std::vector<QueryResult>& results,
+                    Start start) {
+  const std::size_t n = contexts.size();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      std::vector<narrow::Candidate> all;
+      QueryStats stats;
+      start(i, all, stats);
+      for (WorkerSlots& w : workers) {
+        if (w.stats.size() != n) continue;
+        all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
+        stats.node_tests += w.stats[i].node_tests;
+        stats.leaf_tests += w.stats[i].leaf_tests;
+      }
+      results[i] = narrow::finalize(contexts[i], all, stats);
+    }
+  });
+}
+
 }  // namespace
 
 std::string_view to_string(Method method) {
@@ -226,23 +248,11 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   });
   std::vector<std::size_t> split_of(n, SIZE_MAX);
   for (std::size_t s = 0; s < to_split.size(); ++s) split_of[to_split[s]] = s;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      std::vector<narrow::Candidate> all;
-      QueryStats stats;
-      if (split_of[i] != SIZE_MAX) {
-        const tasks::SplitResult& s = splits[split_of[i]];
-        all = s.candidates;
-        stats = s.stats;
-      }
-      for (WorkerSlots& w : workers) {
-        if (w.stats.size() != n) continue;
-        all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
-        stats.node_tests += w.stats[i].node_tests;
-        stats.leaf_tests += w.stats[i].leaf_tests;
-      }
-      results[i] = narrow::finalize(contexts[i], all, stats);
-    }
+  finalize_pairs(contexts, workers, results, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
+    if (split_of[i] == SIZE_MAX) return;
+    const tasks::SplitResult& s = splits[split_of[i]];
+    all = s.candidates;
+    stats = s.stats;
   });
 }
 
@@ -290,20 +300,7 @@ StepResult Engine::step(int k) {
           group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers); });
         }
         group.wait();
-        // Per pair: every worker's candidates and counts, then the same finalization.
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            std::vector<narrow::Candidate> all;
-            QueryStats stats;
-            for (WorkerSlots& w : workers) {
-              if (w.stats.size() != n) continue;
-              all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
-              stats.node_tests += w.stats[i].node_tests;
-              stats.leaf_tests += w.stats[i].leaf_tests;
-            }
-            results[i] = narrow::finalize(contexts[i], all, stats);
-          }
-        });
+        finalize_pairs(contexts, workers, results, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
       });
       break;
     }
