@@ -26,6 +26,7 @@ struct RunOptions {
   int stealing_depth = 10;
   double beta = 2.0;
   double epsilon = 0.25;
+  std::vector<int> simulate = {2, 4, 8, 16, 32, 64};
   int steps = -1;
   std::string json;
   std::string contacts;
@@ -39,13 +40,15 @@ nlohmann::json step_record(const StepResult& s) {
     tasks.push_back({{"a", t.task.a}, {"b", t.task.b}, {"node_tests", t.stats.node_tests},
                      {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}});
   }
-  const CalibrationRecord& c = s.calibration;
+  const ScheduleRecord& c = s.schedule;
   nlohmann::json calibration = {{"omega", c.omega},
                                 {"kept", c.kept},
                                 {"split", c.split},
                                 {"carted", c.carted},
                                 {"generated", c.generated},
                                 {"stage_node_tests", c.stage_node_tests},
+                                {"stage_task_node_tests", c.stage_task_node_tests},
+                                {"split_node_tests", c.split_node_tests},
                                 {"queue_peak", c.queue_peak},
                                 {"task_node_tests", c.task_node_tests},
                                 {"task_weights", c.task_weights}};
@@ -111,10 +114,20 @@ int run_scene(const RunOptions& opt) {
   }
   nlohmann::json steps = nlohmann::json::array();
   RunStats stats;
+  for (const int p : opt.simulate) {
+    if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
+  }
+  // Load-balance simulation, over the whole run: total node tests / total simulated makespan.
+  std::vector<double> simulated_time(opt.simulate.size(), 0.0);
+  double simulated_work = 0.0;
   const Progress progress(static_cast<std::size_t>(sc.steps));
   for (int k = 0; k < sc.steps; ++k) {
     const StepResult s = engine.step(k);
     stats.add(s);
+    simulated_work += static_cast<double>(s.stats.node_tests);
+    for (std::size_t p = 0; p < opt.simulate.size(); ++p) {
+      simulated_time[p] += static_cast<double>(s.stats.node_tests) / simulated_speedup(s, engine.options().method, opt.simulate[p]);
+    }
     if (!opt.json.empty()) steps.push_back(step_record(s));
     if (contacts_out) *contacts_out << contacts_line(world, s).dump() << '\n';
     char line[256];
@@ -138,6 +151,17 @@ int run_scene(const RunOptions& opt) {
   if (stats.candidate_pairs() > 1) {
     std::printf("  second heaviest    %s: %.1f %% of node tests\n", pair_name(world, second).c_str(), 100.0 * second_share);
   }
+  nlohmann::json simulated = nlohmann::json::object();
+  if (!opt.simulate.empty()) {
+    std::printf("  simulated speed-up (%s; node tests, list scheduling on P virtual cores):\n   ",
+                std::string(to_string(engine.options().method)).c_str());
+    for (std::size_t p = 0; p < opt.simulate.size(); ++p) {
+      const double speedup = simulated_time[p] > 0.0 ? simulated_work / simulated_time[p] : 1.0;
+      std::printf(" P=%d: %.2fx", opt.simulate[p], speedup);
+      simulated[std::to_string(opt.simulate[p])] = speedup;
+    }
+    std::printf("\n");
+  }
 
   if (!opt.json.empty()) {
     nlohmann::json report = {
@@ -159,7 +183,8 @@ int run_scene(const RunOptions& opt) {
           {"candidate_pairs", stats.candidate_pairs()},
           {"steps_with_contacts", stats.steps_with_contacts()},
           {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
-          {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}}}},
+          {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
+          {"simulated_speedup", simulated}}},
         {"steps", steps}};
     std::ofstream out(opt.json);
     if (!out) throw Error(ErrorCode::unreadable, opt.json, "cannot be opened for writing");
@@ -180,6 +205,9 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
       ->capture_default_str();
   cmd->add_option("--epsilon", opt->epsilon, "Calibration: tolerance on Omega, as a fraction of Omega")->capture_default_str();
+  cmd->add_option("--simulate-cores", opt->simulate, "Virtual core counts for the load-balance simulation")
+      ->delimiter(',')
+      ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();
   cmd->add_option("--stealing-depth", opt->stealing_depth, "Stealing: CD-tree depth below which a subtree runs serially")
       ->capture_default_str();

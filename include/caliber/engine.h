@@ -43,6 +43,17 @@ struct EngineOptions {
   double epsilon = 0.25;
 };
 
+/// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded
+/// of `cores` virtual cores (the policy of a dynamic parallel loop with grain 1).
+[[nodiscard]] double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores);
+
+/// The load-balance simulation: the speed-up on `cores` virtual cores that the step's recorded
+/// work units predict for `method` (total node tests / simulated makespan). Calibrated methods: the
+/// weight-driven stage, then a barrier, then the run-time tasks in handout order. Exploitation: the
+/// pairs in order. Stealing: its depth-first pieces, largest first, plus the splitting work spread
+/// evenly (an optimistic model of stealing). Sequential: 1.
+[[nodiscard]] double simulated_speedup(const StepResult& step, Method method, int cores);
+
 /// Runs a world's steps with a method on a fixed number of threads (a oneTBB task arena of exactly
 /// that many). Not thread-safe itself: one step at a time.
 class Engine {
@@ -63,7 +74,7 @@ class Engine {
  private:
   struct Impl;
   void run_calibrated(const std::vector<Task>& tasks, const std::vector<narrow::PairContext>& contexts,
-                      std::vector<QueryResult>& results, CalibrationRecord& record);
+                      std::vector<QueryResult>& results, ScheduleRecord& record);
   const World& mWorld;
   EngineOptions mOptions;
   std::unique_ptr<Impl> mImpl;

@@ -38,8 +38,9 @@ struct TaskRecord {
   std::size_t pairs = 0;  ///< triangle pairs reported
 };
 
-/// How the engine cut a step's work (calibrated methods; zero otherwise).
-struct CalibrationRecord {
+/// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
+/// that do not calibrate; `task_node_tests` is filled by every engine method.
+struct ScheduleRecord {
   double omega = 0.0;                          ///< the caliber Omega (in weight units)
   std::size_t kept = 0;                        ///< initial tasks run as they are
   std::size_t split = 0;                       ///< initial tasks split by the weight-driven stage
@@ -47,8 +48,13 @@ struct CalibrationRecord {
   std::size_t generated = 0;                   ///< run-time tasks
   std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
   std::size_t queue_peak = 0;                  ///< longest priority queue of the weight-driven stage
-  std::vector<std::uint64_t> task_node_tests;  ///< node tests of each run-time task
-  std::vector<double> task_weights;            ///< estimated weight of each run-time task
+  std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
+  /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
+  /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
+  /// cut-off and the single node tests above it (stealing). The load-balance simulation replays them.
+  std::vector<std::uint64_t> task_node_tests;
+  std::vector<double> task_weights;            ///< estimated weight of each run-time task (calibrated methods)
+  std::uint64_t split_node_tests = 0;          ///< stealing: node tests made above the cut-off, while splitting
 };
 
 /// Everything one step produced.
@@ -61,7 +67,7 @@ struct StepResult {
   std::vector<TaskRecord> tasks;        ///< one per initial task, in task order
   std::vector<SceneContact> contacts;   ///< sorted by (object a, object b, tri a, tri b)
   QueryStats stats;                     ///< totals over the tasks
-  CalibrationRecord calibration;        ///< how the work was cut (calibrated methods)
+  ScheduleRecord schedule;              ///< how the work was cut and scheduled
 };
 
 /// The reduction of a step: per-task records and the contacts of every task, in task order (tasks

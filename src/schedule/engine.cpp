@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <queue>
 #include <string>
 #include <thread>
 
@@ -38,11 +40,15 @@ struct WorkerSlots {
   narrow::TraversalScratch scratch;
   std::vector<std::vector<narrow::Candidate>> candidates;  ///< per pair
   std::vector<QueryStats> stats;                           ///< per pair
+  std::vector<std::uint64_t> pieces;                       ///< stealing: node tests of each depth-first piece
+  std::uint64_t split_node_tests = 0;                      ///< stealing: node tests above the cut-off
 
   void reset(std::size_t pairs) {
     candidates.resize(pairs);
     stats.assign(pairs, QueryStats{});
     for (auto& c : candidates) c.clear();
+    pieces.clear();
+    split_node_tests = 0;
   }
 };
 
@@ -136,10 +142,13 @@ void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, 
   {
     WorkerSlots& w = local_slots(workers, pairs);
     if (depth >= cutoff) {
+      const std::uint64_t before = w.stats[pair].node_tests;
       narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair]);
+      w.pieces.push_back(w.stats[pair].node_tests - before);
       return;
     }
     ++w.stats[pair].node_tests;
+    ++w.split_node_tests;
     if (!ctx.node_test(n.a, n.b)) return;
     const BvhNode& a = ctx.a().nodes[n.a];
     const BvhNode& b = ctx.b().nodes[n.b];
@@ -163,7 +172,7 @@ void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, 
 }  // namespace
 
 void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<narrow::PairContext>& contexts,
-                            std::vector<QueryResult>& results, CalibrationRecord& record) {
+                            std::vector<QueryResult>& results, ScheduleRecord& record) {
   const std::size_t n = tasks.size();
   const int threads = mOptions.threads;
   auto& workers = mImpl->workers;
@@ -220,6 +229,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     for (const tasks::Root& r : s.roots) run.push_back(tasks::RunTask{{r}, r.weight});
     cart.insert(cart.end(), s.cart.begin(), s.cart.end());
     record.stage_node_tests += s.stats.node_tests;
+    record.stage_task_node_tests.push_back(s.stats.node_tests);
     record.queue_peak = std::max(record.queue_peak, s.queue_peak);
   }
   record.carted = cart.size();
@@ -254,6 +264,39 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     all = s.candidates;
     stats = s.stats;
   });
+}
+
+double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores) {
+  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+  std::priority_queue<double, std::vector<double>, std::greater<>> loads;
+  for (int c = 0; c < cores; ++c) loads.push(0.0);
+  double makespan = 0.0;
+  for (const std::uint64_t cost : costs) {
+    const double load = loads.top() + static_cast<double>(cost);
+    loads.pop();
+    loads.push(load);
+    makespan = std::max(makespan, load);
+  }
+  return makespan;
+}
+
+double simulated_speedup(const StepResult& step, Method method, int cores) {
+  const ScheduleRecord& r = step.schedule;
+  const double total = static_cast<double>(step.stats.node_tests);
+  if (total <= 0.0 || method == Method::sequential) return 1.0;
+  double makespan = 0.0;
+  switch (method) {
+    case Method::sequential: return 1.0;
+    case Method::exploitation: makespan = list_schedule_makespan(r.task_node_tests, cores); break;
+    case Method::stealing:
+      makespan = list_schedule_makespan(r.task_node_tests, cores) + static_cast<double>(r.split_node_tests) / cores;
+      break;
+    case Method::apriori:
+    case Method::hybrid:
+      makespan = list_schedule_makespan(r.stage_task_node_tests, cores) + list_schedule_makespan(r.task_node_tests, cores);
+      break;
+  }
+  return makespan > 0.0 ? total / makespan : 1.0;
 }
 
 StepResult Engine::step(int k) {
@@ -301,13 +344,22 @@ StepResult Engine::step(int k) {
         }
         group.wait();
         finalize_pairs(contexts, workers, results, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
+        for (WorkerSlots& w : workers) {
+          out.schedule.task_node_tests.insert(out.schedule.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
+          out.schedule.split_node_tests += w.split_node_tests;
+        }
+        // Pieces were collected per worker; sort them so the record does not depend on who ran what.
+        std::sort(out.schedule.task_node_tests.begin(), out.schedule.task_node_tests.end(), std::greater<>());
       });
       break;
     }
     case Method::apriori:
     case Method::hybrid:
-      mImpl->arena.execute([&] { run_calibrated(tasks, contexts, results, out.calibration); });
+      mImpl->arena.execute([&] { run_calibrated(tasks, contexts, results, out.schedule); });
       break;
+  }
+  if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
+    for (const QueryResult& r : results) out.schedule.task_node_tests.push_back(r.stats.node_tests);
   }
   for (std::size_t i = 0; i < n; ++i) mImpl->history[tasks[i]] = results[i].stats.node_tests;
   out.narrow_ms = ms_since(start);

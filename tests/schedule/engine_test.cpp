@@ -54,13 +54,17 @@ void expect_all_methods_identical(const World& world, int steps) {
         const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads) + " step " + std::to_string(k);
         expect_same_step(got, reference[k], what);
         if (::testing::Test::HasFatalFailure()) return;
+        std::uint64_t units = got.schedule.split_node_tests;
+        for (const std::uint64_t t : got.schedule.task_node_tests) units += t;
+        for (const std::uint64_t t : got.schedule.stage_task_node_tests) units += t;
+        EXPECT_EQ(units, reference[k].stats.node_tests) << what << ": the recorded work units must add up";
         if (method == Method::apriori || method == Method::hybrid) {
           // Conservation: the weight-driven stage and the run-time tasks test every node once.
-          std::uint64_t cut = got.calibration.stage_node_tests;
-          for (const std::uint64_t t : got.calibration.task_node_tests) cut += t;
+          std::uint64_t cut = got.schedule.stage_node_tests;
+          for (const std::uint64_t t : got.schedule.task_node_tests) cut += t;
           EXPECT_EQ(cut, reference[k].stats.node_tests) << what;
-          for (const std::uint64_t t : got.calibration.task_node_tests) EXPECT_GT(t, 0u) << what << ": an empty run-time task";
-          EXPECT_EQ(got.calibration.generated, got.calibration.task_node_tests.size()) << what;
+          for (const std::uint64_t t : got.schedule.task_node_tests) EXPECT_GT(t, 0u) << what << ": an empty run-time task";
+          EXPECT_EQ(got.schedule.generated, got.schedule.task_node_tests.size()) << what;
         }
       }
     }
@@ -129,8 +133,24 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
   options.threads = 2;
   Engine engine(single, options);
   const StepResult s = engine.step(0);
-  EXPECT_EQ(s.calibration.split, 1u);
-  EXPECT_GT(s.calibration.generated, 1u);
+  EXPECT_EQ(s.schedule.split, 1u);
+  EXPECT_GT(s.schedule.generated, 1u);
+}
+
+TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
+  EXPECT_EQ(list_schedule_makespan({}, 4), 0.0);
+  EXPECT_EQ(list_schedule_makespan({5, 5, 5, 5}, 2), 10.0);
+  EXPECT_EQ(list_schedule_makespan({1, 1, 1, 9}, 2), 10.0) << "handout order, not sorted: the 9 lands on a loaded core";
+  EXPECT_EQ(list_schedule_makespan({9, 1, 1, 1}, 2), 9.0);
+  EXPECT_THROW((void)list_schedule_makespan({1}, 0), Error);
+  StepResult step;
+  step.stats.node_tests = 100;
+  step.schedule.task_node_tests = {60, 30, 10};
+  EXPECT_NEAR(simulated_speedup(step, Method::exploitation, 8), 100.0 / 60.0, 1e-12) << "bound by the heaviest pair";
+  EXPECT_EQ(simulated_speedup(step, Method::sequential, 8), 1.0);
+  step.schedule.task_node_tests = {20, 20, 20, 20};
+  step.schedule.stage_task_node_tests = {20};
+  EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / 40.0, 1e-12) << "stage, barrier, then the tasks";
 }
 
 TEST(EngineOptionsValidation, RejectsBadValues) {
