@@ -20,11 +20,12 @@ enum class Method : std::uint8_t {
   sequential,    ///< one thread, the initial tasks one after another
   exploitation,  ///< a parallel loop over the initial tasks (the paper's "parallelism exploitation")
   stealing,      ///< recursive parallel traversal on oneTBB's work stealing, serial below a depth cut-off
+  aposteriori,   ///< task calibration with temporal weights: last step's node tests, summary tree, taboo lists
   apriori,       ///< task calibration with geometric weights (the weight-driven stage splits heavy pairs)
   hybrid,        ///< task calibration with geometric weights rescaled by the previous step's node tests
 };
 
-/// "sequential", "exploitation", "stealing", "apriori" or "hybrid".
+/// "sequential", "exploitation", "stealing", "aposteriori", "apriori" or "hybrid".
 [[nodiscard]] std::string_view to_string(Method method);
 /// Parses a method name; throws caliber::Error on an unknown one.
 [[nodiscard]] Method parse_method(std::string_view name);
@@ -41,6 +42,8 @@ struct EngineOptions {
   double beta = 2.0;
   /// Calibration: tolerance on Omega, as a fraction of Omega (>= 0).
   double epsilon = 0.25;
+  /// A posteriori: the most sub-task roots (taboo nodes) one task may hand out (>= 1).
+  int taboo_cap = 64;
 };
 
 /// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded

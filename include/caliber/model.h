@@ -70,6 +70,17 @@ struct Model {
   std::vector<BvhNode> nodes;
   /// filters[i]: normal cone and group mask of nodes[i].
   std::vector<BvhNodeFilter> filters;
+  /// The triangles below node i are those whose leaf_position lies in
+  /// [first_leaf[i], first_leaf[i] + nodes[i].count): every subtree is a run of the leaf order.
+  std::vector<std::uint32_t> first_leaf;
+  /// Position of each triangle in the leaf order (see first_leaf).
+  std::vector<std::uint32_t> leaf_position;
+
+  /// Whether triangle t lies below node i.
+  [[nodiscard]] bool holds(std::uint32_t node, std::uint32_t triangle) const {
+    const std::uint32_t p = leaf_position[triangle];
+    return p >= first_leaf[node] && p < first_leaf[node] + nodes[node].count;
+  }
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
   std::vector<Eigen::Vector3d> normals;
   /// Triangles sharing a vertex position with triangle t are

@@ -55,6 +55,11 @@ struct ScheduleRecord {
   std::vector<std::uint64_t> task_node_tests;
   std::vector<double> task_weights;            ///< estimated weight of each run-time task (calibrated methods)
   std::uint64_t split_node_tests = 0;          ///< stealing: node tests made above the cut-off, while splitting
+  std::size_t taboo = 0;                       ///< a posteriori: taboo nodes (sub-task roots) handed out
+  /// A posteriori: node tests of sub-tasks whose root the original task never reached (an ancestor
+  /// was pruned at this step): work the sequential traversal does not do. The other node tests add
+  /// up to sequential's exactly.
+  std::uint64_t taboo_unreached_node_tests = 0;
 };
 
 /// Everything one step produced.

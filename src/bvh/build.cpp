@@ -49,6 +49,7 @@ struct WorkNode {
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
+  std::uint32_t first = 0;  ///< first position of its triangles in leaf order
 };
 
 class Builder {
@@ -65,18 +66,25 @@ class Builder {
     mWork.reserve(2 * n - 1);
   }
 
-  void build(std::vector<BvhNode>& nodes, std::vector<BvhNodeFilter>& filters, int& height) {
+  void build(Model& model) {
     mWork.emplace_back();
-    height = build_range(0, 0, static_cast<std::uint32_t>(mOrder.size()));
-    nodes.resize(mWork.size());
-    filters.resize(mWork.size());
-    for (std::size_t i = 0; i < mWork.size(); ++i) convert(mWork[i], nodes[i], filters[i]);
+    model.height = build_range(0, 0, static_cast<std::uint32_t>(mOrder.size()));
+    model.nodes.resize(mWork.size());
+    model.filters.resize(mWork.size());
+    model.first_leaf.resize(mWork.size());
+    model.leaf_position.resize(mOrder.size());
+    for (std::size_t i = 0; i < mWork.size(); ++i) {
+      convert(mWork[i], model.nodes[i], model.filters[i]);
+      model.first_leaf[i] = mWork[i].first;
+    }
+    for (std::uint32_t p = 0; p < mOrder.size(); ++p) model.leaf_position[mOrder[p]] = p;
   }
 
  private:
   /// Builds the subtree over mOrder[begin, end) into mWork[slot]; returns its height.
   int build_range(std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
     if (end - begin == 1) {
+      mWork[slot].first = begin;
       make_leaf(slot, mOrder[begin]);
       return 1;
     }
@@ -87,6 +95,7 @@ class Builder {
     const int hl = build_range(first, begin, mid);
     const int hr = build_range(first + 1, mid, end);
     make_internal(slot, first, begin, end);
+    mWork[slot].first = begin;
     return 1 + std::max(hl, hr);
   }
 
@@ -312,7 +321,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   auto model = std::make_shared<Model>();
   model->normals = face_normals(mesh);
   Builder builder(mesh, model->normals);
-  builder.build(model->nodes, model->filters, model->height);
+  builder.build(*model);
   double extent = 0.0;
   for (const auto& tri : mesh.triangles) {
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].norm());

@@ -3,6 +3,8 @@
 /// The one traversal of the CD tree (the product of two BVHs). Every method of the parallel engine
 /// cuts this tree into tasks differently; all of them run this routine on their pieces.
 
+#include <algorithm>
+#include <compare>
 #include <cstdint>
 #include <vector>
 
@@ -15,6 +17,21 @@ namespace caliber::narrow {
 struct NodePair {
   std::uint32_t a;  ///< node index in A's BVH
   std::uint32_t b;  ///< node index in B's BVH
+  friend bool operator==(const NodePair&, const NodePair&) = default;
+  friend auto operator<=>(const NodePair&, const NodePair&) = default;
+};
+
+/// The a posteriori method's taboo list: CD-tree nodes that sub-tasks own. A traversal that meets
+/// one skips it without testing it (its sub-task tests it) and records that it met it.
+struct Taboo {
+  std::vector<NodePair> nodes;         ///< sorted, distinct
+  mutable std::vector<char> reached;   ///< reached[i]: the traversal met nodes[i] (one thread writes it)
+
+  /// Index of n in the list, or -1.
+  [[nodiscard]] int find(NodePair n) const {
+    const auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
+    return (it != nodes.end() && *it == n) ? static_cast<int>(it - nodes.begin()) : -1;
+  }
 };
 
 /// A node whose sphere is more than this many times larger than its partner's descends alone.
@@ -51,11 +68,13 @@ struct TraversalScratch {
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
 /// was tested, and passed, earlier) and every node below it whose parent passed; runs the leaf
 /// test on passing leaf pairs; appends the kept pairs to `out` and counts the work in `stats`
-/// (every node test, every leaf test).
+/// (every node test, every leaf test). With a taboo list, a child on the list is neither tested nor
+/// entered, only marked as reached.
 /// Children are tested when their parent is expanded, so each child node of A and of B is
 /// prepared once for the (up to) four pairs it takes part in; only passing children are pushed.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
-                                 std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false) {
+                                 std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false,
+                                 const Taboo* taboo = nullptr) {
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
   // Each expansion pops one node and pushes at most four, one level deeper: the stack never holds
@@ -86,6 +105,13 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     // Pushed in reverse so that the first child is popped first (the same order as cd_children).
     for (int i = na - 1; i >= 0; --i) {
       for (int j = nb - 1; j >= 0; --j) {
+        if (taboo != nullptr) {
+          const int t = taboo->find(NodePair{sa[i].index, sb[j].index});
+          if (t >= 0) {
+            taboo->reached[static_cast<std::size_t>(t)] = 1;
+            continue;
+          }
+        }
         ++node_tests;
         if (ctx.node_test(sa[i], sb[j])) *top++ = NodePair{sa[i].index, sb[j].index};
       }

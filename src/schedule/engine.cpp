@@ -90,6 +90,7 @@ std::string_view to_string(Method method) {
     case Method::sequential: return "sequential";
     case Method::exploitation: return "exploitation";
     case Method::stealing: return "stealing";
+    case Method::aposteriori: return "aposteriori";
     case Method::apriori: return "apriori";
     case Method::hybrid: return "hybrid";
   }
@@ -100,10 +101,12 @@ Method parse_method(std::string_view name) {
   if (name == "sequential") return Method::sequential;
   if (name == "exploitation") return Method::exploitation;
   if (name == "stealing") return Method::stealing;
+  if (name == "aposteriori") return Method::aposteriori;
   if (name == "apriori") return Method::apriori;
   if (name == "hybrid") return Method::hybrid;
   throw Error(ErrorCode::bad_value, "method",
-              "unknown method '" + std::string(name) + "' (expected sequential, exploitation, stealing, apriori or hybrid)");
+              "unknown method '" + std::string(name) +
+                  "' (expected sequential, exploitation, stealing, aposteriori, apriori or hybrid)");
 }
 
 struct Engine::Impl {
@@ -112,6 +115,8 @@ struct Engine::Impl {
   Workers workers;
   /// Temporal state: node tests of each object pair at its last step. Changes only how work is cut.
   std::map<Task, std::uint64_t> history;
+  /// A posteriori: the triangle pairs each object pair reported at its last step.
+  std::map<Task, std::vector<TrianglePair>> reported;
 };
 
 Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world), mOptions(options) {
@@ -123,6 +128,7 @@ Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world)
   if (!(mOptions.epsilon >= 0.0) || !std::isfinite(mOptions.epsilon)) {
     throw Error(ErrorCode::bad_value, "epsilon", "must be a finite number >= 0");
   }
+  if (mOptions.taboo_cap < 1) throw Error(ErrorCode::bad_value, "taboo cap", "must be >= 1");
   if (mOptions.threads == 0) mOptions.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   if (mOptions.method == Method::sequential) mOptions.threads = 1;
   mImpl = std::make_unique<Impl>(mOptions.threads);
@@ -183,7 +189,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   //    history is rescaled by the ratio measured over the pairs that have one (1 if none has).
   std::vector<double> root(n), weight(n), scale(n, 1.0);
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { root[i] = tasks::apriori_weight(contexts[i], {0, 0}); });
-  if (mOptions.method == Method::hybrid) {
+  if (mOptions.method == Method::hybrid || mOptions.method == Method::aposteriori) {
     double measured = 0.0, estimated = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       const auto it = mImpl->history.find(tasks[i]);
@@ -221,10 +227,50 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   }
   record.split = to_split.size();
   std::vector<tasks::SplitResult> splits(to_split.size());
-  tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
-    const std::size_t i = to_split[s];
-    splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps);
-  });
+  std::vector<narrow::Taboo> taboos;
+  if (mOptions.method == Method::aposteriori) {
+    // Sub-task roots from last step's summary tree; nothing is tested here. A task without
+    // reported pairs last step cannot be split (the metric's known blind spot) and runs whole.
+    std::vector<tasks::PosterioriSplit> chosen(to_split.size());
+    tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
+      const std::size_t i = to_split[s];
+      const auto it = mImpl->reported.find(tasks[i]);
+      if (it == mImpl->reported.end()) return;
+      const auto summary = tasks::build_summary(contexts[i].a(), contexts[i].b(), it->second);
+      chosen[s] = tasks::split_aposteriori(summary, static_cast<std::uint32_t>(i), weight[i], omega, eps,
+                                           static_cast<std::size_t>(mOptions.taboo_cap));
+      chosen[s].rest = chosen[s].taboo.empty() ? weight[i] : chosen[s].rest;
+    });
+    for (std::size_t s = 0; s < to_split.size(); ++s) {
+      const auto pair = static_cast<std::uint32_t>(to_split[s]);
+      tasks::PosterioriSplit& ps = chosen[s];
+      tasks::Root original{pair, narrow::NodePair{0, 0}, false, ps.rest};
+      if (!ps.taboo.empty()) {
+        original.taboo = static_cast<std::int32_t>(taboos.size());
+        narrow::Taboo taboo;
+        taboo.nodes = ps.taboo;
+        taboo.reached.assign(ps.taboo.size(), 0);
+        taboos.push_back(std::move(taboo));
+        for (std::vector<tasks::Root>* list : {&ps.roots, &ps.cart}) {
+          for (tasks::Root& r : *list) {
+            r.owner = original.taboo;
+            r.slot = taboos.back().find(r.node);
+          }
+        }
+      }
+      run.push_back(tasks::RunTask{{original}, original.weight});
+      for (const tasks::Root& r : ps.roots) run.push_back(tasks::RunTask{{r}, r.weight});
+      cart.insert(cart.end(), ps.cart.begin(), ps.cart.end());
+      record.taboo += ps.taboo.size();
+    }
+    to_split.clear();
+    splits.clear();
+  } else {
+    tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
+      const std::size_t i = to_split[s];
+      splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps);
+    });
+  }
   for (tasks::SplitResult& s : splits) {
     for (const tasks::Root& r : s.roots) run.push_back(tasks::RunTask{{r}, r.weight});
     cart.insert(cart.end(), s.cart.begin(), s.cart.end());
@@ -241,6 +287,8 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   // 3. Every run-time task depth first, by one thread; then per pair, the same finalization.
   record.task_node_tests.assign(run.size(), 0);
   record.task_weights.resize(run.size());
+  std::vector<std::vector<std::uint64_t>> sub_tests(taboos.size());
+  for (std::size_t t = 0; t < taboos.size(); ++t) sub_tests[t].assign(taboos[t].nodes.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, run.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
       WorkerSlots& w = local_slots(workers, n);
@@ -249,13 +297,19 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
         QueryStats& stats = w.stats[root_ref.pair];
         const std::uint64_t before = stats.node_tests;
         narrow::traverse_depth_first(contexts[root_ref.pair], root_ref.node, w.scratch, w.candidates[root_ref.pair], stats,
-                                     root_ref.tested);
+                                     root_ref.tested, root_ref.taboo >= 0 ? &taboos[root_ref.taboo] : nullptr);
         tests += stats.node_tests - before;
+        if (root_ref.owner >= 0) sub_tests[root_ref.owner][root_ref.slot] = stats.node_tests - before;
       }
       record.task_node_tests[t] = tests;
       record.task_weights[t] = run[t].weight;
     }
   });
+  for (std::size_t t = 0; t < taboos.size(); ++t) {
+    for (std::size_t k = 0; k < taboos[t].nodes.size(); ++k) {
+      if (!taboos[t].reached[k]) record.taboo_unreached_node_tests += sub_tests[t][k];
+    }
+  }
   std::vector<std::size_t> split_of(n, SIZE_MAX);
   for (std::size_t s = 0; s < to_split.size(); ++s) split_of[to_split[s]] = s;
   finalize_pairs(contexts, workers, results, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
@@ -291,6 +345,7 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
     case Method::stealing:
       makespan = list_schedule_makespan(r.task_node_tests, cores) + static_cast<double>(r.split_node_tests) / cores;
       break;
+    case Method::aposteriori:
     case Method::apriori:
     case Method::hybrid:
       makespan = list_schedule_makespan(r.stage_task_node_tests, cores) + list_schedule_makespan(r.task_node_tests, cores);
@@ -353,10 +408,14 @@ StepResult Engine::step(int k) {
       });
       break;
     }
+    case Method::aposteriori:
     case Method::apriori:
     case Method::hybrid:
       mImpl->arena.execute([&] { run_calibrated(tasks, contexts, results, out.schedule); });
       break;
+  }
+  if (mOptions.method == Method::aposteriori) {
+    for (std::size_t i = 0; i < n; ++i) mImpl->reported[tasks[i]] = results[i].pairs;
   }
   if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
     for (const QueryResult& r : results) out.schedule.task_node_tests.push_back(r.stats.node_tests);

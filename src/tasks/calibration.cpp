@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <queue>
 
+#include "caliber/model.h"
+
 #include "tasks/weights.h"
 
 namespace caliber::tasks {
@@ -82,6 +84,85 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
         break;
     }
   }
+  return out;
+}
+
+namespace {
+
+/// Fills summary[slot] for CD node n with the reported pairs `items` below it, then its children.
+void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::NodePair n, std::vector<TrianglePair> items,
+                  std::vector<SummaryNode>& summary) {
+  summary[slot].node = n;
+  summary[slot].contacts = static_cast<std::uint32_t>(items.size());
+  if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return;
+  narrow::NodePair kids[4];
+  const int count = narrow::cd_children(a, b, n, kids);
+  std::vector<TrianglePair> parts[4];
+  for (const TrianglePair& p : items) {
+    for (int k = 0; k < count; ++k) {
+      if (a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b)) {
+        parts[k].push_back(p);
+        break;
+      }
+    }
+  }
+  items.clear();
+  items.shrink_to_fit();
+  const auto first = static_cast<std::uint32_t>(summary.size());
+  std::uint32_t children = 0;
+  for (int k = 0; k < count; ++k) children += parts[k].empty() ? 0 : 1;
+  summary[slot].first = first;
+  summary[slot].children = children;
+  summary.resize(summary.size() + children);
+  std::uint32_t next = first;
+  for (int k = 0; k < count; ++k) {
+    if (!parts[k].empty()) fill_summary(a, b, next++, kids[k], std::move(parts[k]), summary);
+  }
+}
+
+}  // namespace
+
+std::vector<SummaryNode> build_summary(const Model& a, const Model& b, const std::vector<TrianglePair>& reported) {
+  std::vector<SummaryNode> summary;
+  if (reported.empty()) return summary;
+  summary.resize(1);
+  fill_summary(a, b, 0, narrow::NodePair{0, 0}, reported, summary);
+  return summary;
+}
+
+PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight,
+                                  double omega, double eps, std::size_t taboo_cap) {
+  PosterioriSplit out;
+  out.rest = weight;
+  if (summary.empty() || summary[0].contacts == 0 || summary[0].children == 0) return out;
+  const double per_contact = weight / summary[0].contacts;
+  struct Entry {
+    double weight;
+    std::uint32_t index;
+    bool operator<(const Entry& o) const { return weight != o.weight ? weight < o.weight : index > o.index; }
+  };
+  std::priority_queue<Entry> queue;
+  // The root itself is the original task: start from its children.
+  for (std::uint32_t c = 0; c < summary[0].children; ++c) {
+    const std::uint32_t k = summary[0].first + c;
+    queue.push(Entry{per_contact * summary[k].contacts, k});
+  }
+  while (!queue.empty() && out.taboo.size() < taboo_cap) {
+    const Entry e = queue.top();
+    queue.pop();
+    const SummaryNode& s = summary[e.index];
+    const Verdict v = classify(e.weight, omega, eps);
+    if (v == Verdict::split && s.children > 0) {
+      for (std::uint32_t c = 0; c < s.children; ++c) queue.push(Entry{per_contact * summary[s.first + c].contacts, s.first + c});
+      continue;
+    }
+    Root r{pair, s.node, false, e.weight};
+    (v == Verdict::cart ? out.cart : out.roots).push_back(r);
+    out.taboo.push_back(s.node);
+    out.rest -= e.weight;
+  }
+  std::sort(out.taboo.begin(), out.taboo.end());
+  out.rest = std::max(out.rest, 1.0);
   return out;
 }
 

@@ -22,6 +22,9 @@ struct Root {
   narrow::NodePair node;   ///< CD-tree node
   bool tested;             ///< already tested (and passed) in the weight-driven stage
   double weight;           ///< its estimated weight
+  std::int32_t taboo = -1;     ///< a posteriori: the taboo list this traversal skips (original tasks)
+  std::int32_t owner = -1;     ///< a posteriori: the taboo list this root is on (sub-tasks)
+  std::int32_t slot = -1;      ///< a posteriori: its place on that list
 };
 
 /// A run-time task: one or more roots, traversed depth first by one thread.
@@ -59,5 +62,29 @@ struct SplitResult {
 /// `root_weight`; a node's weight is `scale` times its a priori weight.
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
                        double omega, double eps);
+
+/// The a posteriori summary tree of one pair: the CD-tree nodes above the triangle pairs reported at
+/// the previous step, each weighted by how many of them lie below it. Children are contiguous.
+struct SummaryNode {
+  narrow::NodePair node;        ///< the CD-tree node
+  std::uint32_t contacts = 0;   ///< reported pairs below it
+  std::uint32_t first = 0;      ///< index of its first child in the summary
+  std::uint32_t children = 0;   ///< how many children (only those with contacts below)
+};
+
+/// Builds the summary tree from the previous step's reported pairs (empty if there were none).
+std::vector<SummaryNode> build_summary(const Model& a, const Model& b, const std::vector<TrianglePair>& reported);
+
+/// The a posteriori split of one heavy task: sub-task roots chosen on its summary tree by weight
+/// (a node's weight is the task's weight times its share of the contacts), the original task keeping
+/// the rest of the tree with those roots on its taboo list (at most `taboo_cap` of them).
+struct PosterioriSplit {
+  std::vector<Root> roots;         ///< sub-task roots meeting omega (untested)
+  std::vector<Root> cart;          ///< lighter sub-task roots (untested)
+  std::vector<narrow::NodePair> taboo;  ///< every chosen root, sorted
+  double rest = 0.0;               ///< estimated weight left to the original task
+};
+PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight,
+                                  double omega, double eps, std::size_t taboo_cap);
 
 }  // namespace caliber::tasks

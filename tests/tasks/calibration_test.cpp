@@ -4,6 +4,11 @@
 
 #include "tasks/calibration.h"
 
+#include <algorithm>
+
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+
 namespace caliber::tasks {
 namespace {
 
@@ -56,6 +61,33 @@ TEST(Calibration, CartEdgeCases) {
   const auto tasks = merge_cart(tiny, 25.0);
   EXPECT_EQ(tasks.size(), 12u);
   for (const RunTask& t : tasks) EXPECT_EQ(t.weight, 25.0);
+}
+
+TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
+  const auto a = build_model(make_sphere(1.0, 8, 12));
+  const auto b = build_model(make_torus(1.0, 0.3, 10, 8));
+  std::vector<TrianglePair> reported;
+  for (std::uint32_t i = 0; i < 40; ++i) reported.push_back({(i * 7) % 192, (i * 13) % 160});
+  const auto summary = build_summary(*a, *b, reported);
+  ASSERT_FALSE(summary.empty());
+  EXPECT_EQ(summary[0].contacts, reported.size());
+  for (const SummaryNode& s : summary) {
+    if (s.children == 0) {
+      EXPECT_TRUE(a->nodes[s.node.a].is_leaf() && b->nodes[s.node.b].is_leaf()) << "only leaf pairs end the summary";
+      continue;
+    }
+    std::uint32_t below = 0;
+    for (std::uint32_t c = 0; c < s.children; ++c) below += summary[s.first + c].contacts;
+    EXPECT_EQ(below, s.contacts);
+  }
+  EXPECT_TRUE(build_summary(*a, *b, {}).empty());
+  // Splitting it: chosen roots are distinct, sorted on the taboo list, and never the root.
+  const PosterioriSplit split = split_aposteriori(summary, 0, 4000.0, 500.0, 50.0, 64);
+  EXPECT_FALSE(split.taboo.empty());
+  EXPECT_TRUE(std::is_sorted(split.taboo.begin(), split.taboo.end()));
+  EXPECT_EQ(split.taboo.size(), split.roots.size() + split.cart.size());
+  for (const narrow::NodePair& n : split.taboo) EXPECT_FALSE(n.a == 0 && n.b == 0);
+  EXPECT_LE(split_aposteriori(summary, 0, 4000.0, 500.0, 50.0, 3).taboo.size(), 3u) << "the cap holds";
 }
 
 }  // namespace
