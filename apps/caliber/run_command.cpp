@@ -41,7 +41,7 @@ nlohmann::json step_record(const StepResult& s) {
                      {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}});
   }
   const ScheduleRecord& c = s.schedule;
-  nlohmann::json calibration = {{"omega", c.omega},
+  nlohmann::json schedule = {{"omega", c.omega},
                                 {"kept", c.kept},
                                 {"split", c.split},
                                 {"carted", c.carted},
@@ -51,10 +51,16 @@ nlohmann::json step_record(const StepResult& s) {
                                 {"split_node_tests", c.split_node_tests},
                                 {"queue_peak", c.queue_peak},
                                 {"task_node_tests", c.task_node_tests},
+                                {"thread_node_tests", c.thread_node_tests},
+                                {"taboo", c.taboo},
+                                {"taboo_unreached_node_tests", c.taboo_unreached_node_tests},
+                                {"calibrate_ms", c.calibrate_ms},
+                                {"traverse_ms", c.traverse_ms},
+                                {"finalize_ms", c.finalize_ms},
                                 {"task_weights", c.task_weights}};
   return {{"step", s.step},
           {"time", s.time},
-          {"calibration", calibration},
+          {"schedule", schedule},
           {"broad_ms", s.broad_ms},
           {"narrow_ms", s.narrow_ms},
           {"reduce_ms", s.reduce_ms},

@@ -60,6 +60,12 @@ struct ScheduleRecord {
   /// was pruned at this step): work the sequential traversal does not do. The other node tests add
   /// up to sequential's exactly.
   std::uint64_t taboo_unreached_node_tests = 0;
+  /// Depth-first node tests done by each worker thread (unordered; the weight-driven stage's tests
+  /// are in stage_task_node_tests).
+  std::vector<std::uint64_t> thread_node_tests;
+  double calibrate_ms = 0.0;  ///< calibrated methods: weights, keep/split/cart, weight-driven stage, cart
+  double traverse_ms = 0.0;   ///< depth-first traversals of the run-time tasks (or pairs, or pieces)
+  double finalize_ms = 0.0;   ///< per-pair merge, sort, local minima and world coordinates
 };
 
 /// Everything one step produced.

@@ -183,6 +183,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   const int threads = mOptions.threads;
   auto& workers = mImpl->workers;
   for (WorkerSlots& w : workers) w.reset(n);
+  auto phase = Clock::now();
 
   // 1. Weights of the initial tasks. A priori: the root's geometric estimate. Hybrid: the pair's node
   //    tests at the previous step, and node weights rescaled by N(t-1) / w~root(t); a pair with no
@@ -284,6 +285,8 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   std::stable_sort(run.begin(), run.end(), [](const tasks::RunTask& x, const tasks::RunTask& y) { return x.weight > y.weight; });
   record.generated = run.size();
 
+  record.calibrate_ms = ms_since(phase);
+  phase = Clock::now();
   // 3. Every run-time task depth first, by one thread; then per pair, the same finalization.
   record.task_node_tests.assign(run.size(), 0);
   record.task_weights.resize(run.size());
@@ -305,6 +308,8 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
       record.task_weights[t] = run[t].weight;
     }
   });
+  record.traverse_ms = ms_since(phase);
+  phase = Clock::now();
   for (std::size_t t = 0; t < taboos.size(); ++t) {
     for (std::size_t k = 0; k < taboos[t].nodes.size(); ++k) {
       if (!taboos[t].reached[k]) record.taboo_unreached_node_tests += sub_tests[t][k];
@@ -318,6 +323,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     all = s.candidates;
     stats = s.stats;
   });
+  record.finalize_ms = ms_since(phase);
 }
 
 double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores) {
@@ -375,9 +381,8 @@ StepResult Engine::step(int k) {
   for (WorkerSlots& w : workers) w.reset(n);
   const auto run_pair = [&](std::size_t i) {
     WorkerSlots& w = local_slots(workers, n);
-    QueryStats stats;
-    narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], stats);
-    results[i] = narrow::finalize(contexts[i], w.candidates[i], stats);
+    narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], w.stats[i]);
+    results[i] = narrow::finalize(contexts[i], w.candidates[i], w.stats[i]);
   };
 
   switch (mOptions.method) {
@@ -398,7 +403,10 @@ StepResult Engine::step(int k) {
           group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers); });
         }
         group.wait();
+        out.schedule.traverse_ms = ms_since(start);
+        const auto finalize_start = Clock::now();
         finalize_pairs(contexts, workers, results, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
+        out.schedule.finalize_ms = ms_since(finalize_start);
         for (WorkerSlots& w : workers) {
           out.schedule.task_node_tests.insert(out.schedule.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
           out.schedule.split_node_tests += w.split_node_tests;
@@ -417,6 +425,13 @@ StepResult Engine::step(int k) {
   if (mOptions.method == Method::aposteriori) {
     for (std::size_t i = 0; i < n; ++i) mImpl->reported[tasks[i]] = results[i].pairs;
   }
+  for (const WorkerSlots& w : workers) {
+    if (w.stats.size() != n) continue;
+    std::uint64_t tests = 0;
+    for (const QueryStats& st : w.stats) tests += st.node_tests;
+    if (tests > 0) out.schedule.thread_node_tests.push_back(tests);
+  }
+  std::sort(out.schedule.thread_node_tests.begin(), out.schedule.thread_node_tests.end(), std::greater<>());
   if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
     for (const QueryResult& r : results) out.schedule.task_node_tests.push_back(r.stats.node_tests);
   }
