@@ -1,6 +1,9 @@
 // The query front-end: one object pair, one traversal, and the brute-force oracle beside it.
 
 #include <algorithm>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <cmath>
 #include <string>
 
@@ -40,6 +43,10 @@ void validate_request(const QueryRequest& request) {
 namespace narrow {
 namespace {
 
+/// Below this many candidates a pair is finalized serially; above, its sort, local-minimum test and
+/// world transform run in parallel (one heavy pair's finalization would otherwise be serial work).
+constexpr std::size_t kParallelGrain = 2048;
+
 /// Strict total order used by the local-minimum reduction: closer first, then lower ids.
 bool closer(const Candidate& x, const Candidate& y) {
   if (x.distance != y.distance) return x.distance < y.distance;
@@ -53,7 +60,7 @@ bool by_ids(const Candidate& x, const Candidate& y) {
 
 /// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win).
-std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted) {
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted, std::size_t grain) {
   const auto find = [&](std::uint32_t ta, std::uint32_t tb) -> const Candidate* {
     const Candidate key{ta, tb, 0.0, {}, {}};
     const auto it = std::lower_bound(sorted.begin(), sorted.end(), key, by_ids);
@@ -61,8 +68,11 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   };
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
-  std::vector<Candidate> kept;
-  for (const Candidate& c : sorted) {
+  // Each candidate's verdict depends only on the sorted list: decided in parallel, kept in order.
+  std::vector<char> keep(sorted.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sorted.size(), grain), [&](const tbb::blocked_range<std::size_t>& r) {
+  for (std::size_t i = r.begin(); i != r.end(); ++i) {
+    const Candidate& c = sorted[i];
     bool dominated = false;
     for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
       const Candidate* other = find(ma.adjacency[k], c.tri_b);
@@ -72,23 +82,35 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
       const Candidate* other = find(c.tri_a, mb.adjacency[k]);
       dominated = other != nullptr && closer(*other, c);
     }
-    if (!dominated) kept.push_back(c);
+    keep[i] = dominated ? 0 : 1;
+  }
+  });
+  std::vector<Candidate> kept;
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    if (keep[i]) kept.push_back(sorted[i]);
   }
   return kept;
 }
 
 }  // namespace
 
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats) {
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
+  // Serial unless asked: a grain as large as the input keeps tbb::parallel_for on this thread.
+  const std::size_t grain = parallel ? kParallelGrain : std::max<std::size_t>(candidates.size(), 1);
   QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
-  std::sort(candidates.begin(), candidates.end(), by_ids);
+  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
+  if (parallel && candidates.size() >= kParallelGrain) {
+    tbb::parallel_sort(candidates.begin(), candidates.end(), by_ids);
+  } else {
+    std::sort(candidates.begin(), candidates.end(), by_ids);
+  }
   if (result.kind == QueryKind::contact) {
     if (ctx.a().adjacency_offsets.empty() || ctx.b().adjacency_offsets.empty()) {
       throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
     }
-    candidates = local_minima(ctx, candidates);
+    candidates = local_minima(ctx, candidates, grain);
   }
   result.pairs.reserve(candidates.size());
   for (const Candidate& c : candidates) result.pairs.push_back(TrianglePair{c.tri_a, c.tri_b});
@@ -96,8 +118,10 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
 
   const Pose& pose = ctx.pose_a();
   const Eigen::Matrix3d ra = pose.rotation_matrix();
-  result.contacts.reserve(candidates.size());
-  for (const Candidate& c : candidates) {
+  result.contacts.resize(candidates.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), grain), [&](const tbb::blocked_range<std::size_t>& r) {
+  for (std::size_t i = r.begin(); i != r.end(); ++i) {
+    const Candidate& c = candidates[i];
     Contact contact;
     contact.tri_a = c.tri_a;
     contact.tri_b = c.tri_b;
@@ -115,8 +139,9 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
       normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
     }
     contact.normal = ra * normal;
-    result.contacts.push_back(contact);
+    result.contacts[i] = contact;
   }
+  });
   return result;
 }
 

@@ -122,7 +122,9 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
 }
 
 /// Sorts the candidates of one object pair canonically, applies the contact reduction (local
-/// minima) for contact queries, and converts them to world coordinates.
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats);
+/// minima) for contact queries, and converts them to world coordinates. With `parallel`, a large
+/// candidate list is processed by several tasks of the current oneTBB arena (same result).
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats,
+                     bool parallel = false);
 
 }  // namespace caliber::narrow

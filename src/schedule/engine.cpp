@@ -78,7 +78,7 @@ void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& w
         stats.node_tests += w.stats[i].node_tests;
         stats.leaf_tests += w.stats[i].leaf_tests;
       }
-      results[i] = narrow::finalize(contexts[i], all, stats);
+      results[i] = narrow::finalize(contexts[i], all, stats, /*parallel=*/true);
     }
   });
 }

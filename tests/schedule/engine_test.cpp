@@ -172,6 +172,26 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / 40.0, 1e-12) << "stage, barrier, then the tasks";
 }
 
+TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
+  // two_large's one pair keeps thousands of candidates: its sort, local minima and transforms run
+  // as parallel tasks in the calibrated and stealing methods; the contacts must not change.
+  if (!std::filesystem::exists(std::filesystem::path(CALIBER_MESH_DATA) / "dragknob.off")) {
+    GTEST_SKIP() << "run scripts/fetch_meshes.sh first";
+  }
+  const World world(load_scene(std::filesystem::path(CALIBER_SCENES) / "two_large.json"));
+  const StepResult reference = world.step(3);
+  ASSERT_GT(reference.contacts.size(), 100u);
+  for (const Method method : {Method::stealing, Method::hybrid}) {
+    for (const int threads : {2, 8}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      Engine engine(world, options);
+      expect_same_step(engine.step(3), reference, std::string(to_string(method)) + " x" + std::to_string(threads));
+    }
+  }
+}
+
 TEST(EngineOptionsValidation, RejectsBadValues) {
   const World world(parse_scene(R"({"objects": [{"mesh": "tetra.off"}]})", CALIBER_TEST_DATA, "x.json"));
   EngineOptions options;
