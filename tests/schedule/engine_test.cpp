@@ -9,6 +9,7 @@
 #include "caliber/error.h"
 #include "caliber/procedural.h"
 #include "caliber/world.h"
+#include "support/temp_dir.h"
 
 namespace caliber {
 namespace {
@@ -84,14 +85,12 @@ void expect_all_methods_identical(const World& world, int steps) {
 class EngineScenes : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = std::filesystem::temp_directory_path() / ("caliber_engine_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
     save_off(make_box(0.5, 0.5, 0.5, 3), dir / "cube.off");
     save_off(make_sphere(0.6, 10, 14), dir / "sphere.off");
     save_off(make_torus(0.8, 0.25, 16, 10), dir / "torus.off");
   }
-  void TearDown() override { std::filesystem::remove_all(dir); }
-  std::filesystem::path dir;
+  test::TempDir temp{"engine"};
+  const std::filesystem::path& dir = temp.path();
 };
 
 TEST_F(EngineScenes, SmallSceneEveryKind) {

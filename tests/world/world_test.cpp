@@ -10,6 +10,7 @@
 #include "caliber/procedural.h"
 #include "caliber/world.h"
 #include "support/random_poses.h"
+#include "support/temp_dir.h"
 
 namespace caliber {
 namespace {
@@ -18,18 +19,16 @@ namespace {
 class WorldFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = std::filesystem::temp_directory_path() / ("caliber_world_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
     save_off(make_box(0.5, 0.5, 0.5, 2), dir / "cube.off");
     save_off(make_box(0.5, 0.5, 0.5, 2), dir / "cube_copy.off");
     save_off(make_sphere(0.6, 8, 12), dir / "sphere.off");
     save_off(make_torus(0.8, 0.25, 12, 8), dir / "torus.off");
   }
-  void TearDown() override { std::filesystem::remove_all(dir); }
 
   Scene scene(const std::string& json) const { return parse_scene(json, dir, "world_test.json"); }
 
-  std::filesystem::path dir;
+  test::TempDir temp{"world"};
+  const std::filesystem::path& dir = temp.path();
 };
 
 /// Each step's contacts must equal, bit for bit, the oracle run on every object pair.
