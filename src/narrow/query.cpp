@@ -45,7 +45,7 @@ namespace {
 
 /// Below this many candidates a pair is finalized serially; above, its sort, local-minimum test and
 /// world transform run in parallel (one heavy pair's finalization would otherwise be serial work).
-constexpr std::size_t kParallelGrain = 2048;
+constexpr std::size_t kParallelGrain = 512;
 
 /// Strict total order used by the local-minimum reduction: closer first, then lower ids.
 bool closer(const Candidate& x, const Candidate& y) {
@@ -61,10 +61,24 @@ bool by_ids(const Candidate& x, const Candidate& y) {
 /// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win).
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted, std::size_t grain) {
+  // Lookup structure over the sorted candidates: the distinct triangles of A (one run each) and the
+  // triangles of B packed contiguously, so a neighbour lookup is two small binary searches.
+  std::vector<std::uint32_t> run_a, run_begin, tri_b(sorted.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    tri_b[i] = sorted[i].tri_b;
+    if (i == 0 || sorted[i].tri_a != sorted[i - 1].tri_a) {
+      run_a.push_back(sorted[i].tri_a);
+      run_begin.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  run_begin.push_back(static_cast<std::uint32_t>(sorted.size()));
   const auto find = [&](std::uint32_t ta, std::uint32_t tb) -> const Candidate* {
-    const Candidate key{ta, tb, 0.0, {}, {}};
-    const auto it = std::lower_bound(sorted.begin(), sorted.end(), key, by_ids);
-    return (it != sorted.end() && it->tri_a == ta && it->tri_b == tb) ? &*it : nullptr;
+    const auto r = std::lower_bound(run_a.begin(), run_a.end(), ta);
+    if (r == run_a.end() || *r != ta) return nullptr;
+    const std::size_t k = static_cast<std::size_t>(r - run_a.begin());
+    const auto first = tri_b.begin() + run_begin[k], last = tri_b.begin() + run_begin[k + 1];
+    const auto it = std::lower_bound(first, last, tb);
+    return (it != last && *it == tb) ? &sorted[static_cast<std::size_t>(it - tri_b.begin())] : nullptr;
   };
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
