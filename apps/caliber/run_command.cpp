@@ -26,6 +26,7 @@ struct RunOptions {
   int stealing_depth = 10;
   double beta = 2.0;
   double epsilon = 0.25;
+  bool node_history = false;
   std::vector<int> simulate = {2, 4, 8, 16, 32, 64};
   int steps = -1;
   std::string json;
@@ -103,6 +104,7 @@ int run_scene(const RunOptions& opt) {
   engine_options.stealing_depth = opt.stealing_depth;
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
+  engine_options.node_history = opt.node_history;
   Engine engine(world, engine_options);
   const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count();
   const Scene& sc = world.scene();
@@ -211,6 +213,8 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
       ->capture_default_str();
   cmd->add_option("--epsilon", opt->epsilon, "Calibration: tolerance on Omega, as a fraction of Omega")->capture_default_str();
+  cmd->add_flag("--node-history", opt->node_history,
+                "Hybrid: weigh CD nodes by the node tests their subtrees took at the previous step (not in the paper)");
   cmd->add_option("--simulate-cores", opt->simulate, "Virtual core counts for the load-balance simulation")
       ->delimiter(',')
       ->capture_default_str();

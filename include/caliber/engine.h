@@ -44,6 +44,9 @@ struct EngineOptions {
   double epsilon = 0.25;
   /// A posteriori: the most sub-task roots (taboo nodes) one task may hand out (>= 1).
   int taboo_cap = 64;
+  /// Hybrid: weigh a CD node by the node tests its subtree took at the previous step when the
+  /// weight-driven stage popped it then (a priori, rescaled, otherwise). Not in the paper.
+  bool node_history = false;
 };
 
 /// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded

@@ -117,6 +117,8 @@ struct Engine::Impl {
   std::map<Task, std::uint64_t> history;
   /// A posteriori: the triangle pairs each object pair reported at its last step.
   std::map<Task, std::vector<TrianglePair>> reported;
+  /// Hybrid with node history: node tests of the subtrees the weight-driven stage popped, per pair.
+  std::map<Task, tasks::NodeCounts> node_counts;
 };
 
 Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world), mOptions(options) {
@@ -267,9 +269,15 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     to_split.clear();
     splits.clear();
   } else {
+    const bool history = mOptions.method == Method::hybrid && mOptions.node_history;
     tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
       const std::size_t i = to_split[s];
-      splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps);
+      const tasks::NodeCounts* measured = nullptr;
+      if (history) {
+        const auto it = mImpl->node_counts.find(tasks[i]);
+        if (it != mImpl->node_counts.end()) measured = &it->second;
+      }
+      splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps, measured);
     });
   }
   for (tasks::SplitResult& s : splits) {
@@ -290,6 +298,10 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   // 3. Every run-time task depth first, by one thread; then per pair, the same finalization.
   record.task_node_tests.assign(run.size(), 0);
   record.task_weights.resize(run.size());
+  std::vector<std::size_t> split_of(n, SIZE_MAX);
+  for (std::size_t s = 0; s < to_split.size(); ++s) split_of[to_split[s]] = s;
+  std::vector<std::vector<std::uint64_t>> stage_root_tests(splits.size());
+  for (std::size_t s = 0; s < splits.size(); ++s) stage_root_tests[s].assign(splits[s].stage.size(), 0);
   std::vector<std::vector<std::uint64_t>> sub_tests(taboos.size());
   for (std::size_t t = 0; t < taboos.size(); ++t) sub_tests[t].assign(taboos[t].nodes.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, run.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -303,6 +315,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
                                      root_ref.tested, root_ref.taboo >= 0 ? &taboos[root_ref.taboo] : nullptr);
         tests += stats.node_tests - before;
         if (root_ref.owner >= 0) sub_tests[root_ref.owner][root_ref.slot] = stats.node_tests - before;
+        if (root_ref.stage >= 0) stage_root_tests[split_of[root_ref.pair]][root_ref.stage] = stats.node_tests - before;
       }
       record.task_node_tests[t] = tests;
       record.task_weights[t] = run[t].weight;
@@ -315,8 +328,11 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
       if (!taboos[t].reached[k]) record.taboo_unreached_node_tests += sub_tests[t][k];
     }
   }
-  std::vector<std::size_t> split_of(n, SIZE_MAX);
-  for (std::size_t s = 0; s < to_split.size(); ++s) split_of[to_split[s]] = s;
+  if (mOptions.method == Method::hybrid && mOptions.node_history) {
+    for (std::size_t s = 0; s < splits.size(); ++s) {
+      mImpl->node_counts[tasks[to_split[s]]] = tasks::subtree_counts(splits[s].stage, stage_root_tests[s]);
+    }
+  }
   finalize_pairs(contexts, workers, results, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
     if (split_of[i] == SIZE_MAX) return;
     const tasks::SplitResult& s = splits[split_of[i]];

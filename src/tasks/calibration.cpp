@@ -1,6 +1,7 @@
 #include "tasks/calibration.h"
 
 #include <algorithm>
+#include <map>
 #include <queue>
 
 #include "caliber/model.h"
@@ -43,7 +44,15 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
 }
 
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
-                       double omega, double eps) {
+                       double omega, double eps, const NodeCounts* measured) {
+  const auto weight_of = [&](narrow::NodePair n) {
+    if (measured != nullptr) {
+      const auto it = std::lower_bound(measured->begin(), measured->end(), n,
+                                       [](const auto& entry, narrow::NodePair key) { return entry.first < key; });
+      if (it != measured->end() && it->first == n) return static_cast<double>(it->second);
+    }
+    return scale * apriori_weight(ctx, n);
+  };
   struct Entry {
     double weight;
     narrow::NodePair node;
@@ -62,6 +71,9 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
     const Entry e = queue.top();
     queue.pop();
     ++out.stats.node_tests;
+    StageRecord popped{};
+    popped.node = e.node;
+    out.stage.push_back(popped);
     if (!ctx.node_test(e.node.a, e.node.b)) continue;
     const BvhNode& a = ctx.a().nodes[e.node.a];
     const BvhNode& b = ctx.b().nodes[e.node.b];
@@ -73,18 +85,43 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
     switch (classify(e.weight, omega, eps)) {
       case Verdict::split: {
         const int count = narrow::cd_children(ctx.a(), ctx.b(), e.node, kids);
-        for (int i = 0; i < count; ++i) queue.push(Entry{scale * apriori_weight(ctx, kids[i]), kids[i]});
+        StageRecord& record = out.stage.back();
+        record.children = static_cast<std::uint8_t>(count);
+        for (int i = 0; i < count; ++i) {
+          record.child[i] = kids[i];
+          queue.push(Entry{weight_of(kids[i]), kids[i]});
+        }
         break;
       }
       case Verdict::keep:
-        out.roots.push_back(Root{pair, e.node, true, e.weight});
+      case Verdict::cart: {
+        out.stage.back().root = true;
+        Root r{pair, e.node, true, e.weight};
+        r.stage = static_cast<std::int32_t>(out.stage.size() - 1);
+        (classify(e.weight, omega, eps) == Verdict::keep ? out.roots : out.cart).push_back(r);
         break;
-      case Verdict::cart:
-        out.cart.push_back(Root{pair, e.node, true, e.weight});
-        break;
+      }
     }
   }
   return out;
+}
+
+NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vector<std::uint64_t>& root_tests) {
+  // Children are popped after their parent: add up in reverse pop order.
+  std::vector<std::pair<narrow::NodePair, std::uint64_t>> counts;
+  std::map<narrow::NodePair, std::uint64_t> known;
+  for (std::size_t k = stage.size(); k-- > 0;) {
+    const StageRecord& r = stage[k];
+    std::uint64_t total = 1;  // its own test
+    if (r.root) total += root_tests[k];
+    for (int c = 0; c < r.children; ++c) {
+      const auto it = known.find(r.child[c]);
+      if (it != known.end()) total += it->second;
+    }
+    known[r.node] = total;
+  }
+  counts.assign(known.begin(), known.end());
+  return counts;
 }
 
 namespace {

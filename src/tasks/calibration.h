@@ -25,6 +25,7 @@ struct Root {
   std::int32_t taboo = -1;     ///< a posteriori: the taboo list this traversal skips (original tasks)
   std::int32_t owner = -1;     ///< a posteriori: the taboo list this root is on (sub-tasks)
   std::int32_t slot = -1;      ///< a posteriori: its place on that list
+  std::int32_t stage = -1;     ///< weight-driven stage: index of its record in SplitResult::stage
 };
 
 /// A run-time task: one or more roots, traversed depth first by one thread.
@@ -46,6 +47,18 @@ double caliber_threshold(double total, double beta, int threads);
 /// ones until their sum reaches omega; repeats until the cart is empty. No task comes out empty.
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 
+/// One node the weight-driven stage popped: what happened to it, so that its subtree's node tests
+/// can be added up after the step (the node-history variant of hybrid reuses them).
+struct StageRecord {
+  narrow::NodePair node;                 ///< the CD-tree node
+  std::uint8_t children = 0;             ///< expanded: how many children were pushed
+  narrow::NodePair child[4];             ///< expanded: the children
+  bool root = false;                     ///< became a sub-task root or a cart item (tested)
+};
+
+/// Measured node tests of CD subtrees at the previous step, per CD node, sorted by node.
+using NodeCounts = std::vector<std::pair<narrow::NodePair, std::uint64_t>>;
+
 /// The weight-driven stage's output for one split task.
 struct SplitResult {
   std::vector<Root> roots;                    ///< sub-task roots whose weight meets omega
@@ -53,15 +66,21 @@ struct SplitResult {
   std::vector<narrow::Candidate> candidates;  ///< leaf pairs found in the stage
   QueryStats stats;                           ///< node and leaf tests made in the stage
   std::size_t queue_peak = 0;                 ///< longest the priority queue grew
+  std::vector<StageRecord> stage;             ///< every node popped, in pop order
 };
 
 /// The weight-driven partial traversal of one pair's CD tree (the paper's alternate traversal):
 /// a priority queue of untested nodes keyed by weight; pop the heaviest, test it (a failed test
 /// prunes it; a leaf pair gets its leaf test here); if its weight meets omega it becomes a sub-task
 /// root, if heavier its children are pushed, if lighter it goes to the cart. The root enters with
-/// `root_weight`; a node's weight is `scale` times its a priori weight.
+/// `root_weight`; a node's weight is `scale` times its a priori weight, or, when `measured` holds
+/// it, the node tests its subtree took at the previous step.
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
-                       double omega, double eps);
+                       double omega, double eps, const NodeCounts* measured = nullptr);
+
+/// After a step: the node tests of every subtree the stage popped, from its records and the
+/// depth-first node tests of its roots (`root_tests[k]` for the root at record k). Sorted by node.
+NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vector<std::uint64_t>& root_tests);
 
 /// The a posteriori summary tree of one pair: the CD-tree nodes above the triangle pairs reported at
 /// the previous step, each weighted by how many of them lie below it. Children are contiguous.

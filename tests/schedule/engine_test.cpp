@@ -49,17 +49,22 @@ void expect_all_methods_identical(const World& world, int steps) {
   std::size_t contacts = 0;
   for (const auto& r : reference) contacts += r.contacts.size();
   EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
-  for (const Method method :
-       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+  const std::pair<Method, bool> configs[] = {{Method::sequential, false}, {Method::exploitation, false},
+                                             {Method::stealing, false},   {Method::aposteriori, false},
+                                             {Method::apriori, false},    {Method::hybrid, false},
+                                             {Method::hybrid, true}};
+  for (const auto& [method, node_history] : configs) {
     for (const int threads : {1, 2, 3, 4, 8}) {
       EngineOptions options;
       options.method = method;
+      options.node_history = node_history;
       options.threads = threads;
       options.stealing_depth = 3;  // shallow: many tasks, much stealing
       Engine engine(world, options);
       for (int k = 0; k < steps; ++k) {
         const StepResult got = engine.step(k);
-        const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads) + " step " + std::to_string(k);
+        const std::string what = std::string(to_string(method)) + (node_history ? "+history" : "") + " x" +
+                                 std::to_string(threads) + " step " + std::to_string(k);
         expect_same_step(got, reference[k], what, method != Method::aposteriori);
         if (::testing::Test::HasFatalFailure()) return;
         std::uint64_t units = got.schedule.split_node_tests;
