@@ -63,6 +63,24 @@ TEST(Calibration, CartEdgeCases) {
   for (const RunTask& t : tasks) EXPECT_EQ(t.weight, 25.0);
 }
 
+TEST(Calibration, SubtreeCountsAddUpTheStage) {
+  // Popped in this order: the root (expanded into two children), child 1 (a sub-task root whose
+  // depth-first traversal took 10 node tests), child 2 (failed its test).
+  std::vector<StageRecord> stage(3);
+  stage[0].node = {0, 0};
+  stage[0].children = 2;
+  stage[0].child[0] = {1, 1};
+  stage[0].child[1] = {2, 1};
+  stage[1].node = {1, 1};
+  stage[1].root = true;
+  stage[2].node = {2, 1};
+  const NodeCounts counts = subtree_counts(stage, {0, 10, 0});
+  ASSERT_EQ(counts.size(), 3u);
+  EXPECT_EQ(counts[0], std::make_pair(narrow::NodePair{0, 0}, std::uint64_t{13}));
+  EXPECT_EQ(counts[1], std::make_pair(narrow::NodePair{1, 1}, std::uint64_t{11}));
+  EXPECT_EQ(counts[2], std::make_pair(narrow::NodePair{2, 1}, std::uint64_t{1}));
+}
+
 TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   const auto a = build_model(make_sphere(1.0, 8, 12));
   const auto b = build_model(make_torus(1.0, 0.3, 10, 8));
