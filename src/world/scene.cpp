@@ -261,9 +261,10 @@ Pose pose_at(const Pose& initial, const Motion& motion, double t) {
       p.translation = initial.translation + motion.linear * t;
       const Eigen::Vector3d turn = motion.angular * t;
       const double angle = turn.norm();
-      const Eigen::Quaterniond spin =
-          angle > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, turn / angle)) : Eigen::Quaterniond::Identity();
-      p.rotation = (spin * initial.rotation).normalized();
+      // Without a turn the orientation is the initial one, bit for bit (no renormalization), so a
+      // velocity object at t = 0, or one that only translates, has exactly the pose it was given.
+      p.rotation = angle > 0.0 ? (Eigen::Quaterniond(Eigen::AngleAxisd(angle, turn / angle)) * initial.rotation).normalized()
+                               : initial.rotation;
       return p;
     }
     case Motion::Type::keyframes: {

@@ -46,6 +46,23 @@ for c, p in zip(r["contacts"], r["pairs"]):
     assert len(c["point_a"]) == 3 and len(c["normal"]) == 3 and c["distance"] <= 0.1
 assert r["stats"]["node_tests"] >= r["stats"]["leaf_tests"] > 0
 PY
+# The engine's methods give caliber query the same pairs and contacts, bit for bit.
+tmpq=$(mktemp -d)
+for m in sequential stealing hybrid; do
+  "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.3 0.2 -0.2 0.9 0.1 0.3 0.2" --kind proximity \
+    --tolerance 0.3 --method $m --threads 2 --json > "$tmpq/$m.json" 2>/dev/null
+done
+python3 - "$tmpq" <<'PY' && passes=$((passes + 1)) || { echo "FAIL query-methods"; failures=$((failures + 1)); }
+import json, sys
+r = {m: json.load(open(f"{sys.argv[1]}/{m}.json")) for m in ("sequential", "stealing", "hybrid")}
+assert len(r["sequential"]["pairs"]) > 0
+for m in ("stealing", "hybrid"):
+    assert r[m]["pairs"] == r["sequential"]["pairs"], m
+    assert r[m]["contacts"] == r["sequential"]["contacts"], m
+PY
+rm -rf "$tmpq"
+check bad-method 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --method turbo
+contains bad-method "unknown method"
 check missing 2 "$cli" query "$data/nope.off" "$data/tetra.off"
 contains missing "nope.off: no such file"
 check bad-index 2 "$cli" query "$data/bad/index_range.off" "$data/tetra.off"

@@ -126,6 +126,19 @@ TEST(Motion, VelocityMovesAndTurns) {
   EXPECT_NEAR(x.y(), 0.0, 1e-12);
 }
 
+TEST(Motion, AtTimeZeroThePoseIsTheInitialOneBitForBit) {
+  const Pose initial = Pose::from_values(0.1, -2.3, 7.7, 0.9659258, 0.2312, 0.0, 0.1156);
+  Motion m;
+  m.type = Motion::Type::velocity;
+  m.linear = Eigen::Vector3d(1, 2, 3);
+  m.angular = Eigen::Vector3d(0.3, 0, 0);
+  const Pose p = pose_at(initial, m, 0.0);
+  EXPECT_EQ(p.translation, initial.translation);
+  EXPECT_EQ(p.rotation.coeffs(), initial.rotation.coeffs());
+  m.angular = Eigen::Vector3d::Zero();
+  EXPECT_EQ(pose_at(initial, m, 5.0).rotation.coeffs(), initial.rotation.coeffs()) << "translation only";
+}
+
 TEST(Motion, KeyframesInterpolateWithSlerpAndHold) {
   Motion m;
   m.type = Motion::Type::keyframes;
