@@ -183,8 +183,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
                             std::vector<QueryResult>& results, ScheduleRecord& record) {
   const std::size_t n = tasks.size();
   const int threads = mOptions.threads;
-  auto& workers = mImpl->workers;
-  for (WorkerSlots& w : workers) w.reset(n);
+  auto& workers = mImpl->workers;  // already reset for this step by Engine::step
   auto phase = Clock::now();
 
   // 1. Weights of the initial tasks. A priori: the root's geometric estimate. Hybrid: the pair's node
