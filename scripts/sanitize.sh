@@ -7,11 +7,11 @@ kind="${1:-thread}"
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/fetch_meshes.sh" >/dev/null
 cmake -S "$root" -B "$root/build-$kind" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALIBER_SANITIZE="$kind" -DCALIBER_BUILD_BENCH=OFF >/dev/null
-cmake --build "$root/build-$kind" -j "${JOBS:-2}" --target caliber_tests caliber_cli
+cmake --build "$root/build-$kind" -j "${JOBS:-2}" --target all
 cd "$root/build-$kind"
 if [ "$kind" = thread ]; then
   export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
-  ctest --output-on-failure -j "${JOBS:-2}" -R "Engine|World|QueryOracle"
+  ctest --output-on-failure -j "${JOBS:-2}" -R "Engine|World|QueryOracle|Executor|Concurrency"
 else
   export ASAN_OPTIONS="detect_leaks=1 halt_on_error=1"
   export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp"

@@ -8,6 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libfcl-dev      # benchmarks only: the peer comparison against FCL
   libcgal-demo    # CGAL's mesh collection, extracted by scripts/fetch_meshes.sh
+  clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,9 +1,6 @@
 // The query front-end: one object pair, one traversal, and the brute-force oracle beside it.
 
 #include <algorithm>
-
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 #include <cmath>
 #include <string>
 
@@ -11,6 +8,7 @@
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
+#include "parallel/executor.h"
 
 namespace caliber {
 
@@ -84,8 +82,8 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   const Model& mb = ctx.b();
   // Each candidate's verdict depends only on the sorted list: decided in parallel, kept in order.
   std::vector<char> keep(sorted.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sorted.size(), grain), [&](const tbb::blocked_range<std::size_t>& r) {
-  for (std::size_t i = r.begin(); i != r.end(); ++i) {
+  parallel::parallel_for(0, sorted.size(), grain, [&](std::size_t lo, std::size_t hi) {
+  for (std::size_t i = lo; i != hi; ++i) {
     const Candidate& c = sorted[i];
     bool dominated = false;
     for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
@@ -109,14 +107,14 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
 }  // namespace
 
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
-  // Serial unless asked: a grain as large as the input keeps tbb::parallel_for on this thread.
+  // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
   const std::size_t grain = parallel ? kParallelGrain : std::max<std::size_t>(candidates.size(), 1);
   QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && candidates.size() >= kParallelGrain) {
-    tbb::parallel_sort(candidates.begin(), candidates.end(), by_ids);
+    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
   } else {
     std::sort(candidates.begin(), candidates.end(), by_ids);
   }
@@ -133,8 +131,8 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   const Pose& pose = ctx.pose_a();
   const Eigen::Matrix3d ra = pose.rotation_matrix();
   result.contacts.resize(candidates.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), grain), [&](const tbb::blocked_range<std::size_t>& r) {
-  for (std::size_t i = r.begin(); i != r.end(); ++i) {
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+  for (std::size_t i = lo; i != hi; ++i) {
     const Candidate& c = candidates[i];
     Contact contact;
     contact.tri_a = c.tri_a;

@@ -1,8 +1,9 @@
 // The engine: one traversal (narrow/traversal.h), several ways to cut and schedule it.
 //   sequential    the initial tasks one after another on the calling thread
-//   exploitation  tbb::parallel_for over the initial tasks, one task per pair
-//   stealing      every pair's CD tree split recursively into tbb tasks down to a depth, then
+//   exploitation  a parallel loop over the initial tasks, one task per pair
+//   stealing      every pair's CD tree split recursively into tasks down to a depth, then
 //                 traversed depth first; oneTBB's scheduler steals the pieces
+// Threads are reached only through parallel/executor.h (oneTBB, or std::thread for TSan).
 // All of them end with the same per-pair finalization and the same reduction, so the contacts
 // do not depend on the method or the thread count.
 
@@ -17,13 +18,9 @@
 #include <string>
 #include <thread>
 
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-#include <tbb/task_group.h>
-
 #include "caliber/error.h"
 #include "narrow/pair_context.h"
+#include "parallel/executor.h"
 #include "narrow/traversal.h"
 #include "tasks/calibration.h"
 #include "tasks/weights.h"
@@ -52,7 +49,7 @@ struct WorkerSlots {
   }
 };
 
-using Workers = tbb::enumerable_thread_specific<WorkerSlots>;
+using Workers = parallel::PerThread<WorkerSlots>;
 
 /// This thread's slots, sized for `pairs` (a thread that joins mid-step starts with empty slots).
 WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
@@ -67,16 +64,17 @@ template <class Start>
 void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& workers, std::vector<QueryResult>& results,
                     Start start) {
   const std::size_t n = contexts.size();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+  const std::vector<WorkerSlots*> slots = workers.all();
+  parallel::parallel_for(0, n, 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) {
       std::vector<narrow::Candidate> all;
       QueryStats stats;
       start(i, all, stats);
-      for (WorkerSlots& w : workers) {
-        if (w.stats.size() != n) continue;
-        all.insert(all.end(), w.candidates[i].begin(), w.candidates[i].end());
-        stats.node_tests += w.stats[i].node_tests;
-        stats.leaf_tests += w.stats[i].leaf_tests;
+      for (const WorkerSlots* w : slots) {
+        if (w->stats.size() != n) continue;
+        all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
+        stats.node_tests += w->stats[i].node_tests;
+        stats.leaf_tests += w->stats[i].leaf_tests;
       }
       results[i] = narrow::finalize(contexts[i], all, stats, /*parallel=*/true);
     }
@@ -110,8 +108,8 @@ Method parse_method(std::string_view name) {
 }
 
 struct Engine::Impl {
-  explicit Impl(int threads) : arena(threads) {}
-  tbb::task_arena arena;
+  explicit Impl(int threads) : executor(threads) {}
+  parallel::Executor executor;
   Workers workers;
   /// Temporal state: node tests of each object pair at its last step. Changes only how work is cut.
   std::map<Task, std::uint64_t> history;
@@ -168,7 +166,7 @@ void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, 
   }
   narrow::NodePair kids[4];
   const int count = narrow::cd_children(ctx.a(), ctx.b(), n, kids);
-  tbb::task_group group;
+  parallel::TaskGroup group;
   for (int i = 1; i < count; ++i) {
     const narrow::NodePair kid = kids[i];
     group.run([&ctx, pair, pairs, kid, depth, cutoff, &workers] { steal(ctx, pair, pairs, kid, depth + 1, cutoff, workers); });
@@ -190,7 +188,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   //    tests at the previous step, and node weights rescaled by N(t-1) / w~root(t); a pair with no
   //    history is rescaled by the ratio measured over the pairs that have one (1 if none has).
   std::vector<double> root(n), weight(n), scale(n, 1.0);
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) { root[i] = tasks::apriori_weight(contexts[i], {0, 0}); });
+  parallel::parallel_for_each(0, n, [&](std::size_t i) { root[i] = tasks::apriori_weight(contexts[i], {0, 0}); });
   if (mOptions.method == Method::hybrid || mOptions.method == Method::aposteriori) {
     double measured = 0.0, estimated = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -234,7 +232,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     // Sub-task roots from last step's summary tree; nothing is tested here. A task without
     // reported pairs last step cannot be split (the metric's known blind spot) and runs whole.
     std::vector<tasks::PosterioriSplit> chosen(to_split.size());
-    tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
+    parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
       const std::size_t i = to_split[s];
       const auto it = mImpl->reported.find(tasks[i]);
       if (it == mImpl->reported.end()) return;
@@ -269,7 +267,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
     splits.clear();
   } else {
     const bool history = mOptions.method == Method::hybrid && mOptions.node_history;
-    tbb::parallel_for(std::size_t{0}, to_split.size(), [&](std::size_t s) {
+    parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
       const std::size_t i = to_split[s];
       const tasks::NodeCounts* measured = nullptr;
       if (history) {
@@ -303,8 +301,8 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   for (std::size_t s = 0; s < splits.size(); ++s) stage_root_tests[s].assign(splits[s].stage.size(), 0);
   std::vector<std::vector<std::uint64_t>> sub_tests(taboos.size());
   for (std::size_t t = 0; t < taboos.size(); ++t) sub_tests[t].assign(taboos[t].nodes.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, run.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t t = r.begin(); t != r.end(); ++t) {
+  parallel::parallel_for(0, run.size(), 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t t = lo; t != hi; ++t) {
       WorkerSlots& w = local_slots(workers, n);
       std::uint64_t tests = 0;
       for (const tasks::Root& root_ref : run[t].roots) {
@@ -393,7 +391,7 @@ StepResult Engine::step(int k) {
   std::vector<QueryResult> results(tasks.size());
   const auto n = tasks.size();
   auto& workers = mImpl->workers;
-  for (WorkerSlots& w : workers) w.reset(n);
+  workers.for_each([n](WorkerSlots& w) { w.reset(n); });
   const auto run_pair = [&](std::size_t i) {
     WorkerSlots& w = local_slots(workers, n);
     narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], w.stats[i]);
@@ -405,15 +403,15 @@ StepResult Engine::step(int k) {
       for (std::size_t i = 0; i < n; ++i) run_pair(i);
       break;
     case Method::exploitation:
-      mImpl->arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t i = r.begin(); i != r.end(); ++i) run_pair(i);
+      mImpl->executor.execute([&] {
+        parallel::parallel_for(0, n, 1, [&](std::size_t lo, std::size_t hi) {
+          for (std::size_t i = lo; i != hi; ++i) run_pair(i);
         });
       });
       break;
     case Method::stealing: {
-      mImpl->arena.execute([&] {
-        tbb::task_group group;
+      mImpl->executor.execute([&] {
+        parallel::TaskGroup group;
         for (std::size_t i = 0; i < n; ++i) {
           group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers); });
         }
@@ -422,10 +420,10 @@ StepResult Engine::step(int k) {
         const auto finalize_start = Clock::now();
         finalize_pairs(contexts, workers, results, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
         out.schedule.finalize_ms = ms_since(finalize_start);
-        for (WorkerSlots& w : workers) {
+        workers.for_each([&](const WorkerSlots& w) {
           out.schedule.task_node_tests.insert(out.schedule.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
           out.schedule.split_node_tests += w.split_node_tests;
-        }
+        });
         // Pieces were collected per worker; sort them so the record does not depend on who ran what.
         std::sort(out.schedule.task_node_tests.begin(), out.schedule.task_node_tests.end(), std::greater<>());
       });
@@ -434,18 +432,18 @@ StepResult Engine::step(int k) {
     case Method::aposteriori:
     case Method::apriori:
     case Method::hybrid:
-      mImpl->arena.execute([&] { run_calibrated(tasks, contexts, results, out.schedule); });
+      mImpl->executor.execute([&] { run_calibrated(tasks, contexts, results, out.schedule); });
       break;
   }
   if (mOptions.method == Method::aposteriori) {
     for (std::size_t i = 0; i < n; ++i) mImpl->reported[tasks[i]] = results[i].pairs;
   }
-  for (const WorkerSlots& w : workers) {
-    if (w.stats.size() != n) continue;
+  workers.for_each([&](const WorkerSlots& w) {
+    if (w.stats.size() != n) return;
     std::uint64_t tests = 0;
     for (const QueryStats& st : w.stats) tests += st.node_tests;
     if (tests > 0) out.schedule.thread_node_tests.push_back(tests);
-  }
+  });
   std::sort(out.schedule.thread_node_tests.begin(), out.schedule.thread_node_tests.end(), std::greater<>());
   if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
     for (const QueryResult& r : results) out.schedule.task_node_tests.push_back(r.stats.node_tests);

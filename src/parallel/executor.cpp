@@ -1,0 +1,195 @@
+#include "parallel/executor.h"
+
+#include <algorithm>
+
+#include "caliber/error.h"
+
+#ifdef CALIBER_EXECUTOR_STD
+#include <condition_variable>
+#include <deque>
+#endif
+
+namespace caliber::parallel {
+
+#ifdef CALIBER_EXECUTOR_STD
+
+std::string_view backend() { return "std::thread"; }
+
+/// The std backend: threads - 1 workers and one shared queue; a thread waiting on a TaskGroup runs
+/// queued tasks meanwhile (newest first, so it tends to finish its own children), idle workers take
+/// the oldest (the biggest pieces of a recursive split). Every hand-off goes through `mutex`.
+struct Executor::Pool {
+  struct Job {
+    std::function<void()> fn;
+    TaskGroup* group;
+  };
+
+  std::mutex mutex;
+  std::condition_variable changed;  ///< a job was queued, a group finished, or the pool stops
+  std::deque<Job> queue;
+  bool stop = false;
+  std::vector<std::thread> workers;
+
+  /// Runs a job taken off the queue (lock not held) and signs it off in its group.
+  void run_job(Job& job) {
+    std::exception_ptr error;
+    try {
+      job.fn();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    job.fn = nullptr;
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (error && !job.group->mError) job.group->mError = error;
+    // The group's owner may destroy it as soon as the lock is released: nothing touches it after.
+    if (--job.group->mPending == 0) changed.notify_all();
+  }
+
+  void work();
+};
+
+namespace {
+/// The pool the calling thread works for: set for workers, and for a caller inside execute().
+thread_local Executor::Pool* t_pool = nullptr;
+}  // namespace
+
+void Executor::Pool::work() {
+  t_pool = this;
+  std::unique_lock<std::mutex> lock(mutex);
+  for (;;) {
+    changed.wait(lock, [&] { return stop || !queue.empty(); });
+    if (queue.empty()) return;  // stopping, nothing left
+    Job job = std::move(queue.front());
+    queue.pop_front();
+    lock.unlock();
+    run_job(job);
+    lock.lock();
+  }
+}
+
+Executor::Executor(int threads) : mThreads(threads), mPool(std::make_unique<Pool>()) {
+  if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
+  for (int t = 1; t < threads; ++t) mPool->workers.emplace_back([pool = mPool.get()] { pool->work(); });
+}
+
+Executor::~Executor() {
+  {
+    const std::lock_guard<std::mutex> lock(mPool->mutex);
+    mPool->stop = true;
+  }
+  mPool->changed.notify_all();
+  for (std::thread& t : mPool->workers) t.join();
+}
+
+void Executor::execute(const std::function<void()>& f) {
+  Pool* const previous = t_pool;
+  t_pool = mPool.get();
+  try {
+    f();
+  } catch (...) {
+    t_pool = previous;
+    throw;
+  }
+  t_pool = previous;
+}
+
+TaskGroup::TaskGroup() : mPool(t_pool) {}
+
+TaskGroup::~TaskGroup() {
+  try {
+    wait();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): an unwaited group's error has nowhere to go
+  }
+}
+
+void TaskGroup::run(std::function<void()> f) {
+  if (mPool == nullptr) {  // outside any executor: run it now
+    try {
+      f();
+    } catch (...) {
+      if (!mError) mError = std::current_exception();
+    }
+    return;
+  }
+  {
+    const std::lock_guard<std::mutex> lock(mPool->mutex);
+    ++mPending;
+    mPool->queue.push_back(Executor::Pool::Job{std::move(f), this});
+  }
+  mPool->changed.notify_one();
+}
+
+void TaskGroup::wait() {
+  std::exception_ptr error;
+  if (mPool != nullptr) {
+    std::unique_lock<std::mutex> lock(mPool->mutex);
+    while (mPending > 0) {
+      if (mPool->queue.empty()) {
+        mPool->changed.wait(lock);
+        continue;
+      }
+      Executor::Pool::Job job = std::move(mPool->queue.back());
+      mPool->queue.pop_back();
+      lock.unlock();
+      mPool->run_job(job);
+      lock.lock();
+    }
+    error = std::exchange(mError, nullptr);
+  } else {
+    error = std::exchange(mError, nullptr);
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
+                  const std::function<void(std::size_t, std::size_t)>& body) {
+  if (begin >= end) return;
+  grain = std::max<std::size_t>(grain, 1);
+  if (end - begin <= grain) {
+    body(begin, end);
+    return;
+  }
+  const std::size_t length = end - begin;
+  const std::size_t chunks = (length + grain - 1) / grain;
+  TaskGroup group;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const std::size_t lo = begin + length * c / chunks, hi = begin + length * (c + 1) / chunks;
+    group.run([&body, lo, hi] { body(lo, hi); });
+  }
+  group.wait();
+}
+
+#else  // oneTBB
+
+std::string_view backend() { return "oneTBB"; }
+
+Executor::Executor(int threads) : mThreads(threads), mArena(std::max(threads, 1)) {
+  if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
+}
+
+Executor::~Executor() = default;
+
+void Executor::execute(const std::function<void()>& f) { mArena.execute(f); }
+
+TaskGroup::TaskGroup() = default;
+TaskGroup::~TaskGroup() = default;
+
+void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
+                  const std::function<void(std::size_t, std::size_t)>& body) {
+  if (begin >= end) return;
+  grain = std::max<std::size_t>(grain, 1);
+  if (end - begin <= grain) {
+    body(begin, end);
+    return;
+  }
+  // simple_partitioner: split down to the grain. The default (auto) partitioner stops splitting
+  // early when nobody steals, so a thread would run ~16 consecutive run-time tasks as one chunk and
+  // the heaviest-first order would not be the greedy list schedule it is meant to be.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
+                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); },
+                    tbb::simple_partitioner());
+}
+
+#endif
+
+}  // namespace caliber::parallel

@@ -1,0 +1,176 @@
+#pragma once
+/// \file
+/// The one seam between "what tasks to run" and "how to run them": every parallel construct in
+/// caliber goes through this header. Two backends, chosen when the library is built:
+///   - oneTBB (default): a tbb::task_arena of exactly N threads, tbb::parallel_for, tbb::task_group
+///     (work stealing), tbb::enumerable_thread_specific. These wrappers add nothing on hot paths.
+///   - std::thread (`-DCALIBER_EXECUTOR=std`, forced by `-DCALIBER_SANITIZE=thread`): a small pool
+///     whose every synchronization is a std::mutex / std::condition_variable, so ThreadSanitizer
+///     sees all of it. Debian's libtbb is not instrumented: under TSan its own hand-offs look like
+///     races, which would hide the real ones in caliber. Slower, and not work stealing in the
+///     strict sense (waiting threads help from one shared queue), but it runs the same code paths.
+/// Results never depend on the backend or on the schedule (tested in both builds).
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#ifdef CALIBER_EXECUTOR_STD
+#include <algorithm>
+#include <exception>
+#include <list>
+#include <map>
+#include <mutex>
+#include <thread>
+#else
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+#endif
+
+namespace caliber::parallel {
+
+/// "oneTBB" or "std::thread": the backend this library was built with.
+[[nodiscard]] std::string_view backend();
+
+/// A fixed set of `threads` threads (the caller of execute() being one of them). Parallel work
+/// started inside execute() — parallel_for, TaskGroup — runs on them and on no other thread.
+class Executor {
+ public:
+  /// `threads` >= 1.
+  explicit Executor(int threads);
+  ~Executor();
+  Executor(const Executor&) = delete;
+  Executor& operator=(const Executor&) = delete;
+
+  /// The number of threads, the caller included.
+  [[nodiscard]] int threads() const { return mThreads; }
+
+  /// Runs `f` on the calling thread, joined by the executor's other threads until it returns.
+  /// Exceptions thrown by `f` (or by tasks it waits for) propagate to the caller.
+  void execute(const std::function<void()>& f);
+
+ private:
+  int mThreads;
+#ifdef CALIBER_EXECUTOR_STD
+ public:
+  struct Pool;
+
+ private:
+  std::unique_ptr<Pool> mPool;
+#else
+  tbb::task_arena mArena;
+#endif
+};
+
+/// A set of tasks run in parallel (on the executor the caller runs in) and waited for together.
+/// Outside any executor, run() calls the task at once (std backend) or on oneTBB's default arena.
+class TaskGroup {
+ public:
+  TaskGroup();
+  ~TaskGroup();
+  TaskGroup(const TaskGroup&) = delete;
+  TaskGroup& operator=(const TaskGroup&) = delete;
+
+#ifdef CALIBER_EXECUTOR_STD
+  /// Queues `f`; the first exception a task throws is rethrown by wait().
+  void run(std::function<void()> f);
+  /// Waits for every task run() so far, helping to run queued tasks meanwhile.
+  void wait();
+
+ private:
+  Executor::Pool* mPool;
+  std::size_t mPending = 0;  ///< guarded by the pool's mutex
+  std::exception_ptr mError;  ///< guarded by the pool's mutex
+  friend struct Executor::Pool;
+#else
+  template <class F>
+  void run(F&& f) {
+    mGroup.run(std::forward<F>(f));
+  }
+  void wait() { mGroup.wait(); }
+
+ private:
+  tbb::task_group mGroup;
+#endif
+};
+
+/// Calls body(lo, hi) on disjoint chunks covering [begin, end), each at most `grain` long (and at
+/// least grain / 2 where the range allows), in parallel on the current executor. A range no longer
+/// than `grain` runs at once on the calling thread.
+void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
+                  const std::function<void(std::size_t, std::size_t)>& body);
+
+/// Calls f(i) for every i in [begin, end), in parallel; the backend picks the chunk sizes.
+template <class F>
+void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {
+#ifdef CALIBER_EXECUTOR_STD
+  parallel_for(begin, end, 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) f(i);
+  });
+#else
+  if (begin < end) tbb::parallel_for(begin, end, std::forward<F>(f));
+#endif
+}
+
+/// Sorts [first, last) by `less`, in parallel where the backend can (std backend: one thread).
+/// Only for orders where no two elements compare equal, so that the result is unique.
+template <class It, class Less>
+void parallel_sort(It first, It last, Less less) {
+#ifdef CALIBER_EXECUTOR_STD
+  std::sort(first, last, less);
+#else
+  tbb::parallel_sort(first, last, less);
+#endif
+}
+
+/// One T per thread that asked for it: local() is the calling thread's (default-constructed on
+/// first use), for_each() visits all of them. local() may be called concurrently; for_each() only
+/// while no thread calls local().
+template <class T>
+class PerThread {
+ public:
+  T& local() {
+#ifdef CALIBER_EXECUTOR_STD
+    const std::lock_guard<std::mutex> lock(mMutex);
+    auto [it, inserted] = mSlots.try_emplace(std::this_thread::get_id(), nullptr);
+    if (inserted) it->second = &mStorage.emplace_back();
+    return *it->second;
+#else
+    return mSlots.local();
+#endif
+  }
+
+  template <class F>
+  void for_each(F&& f) {
+#ifdef CALIBER_EXECUTOR_STD
+    const std::lock_guard<std::mutex> lock(mMutex);
+    for (T& t : mStorage) f(t);
+#else
+    for (T& t : mSlots) f(t);
+#endif
+  }
+
+  /// Pointers to every thread's T, for reading them from several threads at once.
+  std::vector<T*> all() {
+    std::vector<T*> out;
+    for_each([&](T& t) { out.push_back(&t); });
+    return out;
+  }
+
+ private:
+#ifdef CALIBER_EXECUTOR_STD
+  std::mutex mMutex;
+  std::map<std::thread::id, T*> mSlots;
+  std::list<T> mStorage;
+#else
+  tbb::enumerable_thread_specific<T> mSlots;
+#endif
+};
+
+}  // namespace caliber::parallel

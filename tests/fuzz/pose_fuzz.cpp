@@ -1,0 +1,45 @@
+// Fuzz target: the pose parser ("tx ty tz qw qx qy qz"), Pose::from_values on raw doubles, and the
+// query request check. What they accept must be finite with a unit quaternion.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
+#include "caliber/error.h"
+#include "caliber/pose.h"
+#include "caliber/query.h"
+#include "fuzz_target.h"
+
+namespace {
+
+void check(const caliber::Pose& p) {
+  // Anything accepted must be usable: finite, unit quaternion (validate_pose throws otherwise,
+  // which here is a finding, not bad input).
+  caliber::validate_pose(p, "accepted pose");
+  if (!p.apply(Eigen::Vector3d(1, 2, 3)).allFinite()) std::abort();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    check(caliber::parse_pose(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz"));
+  } catch (const caliber::Error&) {
+  }
+  if (size >= 7 * sizeof(double)) {
+    double v[9] = {};
+    std::memcpy(v, data, std::min(size, sizeof v));
+    try {
+      check(caliber::Pose::from_values(v[0], v[1], v[2], v[3], v[4], v[5], v[6], "fuzz"));
+    } catch (const caliber::Error&) {
+    }
+    try {
+      caliber::validate_request(caliber::QueryRequest{caliber::QueryKind::contact, v[7], v[8], nullptr});
+      if (!(v[7] >= 0 && std::isfinite(v[7]) && v[8] >= 0 && v[8] <= 180)) std::abort();
+    } catch (const caliber::Error&) {
+    }
+  }
+  return 0;
+}

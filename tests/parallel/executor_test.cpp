@@ -1,0 +1,132 @@
+// The executor seam (src/parallel/executor.h), whichever backend this build has: every index once,
+// nested task groups, exceptions reaching wait(), and never more threads at once than asked for.
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/error.h"
+#include "parallel/executor.h"
+
+namespace caliber::parallel {
+namespace {
+
+/// Counts how many threads are inside a region at once, and the most seen.
+struct Occupancy {
+  std::atomic<int> now{0}, peak{0};
+  void enter() {
+    const int n = ++now;
+    int p = peak.load();
+    while (n > p && !peak.compare_exchange_weak(p, n)) {
+    }
+  }
+  void leave() { --now; }
+};
+
+TEST(Executor, ParallelForCoversEveryIndexOnce) {
+  for (const int threads : {1, 2, 4}) {
+    Executor executor(threads);
+    for (const std::size_t grain : {std::size_t{1}, std::size_t{3}, std::size_t{64}, std::size_t{5000}}) {
+      std::vector<std::atomic<int>> hits(1000);
+      executor.execute([&] {
+        parallel_for(0, hits.size(), grain, [&](std::size_t lo, std::size_t hi) {
+          EXPECT_LT(lo, hi);
+          EXPECT_LE(hi - lo, grain);
+          for (std::size_t i = lo; i != hi; ++i) ++hits[i];
+        });
+      });
+      for (std::size_t i = 0; i < hits.size(); ++i) ASSERT_EQ(hits[i].load(), 1) << "index " << i << " grain " << grain;
+    }
+    std::vector<std::atomic<int>> each(777);
+    executor.execute([&] { parallel_for_each(0, each.size(), [&](std::size_t i) { ++each[i]; }); });
+    for (const auto& h : each) ASSERT_EQ(h.load(), 1);
+    parallel_for(5, 5, 1, [](std::size_t, std::size_t) { FAIL() << "an empty range runs nothing"; });
+  }
+}
+
+long fib(int n) {
+  if (n < 2) return n;
+  long a = 0, b = 0;
+  TaskGroup group;
+  group.run([&] { a = fib(n - 1); });
+  b = fib(n - 2);
+  group.wait();
+  return a + b;
+}
+
+TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
+  for (const int threads : {1, 2, 3, 8}) {
+    Executor executor(threads);
+    EXPECT_EQ(executor.threads(), threads);
+    long result = 0;
+    executor.execute([&] { result = fib(18); });
+    EXPECT_EQ(result, 2584);
+    Occupancy occupancy;
+    executor.execute([&] {
+      parallel_for(0, 64, 1, [&](std::size_t, std::size_t) {
+        occupancy.enter();
+        volatile double x = 0;
+        for (int i = 0; i < 20000; ++i) x = x + 1.0;
+        occupancy.leave();
+      });
+    });
+    EXPECT_LE(occupancy.peak.load(), threads);
+    EXPECT_GE(occupancy.peak.load(), 1);
+  }
+  EXPECT_EQ(fib(12), 144) << "task groups work outside any executor too";
+}
+
+TEST(Executor, ExceptionsReachTheWaiter) {
+  Executor executor(3);
+  EXPECT_THROW(executor.execute([] {
+    TaskGroup group;
+    for (int i = 0; i < 20; ++i) group.run([i] {
+      if (i == 7) throw std::runtime_error("task 7");
+    });
+    group.wait();
+  }), std::runtime_error);
+  EXPECT_THROW(executor.execute([] {
+    parallel_for(0, 100, 1, [](std::size_t lo, std::size_t) {
+      if (lo == 42) throw std::runtime_error("chunk 42");
+    });
+  }), std::runtime_error);
+  // The executor is still usable afterwards.
+  std::atomic<int> sum{0};
+  executor.execute([&] { parallel_for_each(0, 100, [&](std::size_t i) { sum += static_cast<int>(i); }); });
+  EXPECT_EQ(sum.load(), 4950);
+  EXPECT_THROW(Executor(0), Error);
+}
+
+TEST(Executor, PerThreadSlotsAreDistinct) {
+  Executor executor(4);
+  PerThread<std::vector<std::size_t>> slots;
+  executor.execute([&] {
+    parallel_for(0, 500, 1, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) slots.local().push_back(i);
+    });
+  });
+  std::vector<std::size_t> all;
+  std::size_t used = 0;
+  slots.for_each([&](const std::vector<std::size_t>& s) {
+    all.insert(all.end(), s.begin(), s.end());
+    ++used;
+  });
+  EXPECT_GE(used, 1u);
+  EXPECT_EQ(slots.all().size(), used);
+  std::sort(all.begin(), all.end());
+  std::vector<std::size_t> want(500);
+  std::iota(want.begin(), want.end(), std::size_t{0});
+  EXPECT_EQ(all, want);
+  std::vector<int> v(3000);
+  std::iota(v.rbegin(), v.rend(), 0);
+  parallel_sort(v.begin(), v.end(), std::less<>());
+  EXPECT_TRUE(std::is_sorted(v.begin(), v.end()));
+  EXPECT_FALSE(backend().empty());
+}
+
+}  // namespace
+}  // namespace caliber::parallel

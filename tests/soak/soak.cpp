@@ -1,0 +1,142 @@
+// Soak: runs one engine over many steps of a world whose objects keep touching (pure rotations),
+// and checks that (1) peak memory stays flat: VmHWM after the last step is within 2 % + 1 MiB of
+// VmHWM after step 1,000, and (2) the engine's answer at sampled steps, after thousands of steps
+// of temporal state, is byte-identical to a fresh engine's and to World::step at the same step.
+//   caliber_soak [--steps N] [--method NAME] [--threads T] [--node-history]
+// Exit 0: flat and identical; 1: a check failed; 2: bad arguments.
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+#include "caliber/engine.h"
+#include "caliber/error.h"
+#include "caliber/mesh.h"
+#include "caliber/procedural.h"
+#include "caliber/world.h"
+
+namespace {
+
+/// A field of /proc/self/status in KiB (VmRSS, VmHWM), or -1 where there is none.
+long status_kib(const std::string& field) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(field + ":", 0) == 0) return std::strtol(line.c_str() + field.size() + 1, nullptr, 10);
+  }
+  return -1;
+}
+
+bool same(const caliber::StepResult& a, const caliber::StepResult& b) {
+  if (a.contacts.size() != b.contacts.size() || a.tasks.size() != b.tasks.size()) return false;
+  for (std::size_t i = 0; i < a.tasks.size(); ++i) {
+    if (!(a.tasks[i].task == b.tasks[i].task)) return false;
+  }
+  for (std::size_t i = 0; i < a.contacts.size(); ++i) {
+    const auto& x = a.contacts[i];
+    const auto& y = b.contacts[i];
+    if (x.object_a != y.object_a || x.object_b != y.object_b || x.contact.tri_a != y.contact.tri_a ||
+        x.contact.tri_b != y.contact.tri_b || x.contact.distance != y.contact.distance ||
+        x.contact.point_a != y.contact.point_a || x.contact.point_b != y.contact.point_b ||
+        x.contact.normal != y.contact.normal) {
+      return false;
+    }
+  }
+  return true;
+}
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;  // the sanitizers' allocators hold freed memory back on purpose
+#else
+constexpr bool kSanitized = false;
+#endif
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int steps = 10000, threads = 2;
+  caliber::EngineOptions options;
+  options.method = caliber::Method::hybrid;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      const auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw caliber::Error(caliber::ErrorCode::bad_argument, arg, "needs a value");
+        return argv[++i];
+      };
+      if (arg == "--steps") steps = std::stoi(value());
+      else if (arg == "--threads") threads = std::stoi(value());
+      else if (arg == "--method") options.method = caliber::parse_method(value());
+      else if (arg == "--node-history") options.node_history = true;
+      else throw caliber::Error(caliber::ErrorCode::bad_argument, arg, "unknown argument");
+    }
+    if (steps < 1000) throw caliber::Error(caliber::ErrorCode::bad_value, "--steps", "must be >= 1000");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "caliber_soak: %s\n", e.what());
+    return 2;
+  }
+  options.threads = threads;
+
+  const auto dir = std::filesystem::temp_directory_path() / ("caliber-soak-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  caliber::save_off(caliber::make_box(0.5, 0.5, 0.5, 6), dir / "box.off");
+  caliber::save_off(caliber::make_sphere(0.6, 16, 24), dir / "sphere.off");
+  caliber::save_off(caliber::make_torus(0.8, 0.25, 32, 16), dir / "torus.off");
+  // Rotations only, so contacts come and go forever without anything drifting away. The box spins
+  // against the sphere; the torus tumbles around the sphere, touching it and the box by turns.
+  const caliber::World world(caliber::parse_scene(R"({"name": "soak", "dt": 0.01,
+    "query": {"kind": "contact", "tolerance": 0.02, "angle": 30}, "objects": [
+      {"name": "box", "mesh": "box.off", "motion": {"type": "velocity", "angular": [0, 0, 2.1]}},
+      {"name": "ball", "mesh": "sphere.off", "position": [1.05, 0, 0], "motion": {"type": "velocity", "angular": [0.7, 0.3, 0]}},
+      {"name": "ring", "mesh": "torus.off", "position": [1.05, 0.1, 0], "motion": {"type": "velocity", "angular": [0.31, 1.3, 0.2]}}]})",
+                                                  dir, "soak.json"));
+  std::filesystem::remove_all(dir);
+
+  caliber::Engine engine(world, options);
+  const auto start = std::chrono::steady_clock::now();
+  long hwm_1000 = -1;
+  std::size_t contacts = 0, mismatches = 0, samples = 0;
+  for (int k = 0; k < steps; ++k) {
+    const caliber::StepResult got = engine.step(k);
+    contacts += got.contacts.size();
+    if (k % 1000 == 999 || k == steps - 1) {
+      caliber::EngineOptions fresh_options = options;
+      caliber::Engine fresh(world, fresh_options);
+      const bool ok = same(got, fresh.step(k)) && same(got, world.step(k));
+      ++samples;
+      if (!ok) ++mismatches;
+      std::printf("step %5d: %zu contacts, VmRSS %ld KiB, VmHWM %ld KiB%s\n", k + 1, got.contacts.size(),
+                  status_kib("VmRSS"), status_kib("VmHWM"), ok ? "" : "  MISMATCH with a fresh run");
+      std::fflush(stdout);
+    }
+    if (k == 999) hwm_1000 = status_kib("VmHWM");
+  }
+  const long hwm_end = status_kib("VmHWM");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%d steps of %s on %d thread(s) in %.1f s, %zu contacts in all\n", steps,
+              std::string(caliber::to_string(options.method)).c_str(), engine.threads(), seconds, contacts);
+  bool failed = false;
+  if (contacts == 0) {
+    std::printf("FAIL: no contacts at all; the soak tested nothing\n");
+    failed = true;
+  }
+  if (mismatches > 0) {
+    std::printf("FAIL: %zu of %zu sampled steps differ from a fresh run\n", mismatches, samples);
+    failed = true;
+  }
+  const long allowed = hwm_1000 + hwm_1000 / 50 + 1024;
+  if (kSanitized) {
+    std::printf("memory: VmHWM %ld -> %ld KiB (not checked under a sanitizer)\n", hwm_1000, hwm_end);
+  } else if (hwm_1000 < 0 || hwm_end > allowed) {
+    std::printf("FAIL: peak memory grew: VmHWM %ld KiB after step 1000, %ld KiB after step %d (allowed %ld)\n",
+                hwm_1000, hwm_end, steps, allowed);
+    failed = true;
+  } else {
+    std::printf("memory flat: VmHWM %ld KiB after step 1000, %ld KiB after step %d\n", hwm_1000, hwm_end, steps);
+  }
+  return failed ? 1 : 0;
+}
