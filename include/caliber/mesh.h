@@ -29,6 +29,11 @@ struct Mesh {
 /// Largest number of primitive groups (one bit each in a BVH node's mask).
 inline constexpr int kMaxGroups = 64;
 
+/// Largest magnitude caliber accepts for a vertex coordinate (after scaling), a pose translation or
+/// a query tolerance. It keeps every product in the exact predicates and every float bound in the
+/// BVH far from overflow, so that no input can turn into infinities and a silent wrong answer.
+inline constexpr double kMaxCoordinate = 1e15;
+
 /// Loads OFF, OBJ, STL (ascii and binary) or PLY through assimp.
 /// Triangle ids follow the file's face order; a polygon with n > 3 corners becomes n-2 triangles
 /// fanned from its first corner, in place. Vertices are not merged or reordered.
@@ -36,8 +41,8 @@ inline constexpr int kMaxGroups = 64;
 /// an index out of range, a face with fewer than 3 corners, or a mesh without triangles.
 [[nodiscard]] Mesh load_mesh(const std::filesystem::path& path);
 
-/// Checks the invariants every routine relies on: at least one triangle, finite coordinates,
-/// indices in range, groups (if any) one per triangle and below kMaxGroups.
+/// Checks the invariants every routine relies on: at least one triangle, finite coordinates of
+/// magnitude <= kMaxCoordinate, indices in range, groups (if any) one per triangle and below kMaxGroups.
 /// Throws caliber::Error naming `mesh.source` and the first problem found.
 void validate_mesh(const Mesh& mesh);
 

@@ -14,6 +14,7 @@
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
+#include "mesh/ply.h"
 
 namespace caliber {
 namespace {
@@ -67,6 +68,17 @@ std::string strip_log_prefix(const std::string& message) {
 
 Mesh load_mesh(const std::filesystem::path& path) {
   check_file(path);
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(5, '\0');
+    in.read(head.data(), 5);
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (mesh_io::looks_like_ply(head)) {
+      Mesh mesh = mesh_io::read_ply(path);
+      validate_mesh(mesh);
+      return mesh;
+    }
+  }
   std::lock_guard<std::mutex> lock(logger_mutex());
   Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
   auto* errors = new ErrorCollector();  // owned by the logger once attached

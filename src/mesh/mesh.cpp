@@ -14,6 +14,10 @@ void validate_mesh(const Mesh& mesh) {
     if (!mesh.vertices[v].allFinite()) {
       throw Error(ErrorCode::bad_value, src, "vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
+    if (mesh.vertices[v].cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      throw Error(ErrorCode::bad_value, src,
+                  "vertex " + std::to_string(v) + " has a coordinate beyond +-1e15 (caliber's limit on coordinates)");
+    }
   }
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (const std::uint32_t index : mesh.triangles[t]) {
@@ -41,6 +45,14 @@ void validate_mesh(const Mesh& mesh) {
 void scale_mesh(Mesh& mesh, double factor) {
   if (!std::isfinite(factor) || factor <= 0.0) {
     throw Error(ErrorCode::bad_value, mesh.source, "scale must be a finite number > 0");
+  }
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Eigen::Vector3d scaled = mesh.vertices[v] * factor;
+    if (!scaled.allFinite() || scaled.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      throw Error(ErrorCode::bad_value, mesh.source,
+                  "scaling by " + std::to_string(factor) + " puts vertex " + std::to_string(v) +
+                      " beyond +-1e15 (caliber's limit on coordinates)");
+    }
   }
   for (auto& v : mesh.vertices) v *= factor;
 }

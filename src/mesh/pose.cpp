@@ -1,9 +1,11 @@
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "caliber/error.h"
+#include "caliber/mesh.h"
 #include "caliber/pose.h"
 
 namespace caliber {
@@ -14,12 +16,23 @@ Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, do
   for (const double v : values) {
     if (!std::isfinite(v)) throw Error(ErrorCode::bad_value, std::string(source), "pose has a non-finite value");
   }
-  const double norm = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+  for (const double v : {tx, ty, tz}) {
+    if (std::abs(v) > kMaxCoordinate) {
+      throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
+    }
+  }
+  // Scaled before squaring, so that a huge quaternion does not overflow into a zero rotation.
+  const double largest = std::max({std::abs(qw), std::abs(qx), std::abs(qy), std::abs(qz)});
+  if (largest > 0.0) {
+    qw /= largest, qx /= largest, qy /= largest, qz /= largest;
+  }
+  const double unit_norm = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+  const double norm = largest * unit_norm;
   if (!(norm > 1e-9)) {
     throw Error(ErrorCode::bad_value, std::string(source), "quaternion is zero; a rotation needs a non-zero quaternion");
   }
   Pose pose;
-  pose.rotation = Eigen::Quaterniond(qw / norm, qx / norm, qy / norm, qz / norm);
+  pose.rotation = Eigen::Quaterniond(qw / unit_norm, qx / unit_norm, qy / unit_norm, qz / unit_norm);
   pose.translation = Eigen::Vector3d(tx, ty, tz);
   return pose;
 }
@@ -55,6 +68,9 @@ Pose parse_pose(std::string_view text, std::string_view source) {
 void validate_pose(const Pose& pose, std::string_view source) {
   if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite()) {
     throw Error(ErrorCode::bad_value, std::string(source), "pose has a non-finite value");
+  }
+  if (pose.translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+    throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
   }
   if (std::abs(pose.rotation.norm() - 1.0) > 1e-9) {
     throw Error(ErrorCode::bad_value, std::string(source), "quaternion is not unit length");

@@ -33,6 +33,9 @@ void validate_request(const QueryRequest& request) {
   if (!std::isfinite(request.tolerance) || request.tolerance < 0.0) {
     throw Error(ErrorCode::bad_value, "tolerance", "must be a finite number >= 0");
   }
+  if (request.tolerance > kMaxCoordinate) {
+    throw Error(ErrorCode::bad_value, "tolerance", "must be at most 1e15 (caliber's limit on coordinates)");
+  }
   if (!std::isfinite(request.angle_deg) || request.angle_deg < 0.0 || request.angle_deg > 180.0) {
     throw Error(ErrorCode::bad_value, "angle", "must be a number of degrees in [0, 180]");
   }

@@ -87,7 +87,14 @@ std::vector<Pose> World::poses_at(int step) const {
   std::vector<Pose> poses;
   poses.reserve(mScene.objects.size());
   const double t = step * mScene.dt;
-  for (const SceneObject& o : mScene.objects) poses.push_back(pose_at(o.pose, o.motion, t));
+  for (const SceneObject& o : mScene.objects) {
+    poses.push_back(pose_at(o.pose, o.motion, t));
+    if (!poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      throw Error(ErrorCode::bad_value, "scene " + mScene.name,
+                  "object '" + o.name + "' moves beyond +-1e15 (caliber's limit on coordinates) by step " +
+                      std::to_string(step));
+    }
+  }
   return poses;
 }
 

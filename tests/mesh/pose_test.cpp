@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include "caliber/error.h"
+#include "caliber/mesh.h"
 #include "caliber/pose.h"
+#include "caliber/query.h"
 
 namespace caliber {
 namespace {
@@ -49,6 +51,44 @@ TEST(Pose, ValidateRejectsHandBuiltBadPoses) {
   p.rotation = Eigen::Quaterniond::Identity();
   p.translation.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(validate_pose(p), Error);
+}
+
+TEST(Pose, HugeQuaternionsDoNotOverflowIntoAZeroRotation) {
+  // Squaring 1e200 overflows; the quaternion is scaled first (found while writing the pose fuzzer).
+  const Pose p = Pose::from_values(0, 0, 0, 1e200, 0, 0, 1e200);
+  EXPECT_NEAR(p.rotation.w(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(p.rotation.z(), std::sqrt(0.5), 1e-15);
+  EXPECT_NO_THROW(validate_pose(p));
+  const Pose tiny = Pose::from_values(0, 0, 0, 0, 3e-9, 4e-9, 0);
+  EXPECT_NEAR(tiny.rotation.x(), 0.6, 1e-15);
+  EXPECT_THROW((void)Pose::from_values(0, 0, 0, 1e-12, 0, 0, 0), Error) << "nearly zero";
+}
+
+TEST(Limits, CoordinatesBeyondTheLimitAreErrors) {
+  EXPECT_NO_THROW((void)Pose::from_values(kMaxCoordinate, 0, 0, 1, 0, 0, 0));
+  EXPECT_THROW((void)Pose::from_values(0, -2e15, 0, 1, 0, 0, 0), Error);
+  EXPECT_THROW((void)parse_pose("1e300 0 0 1 0 0 0"), Error);
+  Pose p;
+  p.translation.z() = 1e16;
+  EXPECT_THROW(validate_pose(p), Error);
+  QueryRequest request;
+  request.kind = QueryKind::proximity;
+  request.tolerance = 1e16;
+  EXPECT_THROW(validate_request(request), Error);
+  Mesh mesh;
+  mesh.source = "hand-built";
+  mesh.vertices = {{0, 0, 0}, {1e15, 0, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}};
+  EXPECT_NO_THROW(validate_mesh(mesh));
+  try {
+    scale_mesh(mesh, 10.0);
+    FAIL() << "scaling beyond the limit must fail";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 1"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(mesh.vertices[1].x(), 1e15) << "a failed scale leaves the mesh as it was";
+  mesh.vertices[2].y() = -1.5e15;
+  EXPECT_THROW(validate_mesh(mesh), Error);
 }
 
 }  // namespace

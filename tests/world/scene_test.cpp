@@ -7,6 +7,7 @@
 
 #include "caliber/error.h"
 #include "caliber/scene.h"
+#include "caliber/world.h"
 
 namespace caliber {
 namespace {
@@ -156,6 +157,20 @@ TEST(Motion, KeyframesInterpolateWithSlerpAndHold) {
   const Eigen::Vector3d x = mid.rotation * Eigen::Vector3d::UnitX();
   EXPECT_NEAR(std::atan2(x.y(), x.x()), 3.14159265358979323846 / 4, 1e-12) << "slerp: half of a quarter turn";
   EXPECT_NEAR(mid.rotation.norm(), 1.0, 1e-15);
+}
+
+TEST(Motion, MovingBeyondTheCoordinateLimitIsAnErrorNamingTheObject) {
+  const World world(parse_scene(R"({"name": "runaway", "dt": 1, "objects": [{"mesh": "tetra.off"},
+      {"name": "rocket", "mesh": "tetra.off", "motion": {"type": "velocity", "linear": [1e14, 0, 0]}}]})",
+                                CALIBER_TEST_DATA, "runaway.json"));
+  EXPECT_NO_THROW((void)world.poses_at(10));
+  try {
+    (void)world.step(20);
+    FAIL() << "2e15 is beyond the limit";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'rocket'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("step 20"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
