@@ -1,5 +1,7 @@
 // Mesh loading through assimp, keeping the file's face order as triangle ids.
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <mutex>
@@ -14,7 +16,7 @@
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
-#include "mesh/ply.h"
+#include "mesh/readers.h"
 
 namespace caliber {
 namespace {
@@ -70,11 +72,16 @@ Mesh load_mesh(const std::filesystem::path& path) {
   check_file(path);
   {
     std::ifstream in(path, std::ios::binary);
-    std::string head(5, '\0');
-    in.read(head.data(), 5);
+    std::string head(64, '\0');
+    in.read(head.data(), 64);
     head.resize(static_cast<std::size_t>(in.gcount()));
-    if (mesh_io::looks_like_ply(head)) {
-      Mesh mesh = mesh_io::read_ply(path);
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    // PLY and OFF: caliber's own readers (src/mesh/readers.h); assimp crashes or hangs on some bad
+    // files of both formats. Everything else goes to assimp.
+    if (mesh_io::looks_like_ply(head) || mesh_io::looks_like_off(head) || ext == ".ply" || ext == ".off") {
+      Mesh mesh = (mesh_io::looks_like_ply(head) || (ext == ".ply" && !mesh_io::looks_like_off(head))) ? mesh_io::read_ply(path)
+                                                                                                      : mesh_io::read_off(path);
       validate_mesh(mesh);
       return mesh;
     }

@@ -4,7 +4,7 @@
 // checked against the bytes that are really there before anything is allocated, and every problem
 // is an error naming the file.
 
-#include "mesh/ply.h"
+#include "mesh/readers.h"
 
 #include <algorithm>
 #include <array>

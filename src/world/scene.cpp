@@ -166,7 +166,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
   Json root;
   try {
     root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     throw Error(ErrorCode::unreadable, source, std::string("not valid JSON: ") + e.what());
   }
   r.only_keys(root, "", {"name", "steps", "dt", "query", "groups", "ignore", "objects"});

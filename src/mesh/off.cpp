@@ -1,0 +1,146 @@
+// caliber's own OFF reader. assimp's OFF importer crashes (SEGV) on some malformed files (found by
+// tests/fuzz/mesh_loader_fuzz.cpp, kept in tests/fuzz/regressions/mesh_loader/), clamps
+// out-of-range indices and stores coordinates as floats; this one is strict and keeps doubles.
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "caliber/error.h"
+#include "mesh/readers.h"
+
+namespace caliber::mesh_io {
+namespace {
+
+/// The file as lines of whitespace-separated tokens: comments ('#' to the end of the line) and
+/// blank lines dropped, each line remembering its number for error messages.
+struct Line {
+  std::size_t number;
+  std::vector<std::string_view> tokens;
+};
+
+std::vector<Line> tokenize(const std::string& data) {
+  std::vector<Line> lines;
+  std::size_t pos = 0, number = 0;
+  while (pos < data.size()) {
+    std::size_t eol = data.find('\n', pos);
+    if (eol == std::string::npos) eol = data.size();
+    ++number;
+    std::string_view text(data.data() + pos, eol - pos);
+    if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
+    Line line{number, {}};
+    std::size_t i = 0;
+    while (i < text.size()) {
+      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+      std::size_t j = i;
+      while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      if (j > i) line.tokens.push_back(text.substr(i, j - i));
+      i = j;
+    }
+    if (!line.tokens.empty()) lines.push_back(std::move(line));
+    pos = eol + 1;
+  }
+  return lines;
+}
+
+/// "OFF" and the variants whose extra per-vertex values follow x y z: ST (texture), C (colour),
+/// N (normal). "4OFF", "nOFF" (other dimensions) and binary OFF are not supported.
+bool is_header(std::string_view t) {
+  if (t.size() < 3 || t.substr(t.size() - 3) != "OFF") return false;
+  std::string_view prefix = t.substr(0, t.size() - 3);
+  if (prefix.substr(0, 2) == "ST") prefix.remove_prefix(2);
+  if (!prefix.empty() && prefix[0] == 'C') prefix.remove_prefix(1);
+  if (!prefix.empty() && prefix[0] == 'N') prefix.remove_prefix(1);
+  return prefix.empty();
+}
+
+}  // namespace
+
+bool looks_like_off(const std::string& head) {
+  std::size_t i = 0;
+  while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) ++i;
+  std::size_t j = i;
+  while (j < head.size() && std::isalnum(static_cast<unsigned char>(head[j]))) ++j;
+  return is_header(std::string_view(head).substr(i, j - i));
+}
+
+Mesh read_off(const std::filesystem::path& file) {
+  const std::string path = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto fail = [&](const std::string& why) { throw Error(ErrorCode::unreadable, path, "cannot parse mesh: " + why); };
+  const std::vector<Line> lines = tokenize(data);
+  const auto where = [&](std::size_t l) { return "line " + std::to_string(lines[l].number); };
+  const auto number = [&](std::size_t l, std::size_t k, const char* what) {
+    std::string_view t = lines[l].tokens[k];
+    if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec != std::errc() || end != t.data() + t.size()) {
+      fail(where(l) + ": '" + std::string(lines[l].tokens[k]) + "' is not " + what);
+    }
+    return v;
+  };
+  const auto count = [&](std::size_t l, std::size_t k, const char* what) -> std::uint64_t {
+    const double v = number(l, k, what);
+    if (!(v >= 0) || v != std::floor(v) || v > 4e9) fail(where(l) + ": '" + std::string(lines[l].tokens[k]) + "' is not " + what);
+    return static_cast<std::uint64_t>(v);
+  };
+
+  if (lines.empty()) fail("no content");
+  std::size_t l = 0, k = 0;
+  if (is_header(lines[0].tokens[0])) {
+    if (lines[0].tokens.size() > 1 && lines[0].tokens[1] == "BINARY") fail("binary OFF is not supported");
+    if (lines[0].tokens.size() == 1) l = 1; else k = 1;  // counts may follow the header on its line
+  } else if (lines[0].tokens[0].find("OFF") != std::string_view::npos) {
+    fail("unsupported OFF variant '" + std::string(lines[0].tokens[0]) + "'");
+  }
+  if (l >= lines.size()) fail("no vertex and face counts after the header (truncated file?)");
+  if (lines[l].tokens.size() < k + 2) fail(where(l) + ": expected the vertex and face counts");
+  const std::uint64_t nv = count(l, k, "a vertex count"), nf = count(l, k + 1, "a face count");
+  ++l;
+  // One line per vertex and per face: counts the file cannot hold fail before any allocation.
+  if (nv + nf > lines.size() - l) {
+    fail("the header announces " + std::to_string(nv) + " vertices and " + std::to_string(nf) + " faces but only " +
+         std::to_string(lines.size() - l) + " lines follow (truncated file?)");
+  }
+  Mesh mesh;
+  mesh.source = path;
+  mesh.vertices.reserve(nv);
+  for (std::uint64_t v = 0; v < nv; ++v, ++l) {
+    if (lines[l].tokens.size() < 3) fail(where(l) + ": vertex " + std::to_string(v) + " needs x y z");
+    Eigen::Vector3d p;
+    for (int c = 0; c < 3; ++c) p[c] = number(l, static_cast<std::size_t>(c), "a coordinate");
+    if (!p.allFinite()) throw Error(ErrorCode::bad_value, path, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    mesh.vertices.push_back(p);
+  }
+  for (std::uint64_t f = 0; f < nf; ++f, ++l) {
+    const std::uint64_t corners = count(l, 0, "a corner count");
+    if (corners < 3) {
+      throw Error(ErrorCode::bad_index, path,
+                  "face " + std::to_string(f) + " has " + std::to_string(corners) + " corner(s); a face needs at least 3");
+    }
+    if (lines[l].tokens.size() < corners + 1) fail(where(l) + ": face " + std::to_string(f) + " lists fewer than " + std::to_string(corners) + " corners");
+    std::vector<std::uint32_t> idx;
+    for (std::uint64_t c = 0; c < corners; ++c) {
+      const std::uint64_t i = count(l, static_cast<std::size_t>(c + 1), "a vertex index");
+      if (i >= nv) {
+        throw Error(ErrorCode::bad_index, path, "face " + std::to_string(f) + " refers to vertex " + std::to_string(i) +
+                                                    " but there are only " + std::to_string(nv));
+      }
+      idx.push_back(static_cast<std::uint32_t>(i));
+    }
+    for (std::size_t c = 1; c + 1 < idx.size(); ++c) mesh.triangles.push_back({idx[0], idx[c], idx[c + 1]});
+  }
+  if (mesh.triangles.empty()) throw Error(ErrorCode::empty_mesh, path, "mesh has no triangles");
+  return mesh;
+}
+
+}  // namespace caliber::mesh_io

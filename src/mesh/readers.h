@@ -1,0 +1,31 @@
+#pragma once
+// caliber's own readers for PLY (src/mesh/ply.cpp) and OFF (src/mesh/off.cpp): load_mesh sends
+// those formats here; assimp reads the others (OBJ, STL). Both readers are strict: every problem is
+// a caliber::Error naming the file, and no count is trusted before the bytes behind it are there.
+
+#include <filesystem>
+#include <string>
+
+#include "caliber/mesh.h"
+
+namespace caliber::mesh_io {
+
+/// True when `head` (the file's first bytes) starts with the PLY magic line.
+[[nodiscard]] bool looks_like_ply(const std::string& head);
+
+/// Reads an ascii or binary PLY file: element `vertex` (x, y, z of any numeric type) and element
+/// `face` (list `vertex_indices`, or `vertex_index`); other elements and properties are skipped.
+/// Polygons are fanned from their first corner, in file order. Throws caliber::Error naming the
+/// file on any problem; does not call validate_mesh.
+[[nodiscard]] Mesh read_ply(const std::filesystem::path& path);
+
+/// True when `head` (the file's first bytes) starts with an OFF header keyword (OFF, COFF, NOFF,
+/// CNOFF, STOFF, ...).
+[[nodiscard]] bool looks_like_off(const std::string& head);
+
+/// Reads an ascii OFF file (header keyword optional; extra per-vertex and per-face values such as
+/// colours are skipped). Polygons are fanned from their first corner, in file order. Throws
+/// caliber::Error naming the file on any problem; does not call validate_mesh.
+[[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+
+}  // namespace caliber::mesh_io
