@@ -107,6 +107,19 @@ contains run-missing "no such scene file"
 check run-bad-key 2 "$cli" run "$data/scenes/bad_key.json"
 contains run-bad-key "'objects[0].wobble': unknown key"
 check run-directory 2 "$cli" run "$data/scenes"
+# A scene whose mesh is the scene file itself; thread counts out of range.
+selfdir=$(mktemp -d)
+echo '{"objects": [{"mesh": "self.json"}, {"mesh": "self.json", "position": [0.1, 0, 0]}]}' > "$selfdir/self.json"
+check run-self 2 "$cli" run "$selfdir/self.json"
+contains run-self "self.json: cannot parse mesh"
+rm -rf "$selfdir"
+check run-threads-negative 2 "$cli" run "$data/scenes/tetras.json" --threads -1
+contains run-threads-negative "threads: must be between 1 and 1024"
+check run-threads-absurd 2 "$cli" run "$data/scenes/tetras.json" --threads 5000 --method hybrid
+check query-threads-absurd 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads 100000 --method stealing
+check run-threads-zero 0 "$cli" run "$data/scenes/tetras.json" --threads 0 --method hybrid --steps 2
+check query-far-pose 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "1e300 0 0 1 0 0 0"
+contains query-far-pose "beyond +-1e15"
 # caliber refine
 check refine 0 "$cli" refine "$data/tetra.off" "$tmp/fine.off" --levels 2
 contains refine "4 triangles"

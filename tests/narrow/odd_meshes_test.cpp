@@ -1,0 +1,97 @@
+// Meshes that are legal but unusual, from the bad-input catalog (docs/bad_input.md): duplicate
+// vertices, non-manifold edges, only degenerate triangles. Documented behaviour: all are accepted,
+// and queries on them are exact (identical to the brute-force oracle).
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/mesh.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "support/random_poses.h"
+
+namespace caliber {
+namespace {
+
+/// Every triangle with its own three vertices (as STL stores meshes): same triangles, same ids.
+Mesh as_soup(const Mesh& mesh) {
+  Mesh soup;
+  soup.source = mesh.source + " (soup)";
+  for (const auto& t : mesh.triangles) {
+    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+    for (const std::uint32_t v : t) soup.vertices.push_back(mesh.vertices[v]);
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  return soup;
+}
+
+/// `pages` triangles sharing one edge (the z axis from 0 to 1): a non-manifold edge.
+Mesh book(int pages) {
+  Mesh m;
+  m.source = "book";
+  m.vertices = {{0, 0, 0}, {0, 0, 1}};
+  for (int p = 0; p < pages; ++p) {
+    const double a = 2.0 * 3.141592653589793 * p / pages;
+    m.vertices.emplace_back(0.8 * std::cos(a), 0.8 * std::sin(a), 0.5);
+    m.triangles.push_back({0, 1, static_cast<std::uint32_t>(m.vertices.size() - 1)});
+  }
+  return m;
+}
+
+int compare_with_oracle(const Model& a, const Model& b, int poses, double spread, std::uint64_t seed, const std::string& name) {
+  std::mt19937_64 rng(seed);
+  int non_empty = 0;
+  for (int i = 0; i < poses; ++i) {
+    QueryRequest request;
+    request.kind = static_cast<QueryKind>(i % 3);
+    request.tolerance = 0.05;
+    request.angle_deg = 40.0;
+    const Pose pa = test::random_pose(rng, spread), pb = test::random_pose(rng, spread);
+    const QueryResult fast = query(a, pa, b, pb, request);
+    test::expect_identical(fast, query_brute_force(a, pa, b, pb, request), name + " pose " + std::to_string(i));
+    if (::testing::Test::HasFatalFailure()) return non_empty;
+    non_empty += fast.pairs.empty() ? 0 : 1;
+  }
+  return non_empty;
+}
+
+TEST(OddMeshes, DuplicateVerticesGiveTheSameAnswerAsSharedOnes) {
+  const Mesh torus = make_torus(0.8, 0.3, 14, 9);
+  const auto indexed = build_model(torus);
+  const auto soup = build_model(as_soup(torus));
+  const auto sphere = build_model(make_sphere(0.5, 8, 10));
+  std::mt19937_64 rng(7);
+  int non_empty = 0;
+  for (int i = 0; i < 150; ++i) {
+    QueryRequest request;
+    request.kind = static_cast<QueryKind>(i % 3);
+    request.tolerance = 0.05;
+    const Pose p = test::random_pose(rng, 0.7);
+    const QueryResult want = query(*indexed, Pose{}, *sphere, p, request);
+    // Vertices are welded by exact position for adjacency, so even the contact reduction agrees.
+    test::expect_identical(query(*soup, Pose{}, *sphere, p, request), want, "soup pose " + std::to_string(i));
+    if (HasFatalFailure()) return;
+    non_empty += want.pairs.empty() ? 0 : 1;
+  }
+  EXPECT_GT(non_empty, 30);
+  EXPECT_GT(compare_with_oracle(*soup, *sphere, 60, 0.7, 8, "soup-sphere"), 10);
+}
+
+TEST(OddMeshes, NonManifoldEdgesAreExact) {
+  const auto pages = build_model(book(9));
+  const auto sphere = build_model(make_sphere(0.4, 8, 10));
+  EXPECT_GT(compare_with_oracle(*pages, *sphere, 150, 0.5, 9, "book-sphere"), 30);
+  EXPECT_GT(compare_with_oracle(*pages, *pages, 150, 0.3, 10, "book-book"), 30);
+}
+
+TEST(OddMeshes, OnlyDegenerateTrianglesAreExact) {
+  Mesh m = load_mesh(std::filesystem::path(CALIBER_TEST_DATA) / "degenerate_only.off");
+  const auto degenerate = build_model(m);
+  const auto box = build_model(make_box(0.4, 0.4, 0.4, 2));
+  EXPECT_GT(compare_with_oracle(*degenerate, *box, 300, 0.4, 11, "degenerate-box"), 0);
+}
+
+}  // namespace
+}  // namespace caliber
