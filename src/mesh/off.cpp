@@ -19,14 +19,22 @@ namespace caliber::mesh_io {
 namespace {
 
 /// The file as lines of whitespace-separated tokens: comments ('#' to the end of the line) and
-/// blank lines dropped, each line remembering its number for error messages.
-struct Line {
-  std::size_t number;
+/// blank lines dropped, each line remembering its number for error messages. Flat arrays, so that
+/// a file of millions of lines costs no allocation per line.
+struct Lines {
   std::vector<std::string_view> tokens;
+  std::vector<std::size_t> first;   ///< line l's tokens are tokens[first[l] .. first[l + 1])
+  std::vector<std::size_t> number;  ///< line l's number in the file (1-based)
+
+  [[nodiscard]] std::size_t size() const { return number.size(); }
+  [[nodiscard]] bool empty() const { return number.empty(); }
+  [[nodiscard]] std::size_t count(std::size_t l) const { return first[l + 1] - first[l]; }
+  [[nodiscard]] std::string_view token(std::size_t l, std::size_t k) const { return tokens[first[l] + k]; }
 };
 
-std::vector<Line> tokenize(const std::string& data) {
-  std::vector<Line> lines;
+Lines tokenize(const std::string& data) {
+  Lines lines;
+  lines.first.push_back(0);
   std::size_t pos = 0, number = 0;
   while (pos < data.size()) {
     std::size_t eol = data.find('\n', pos);
@@ -34,16 +42,19 @@ std::vector<Line> tokenize(const std::string& data) {
     ++number;
     std::string_view text(data.data() + pos, eol - pos);
     if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
-    Line line{number, {}};
+    const std::size_t before = lines.tokens.size();
     std::size_t i = 0;
     while (i < text.size()) {
       while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
       std::size_t j = i;
       while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
-      if (j > i) line.tokens.push_back(text.substr(i, j - i));
+      if (j > i) lines.tokens.push_back(text.substr(i, j - i));
       i = j;
     }
-    if (!line.tokens.empty()) lines.push_back(std::move(line));
+    if (lines.tokens.size() > before) {
+      lines.first.push_back(lines.tokens.size());
+      lines.number.push_back(number);
+    }
     pos = eol + 1;
   }
   return lines;
@@ -76,34 +87,34 @@ Mesh read_off(const std::filesystem::path& file) {
   if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
   const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto fail = [&](const std::string& why) { throw Error(ErrorCode::unreadable, path, "cannot parse mesh: " + why); };
-  const std::vector<Line> lines = tokenize(data);
-  const auto where = [&](std::size_t l) { return "line " + std::to_string(lines[l].number); };
+  const Lines lines = tokenize(data);
+  const auto where = [&](std::size_t l) { return "line " + std::to_string(lines.number[l]); };
   const auto number = [&](std::size_t l, std::size_t k, const char* what) {
-    std::string_view t = lines[l].tokens[k];
+    std::string_view t = lines.token(l, k);
     if (!t.empty() && t[0] == '+') t.remove_prefix(1);
     double v = 0.0;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
     if (ec != std::errc() || end != t.data() + t.size()) {
-      fail(where(l) + ": '" + std::string(lines[l].tokens[k]) + "' is not " + what);
+      fail(where(l) + ": '" + std::string(lines.token(l, k)) + "' is not " + what);
     }
     return v;
   };
   const auto count = [&](std::size_t l, std::size_t k, const char* what) -> std::uint64_t {
     const double v = number(l, k, what);
-    if (!(v >= 0) || v != std::floor(v) || v > 4e9) fail(where(l) + ": '" + std::string(lines[l].tokens[k]) + "' is not " + what);
+    if (!(v >= 0) || v != std::floor(v) || v > 4e9) fail(where(l) + ": '" + std::string(lines.token(l, k)) + "' is not " + what);
     return static_cast<std::uint64_t>(v);
   };
 
   if (lines.empty()) fail("no content");
   std::size_t l = 0, k = 0;
-  if (is_header(lines[0].tokens[0])) {
-    if (lines[0].tokens.size() > 1 && lines[0].tokens[1] == "BINARY") fail("binary OFF is not supported");
-    if (lines[0].tokens.size() == 1) l = 1; else k = 1;  // counts may follow the header on its line
-  } else if (lines[0].tokens[0].find("OFF") != std::string_view::npos) {
-    fail("unsupported OFF variant '" + std::string(lines[0].tokens[0]) + "'");
+  if (is_header(lines.token(0, 0))) {
+    if (lines.count(0) > 1 && lines.token(0, 1) == "BINARY") fail("binary OFF is not supported");
+    if (lines.count(0) == 1) l = 1; else k = 1;  // counts may follow the header on its line
+  } else if (lines.token(0, 0).find("OFF") != std::string_view::npos) {
+    fail("unsupported OFF variant '" + std::string(lines.token(0, 0)) + "'");
   }
   if (l >= lines.size()) fail("no vertex and face counts after the header (truncated file?)");
-  if (lines[l].tokens.size() < k + 2) fail(where(l) + ": expected the vertex and face counts");
+  if (lines.count(l) < k + 2) fail(where(l) + ": expected the vertex and face counts");
   const std::uint64_t nv = count(l, k, "a vertex count"), nf = count(l, k + 1, "a face count");
   ++l;
   // One line per vertex and per face: counts the file cannot hold fail before any allocation.
@@ -115,20 +126,22 @@ Mesh read_off(const std::filesystem::path& file) {
   mesh.source = path;
   mesh.vertices.reserve(nv);
   for (std::uint64_t v = 0; v < nv; ++v, ++l) {
-    if (lines[l].tokens.size() < 3) fail(where(l) + ": vertex " + std::to_string(v) + " needs x y z");
+    if (lines.count(l) < 3) fail(where(l) + ": vertex " + std::to_string(v) + " needs x y z");
     Eigen::Vector3d p;
     for (int c = 0; c < 3; ++c) p[c] = number(l, static_cast<std::size_t>(c), "a coordinate");
     if (!p.allFinite()) throw Error(ErrorCode::bad_value, path, "vertex " + std::to_string(v) + " has a non-finite coordinate");
     mesh.vertices.push_back(p);
   }
+  std::vector<std::uint32_t> idx;
+  mesh.triangles.reserve(nf);
   for (std::uint64_t f = 0; f < nf; ++f, ++l) {
     const std::uint64_t corners = count(l, 0, "a corner count");
     if (corners < 3) {
       throw Error(ErrorCode::bad_index, path,
                   "face " + std::to_string(f) + " has " + std::to_string(corners) + " corner(s); a face needs at least 3");
     }
-    if (lines[l].tokens.size() < corners + 1) fail(where(l) + ": face " + std::to_string(f) + " lists fewer than " + std::to_string(corners) + " corners");
-    std::vector<std::uint32_t> idx;
+    if (lines.count(l) < corners + 1) fail(where(l) + ": face " + std::to_string(f) + " lists fewer than " + std::to_string(corners) + " corners");
+    idx.clear();
     for (std::uint64_t c = 0; c < corners; ++c) {
       const std::uint64_t i = count(l, static_cast<std::size_t>(c + 1), "a vertex index");
       if (i >= nv) {
