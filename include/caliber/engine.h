@@ -47,6 +47,9 @@ struct EngineOptions {
   /// Hybrid: weigh a CD node by the node tests its subtree took at the previous step when the
   /// weight-driven stage popped it then (a priori, rescaled, otherwise). Not in the paper.
   bool node_history = false;
+  /// Record ScheduleRecord::timeline (thread and times of every piece of work). Costs two clock
+  /// reads per piece; off by default.
+  bool timeline = false;
 };
 
 /// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded

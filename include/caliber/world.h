@@ -38,6 +38,17 @@ struct TaskRecord {
   std::size_t pairs = 0;  ///< triangle pairs reported
 };
 
+/// One piece of a step's work on one thread (EngineOptions::timeline): what a Gantt chart draws.
+struct TaskSpan {
+  /// Which part of the step: the weight-driven stage of one split task, one unit of depth-first
+  /// traversal (a run-time task, a pair, a stealing piece), or one pair's finalization.
+  enum class Phase : std::uint8_t { stage, traverse, finalize };
+  int thread = 0;         ///< the executor's thread index (0 .. threads-1)
+  double start_ms = 0.0;  ///< since the start of the step's narrow phase
+  double end_ms = 0.0;
+  Phase phase = Phase::traverse;
+};
+
 /// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
 /// that do not calibrate; `task_node_tests` is filled by every engine method.
 struct ScheduleRecord {
@@ -66,6 +77,9 @@ struct ScheduleRecord {
   double calibrate_ms = 0.0;  ///< calibrated methods: weights, keep/split/cart, weight-driven stage, cart
   double traverse_ms = 0.0;   ///< depth-first traversals of the run-time tasks (or pairs, or pieces)
   double finalize_ms = 0.0;   ///< per-pair merge, sort, local minima and world coordinates
+  /// Every piece of work with its thread and times, sorted by thread then start; empty unless
+  /// EngineOptions::timeline is on.
+  std::vector<TaskSpan> timeline;
 };
 
 /// Everything one step produced.

@@ -51,7 +51,11 @@ struct Executor::Pool {
 namespace {
 /// The pool the calling thread works for: set for workers, and for a caller inside execute().
 thread_local Executor::Pool* t_pool = nullptr;
+/// The calling thread's index in that pool: 0 for the caller of execute(), 1.. for workers.
+thread_local int t_index = -1;
 }  // namespace
+
+int current_thread_index() { return t_pool != nullptr ? t_index : -1; }
 
 void Executor::Pool::work() {
   t_pool = this;
@@ -69,7 +73,12 @@ void Executor::Pool::work() {
 
 Executor::Executor(int threads) : mThreads(threads), mPool(std::make_unique<Pool>()) {
   if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
-  for (int t = 1; t < threads; ++t) mPool->workers.emplace_back([pool = mPool.get()] { pool->work(); });
+  for (int t = 1; t < threads; ++t) {
+    mPool->workers.emplace_back([pool = mPool.get(), t] {
+      t_index = t;
+      pool->work();
+    });
+  }
 }
 
 Executor::~Executor() {
@@ -83,14 +92,18 @@ Executor::~Executor() {
 
 void Executor::execute(const std::function<void()>& f) {
   Pool* const previous = t_pool;
+  const int previous_index = t_index;
   t_pool = mPool.get();
+  t_index = 0;
   try {
     f();
   } catch (...) {
     t_pool = previous;
+    t_index = previous_index;
     throw;
   }
   t_pool = previous;
+  t_index = previous_index;
 }
 
 TaskGroup::TaskGroup() : mPool(t_pool) {}
@@ -170,6 +183,11 @@ Executor::Executor(int threads) : mThreads(threads), mArena(std::max(threads, 1)
 Executor::~Executor() = default;
 
 void Executor::execute(const std::function<void()>& f) { mArena.execute(f); }
+
+int current_thread_index() {
+  const int index = tbb::this_task_arena::current_thread_index();
+  return index == tbb::task_arena::not_initialized ? -1 : index;
+}
 
 TaskGroup::TaskGroup() = default;
 TaskGroup::~TaskGroup() = default;

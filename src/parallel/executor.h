@@ -100,6 +100,9 @@ class TaskGroup {
 #endif
 };
 
+/// The calling thread's index in the executor it works for (0 .. threads-1), or -1 outside any.
+[[nodiscard]] int current_thread_index();
+
 /// Calls body(lo, hi) on disjoint chunks covering [begin, end), each at most `grain` long (and at
 /// least grain / 2 where the range allows), in parallel on the current executor. A range no longer
 /// than `grain` runs at once on the calling thread.

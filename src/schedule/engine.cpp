@@ -51,6 +51,45 @@ struct WorkerSlots {
 
 using Workers = parallel::PerThread<WorkerSlots>;
 
+/// Optional record of who ran what when (EngineOptions::timeline), for Gantt charts.
+struct Timeline {
+  bool on = false;
+  Clock::time_point origin;
+  parallel::PerThread<std::vector<TaskSpan>> spans;
+
+  /// Runs f(), recording its span on this thread when the timeline is on.
+  template <class F>
+  void record(TaskSpan::Phase phase, F&& f) {
+    if (!on) {
+      f();
+      return;
+    }
+    const auto start = Clock::now();
+    f();
+    const auto end = Clock::now();
+    const int thread = std::max(parallel::current_thread_index(), 0);
+    spans.local().push_back(TaskSpan{thread, std::chrono::duration<double, std::milli>(start - origin).count(),
+                                     std::chrono::duration<double, std::milli>(end - origin).count(), phase});
+  }
+
+  /// Starts a step: clears the spans and sets the time origin.
+  void begin(bool enabled) {
+    on = enabled;
+    spans.for_each([](std::vector<TaskSpan>& s) { s.clear(); });
+    origin = Clock::now();
+  }
+
+  /// All spans, sorted by thread then start.
+  std::vector<TaskSpan> collect() {
+    std::vector<TaskSpan> all;
+    spans.for_each([&](const std::vector<TaskSpan>& s) { all.insert(all.end(), s.begin(), s.end()); });
+    std::sort(all.begin(), all.end(), [](const TaskSpan& a, const TaskSpan& b) {
+      return a.thread != b.thread ? a.thread < b.thread : a.start_ms < b.start_ms;
+    });
+    return all;
+  }
+};
+
 /// This thread's slots, sized for `pairs` (a thread that joins mid-step starts with empty slots).
 WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
   WorkerSlots& w = workers.local();
@@ -62,11 +101,11 @@ WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
 /// workers' slots), every worker's slots are added, and the pair goes through the one finalization.
 template <class Start>
 void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& workers, std::vector<QueryResult>& results,
-                    Start start) {
+                    Timeline& timeline, Start start) {
   const std::size_t n = contexts.size();
   const std::vector<WorkerSlots*> slots = workers.all();
   parallel::parallel_for(0, n, 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) {
+    for (std::size_t i = lo; i != hi; ++i) timeline.record(TaskSpan::Phase::finalize, [&] {
       std::vector<narrow::Candidate> all;
       QueryStats stats;
       start(i, all, stats);
@@ -77,7 +116,7 @@ void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& w
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
       results[i] = narrow::finalize(contexts[i], all, stats, /*parallel=*/true);
-    }
+    });
   });
 }
 
@@ -117,6 +156,8 @@ struct Engine::Impl {
   std::map<Task, std::vector<TrianglePair>> reported;
   /// Hybrid with node history: node tests of the subtrees the weight-driven stage popped, per pair.
   std::map<Task, tasks::NodeCounts> node_counts;
+  /// Who ran what when, this step (EngineOptions::timeline).
+  Timeline timeline;
 };
 
 Engine::Engine(const World& world, const EngineOptions& options) : mWorld(world), mOptions(options) {
@@ -144,13 +185,15 @@ namespace {
 /// child; from the cut-off down, one depth-first traversal. The node tests made are exactly those
 /// of a single depth-first traversal of the whole tree.
 void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, narrow::NodePair n, int depth, int cutoff,
-           Workers& workers) {
+           Workers& workers, Timeline& timeline) {
   {
     WorkerSlots& w = local_slots(workers, pairs);
     if (depth >= cutoff) {
-      const std::uint64_t before = w.stats[pair].node_tests;
-      narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair]);
-      w.pieces.push_back(w.stats[pair].node_tests - before);
+      timeline.record(TaskSpan::Phase::traverse, [&] {
+        const std::uint64_t before = w.stats[pair].node_tests;
+        narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair]);
+        w.pieces.push_back(w.stats[pair].node_tests - before);
+      });
       return;
     }
     ++w.stats[pair].node_tests;
@@ -169,9 +212,11 @@ void steal(const narrow::PairContext& ctx, std::size_t pair, std::size_t pairs, 
   parallel::TaskGroup group;
   for (int i = 1; i < count; ++i) {
     const narrow::NodePair kid = kids[i];
-    group.run([&ctx, pair, pairs, kid, depth, cutoff, &workers] { steal(ctx, pair, pairs, kid, depth + 1, cutoff, workers); });
+    group.run([&ctx, pair, pairs, kid, depth, cutoff, &workers, &timeline] {
+      steal(ctx, pair, pairs, kid, depth + 1, cutoff, workers, timeline);
+    });
   }
-  steal(ctx, pair, pairs, kids[0], depth + 1, cutoff, workers);
+  steal(ctx, pair, pairs, kids[0], depth + 1, cutoff, workers, timeline);
   group.wait();
 }
 
@@ -274,7 +319,9 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
         const auto it = mImpl->node_counts.find(tasks[i]);
         if (it != mImpl->node_counts.end()) measured = &it->second;
       }
-      splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps, measured);
+      mImpl->timeline.record(TaskSpan::Phase::stage, [&] {
+        splits[s] = tasks::split_task(contexts[i], static_cast<std::uint32_t>(i), weight[i], scale[i], omega, eps, measured);
+      });
     });
   }
   for (tasks::SplitResult& s : splits) {
@@ -302,7 +349,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   std::vector<std::vector<std::uint64_t>> sub_tests(taboos.size());
   for (std::size_t t = 0; t < taboos.size(); ++t) sub_tests[t].assign(taboos[t].nodes.size(), 0);
   parallel::parallel_for(0, run.size(), 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t t = lo; t != hi; ++t) {
+    for (std::size_t t = lo; t != hi; ++t) mImpl->timeline.record(TaskSpan::Phase::traverse, [&] {
       WorkerSlots& w = local_slots(workers, n);
       std::uint64_t tests = 0;
       for (const tasks::Root& root_ref : run[t].roots) {
@@ -316,7 +363,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
       }
       record.task_node_tests[t] = tests;
       record.task_weights[t] = run[t].weight;
-    }
+    });
   });
   record.traverse_ms = ms_since(phase);
   phase = Clock::now();
@@ -330,7 +377,7 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
       mImpl->node_counts[tasks[to_split[s]]] = tasks::subtree_counts(splits[s].stage, stage_root_tests[s]);
     }
   }
-  finalize_pairs(contexts, workers, results, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
+  finalize_pairs(contexts, workers, results, mImpl->timeline, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
     if (split_of[i] == SIZE_MAX) return;
     const tasks::SplitResult& s = splits[split_of[i]];
     all = s.candidates;
@@ -392,10 +439,14 @@ StepResult Engine::step(int k) {
   const auto n = tasks.size();
   auto& workers = mImpl->workers;
   workers.for_each([n](WorkerSlots& w) { w.reset(n); });
+  auto& timeline = mImpl->timeline;
+  timeline.begin(mOptions.timeline);
   const auto run_pair = [&](std::size_t i) {
-    WorkerSlots& w = local_slots(workers, n);
-    narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], w.stats[i]);
-    results[i] = narrow::finalize(contexts[i], w.candidates[i], w.stats[i]);
+    timeline.record(TaskSpan::Phase::traverse, [&] {
+      WorkerSlots& w = local_slots(workers, n);
+      narrow::traverse_depth_first(contexts[i], narrow::NodePair{0, 0}, w.scratch, w.candidates[i], w.stats[i]);
+      results[i] = narrow::finalize(contexts[i], w.candidates[i], w.stats[i]);
+    });
   };
 
   switch (mOptions.method) {
@@ -413,12 +464,12 @@ StepResult Engine::step(int k) {
       mImpl->executor.execute([&] {
         parallel::TaskGroup group;
         for (std::size_t i = 0; i < n; ++i) {
-          group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers); });
+          group.run([&, i] { steal(contexts[i], i, n, narrow::NodePair{0, 0}, 0, mOptions.stealing_depth, workers, timeline); });
         }
         group.wait();
         out.schedule.traverse_ms = ms_since(start);
         const auto finalize_start = Clock::now();
-        finalize_pairs(contexts, workers, results, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
+        finalize_pairs(contexts, workers, results, timeline, [](std::size_t, std::vector<narrow::Candidate>&, QueryStats&) {});
         out.schedule.finalize_ms = ms_since(finalize_start);
         workers.for_each([&](const WorkerSlots& w) {
           out.schedule.task_node_tests.insert(out.schedule.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
@@ -449,6 +500,7 @@ StepResult Engine::step(int k) {
     for (const QueryResult& r : results) out.schedule.task_node_tests.push_back(r.stats.node_tests);
   }
   for (std::size_t i = 0; i < n; ++i) mImpl->history[tasks[i]] = results[i].stats.node_tests;
+  if (mOptions.timeline) out.schedule.timeline = timeline.collect();
   out.narrow_ms = ms_since(start);
 
   start = Clock::now();

@@ -196,6 +196,52 @@ TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
   }
 }
 
+TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
+  const World world(parse_scene(R"({"query": {"kind": "contact", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}},
+      {"name": "c", "mesh": "cube.off", "position": [-0.6, 0.5, 0], "motion": {"type": "velocity"}}]})",
+                                dir, "timeline.json"));
+  const StepResult reference = world.step(0);
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::apriori, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 3;
+    options.timeline = true;
+    Engine engine(world, options);
+    const StepResult got = engine.step(0);
+    const std::string what(to_string(method));
+    expect_same_step(got, reference, what);
+    const ScheduleRecord& r = got.schedule;
+    std::size_t stage = 0, traverse = 0, finalize = 0;
+    for (const TaskSpan& s : r.timeline) {
+      EXPECT_GE(s.thread, 0) << what;
+      EXPECT_LT(s.thread, engine.threads()) << what;
+      EXPECT_LE(0.0, s.start_ms) << what;
+      EXPECT_LE(s.start_ms, s.end_ms) << what;
+      stage += s.phase == TaskSpan::Phase::stage;
+      traverse += s.phase == TaskSpan::Phase::traverse;
+      finalize += s.phase == TaskSpan::Phase::finalize;
+    }
+    const std::size_t pairs = got.tasks.size();
+    ASSERT_GT(pairs, 0u);
+    if (method == Method::sequential || method == Method::exploitation) {
+      EXPECT_EQ(traverse, pairs) << what << ": one span per pair (traversal and finalization)";
+      EXPECT_EQ(stage + finalize, 0u) << what;
+    } else if (method == Method::stealing) {
+      EXPECT_EQ(traverse, r.task_node_tests.size()) << what << ": one span per depth-first piece";
+      EXPECT_EQ(finalize, pairs) << what;
+    } else {
+      EXPECT_EQ(stage, r.split) << what;
+      EXPECT_EQ(traverse, r.generated) << what;
+      EXPECT_EQ(finalize, pairs) << what;
+    }
+  }
+  EngineOptions off;
+  off.method = Method::hybrid;
+  off.threads = 2;
+  EXPECT_TRUE(Engine(world, off).step(0).schedule.timeline.empty()) << "off by default";
+}
+
 TEST(EngineOptionsValidation, RejectsBadValues) {
   const World world(parse_scene(R"({"objects": [{"mesh": "tetra.off"}]})", CALIBER_TEST_DATA, "x.json"));
   EngineOptions options;
