@@ -1,5 +1,5 @@
 #pragma once
-// A one-line description of the machine a benchmark ran on, for committed results.
+// A description of the machine a benchmark ran on, for committed results.
 
 #include <fstream>
 #include <string>
@@ -7,23 +7,27 @@
 
 namespace caliber::bench {
 
-/// "CPU model, N hardware threads, compiler".
-inline std::string machine_description() {
-  std::string model = "unknown CPU";
+/// The CPU's model name from /proc/cpuinfo ("unknown CPU" elsewhere).
+inline std::string cpu_model() {
   std::ifstream cpuinfo("/proc/cpuinfo");
   for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) {
-      model = line.substr(line.find(':') + 2);
-      break;
-    }
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
   }
-  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads, " +
+  return "unknown CPU";
+}
+
+/// The compiler this was built with.
+inline std::string compiler() {
 #if defined(__clang__)
-         "clang "
+  return "clang " __VERSION__;
 #else
-         "g++ "
+  return "g++ " __VERSION__;
 #endif
-         + std::string(__VERSION__);
+}
+
+/// "CPU model, N hardware threads, compiler".
+inline std::string machine_description() {
+  return cpu_model() + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads, " + compiler();
 }
 
 }  // namespace caliber::bench

@@ -9,6 +9,7 @@ packages=(
   libfcl-dev      # benchmarks only: the peer comparison against FCL
   libcgal-demo    # CGAL's mesh collection, extracted by scripts/fetch_meshes.sh
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
+  python3-matplotlib        # caliber bench: figures (scripts/plot_bench.py)
 )
 missing=()
 for p in "${packages[@]}"; do

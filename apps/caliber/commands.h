@@ -13,5 +13,6 @@ using Runner = std::function<int()>;
 Runner add_query_command(CLI::App& app);
 Runner add_run_command(CLI::App& app);
 Runner add_refine_command(CLI::App& app);
+Runner add_bench_command(CLI::App& app);
 
 }  // namespace caliber::cli

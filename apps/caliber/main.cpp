@@ -2,6 +2,7 @@
 //   caliber query A B [...]      two meshes, one query
 //   caliber run SCENE [...]      a scene over its time steps
 //   caliber refine IN OUT -l K   1-to-4 subdivision
+//   caliber bench [SCENES...]    every method on every scene: report.md, results.json, figures
 // Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
 
 #include <iostream>
@@ -18,7 +19,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "caliber 0.1.0");
   const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app),
                                                       caliber::cli::add_run_command(app),
-                                                      caliber::cli::add_refine_command(app)};
+                                                      caliber::cli::add_refine_command(app),
+                                                      caliber::cli::add_bench_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

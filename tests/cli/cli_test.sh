@@ -127,6 +127,35 @@ contains refine "64 triangles"
 check refine-query 0 "$cli" query "$tmp/fine.off" "$data/tetra.off" --show 0
 check refine-bad-levels 2 "$cli" refine "$data/tetra.off" "$tmp/x.off" --levels 12
 check refine-missing 2 "$cli" refine "$data/nope.off" "$tmp/x.off"
+# caliber bench: a tiny run writes the report and the raw figures; bad options fail before any work.
+check bench 0 "$cli" bench "$data/scenes/tetras.json" --steps 4 --repeat 2 --threads 1,2 --simulate 4 --no-fcl --no-figures --out "$tmp/bench"
+contains bench "wrote $tmp/bench/report.md"
+python3 - "$tmp/bench" <<'PY' || { echo "FAIL bench-files"; failures=$((failures + 1)); }
+import json, sys
+d = sys.argv[1]
+r = json.load(open(d + "/results.json"))
+assert r["contacts_identical"] is True
+assert r["threads"] == [1, 2] and r["repeat"] == 2
+(s,) = r["scenes"]
+assert s["name"] == "tetras" and s["steps"] == 4
+assert set(s["methods"]) == {"sequential", "exploitation", "stealing", "aposteriori", "apriori", "hybrid"}
+assert list(s["methods"]["sequential"]["threads"]) == ["1"]
+for m, v in s["methods"].items():
+    for t, run in v["threads"].items():
+        assert len(run["runs_ms"]) == 2 and run["step_ms"] > 0, (m, t)
+    if m != "sequential":
+        assert set(v["simulated_speedup"]) == {"4"}, m
+assert s["table1"]["objects"] == 2
+assert set(r["gantt"]["methods"]) == {"exploitation", "hybrid"}
+report = open(d + "/report.md").read()
+for heading in ("## Table 1", "## Table 2", "## One-thread overhead", "## Simulated speed-up", "## Targets", "**all identical**"):
+    assert heading in report, heading
+PY
+check bench-missing 2 "$cli" bench "$data/scenes/nope.json" --out "$tmp/bench2"
+contains bench-missing "nope.json"
+check bench-bad-method 2 "$cli" bench "$data/scenes/tetras.json" --methods sequential,turbo --out "$tmp/bench2"
+check bench-bad-threads 2 "$cli" bench "$data/scenes/tetras.json" --threads 0 --out "$tmp/bench2"
+check bench-bad-repeat 2 "$cli" bench "$data/scenes/tetras.json" --repeat 0 --out "$tmp/bench2"
 rm -rf "$tmp"
 
 echo "$passes passed, $failures failed"

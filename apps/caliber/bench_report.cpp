@@ -1,0 +1,239 @@
+// report.md of `caliber bench`, written from its results.json: every figure in it is measured
+// (or simulated, and said so) in that run.
+
+#include "bench_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "caliber/error.h"
+
+namespace caliber::cli {
+namespace {
+
+using Json = nlohmann::json;
+
+std::string num(double x, const char* format = "%.2f") {
+  char b[64];
+  std::snprintf(b, sizeof b, format, x);
+  return b;
+}
+
+/// Step time (ms) of a method at t threads in a scene, or NaN if not measured.
+double step_ms(const Json& scene, const std::string& method, int t) {
+  const Json& m = scene["methods"];
+  if (!m.contains(method) || !m[method]["threads"].contains(std::to_string(t))) return std::nan("");
+  return m[method]["threads"][std::to_string(t)]["step_ms"].get<double>();
+}
+
+double phase_ms(const Json& scene, const std::string& method, int t, const char* phase) {
+  const Json& m = scene["methods"];
+  if (!m.contains(method) || !m[method]["threads"].contains(std::to_string(t))) return std::nan("");
+  const Json& p = m[method]["threads"][std::to_string(t)]["phases_per_step"];
+  return p.contains(phase) ? p[phase].get<double>() : std::nan("");
+}
+
+std::vector<std::string> method_names(const Json& scene) {
+  std::vector<std::string> names;
+  for (const auto& [name, value] : scene["methods"].items()) names.push_back(name);
+  // Keep the paper's order: sequential, exploitation, stealing, aposteriori, apriori, hybrid(+history).
+  const std::vector<std::string> order = {"sequential", "exploitation", "stealing", "aposteriori", "apriori", "hybrid", "hybrid+history"};
+  std::vector<std::string> sorted;
+  for (const std::string& o : order) {
+    if (std::find(names.begin(), names.end(), o) != names.end()) sorted.push_back(o);
+  }
+  return sorted;
+}
+
+std::string verdict(double measured, double target, bool at_least = true) {
+  if (std::isnan(measured)) return "not measured";
+  const bool met = at_least ? measured >= target : measured <= target;
+  if (met) return "met";
+  return "missed by " + num(std::fabs(measured - target), "%.2f");
+}
+
+}  // namespace
+
+void write_bench_report(const Json& r, const std::filesystem::path& file) {
+  std::ofstream out(file);
+  if (!out) throw Error(ErrorCode::unreadable, file.string(), "cannot be opened for writing");
+  const std::vector<int> threads = r["threads"].get<std::vector<int>>();
+  const std::vector<int> simulate = r["simulate"].get<std::vector<int>>();
+  const int cores = r["hardware_threads"].get<int>();
+  const int max_t = threads.back();
+
+  out << "# caliber bench\n\n";
+  out << "Machine: " << r["machine"].get<std::string>() << ".\n\n";
+  out << "Each configuration ran " << r["repeat"].get<int>() << " time(s); times are medians of the whole run, per step "
+      << "(broad phase + narrow phase + reduction). Speed-ups are over `sequential` on the same machine. Every run's "
+      << "contacts were compared with `sequential`'s at every step: "
+      << (r["contacts_identical"].get<bool>() ? "**all identical**" : "**MISMATCHES (see the program's output)**") << ".\n\n";
+  out << "Real (measured) figures stop at this machine's " << cores << " hardware thread(s); the columns P = ";
+  for (std::size_t i = 0; i < simulate.size(); ++i) out << (i ? ", " : "") << simulate[i];
+  out << " are the **load-balance simulation** (node tests of the run-time tasks, cut for P threads, list-scheduled on P "
+         "virtual cores; "
+      << (r["simulate_steps"].get<int>() > 0 ? "first " + std::to_string(r["simulate_steps"].get<int>()) + " steps" : std::string("every step"))
+      << "), not measurements.\n\n";
+
+  out << "## Table 1: scenes\n\n| scene | objects | triangles | node tests / step | contacts / step | pairs / step | "
+         "candidate pairs | heaviest pair | second | exploitation bound | sequential ms / step |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Json& s : r["scenes"]) {
+    const Json& t = s["table1"];
+    out << "| " << s["name"].get<std::string>() << " | " << t["objects"] << " | " << t["triangles"] << " | "
+        << num(t["node_tests_per_step"].get<double>(), "%.0f") << " | " << num(t["contacts_per_step"].get<double>(), "%.1f") << " | "
+        << num(t["pairs_per_step"].get<double>(), "%.1f") << " | " << t["candidate_pairs"] << " | "
+        << num(100 * t["heaviest_pair_share"].get<double>(), "%.1f") << " % | " << num(100 * t["second_pair_share"].get<double>(), "%.1f")
+        << " % | " << num(t["exploitation_bound"].get<double>()) << "x | " << num(s["sequential_step_ms"].get<double>()) << " |\n";
+  }
+
+  out << "\n## Table 2: time per step (ms) and speed-up over sequential\n\n| scene | method |";
+  for (const int t : threads) out << " " << t << " thread" << (t > 1 ? "s" : "") << " |";
+  out << "\n|---|---|";
+  for (std::size_t i = 0; i < threads.size(); ++i) out << "---|";
+  out << "\n";
+  for (const Json& s : r["scenes"]) {
+    const double seq = s["sequential_step_ms"].get<double>();
+    for (const std::string& m : method_names(s)) {
+      out << "| " << s["name"].get<std::string>() << " | " << m << " |";
+      for (const int t : threads) {
+        const double ms = step_ms(s, m, t);
+        out << " " << (std::isnan(ms) ? "" : num(ms) + " (" + num(seq / ms) + "x)") << " |";
+      }
+      out << "\n";
+    }
+  }
+
+  if (threads.front() == 1) {
+    out << "\n## One-thread overhead over sequential\n\n(method at 1 thread / sequential - 1; what cutting and scheduling "
+           "cost when there is nothing to gain.)\n\n| scene |";
+    const std::vector<std::string> names = method_names(r["scenes"][0]);
+    for (const std::string& m : names) {
+      if (m != "sequential") out << " " << m << " |";
+    }
+    out << "\n|---|";
+    for (std::size_t i = 1; i < names.size(); ++i) out << "---|";
+    out << "\n";
+    for (const Json& s : r["scenes"]) {
+      out << "| " << s["name"].get<std::string>() << " |";
+      const double seq = s["sequential_step_ms"].get<double>();
+      for (const std::string& m : names) {
+        if (m != "sequential") out << " " << num(100.0 * (step_ms(s, m, 1) / seq - 1.0), "%+.1f") << " % |";
+      }
+      out << "\n";
+    }
+  }
+
+  out << "\n## Simulated speed-up (load-balance simulation, not measured)\n\n| scene | method |";
+  for (const int p : simulate) out << " P=" << p << " |";
+  out << "\n|---|---|";
+  for (std::size_t i = 0; i < simulate.size(); ++i) out << "---|";
+  out << "\n";
+  for (const Json& s : r["scenes"]) {
+    for (const std::string& m : method_names(s)) {
+      if (!s["methods"][m].contains("simulated_speedup")) continue;
+      out << "| " << s["name"].get<std::string>() << " | " << m << " |";
+      for (const int p : simulate) out << " " << num(s["methods"][m]["simulated_speedup"][std::to_string(p)].get<double>()) << "x |";
+      out << "\n";
+    }
+  }
+
+  out << "\n## Estimated vs effective node tests per run-time task\n\n(Pearson r between the weight the calibration gave "
+         "each run-time task and the node tests it took; tasks cut for P = 8 threads when simulated.)\n\n| scene | method | r | tasks |\n|---|---|---|---|\n";
+  for (const Json& s : r["scenes"]) {
+    for (const std::string& m : method_names(s)) {
+      if (!s["methods"][m].contains("correlation")) continue;
+      const Json& c = s["methods"][m]["correlation"];
+      if (m != "apriori" && m != "hybrid" && m != "hybrid+history" && m != "aposteriori") continue;
+      out << "| " << s["name"].get<std::string>() << " | " << m << " | " << num(c["pearson"].get<double>(), "%.3f") << " | " << c["tasks"]
+          << " |\n";
+    }
+  }
+
+  out << "\n## Where the time goes: hybrid per phase (ms / step)\n\n| scene | threads | calibration | depth-first | finalization "
+         "|\n|---|---|---|---|---|\n";
+  for (const Json& s : r["scenes"]) {
+    for (const int t : threads) {
+      const double c = phase_ms(s, "hybrid", t, "calibrate_ms");
+      if (std::isnan(c)) continue;
+      out << "| " << s["name"].get<std::string>() << " | " << t << " | " << num(c) << " | " << num(phase_ms(s, "hybrid", t, "traverse_ms"))
+          << " | " << num(phase_ms(s, "hybrid", t, "finalize_ms")) << " |\n";
+    }
+  }
+
+  // The targets of issue 5, checked against this run.
+  out << "\n## Targets\n\n| target | scene | measured | verdict |\n|---|---|---|---|\n";
+  for (const Json& s : r["scenes"]) {
+    const std::string name = s["name"].get<std::string>();
+    const double seq = s["sequential_step_ms"].get<double>();
+    const int two = std::find(threads.begin(), threads.end(), 2) != threads.end() ? 2 : -1;
+    if (two > 0) {
+      const double target = name == "two_small" ? 1.6 : 1.9;
+      const double sp = seq / step_ms(s, "hybrid", 2);
+      out << "| hybrid >= " << num(target, "%.1f") << "x on 2 threads | " << name << " | " << num(sp) << "x | " << verdict(sp, target);
+      if (!std::isnan(sp) && sp < target) {
+        const double c1 = phase_ms(s, "hybrid", 1, "traverse_ms"), c2 = phase_ms(s, "hybrid", 2, "traverse_ms");
+        const double f1 = phase_ms(s, "hybrid", 1, "finalize_ms"), f2 = phase_ms(s, "hybrid", 2, "finalize_ms");
+        if (!std::isnan(c1) && c2 > 0 && f2 > 0) {
+          out << ": depth-first part " << num(c1 / c2) << "x, finalization " << num(f1 / f2) << "x, calibration "
+              << num(phase_ms(s, "hybrid", 2, "calibrate_ms")) << " ms/step, broad phase " << num(phase_ms(s, "hybrid", 2, "broad_ms"))
+              << " ms/step (serial)";
+        }
+      }
+      out << " |\n";
+    }
+    if (threads.front() == 1) {
+      for (const char* m : {"apriori", "hybrid"}) {
+        const double over = 100.0 * (step_ms(s, m, 1) / seq - 1.0);
+        out << "| " << m << " 1-thread overhead <= 3 % | " << name << " | " << num(over, "%+.1f") << " % | " << verdict(over, 3.0, false)
+            << " |\n";
+      }
+    }
+    const double bound = s["table1"]["exploitation_bound"].get<double>();
+    const double expl = seq / step_ms(s, "exploitation", max_t);
+    out << "| exploitation near its bound (" << num(bound) << "x) at " << max_t << " threads | " << name << " | " << num(expl) << "x | "
+        << (std::isnan(expl) ? "not measured" : num(100.0 * expl / std::min<double>(bound, max_t), "%.0f") + " % of min(bound, threads)")
+        << " |\n";
+    if ((name == "front_car" || name == "two_large") && s["methods"].contains("hybrid") &&
+        s["methods"]["hybrid"]["simulated_speedup"].contains("8")) {
+      const double p8 = s["methods"]["hybrid"]["simulated_speedup"]["8"].get<double>();
+      out << "| simulated hybrid at P = 8 >= 7 | " << name << " | " << num(p8) << "x | " << verdict(p8, 7.0) << " |\n";
+    }
+    if (s["methods"].contains("hybrid") && s["methods"]["hybrid"].contains("correlation") && s["methods"].contains("apriori") &&
+        s["methods"]["apriori"].contains("correlation")) {
+      const double h = s["methods"]["hybrid"]["correlation"]["pearson"].get<double>();
+      const double a = s["methods"]["apriori"]["correlation"]["pearson"].get<double>();
+      out << "| hybrid estimate correlates better than a priori | " << name << " | r = " << num(h, "%.3f") << " vs " << num(a, "%.3f")
+          << " | " << (h > a ? "met" : "missed by " + num(a - h, "%.3f")) << " |\n";
+    }
+  }
+  out << "| sequential interference faster than FCL, identical pairs | all | see the peer comparison below | query ratio < 1 and "
+         "identical = yes on each row |\n";
+
+  out << "\n## Peer comparison: FCL\n\n";
+  std::string fcl = r["fcl_report"].get<std::string>();
+  if (fcl.rfind("# ", 0) == 0) fcl = fcl.substr(fcl.find('\n') + 1);
+  out << fcl << "\n";
+
+  out << "\n## Figures\n\n";
+  const std::string note = r.contains("figures_note") ? r["figures_note"].get<std::string>() : "";
+  if (!note.empty()) out << note << "\n\n";
+  const auto dir = file.parent_path();
+  for (const Json& s : r["scenes"]) {
+    const std::string png = "speedup_" + s["name"].get<std::string>() + ".png";
+    if (std::filesystem::exists(dir / png)) out << "![speed-up, " << s["name"].get<std::string>() << "](" << png << ")\n";
+  }
+  for (const char* png : {"correlation.png", "gantt.png"}) {
+    if (std::filesystem::exists(dir / png)) out << "\n![" << png << "](" << png << ")\n";
+  }
+  out << "\nSpeed-up figures: measured thread counts solid, simulated core counts dashed, the linear limit dotted. "
+         "Correlation: estimated vs effective node tests per run-time task (log-log). Gantt: one step of "
+      << (r.contains("gantt") ? r["gantt"]["scene"].get<std::string>() : std::string("a scene")) << ", exploitation vs hybrid, "
+      << "one row per thread (stage, depth-first, finalization).\n";
+  if (!out) throw Error(ErrorCode::unreadable, file.string(), "write failed");
+}
+
+}  // namespace caliber::cli
