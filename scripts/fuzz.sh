@@ -15,8 +15,7 @@ targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(mesh_loader scene pose)
 command -v clang++ >/dev/null || { echo "fuzz: clang++ not found; run scripts/setup.sh" >&2; exit 2; }
 
-CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALIBER_FUZZ=ON \
-  -DCALIBER_BUILD_BENCH=OFF >/dev/null
+(cd "$root" && cmake --preset fuzz >/dev/null)  # CMakePresets.json: clang, CALIBER_FUZZ=ON, build-fuzz/
 cmake --build "$root/build-fuzz" -j "${JOBS:-2}" --target "${targets[@]/%/_fuzz}"
 
 export ASAN_OPTIONS="detect_leaks=1"

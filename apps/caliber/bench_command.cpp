@@ -190,10 +190,14 @@ int run_bench(BenchOptions opt) {
   if (opt.steps < 0) throw Error(ErrorCode::bad_value, "--steps", "must be >= 1 (0: the scene's)");
   if (opt.simulate_steps < 0) throw Error(ErrorCode::bad_value, "--simulate-steps", "must be >= 1 (0: all the scene's steps)");
   std::vector<Variant> variants;
-  for (const std::string& m : opt.methods) variants.push_back(parse_variant(m));
-  if (std::none_of(variants.begin(), variants.end(), [](const Variant& v) { return v.method == Method::sequential; })) {
-    variants.insert(variants.begin(), parse_variant("sequential"));  // the reference for every speed-up
+  for (const std::string& m : opt.methods) {
+    Variant v = parse_variant(m);
+    if (std::none_of(variants.begin(), variants.end(), [&](const Variant& u) { return u.name == v.name; })) variants.push_back(std::move(v));
   }
+  // Sequential first, exactly once: the reference for every speed-up and every contact check.
+  variants.erase(std::remove_if(variants.begin(), variants.end(), [](const Variant& v) { return v.method == Method::sequential; }),
+                 variants.end());
+  variants.insert(variants.begin(), parse_variant("sequential"));
   if (opt.out.empty()) opt.out = "bench/results/" + machine_slug();
   std::filesystem::create_directories(opt.out);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -237,64 +241,79 @@ int run_bench(BenchOptions opt) {
     Json scene_json = {{"name", sc.name}, {"file", opt.scenes[si]}, {"steps", sc.steps}, {"methods", Json::object()}};
     std::vector<std::uint64_t> reference_hash;
     double sequential_ms = 0.0;
+    // Measured runs in rounds: round r runs every configuration once, so that a slow spell of a
+    // shared machine spreads over all of them instead of landing on one configuration's repeats.
+    // Sequential comes first in every round (it is the reference for the contact check).
+    struct Config {
+      const Variant* variant;
+      int threads;
+      std::vector<double> totals;
+      Json phases;
+    };
+    std::vector<Config> configs;
     for (const Variant& v : variants) {
-      Json method_json = {{"threads", Json::object()}};
-      const std::vector<int> thread_list = v.method == Method::sequential ? std::vector<int>{1} : opt.threads;
-      for (const int t : thread_list) {
-        std::vector<double> totals;
-        Json phases;
-        for (int r = 0; r < opt.repeat; ++r) {
-          Engine engine(world, engine_options(v, t));
-          RunStats stats;
-          double total = 0.0, calibrate = 0.0, traverse = 0.0, finalize = 0.0, broad = 0.0;
-          for (int k = 0; k < sc.steps; ++k) {
-            const StepResult s = engine.step(k);
-            const double ms = s.broad_ms + s.narrow_ms + s.reduce_ms;
-            total += ms;
-            broad += s.broad_ms;
-            calibrate += s.schedule.calibrate_ms;
-            traverse += s.schedule.traverse_ms;
-            finalize += s.schedule.finalize_ms;
-            const std::uint64_t h = contacts_hash(s);
-            if (v.method == Method::sequential && r == 0) {
-              reference_hash.push_back(h);
-              stats.add(s);
-            } else if (reference_hash.size() > static_cast<std::size_t>(k) && reference_hash[k] != h) {
-              mismatch = true;
-              std::fprintf(stderr, "\nMISMATCH: %s, %s on %d threads, step %d: contacts differ from sequential's\n", sc.name.c_str(),
-                           v.name.c_str(), t, k);
-            }
-            ++done;
-            if (progress.terminal() || k + 1 == sc.steps) {  // plain output: one line per run
-              char line[200];
-              std::snprintf(line, sizeof line, "%s: %s x%d, run %d/%d, step %d", sc.name.c_str(), v.name.c_str(), t, r + 1, opt.repeat, k);
-              progress.update(done, line);
-            }
-          }
-          totals.push_back(total);
+      for (const int t : v.method == Method::sequential ? std::vector<int>{1} : opt.threads) configs.push_back(Config{&v, t, {}, {}});
+    }
+    for (int r = 0; r < opt.repeat; ++r) {
+      for (Config& c : configs) {
+        const Variant& v = *c.variant;
+        const int t = c.threads;
+        Engine engine(world, engine_options(v, t));
+        RunStats stats;
+        double total = 0.0, calibrate = 0.0, traverse = 0.0, finalize = 0.0, broad = 0.0;
+        for (int k = 0; k < sc.steps; ++k) {
+          const StepResult s = engine.step(k);
+          const double ms = s.broad_ms + s.narrow_ms + s.reduce_ms;
+          total += ms;
+          broad += s.broad_ms;
+          calibrate += s.schedule.calibrate_ms;
+          traverse += s.schedule.traverse_ms;
+          finalize += s.schedule.finalize_ms;
+          const std::uint64_t h = contacts_hash(s);
           if (v.method == Method::sequential && r == 0) {
-            const auto [heavy, heavy_share] = stats.heaviest_pair();
-            const auto [second, second_share] = stats.second_heaviest_pair();
-            scene_json["table1"] = {{"objects", world.object_count()},
-                                    {"triangles", world.triangle_count()},
-                                    {"node_tests_per_step", stats.mean_node_tests()},
-                                    {"contacts_per_step", stats.mean_contacts()},
-                                    {"pairs_per_step", stats.mean_tasks()},
-                                    {"candidate_pairs", stats.candidate_pairs()},
-                                    {"heaviest_pair_share", heavy_share},
-                                    {"second_pair_share", second_share},
-                                    {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}};
+            reference_hash.push_back(h);
+            stats.add(s);
+          } else if (reference_hash.size() > static_cast<std::size_t>(k) && reference_hash[k] != h) {
+            mismatch = true;
+            std::fprintf(stderr, "\nMISMATCH: %s, %s on %d threads, step %d: contacts differ from sequential's\n", sc.name.c_str(),
+                         v.name.c_str(), t, k);
           }
-          if (r == 0) {
-            phases = {{"broad_ms", broad / sc.steps},
+          ++done;
+          if (progress.terminal() || k + 1 == sc.steps) {  // plain output: one line per run
+            char line[200];
+            std::snprintf(line, sizeof line, "%s: round %d/%d, %s x%d, step %d", sc.name.c_str(), r + 1, opt.repeat, v.name.c_str(), t, k);
+            progress.update(done, line);
+          }
+        }
+        c.totals.push_back(total);
+        if (v.method == Method::sequential && r == 0) {
+          const auto [heavy, heavy_share] = stats.heaviest_pair();
+          const auto [second, second_share] = stats.second_heaviest_pair();
+          scene_json["table1"] = {{"objects", world.object_count()},
+                                  {"triangles", world.triangle_count()},
+                                  {"node_tests_per_step", stats.mean_node_tests()},
+                                  {"contacts_per_step", stats.mean_contacts()},
+                                  {"pairs_per_step", stats.mean_tasks()},
+                                  {"candidate_pairs", stats.candidate_pairs()},
+                                  {"heaviest_pair_share", heavy_share},
+                                  {"second_pair_share", second_share},
+                                  {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}};
+        }
+        if (r == 0) {
+          c.phases = {{"broad_ms", broad / sc.steps},
                       {"calibrate_ms", calibrate / sc.steps},
                       {"traverse_ms", traverse / sc.steps},
                       {"finalize_ms", finalize / sc.steps}};
-          }
         }
-        const double step_ms = median(totals) / sc.steps;
+      }
+    }
+    for (const Variant& v : variants) {
+      Json method_json = {{"threads", Json::object()}};
+      for (const Config& c : configs) {
+        if (c.variant != &v) continue;
+        const double step_ms = median(c.totals) / sc.steps;
         if (v.method == Method::sequential) sequential_ms = step_ms;
-        method_json["threads"][std::to_string(t)] = {{"step_ms", step_ms}, {"runs_ms", totals}, {"phases_per_step", phases}};
+        method_json["threads"][std::to_string(c.threads)] = {{"step_ms", step_ms}, {"runs_ms", c.totals}, {"phases_per_step", c.phases}};
       }
       // The load-balance simulation: tasks cut for P threads (the engine runs P threads here, so
       // calibration targets P), node tests list-scheduled on P virtual cores.

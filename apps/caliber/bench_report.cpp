@@ -68,7 +68,9 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
 
   out << "# caliber bench\n\n";
   out << "Machine: " << r["machine"].get<std::string>() << ".\n\n";
-  out << "Each configuration ran " << r["repeat"].get<int>() << " time(s); times are medians of the whole run, per step "
+  out << "Each configuration ran " << r["repeat"].get<int>() << " time(s), in interleaved rounds (round r runs every "
+      << "configuration once, so that a slow spell of a shared machine does not land on one configuration); times are "
+      << "medians of the whole run, per step "
       << "(broad phase + narrow phase + reduction). Speed-ups are over `sequential` on the same machine. Every run's "
       << "contacts were compared with `sequential`'s at every step: "
       << (r["contacts_identical"].get<bool>() ? "**all identical**" : "**MISMATCHES (see the program's output)**") << ".\n\n";

@@ -178,6 +178,10 @@ std::string_view backend() { return "oneTBB"; }
 
 Executor::Executor(int threads) : mThreads(threads), mArena(std::max(threads, 1)) {
   if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
+  const auto limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  if (static_cast<std::size_t>(threads) > limit) {
+    mLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  }
 }
 
 Executor::~Executor() = default;

@@ -29,6 +29,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 #endif
@@ -64,6 +65,9 @@ class Executor {
  private:
   std::unique_ptr<Pool> mPool;
 #else
+  // oneTBB lets at most (hardware threads - 1) workers join any arena unless told otherwise; above
+  // that, this raises the process-wide limit for the executor's lifetime, so N means N.
+  std::unique_ptr<tbb::global_control> mLimit;
   tbb::task_arena mArena;
 #endif
 };

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -78,6 +80,34 @@ TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
     EXPECT_GE(occupancy.peak.load(), 1);
   }
   EXPECT_EQ(fib(12), 144) << "task groups work outside any executor too";
+}
+
+TEST(Executor, AllNThreadsRunEvenBeyondTheHardwareThreads) {
+  // N tasks that each wait (up to 20 s) until all N are running: they can only all finish early if
+  // N distinct threads run them at once, hardware threads or not (oneTBB caps an arena's workers at
+  // the hardware threads - 1 unless the executor lifts that limit).
+  const int threads = static_cast<int>(std::max(2u, std::thread::hardware_concurrency())) + 2;
+  Executor executor(threads);
+  std::atomic<int> arrived{0};
+  std::atomic<bool> all_met{true};
+  std::vector<std::atomic<int>> seen(static_cast<std::size_t>(threads));
+  executor.execute([&] {
+    parallel_for(0, static_cast<std::size_t>(threads), 1, [&](std::size_t, std::size_t) {
+      ++arrived;
+      const int index = current_thread_index();
+      if (index >= 0 && index < threads) ++seen[static_cast<std::size_t>(index)];
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+      while (arrived.load() < threads) {
+        if (std::chrono::steady_clock::now() > deadline) {
+          all_met = false;
+          return;
+        }
+        std::this_thread::yield();
+      }
+    });
+  });
+  EXPECT_TRUE(all_met.load()) << "the " << threads << " tasks never ran on " << threads << " threads at once (waited 20 s)";
+  for (int t = 0; t < threads; ++t) EXPECT_EQ(seen[static_cast<std::size_t>(t)].load(), 1) << "thread index " << t;
 }
 
 TEST(Executor, ExceptionsReachTheWaiter) {
