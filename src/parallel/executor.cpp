@@ -1,6 +1,9 @@
 #include "parallel/executor.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
 
 #include "caliber/error.h"
 
@@ -56,6 +59,8 @@ thread_local int t_index = -1;
 }  // namespace
 
 int current_thread_index() { return t_pool != nullptr ? t_index : -1; }
+
+int concurrency() { return t_pool != nullptr ? static_cast<int>(t_pool->workers.size()) + 1 : 1; }
 
 void Executor::Pool::work() {
   t_pool = this;
@@ -193,6 +198,8 @@ int current_thread_index() {
   return index == tbb::task_arena::not_initialized ? -1 : index;
 }
 
+int concurrency() { return tbb::this_task_arena::max_concurrency(); }
+
 TaskGroup::TaskGroup() = default;
 TaskGroup::~TaskGroup() = default;
 
@@ -205,13 +212,36 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
     return;
   }
   // simple_partitioner: split down to the grain. The default (auto) partitioner stops splitting
-  // early when nobody steals, so a thread would run ~16 consecutive run-time tasks as one chunk and
-  // the heaviest-first order would not be the greedy list schedule it is meant to be.
+  // early when nobody steals, so a thread would run ~16 consecutive items as one chunk. Even so the
+  // halving hands out contiguous blocks: where the order matters, use for_each_in_order.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
                     [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); },
                     tbb::simple_partitioner());
 }
 
 #endif
+
+void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& body) {
+  std::atomic<std::size_t> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  const auto drain = [&] {
+    for (std::size_t i = next.fetch_add(1, std::memory_order_relaxed); i < n; i = next.fetch_add(1, std::memory_order_relaxed)) {
+      try {
+        body(i);
+      } catch (...) {
+        next.store(n, std::memory_order_relaxed);  // nobody takes another item
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+  };
+  const std::size_t helpers = std::min<std::size_t>(n, static_cast<std::size_t>(std::max(concurrency(), 1))) - (n > 0 ? 1 : 0);
+  TaskGroup group;
+  for (std::size_t k = 0; k < helpers; ++k) group.run(drain);
+  drain();
+  group.wait();
+  if (error) std::rethrow_exception(error);
+}
 
 }  // namespace caliber::parallel

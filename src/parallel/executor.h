@@ -113,6 +113,18 @@ class TaskGroup {
 void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
                   const std::function<void(std::size_t, std::size_t)>& body);
 
+/// The number of threads of the executor the caller runs in (outside any executor: 1 with the std
+/// backend, the size of oneTBB's default arena with oneTBB).
+[[nodiscard]] int concurrency();
+
+/// Greedy list scheduling: calls body(i) for i = 0, 1, ..., n-1, each i taken by whichever of the
+/// executor's threads is free next, in that order. Given items sorted heaviest first this is the
+/// LPT schedule that the load-balance simulation replays. parallel_for is not: its recursive halving
+/// hands each thread a contiguous block (on 2 threads, tasks {0, 1} to one and {2, 3} to the other).
+/// The first exception a body throws is rethrown once every thread has stopped; items not yet
+/// taken are then skipped.
+void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& body);
+
 /// Calls f(i) for every i in [begin, end), in parallel; the backend picks the chunk sizes.
 template <class F>
 void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {

@@ -10,6 +10,7 @@
 #include "caliber/engine.h"
 
 #include <algorithm>
+#include <numeric>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -104,8 +105,18 @@ void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& w
                     Timeline& timeline, Start start) {
   const std::size_t n = contexts.size();
   const std::vector<WorkerSlots*> slots = workers.all();
-  parallel::parallel_for(0, n, 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) timeline.record(TaskSpan::Phase::finalize, [&] {
+  // A pair's finalization costs about its candidate count: most candidates first, to the next free
+  // thread (ties by pair index; the order changes who runs what, never the results).
+  std::vector<std::size_t> candidates(n, 0), order(n);
+  for (const WorkerSlots* w : slots) {
+    if (w->stats.size() != n) continue;
+    for (std::size_t i = 0; i < n; ++i) candidates[i] += w->candidates[i].size();
+  }
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
+  parallel::for_each_in_order(n, [&](std::size_t k) {
+    const std::size_t i = order[k];
+    timeline.record(TaskSpan::Phase::finalize, [&] {
       std::vector<narrow::Candidate> all;
       QueryStats stats;
       start(i, all, stats);
@@ -348,8 +359,9 @@ void Engine::run_calibrated(const std::vector<Task>& tasks, const std::vector<na
   for (std::size_t s = 0; s < splits.size(); ++s) stage_root_tests[s].assign(splits[s].stage.size(), 0);
   std::vector<std::vector<std::uint64_t>> sub_tests(taboos.size());
   for (std::size_t t = 0; t < taboos.size(); ++t) sub_tests[t].assign(taboos[t].nodes.size(), 0);
-  parallel::parallel_for(0, run.size(), 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t t = lo; t != hi; ++t) mImpl->timeline.record(TaskSpan::Phase::traverse, [&] {
+  // Heaviest first, each to the next free thread: the list schedule the simulation replays.
+  parallel::for_each_in_order(run.size(), [&](std::size_t t) {
+    mImpl->timeline.record(TaskSpan::Phase::traverse, [&] {
       WorkerSlots& w = local_slots(workers, n);
       std::uint64_t tests = 0;
       for (const tasks::Root& root_ref : run[t].roots) {

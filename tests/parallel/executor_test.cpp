@@ -131,6 +131,65 @@ TEST(Executor, ExceptionsReachTheWaiter) {
   EXPECT_THROW(Executor(0), Error);
 }
 
+TEST(Executor, ForEachInOrderRunsEveryItemOnceAndRethrows) {
+  for (const int threads : {1, 2, 3, 8}) {
+    Executor executor(threads);
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{500}}) {
+      std::vector<std::atomic<int>> hits(n);
+      Occupancy occupancy;
+      executor.execute([&] {
+        for_each_in_order(n, [&](std::size_t i) {
+          occupancy.enter();
+          ++hits[i];
+          occupancy.leave();
+        });
+      });
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << "item " << i << ", " << threads << " threads";
+      EXPECT_LE(occupancy.peak.load(), threads);
+    }
+    int inside = 0;
+    executor.execute([&] { inside = concurrency(); });
+    EXPECT_EQ(inside, threads);
+    EXPECT_THROW(executor.execute([] {
+      for_each_in_order(100, [](std::size_t i) {
+        if (i == 42) throw std::runtime_error("item 42");
+      });
+    }), std::runtime_error);
+  }
+  std::vector<std::size_t> order;  // on one thread: in order
+  Executor(1).execute([&] { for_each_in_order(5, [&](std::size_t i) { order.push_back(i); }); });
+  EXPECT_EQ(order, (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+}
+
+// The list schedule, not blocks: while one thread holds item 0, the other takes 1, 2, 3, 4, 5 in
+// that order (recursive halving would give it 3, 4, 5 first, then steal 1 and 2).
+TEST(Executor, ForEachInOrderHandsItemsToTheNextFreeThreadInOrder) {
+  Executor executor(2);
+  constexpr std::size_t n = 6;
+  std::atomic<std::size_t> done{0};
+  std::vector<std::size_t> started;  // items 1.. run on one thread while item 0 waits
+  bool waited_out = true;
+  executor.execute([&] {
+    for_each_in_order(n, [&](std::size_t i) {
+      if (i == 0) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while (done.load() < n - 1) {
+          if (std::chrono::steady_clock::now() > deadline) {
+            waited_out = false;
+            return;
+          }
+          std::this_thread::yield();
+        }
+        return;
+      }
+      started.push_back(i);
+      ++done;
+    });
+  });
+  ASSERT_TRUE(waited_out) << "items 1..5 did not run while item 0 was held";
+  EXPECT_EQ(started, (std::vector<std::size_t>{1, 2, 3, 4, 5}));
+}
+
 TEST(Executor, PerThreadSlotsAreDistinct) {
   Executor executor(4);
   PerThread<std::vector<std::size_t>> slots;
