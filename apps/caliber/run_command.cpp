@@ -23,9 +23,9 @@ struct RunOptions {
   std::string scene;
   std::string method = "sequential";
   int threads = 0;
-  int stealing_depth = 10;
-  double beta = 2.0;
-  double epsilon = 0.25;
+  int stealing_depth = EngineOptions{}.stealing_depth;
+  double beta = EngineOptions{}.beta;
+  double epsilon = EngineOptions{}.epsilon;
   bool node_history = false;
   std::vector<int> simulate = {2, 4, 8, 16, 32, 64};
   int steps = -1;
@@ -209,7 +209,7 @@ Runner add_run_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene over its time steps");
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--steps", opt->steps, "Run this many steps instead of the scene's");
-  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | apriori | hybrid")->capture_default_str();
+  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")->capture_default_str();
   cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
       ->capture_default_str();
   cmd->add_option("--epsilon", opt->epsilon, "Calibration: tolerance on Omega, as a fraction of Omega")->capture_default_str();

@@ -143,6 +143,11 @@ assert list(s["methods"]["sequential"]["threads"]) == ["1"]
 for m, v in s["methods"].items():
     for t, run in v["threads"].items():
         assert len(run["runs_ms"]) == 2 and run["step_ms"] > 0, (m, t)
+        if m != "sequential":  # the run's own tasks list-scheduled on as many cores as threads
+            b = run["phases_per_step"]["balance_speedup"]
+            assert 1.0 <= b <= int(t) + 1e-9, (m, t, b)
+            if t == "1":
+                assert abs(b - 1.0) < 1e-9, (m, b)
     if m != "sequential":
         assert set(v["simulated_speedup"]) == {"4"}, m
 assert s["table1"]["objects"] == 2
