@@ -90,7 +90,7 @@ def correlation_figure(r, out):
     for ax, (scene, name, c) in zip(axes.flat, panels):
         xs = [max(p[0], 1e-3) for p in c["points"]]
         ys = [max(p[1], 0.5) for p in c["points"]]
-        ax.scatter(xs, ys, s=4, alpha=0.4, color=COLORS.get(name))
+        ax.scatter(xs, ys, s=4, alpha=0.4, color=COLORS.get(name), rasterized=True)  # thousands of points: a bitmap inside the SVG
         lo, hi = min(xs + ys), max(xs + ys)
         ax.plot([lo, hi], [lo, hi], ":", color="#999999")
         ax.set_xscale("log")
