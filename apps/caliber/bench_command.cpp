@@ -248,7 +248,7 @@ int run_bench(BenchOptions opt) {
       const Variant* variant;
       int threads;
       std::vector<double> totals;
-      Json phases;
+      std::vector<Json> phases;  // per run, in round order
     };
     std::vector<Config> configs;
     for (const Variant& v : variants) {
@@ -272,7 +272,7 @@ int run_bench(BenchOptions opt) {
           calibrate += s.schedule.calibrate_ms;
           traverse += s.schedule.traverse_ms;
           finalize += s.schedule.finalize_ms;
-          if (r == 0 && v.method != Method::sequential && s.stats.node_tests > 0) {
+          if (v.method != Method::sequential && s.stats.node_tests > 0) {
             const double w = static_cast<double>(s.stats.node_tests);
             sim_work += w;
             sim_span += w / simulated_speedup(s, v.method, t);
@@ -307,12 +307,12 @@ int run_bench(BenchOptions opt) {
                                   {"second_pair_share", second_share},
                                   {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}};
         }
-        if (r == 0) {
-          c.phases = {{"broad_ms", broad / sc.steps},
+        {
+          c.phases.push_back({{"broad_ms", broad / sc.steps},
                       {"calibrate_ms", calibrate / sc.steps},
                       {"traverse_ms", traverse / sc.steps},
                       {"finalize_ms", finalize / sc.steps},
-                      {"balance_speedup", sim_span > 0 ? sim_work / sim_span : 1.0}};
+                      {"balance_speedup", sim_span > 0 ? sim_work / sim_span : 1.0}});
         }
       }
     }
@@ -322,7 +322,13 @@ int run_bench(BenchOptions opt) {
         if (c.variant != &v) continue;
         const double step_ms = median(c.totals) / sc.steps;
         if (v.method == Method::sequential) sequential_ms = step_ms;
-        method_json["threads"][std::to_string(c.threads)] = {{"step_ms", step_ms}, {"runs_ms", c.totals}, {"phases_per_step", c.phases}};
+        // The phases of the median run (the lower middle one for an even count), so that they add up
+        // to the reported step time and not to a run that met a slow spell.
+        std::vector<std::size_t> order(c.totals.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return c.totals[x] < c.totals[y]; });
+        const Json& phases = c.phases[order[(order.size() - 1) / 2]];
+        method_json["threads"][std::to_string(c.threads)] = {{"step_ms", step_ms}, {"runs_ms", c.totals}, {"phases_per_step", phases}};
       }
       // The load-balance simulation: tasks cut for P threads (the engine runs P threads here, so
       // calibration targets P), node tests list-scheduled on P virtual cores.
