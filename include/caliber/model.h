@@ -52,6 +52,11 @@ struct BvhNodeFilter {
   float cone_angle;
   /// cos(cone_angle) and sin(cone_angle), so the cone test needs no trigonometric call.
   float cone_cos, cone_sin;
+  /// Slab along cone_axis (as stored, not renormalized): every vertex v below has
+  /// slab_lo <= cone_axis . v <= slab_hi, the bounds rounded outward. Thin where the triangles
+  /// below are nearly coplanar, whatever their tilt against the box's axes; both 0 when the axis
+  /// is 0 (no normal below), which prunes nothing.
+  float slab_lo, slab_hi;
   /// Bit g set when some triangle below is in primitive group g.
   std::uint64_t groups;
 };

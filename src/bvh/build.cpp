@@ -26,10 +26,17 @@ double angle_between(const Vec3& u, const Vec3& v) {
   return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
 }
 
-/// A float that is >= x (x >= 0), so that a stored half-angle never shrinks.
+/// A float that is >= x, so that a stored bound never shrinks.
 float round_up(double x) {
   auto f = static_cast<float>(x);
   if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+/// A float that is <= x.
+float round_down(double x) {
+  auto f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
   return f;
 }
 
@@ -46,6 +53,7 @@ struct WorkNode {
   Vec3 normal_sum = Vec3::Zero();             ///< sum of the unit normals below (cone axis direction)
   Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
+  double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -166,6 +174,21 @@ class Builder {
     if (normal.squaredNorm() > 0.0) {
       node.axis = to_float_axis(normal);
       node.cone = angle_between(node.axis.normalized(), normal) + kConeSlack;
+      node.slab_lo = std::min({node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)});
+      node.slab_hi = std::max({node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)});
+    }
+  }
+
+  /// Range of axis . v over the vertices of the triangles in mOrder[begin, end).
+  void slab_range(const Vec3& axis, std::uint32_t begin, std::uint32_t end, double& lo, double& hi) const {
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
+    for (std::uint32_t i = begin; i < end; ++i) {
+      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
+        const double s = axis.dot(mMesh.vertices[v]);
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+      }
     }
   }
 
@@ -218,6 +241,19 @@ class Builder {
         if (kid->cone >= 0.0) angle = std::max(angle, angle_between(unit, kid->axis.normalized()) + kid->cone);
       }
       node.cone = std::min(angle + kConeSlack, 2.0 * kPi);
+      if (node.count <= kExactRadiusCount) {
+        slab_range(node.axis, begin, end, node.slab_lo, node.slab_hi);
+      } else {
+        // Near the root: the children's boxes projected on the axis (a bound, not the range).
+        node.slab_lo = std::numeric_limits<double>::infinity();
+        node.slab_hi = -node.slab_lo;
+        for (const WorkNode* kid : {&l, &r}) {
+          const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
+          const double mid = node.axis.dot(center), reach = node.axis.cwiseAbs().dot(half);
+          node.slab_lo = std::min(node.slab_lo, mid - reach);
+          node.slab_hi = std::max(node.slab_hi, mid + reach);
+        }
+      }
     }
     mWork[slot] = node;
   }
@@ -243,6 +279,10 @@ class Builder {
     filter.cone_cos = static_cast<float>(std::cos(static_cast<double>(filter.cone_angle)));
     filter.cone_sin = static_cast<float>(std::sin(static_cast<double>(filter.cone_angle)));
     filter.groups = w.groups;
+    // The dot products above carry a few ulps of |axis|_1 * |v|_inf; the pad is far above that.
+    const double slab_pad = 1e-13 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
+    filter.slab_lo = w.cone >= 0.0 ? round_down(w.slab_lo - slab_pad) : 0.0f;
+    filter.slab_hi = w.cone >= 0.0 ? round_up(w.slab_hi + slab_pad) : 0.0f;
   }
 
   const Mesh& mMesh;

@@ -48,9 +48,10 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
-  mAbsRot = mRot.cwiseAbs().array() + 1e-12;
+  mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
   const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
   mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
+  mSlabReach = mReach * (1.0 + 1e-6);
   mTheta = request.angle_deg * kPi / 180.0;
   mCosTheta = std::cos(mTheta);
   mSinTheta = std::sin(mTheta);

@@ -28,6 +28,9 @@ struct Candidate {
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
 /// disjoint parts of one pair's CD tree with the same context.
 class PairContext {
+  /// Added to |rotation . axis| terms: covers rounding in the rotation and in the products.
+  static constexpr double kRotationHair = 1e-12;
+
  public:
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
@@ -43,6 +46,9 @@ class PairContext {
     double half[3];        ///< box half-extents (A's axes)
     double box_in_b[3];    ///< box center in B's frame
     double reach_on_b[3];  ///< half-extent of A's box along each of B's axes
+    double slab_axis[3];   ///< slab axis (A's frame), 0 when the node has none
+    double slab_on_b[3];   ///< |slab axis . B's axis k|: how much of B's half-extent k it sees
+    double slab_lo, slab_hi;
   };
   /// A node of B, prepared the same way: centers brought into A's frame.
   struct SideB {
@@ -53,6 +59,9 @@ class PairContext {
     double half[3];        ///< box half-extents (B's axes)
     double box_in_a[3];    ///< box center in A's frame
     double reach_on_a[3];  ///< half-extent of B's box along each of A's axes
+    double slab_axis[3];   ///< slab axis (B's own frame), 0 when the node has none
+    double slab_on_a[3];   ///< |slab axis . A's axis k|
+    double slab_lo, slab_hi;
   };
 
   /// Prepares node ia of A for node tests.
@@ -72,6 +81,14 @@ class PairContext {
       s.box_in_b[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
       s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
     }
+    const BvhNodeFilter& f = mA.filters[ia];
+    for (int i = 0; i < 3; ++i) s.slab_axis[i] = f.cone_axis[i];
+    for (int j = 0; j < 3; ++j) {
+      s.slab_on_b[j] = std::abs(mRot(0, j) * s.slab_axis[0] + mRot(1, j) * s.slab_axis[1] + mRot(2, j) * s.slab_axis[2]) +
+                       kRotationHair;
+    }
+    s.slab_lo = f.slab_lo;
+    s.slab_hi = f.slab_hi;
     return s;
   }
 
@@ -91,11 +108,20 @@ class PairContext {
       s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
       s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
     }
+    const BvhNodeFilter& f = mB.filters[ib];
+    for (int i = 0; i < 3; ++i) s.slab_axis[i] = f.cone_axis[i];
+    for (int i = 0; i < 3; ++i) {
+      s.slab_on_a[i] = std::abs(mRot(i, 0) * s.slab_axis[0] + mRot(i, 1) * s.slab_axis[1] + mRot(i, 2) * s.slab_axis[2]) +
+                       kRotationHair;
+    }
+    s.slab_lo = f.slab_lo;
+    s.slab_hi = f.slab_hi;
     return s;
   }
 
   /// The node-node test on prepared nodes: spheres within the tolerance, boxes not separated by a
-  /// face axis, normal cones able to face each other (contact only), some compatible groups.
+  /// face axis, each box not separated from the other node's slab, normal cones able to face each
+  /// other (contact only), some compatible groups.
   /// Conservative: every bound carries the safety margin (see the constructor).
   [[nodiscard]] bool node_test(const SideA& a, const SideB& b) const {
     double dist2 = 0.0;
@@ -110,6 +136,17 @@ class PairContext {
     }
     for (int j = 0; j < 3; ++j) {  // B's axes
       if (std::abs(b.box[j] - a.box_in_b[j]) > b.half[j] + a.reach_on_b[j] + mReach) return false;
+    }
+    // Slabs: a gap g along an axis of length |axis| <= 1 + 1e-6 is a distance >= g / |axis|.
+    {
+      const double at = a.slab_axis[0] * b.box_in_a[0] + a.slab_axis[1] * b.box_in_a[1] + a.slab_axis[2] * b.box_in_a[2];
+      const double reach = a.slab_on_b[0] * b.half[0] + a.slab_on_b[1] * b.half[1] + a.slab_on_b[2] * b.half[2];
+      if (at - reach > a.slab_hi + mSlabReach || at + reach < a.slab_lo - mSlabReach) return false;
+    }
+    {
+      const double at = b.slab_axis[0] * a.box_in_b[0] + b.slab_axis[1] * a.box_in_b[1] + b.slab_axis[2] * a.box_in_b[2];
+      const double reach = b.slab_on_a[0] * a.half[0] + b.slab_on_a[1] * a.half[1] + b.slab_on_a[2] * a.half[2];
+      if (at - reach > b.slab_hi + mSlabReach || at + reach < b.slab_lo - mSlabReach) return false;
     }
     if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
     if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
@@ -152,6 +189,7 @@ class PairContext {
   Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
   Eigen::Vector3d mTrans;
   double mReach;       ///< tolerance + safety margin added to the sum of radii
+  double mSlabReach;   ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
   double mTheta;       ///< contact angle, radians
   double mCosTheta;    ///< cos(theta)
   double mSinTheta;    ///< sin(theta)

@@ -32,12 +32,15 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const Eigen::Vector3d bc(node.box_center[0], node.box_center[1], node.box_center[2]);
   const Eigen::Vector3d bh(node.box_half[0], node.box_half[1], node.box_half[2]);
   const Eigen::Vector3d axis = Eigen::Vector3d(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]).normalized();
+  const Eigen::Vector3d stored_axis(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]);
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh.triangles[t]) {
       const Eigen::Vector3d& p = m.mesh.vertices[v];
       EXPECT_LE((p - c).norm(), node.radius) << "node " << index << " sphere must cover its vertices";
       EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
+      const double along = stored_axis.dot(p);
+      EXPECT_TRUE(filter.slab_lo <= along && along <= filter.slab_hi) << "node " << index << " slab must cover its vertices: " << filter.slab_lo << " <= " << along << " <= " << filter.slab_hi << " (triangle " << t << ")";
     }
     if (m.normals[t].squaredNorm() > 0.0) {
       any_normal = true;
@@ -46,6 +49,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
     }
   }
   EXPECT_EQ(any_normal, filter.cone_angle >= 0.0f) << "node " << index;
+  if (!any_normal) EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
   return below;
 }
 
