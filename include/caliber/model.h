@@ -42,8 +42,9 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
 
-/// What only the contact query and the group filter read of a node, kept apart so that the
-/// interference and proximity traversals do not carry it through the cache.
+/// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
+/// tests have passed; the cone only by contact queries) and its group mask (read only with groups).
+/// Kept apart from BvhNode so that the first two tests touch 48 bytes.
 struct BvhNodeFilter {
   /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
   float cone_axis[3];
@@ -73,7 +74,7 @@ struct Model {
   Mesh mesh;
   /// BVH nodes, root first; siblings adjacent.
   std::vector<BvhNode> nodes;
-  /// filters[i]: normal cone and group mask of nodes[i].
+  /// filters[i]: normal cone, slab and group mask of nodes[i].
   std::vector<BvhNodeFilter> filters;
   /// The triangles below node i are those whose leaf_position lies in
   /// [first_leaf[i], first_leaf[i] + nodes[i].count): every subtree is a run of the leaf order.
