@@ -1,4 +1,4 @@
-// Sphere-tree BVH build: top-down median split, exact covering radii, normal cones, group masks.
+// Sphere-tree BVH build: top-down median split, exact covering radii, normal cones and slabs, group masks.
 
 #include <algorithm>
 #include <cmath>
@@ -125,16 +125,22 @@ class Builder {
     return mid;
   }
 
-  /// Largest distances from c1 and from c2 to a vertex of a triangle in mOrder[begin, end), rounded
-  /// up a little so that they cover every vertex despite rounding in the norms.
-  void covering_radii(const Vec3& c1, const Vec3& c2, std::uint32_t begin, std::uint32_t end, double& r1,
-                      double& r2) const {
+  /// One pass over the vertices of the triangles in mOrder[begin, end): the largest distances from
+  /// c1 and from c2, rounded up a little so that they cover every vertex despite rounding in the
+  /// norms, and the range [lo, hi] of axis . v.
+  void exact_bounds(const Vec3& c1, const Vec3& c2, const Vec3& axis, std::uint32_t begin, std::uint32_t end, double& r1,
+                    double& r2, double& lo, double& hi) const {
     double d1 = 0.0, d2 = 0.0;
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
     for (std::uint32_t i = begin; i < end; ++i) {
       for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
         const Vec3& p = mMesh.vertices[v];
         d1 = std::max(d1, (p - c1).squaredNorm());
         d2 = std::max(d2, (p - c2).squaredNorm());
+        const double s = axis.dot(p);
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
       }
     }
     r1 = std::sqrt(d1) * (1.0 + 1e-14);
@@ -174,21 +180,9 @@ class Builder {
     if (normal.squaredNorm() > 0.0) {
       node.axis = to_float_axis(normal);
       node.cone = angle_between(node.axis.normalized(), normal) + kConeSlack;
-      node.slab_lo = std::min({node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)});
-      node.slab_hi = std::max({node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)});
-    }
-  }
-
-  /// Range of axis . v over the vertices of the triangles in mOrder[begin, end).
-  void slab_range(const Vec3& axis, std::uint32_t begin, std::uint32_t end, double& lo, double& hi) const {
-    lo = std::numeric_limits<double>::infinity();
-    hi = -lo;
-    for (std::uint32_t i = begin; i < end; ++i) {
-      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
-        const double s = axis.dot(mMesh.vertices[v]);
-        lo = std::min(lo, s);
-        hi = std::max(hi, s);
-      }
+      const double along[3] = {node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)};
+      node.slab_lo = std::min({along[0], along[1], along[2]});
+      node.slab_hi = std::max({along[0], along[1], along[2]});
     }
   }
 
@@ -201,6 +195,20 @@ class Builder {
     node.groups = l.groups | r.groups;
     node.lo = l.lo.cwiseMin(r.lo);
     node.hi = l.hi.cwiseMax(r.hi);
+
+    // Normal cone: axis along the sum of the unit normals below; half-angle from the children's
+    // cones by the triangle inequality (angle to a child's axis + that child's half-angle).
+    node.normal_sum = l.normal_sum + r.normal_sum;
+    if (l.cone >= 0.0 || r.cone >= 0.0) {
+      const double sum_norm = node.normal_sum.norm();
+      node.axis = to_float_axis(sum_norm > 1e-9 * node.count ? Vec3(node.normal_sum / sum_norm) : Vec3(1.0, 0.0, 0.0));
+      const Vec3 unit = node.axis.normalized();
+      double angle = 0.0;
+      for (const WorkNode* kid : {&l, &r}) {
+        if (kid->cone >= 0.0) angle = std::max(angle, angle_between(unit, kid->axis.normalized()) + kid->cone);
+      }
+      node.cone = std::min(angle + kConeSlack, 2.0 * kPi);
+    }
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.
     Vec3 merged = l.center;
@@ -215,7 +223,8 @@ class Builder {
     const Vec3 box = 0.5 * (node.lo + node.hi);
     double r_merged, r_box;
     if (node.count <= kExactRadiusCount) {
-      covering_radii(merged, box, begin, end, r_merged, r_box);
+      // The slab's range comes from the same pass (unused, and the axis 0, when there is no cone).
+      exact_bounds(merged, box, node.axis, begin, end, r_merged, r_box, node.slab_lo, node.slab_hi);
     } else {
       // Near the root, the children's spheres bound the radius: O(1) instead of a pass over every
       // vertex below, which keeps the build O(n log n) with a small constant. These few large
@@ -225,36 +234,18 @@ class Builder {
       };
       r_merged = bound(merged);
       r_box = bound(box);
+      // The slab likewise: the children's boxes projected on the axis (a bound, not the range).
+      node.slab_lo = std::numeric_limits<double>::infinity();
+      node.slab_hi = -node.slab_lo;
+      for (const WorkNode* kid : {&l, &r}) {
+        const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
+        const double mid = node.axis.dot(center), reach = node.axis.cwiseAbs().dot(half);
+        node.slab_lo = std::min(node.slab_lo, mid - reach);
+        node.slab_hi = std::max(node.slab_hi, mid + reach);
+      }
     }
     node.center = r_box < r_merged ? box : merged;
     node.radius = std::min(r_box, r_merged);
-
-    // Normal cone: axis along the sum of the unit normals below; half-angle from the children's
-    // cones by the triangle inequality (angle to a child's axis + that child's half-angle).
-    node.normal_sum = l.normal_sum + r.normal_sum;
-    if (l.cone >= 0.0 || r.cone >= 0.0) {
-      const double sum_norm = node.normal_sum.norm();
-      node.axis = to_float_axis(sum_norm > 1e-9 * node.count ? Vec3(node.normal_sum / sum_norm) : Vec3(1.0, 0.0, 0.0));
-      const Vec3 unit = node.axis.normalized();
-      double angle = 0.0;
-      for (const WorkNode* kid : {&l, &r}) {
-        if (kid->cone >= 0.0) angle = std::max(angle, angle_between(unit, kid->axis.normalized()) + kid->cone);
-      }
-      node.cone = std::min(angle + kConeSlack, 2.0 * kPi);
-      if (node.count <= kExactRadiusCount) {
-        slab_range(node.axis, begin, end, node.slab_lo, node.slab_hi);
-      } else {
-        // Near the root: the children's boxes projected on the axis (a bound, not the range).
-        node.slab_lo = std::numeric_limits<double>::infinity();
-        node.slab_hi = -node.slab_lo;
-        for (const WorkNode* kid : {&l, &r}) {
-          const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
-          const double mid = node.axis.dot(center), reach = node.axis.cwiseAbs().dot(half);
-          node.slab_lo = std::min(node.slab_lo, mid - reach);
-          node.slab_hi = std::max(node.slab_hi, mid + reach);
-        }
-      }
-    }
     mWork[slot] = node;
   }
 

@@ -137,17 +137,8 @@ class PairContext {
     for (int j = 0; j < 3; ++j) {  // B's axes
       if (std::abs(b.box[j] - a.box_in_b[j]) > b.half[j] + a.reach_on_b[j] + mReach) return false;
     }
-    // Slabs: a gap g along an axis of length |axis| <= 1 + 1e-6 is a distance >= g / |axis|.
-    {
-      const double at = a.slab_axis[0] * b.box_in_a[0] + a.slab_axis[1] * b.box_in_a[1] + a.slab_axis[2] * b.box_in_a[2];
-      const double reach = a.slab_on_b[0] * b.half[0] + a.slab_on_b[1] * b.half[1] + a.slab_on_b[2] * b.half[2];
-      if (at - reach > a.slab_hi + mSlabReach || at + reach < a.slab_lo - mSlabReach) return false;
-    }
-    {
-      const double at = b.slab_axis[0] * a.box_in_b[0] + b.slab_axis[1] * a.box_in_b[1] + b.slab_axis[2] * a.box_in_b[2];
-      const double reach = b.slab_on_a[0] * a.half[0] + b.slab_on_a[1] * a.half[1] + b.slab_on_a[2] * a.half[2];
-      if (at - reach > b.slab_hi + mSlabReach || at + reach < b.slab_lo - mSlabReach) return false;
-    }
+    if (box_beyond_slab(a.slab_axis, a.slab_on_b, a.slab_lo, a.slab_hi, b.box_in_a, b.half)) return false;
+    if (box_beyond_slab(b.slab_axis, b.slab_on_a, b.slab_lo, b.slab_hi, a.box_in_b, a.half)) return false;
     if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
     if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
     return true;
@@ -178,6 +169,15 @@ class PairContext {
  private:
   bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
+  /// Whether a box lies beyond the slab lo <= axis . x <= hi by more than the reach: `center` is the
+  /// box's center in the slab's frame, `half` its half-extents along its own axes, and `on[k]` is
+  /// |axis . box axis k|. A gap g along an axis up to 1 + 1e-6 long is a distance >= g / |axis|.
+  [[nodiscard]] bool box_beyond_slab(const double axis[3], const double on[3], double lo, double hi, const double center[3],
+                                     const double half[3]) const {
+    const double at = axis[0] * center[0] + axis[1] * center[1] + axis[2] * center[2];
+    const double reach = on[0] * half[0] + on[1] * half[1] + on[2] * half[2];
+    return at - reach > hi + mSlabReach || at + reach < lo - mSlabReach;
+  }
 
   const Model& mA;
   const Model& mB;

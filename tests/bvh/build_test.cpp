@@ -31,8 +31,8 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const Eigen::Vector3d c(node.center[0], node.center[1], node.center[2]);
   const Eigen::Vector3d bc(node.box_center[0], node.box_center[1], node.box_center[2]);
   const Eigen::Vector3d bh(node.box_half[0], node.box_half[1], node.box_half[2]);
-  const Eigen::Vector3d axis = Eigen::Vector3d(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]).normalized();
   const Eigen::Vector3d stored_axis(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]);
+  const Eigen::Vector3d axis = stored_axis.normalized();
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh.triangles[t]) {
