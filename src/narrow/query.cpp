@@ -59,46 +59,70 @@ bool by_ids(const Candidate& x, const Candidate& y) {
   return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
 }
 
-/// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
-/// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win).
-std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted, std::size_t grain) {
-  // Lookup structure over the sorted candidates: the distinct triangles of A (one run each) and the
-  // triangles of B packed contiguously, so a neighbour lookup is two small binary searches.
-  std::vector<std::uint32_t> run_a, run_begin, tri_b(sorted.size());
-  for (std::size_t i = 0; i < sorted.size(); ++i) {
-    tri_b[i] = sorted[i].tri_b;
-    if (i == 0 || sorted[i].tri_a != sorted[i - 1].tri_a) {
-      run_a.push_back(sorted[i].tri_a);
-      run_begin.push_back(static_cast<std::uint32_t>(i));
+/// Where each candidate of a sorted list sits, by its triangle pair: an open-addressing hash table
+/// (linear probing, at most half full), so a neighbour lookup costs one or two probes whatever the
+/// list's length. Built once per finalization, then only read (safe to share between threads).
+class PairIndex {
+ public:
+  explicit PairIndex(const std::vector<Candidate>& sorted) : mSorted(sorted) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * sorted.size()) capacity *= 2;
+    mMask = capacity - 1;
+    mSlots.assign(capacity, kEmpty);
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+      std::size_t h = slot(key(sorted[i].tri_a, sorted[i].tri_b));
+      while (mSlots[h] != kEmpty) h = (h + 1) & mMask;
+      mSlots[h] = static_cast<std::uint32_t>(i);
     }
   }
-  run_begin.push_back(static_cast<std::uint32_t>(sorted.size()));
-  const auto find = [&](std::uint32_t ta, std::uint32_t tb) -> const Candidate* {
-    const auto r = std::lower_bound(run_a.begin(), run_a.end(), ta);
-    if (r == run_a.end() || *r != ta) return nullptr;
-    const std::size_t k = static_cast<std::size_t>(r - run_a.begin());
-    const auto first = tri_b.begin() + run_begin[k], last = tri_b.begin() + run_begin[k + 1];
-    const auto it = std::lower_bound(first, last, tb);
-    return (it != last && *it == tb) ? &sorted[static_cast<std::size_t>(it - tri_b.begin())] : nullptr;
-  };
+
+  /// The candidate (ta, tb), or nullptr.
+  [[nodiscard]] const Candidate* find(std::uint32_t ta, std::uint32_t tb) const {
+    for (std::size_t h = slot(key(ta, tb));; h = (h + 1) & mMask) {
+      const std::uint32_t i = mSlots[h];
+      if (i == kEmpty) return nullptr;
+      const Candidate& c = mSorted[i];
+      if (c.tri_a == ta && c.tri_b == tb) return &c;
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  static std::uint64_t key(std::uint32_t ta, std::uint32_t tb) { return (std::uint64_t{ta} << 32) | tb; }
+  /// Fibonacci hashing: the high bits of the key times 2^64 / phi, folded to the table's size.
+  [[nodiscard]] std::size_t slot(std::uint64_t k) const {
+    return static_cast<std::size_t>((k * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
+  }
+
+  const std::vector<Candidate>& mSorted;
+  /// Candidate positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
+  std::vector<std::uint32_t> mSlots;
+  std::size_t mMask = 0;
+};
+
+/// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
+/// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
+/// the candidates (times the adjacency's degree): each neighbour is one hash lookup.
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted, std::size_t grain) {
+  const PairIndex index(sorted);
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
   // Each candidate's verdict depends only on the sorted list: decided in parallel, kept in order.
   std::vector<char> keep(sorted.size(), 0);
   parallel::parallel_for(0, sorted.size(), grain, [&](std::size_t lo, std::size_t hi) {
-  for (std::size_t i = lo; i != hi; ++i) {
-    const Candidate& c = sorted[i];
-    bool dominated = false;
-    for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
-      const Candidate* other = find(ma.adjacency[k], c.tri_b);
-      dominated = other != nullptr && closer(*other, c);
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = sorted[i];
+      bool dominated = false;
+      for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
+        const Candidate* other = index.find(ma.adjacency[k], c.tri_b);
+        dominated = other != nullptr && closer(*other, c);
+      }
+      for (std::uint32_t k = mb.adjacency_offsets[c.tri_b]; !dominated && k < mb.adjacency_offsets[c.tri_b + 1]; ++k) {
+        const Candidate* other = index.find(c.tri_a, mb.adjacency[k]);
+        dominated = other != nullptr && closer(*other, c);
+      }
+      keep[i] = dominated ? 0 : 1;
     }
-    for (std::uint32_t k = mb.adjacency_offsets[c.tri_b]; !dominated && k < mb.adjacency_offsets[c.tri_b + 1]; ++k) {
-      const Candidate* other = find(c.tri_a, mb.adjacency[k]);
-      dominated = other != nullptr && closer(*other, c);
-    }
-    keep[i] = dominated ? 0 : 1;
-  }
   });
   std::vector<Candidate> kept;
   for (std::size_t i = 0; i < sorted.size(); ++i) {
