@@ -1,6 +1,9 @@
 // caliber query: two meshes, one query.
 
+#include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <vector>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -35,7 +38,27 @@ struct QueryOptions {
   int show = 10;
   std::string method = "sequential";
   int threads = 0;
+  int repeat = 1;
 };
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
+  if (x.pairs.size() != y.pairs.size() || x.contacts.size() != y.contacts.size()) return false;
+  for (std::size_t i = 0; i < x.pairs.size(); ++i) {
+    if (x.pairs[i].tri_a != y.pairs[i].tri_a || x.pairs[i].tri_b != y.pairs[i].tri_b) return false;
+  }
+  for (std::size_t i = 0; i < x.contacts.size(); ++i) {
+    const auto& a = x.contacts[i];
+    const auto& b = y.contacts[i];
+    if (a.distance != b.distance || a.point_a != b.point_a || a.point_b != b.point_b || a.normal != b.normal) return false;
+  }
+  return true;
+}
 
 /// Runs the query as a one-step, two-object scene through the parallel engine (the same contacts as
 /// caliber::query, whatever the method). B is given a zero velocity so the pair is not skipped as
@@ -84,27 +107,41 @@ int run_query(const QueryOptions& opt) {
   std::shared_ptr<const caliber::Model> model_a, model_b;
   std::unique_ptr<caliber::World> world;
   caliber::QueryResult result;
-  double build_ms = 0.0, query_ms = 0.0;
+  double build_ms = 0.0;
+  std::vector<double> query_ms;  // one per repetition, the first one cold
   if (method == caliber::Method::sequential) {
     const auto build_start = Clock::now();
     model_a = caliber::build_model(caliber::load_mesh(opt.mesh_a));
     model_b = opt.mesh_b == opt.mesh_a ? model_a : caliber::build_model(caliber::load_mesh(opt.mesh_b));
     build_ms = ms_since(build_start);
-    const auto query_start = Clock::now();
-    result = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
-    query_ms = ms_since(query_start);
-  } else {
-    const auto start = Clock::now();
-    result = query_with_engine(opt, request, pose_a, pose_b, world);
-    query_ms = ms_since(start);  // loading and building included: the engine owns its world
   }
+  for (int r = 0; r < opt.repeat; ++r) {
+    caliber::QueryResult again;
+    const auto start = Clock::now();
+    if (method == caliber::Method::sequential) {
+      again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
+    } else {
+      again = query_with_engine(opt, request, pose_a, pose_b, world);  // loading and building included
+    }
+    query_ms.push_back(ms_since(start));
+    if (r == 0) {
+      result = std::move(again);
+    } else if (!same_result(result, again)) {
+      throw std::runtime_error("repetition " + std::to_string(r + 1) + " of the query gave a different result");
+    }
+  }
+  // Warm: the median of the repetitions after the first (the first alone when there is one).
+  const double cold_ms = query_ms.front();
+  const double warm_ms = query_ms.size() > 1 ? median({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
   const caliber::Model& shown_a = world ? world->model(0) : *model_a;
   const caliber::Model& shown_b = world ? world->model(1) : *model_b;
 
   if (opt.json) {
     nlohmann::json out = caliber::cli::to_json(result);
     out["stats"]["build_ms"] = build_ms;
-    out["stats"]["query_ms"] = query_ms;
+    out["stats"]["query_ms"] = cold_ms;
+    out["stats"]["query_ms_warm"] = warm_ms;
+    out["stats"]["repeat"] = opt.repeat;
     std::cout << out.dump() << "\n";
     return 0;
   }
@@ -116,9 +153,11 @@ int run_query(const QueryOptions& opt) {
               shown_a.height);
   std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh.triangles.size(),
               shown_b.height);
-  std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms\n",
+  std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms",
               static_cast<unsigned long long>(result.stats.node_tests),
-              static_cast<unsigned long long>(result.stats.leaf_tests), build_ms, query_ms);
+              static_cast<unsigned long long>(result.stats.leaf_tests), build_ms, cold_ms);
+  if (opt.repeat > 1) std::printf(" (first; median of the other %d: %.3f ms)", opt.repeat - 1, warm_ms);
+  std::printf("\n");
   const std::size_t shown = std::min<std::size_t>(result.pairs.size(), static_cast<std::size_t>(std::max(opt.show, 0)));
   for (std::size_t i = 0; i < shown; ++i) {
     if (result.contacts.empty()) {
@@ -153,6 +192,11 @@ Runner add_query_command(CLI::App& app) {
                   "apriori, hybrid (same pairs; build time then counted in query_ms)")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Engine threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--repeat", opt->repeat,
+                  "Run the query R times: stats.query_ms is the first (cold) run, stats.query_ms_warm the median of "
+                  "the others (every run must give the same result)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   return [cmd, opt]() { return cmd->parsed() ? run_query(*opt) : -1; };
 }
 

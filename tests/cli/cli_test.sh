@@ -61,6 +61,18 @@ for m in ("stealing", "hybrid"):
     assert r[m]["contacts"] == r["sequential"]["contacts"], m
 PY
 rm -rf "$tmpq"
+# --repeat: the first run is reported as query_ms (cold), the median of the others as query_ms_warm.
+check repeat 0 "$cli" query "$data/tetra.off" "$data/tetra_binary.stl" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind contact --tolerance 0.1 --repeat 5 --json
+python3 - "$out" <<'PY' && passes=$((passes + 1)) || { echo "FAIL repeat-shape: $out"; failures=$((failures + 1)); }
+import json, sys
+s = json.loads(sys.argv[1])["stats"]
+assert s["repeat"] == 5 and s["query_ms"] > 0 and s["query_ms_warm"] > 0, s
+PY
+check repeat-summary 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.5 0.5 0.5 1 0 0 0" --repeat 3
+contains repeat-summary "median of the other 2"
+check repeat-zero 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --repeat 0
+contains repeat-zero "--repeat"
+check repeat-absurd 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --repeat 1000000
 check bad-method 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --method turbo
 contains bad-method "unknown method"
 check missing 2 "$cli" query "$data/nope.off" "$data/tetra.off"
