@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -29,6 +32,7 @@
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
+#include "bench_records.h"
 #include "bench_report.h"
 #include "commands.h"
 #include "machine.h"
@@ -51,6 +55,10 @@ struct BenchOptions {
   std::string out;
   bool figures = true;
   bool fcl = true;
+  bool ceiling = true;
+  double budget_s = 0.0;   // 0: no budget
+  std::string log;         // the JSON-lines log (default: OUT/runs.jsonl)
+  std::string from_log;    // rebuild the report from this log instead of measuring
 };
 
 /// A method name as the bench knows it: the six methods, and "hybrid+history" (node history on).
@@ -113,13 +121,6 @@ std::uint64_t contacts_hash(const StepResult& s) {
   return h;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 double pearson(const std::vector<double>& x, const std::vector<double>& y) {
   const std::size_t n = x.size();
   if (n < 3) return 0.0;
@@ -168,7 +169,348 @@ std::string quote(const std::string& s) {
   return q + "'";
 }
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// The time the bench may take (--budget-s): a run starts only if its estimated time still fits,
+/// so the bench ends inside the budget with every finished run in its log.
+class Budget {
+ public:
+  explicit Budget(double seconds) : mSeconds(seconds) {}
+  /// Whether work estimated at `estimate_s` seconds (a quarter more for safety) still fits.
+  [[nodiscard]] bool allows(double estimate_s) const { return mSeconds <= 0.0 || elapsed_s() + 1.25 * estimate_s <= mSeconds; }
+  [[nodiscard]] double elapsed_s() const { return seconds_since(mStart); }
+
+ private:
+  Clock::time_point mStart = Clock::now();
+  double mSeconds;
+};
+
+/// One scene x method x thread count, and its runs so far (the last one estimates the next).
+struct Config {
+  const Variant* variant;
+  int threads;
+  double last_ms = 0.0;
+};
+
+/// Everything a bench run shares: options, scenes, methods, the log, the budget, the progress.
+struct BenchRun {
+  const BenchOptions& opt;
+  std::vector<std::unique_ptr<World>>& worlds;
+  std::vector<double> load_s;  ///< per scene: loading and building its world once
+  const std::vector<Variant>& variants;
+  BenchLog& log;
+  Budget budget;
+  Progress progress;
+  std::size_t done = 0;
+  bool stopped = false;
+  std::vector<double> sequential_s;  ///< per scene: one sequential run, in seconds (0 until run)
+
+  /// Whether work of `estimate_s` fits; if not, records that the run stops here.
+  bool fits(double estimate_s, const std::string& what) {
+    if (stopped) return false;
+    if (budget.allows(estimate_s)) return true;
+    stopped = true;
+    log.add({{"kind", "stopped"}, {"reason", "budget"}, {"after_s", budget.elapsed_s()}, {"next", what}});
+    std::fprintf(stderr, "\ncaliber bench: --budget-s %g reached after %.0f s; not run: %s and what follows\n", opt.budget_s,
+                 budget.elapsed_s(), what.c_str());
+    return false;
+  }
+};
+
+/// One measured run: every step of the scene on a fresh engine; its record, and the contact check
+/// against the sequential reference (`reference` is filled by the first sequential run).
+Json measure_run(BenchRun& b, const World& world, const Variant& v, int t, int round, std::vector<std::uint64_t>& reference) {
+  const Scene& sc = world.scene();
+  Engine engine(world, engine_options(v, t));
+  RunStats stats;
+  double total = 0.0, calibrate = 0.0, traverse = 0.0, finalize = 0.0, broad = 0.0;
+  // The load-balance simulation of this very run: its tasks' node tests list-scheduled on as many
+  // virtual cores as it has threads (what the cut allows, whatever the clock says).
+  double sim_work = 0.0, sim_span = 0.0;
+  const bool is_reference = v.method == Method::sequential && reference.empty();
+  for (int k = 0; k < sc.steps; ++k) {
+    const StepResult s = engine.step(k);
+    total += s.broad_ms + s.narrow_ms + s.reduce_ms;
+    broad += s.broad_ms;
+    calibrate += s.schedule.calibrate_ms;
+    traverse += s.schedule.traverse_ms;
+    finalize += s.schedule.finalize_ms;
+    if (v.method != Method::sequential && s.stats.node_tests > 0) {
+      const double w = static_cast<double>(s.stats.node_tests);
+      sim_work += w;
+      sim_span += w / simulated_speedup(s, v.method, t);
+    }
+    const std::uint64_t h = contacts_hash(s);
+    if (is_reference) {
+      reference.push_back(h);
+      stats.add(s);
+    } else if (reference.size() > static_cast<std::size_t>(k) && reference[k] != h) {
+      b.log.add({{"kind", "mismatch"}, {"scene", sc.name}, {"method", v.name}, {"threads", t}, {"step", k}});
+      std::fprintf(stderr, "\nMISMATCH: %s, %s on %d threads, step %d: contacts differ from sequential's\n", sc.name.c_str(),
+                   v.name.c_str(), t, k);
+    }
+    ++b.done;
+    if (b.progress.terminal() || k + 1 == sc.steps) {  // plain output: one line per run
+      char line[200];
+      std::snprintf(line, sizeof line, "%s: round %d/%d, %s x%d, step %d", sc.name.c_str(), round + 1, b.opt.repeat, v.name.c_str(), t, k);
+      b.progress.update(b.done, line);
+    }
+  }
+  if (is_reference) {
+    const auto [heavy, heavy_share] = stats.heaviest_pair();
+    const auto [second, second_share] = stats.second_heaviest_pair();
+    b.log.add({{"kind", "table1"},
+               {"scene", sc.name},
+               {"objects", world.object_count()},
+               {"triangles", world.triangle_count()},
+               {"node_tests_per_step", stats.mean_node_tests()},
+               {"contacts_per_step", stats.mean_contacts()},
+               {"pairs_per_step", stats.mean_tasks()},
+               {"candidate_pairs", stats.candidate_pairs()},
+               {"heaviest_pair_share", heavy_share},
+               {"second_pair_share", second_share},
+               {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}});
+  }
+  const double steps = sc.steps;
+  return {{"kind", "run"},
+          {"scene", sc.name},
+          {"method", v.name},
+          {"threads", t},
+          {"round", round},
+          {"total_ms", total},
+          {"phases",
+           {{"broad_ms", broad / steps},
+            {"calibrate_ms", calibrate / steps},
+            {"traverse_ms", traverse / steps},
+            {"finalize_ms", finalize / steps},
+            {"balance_speedup", sim_span > 0 ? sim_work / sim_span : 1.0}}}};
+}
+
+/// The machine's own ceiling at `copies` threads: that many independent sequential copies of the
+/// scene run at once, each with its own world and engine (nothing shared), and each copy's time per
+/// step. Against one copy alone, what memory bandwidth, shared caches and clock boost leave of
+/// `copies` x before any scheduling.
+std::vector<double> measure_ceiling(const Scene& scene, int copies) {
+  std::vector<double> ms(static_cast<std::size_t>(copies), 0.0);
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(copies));
+  std::mutex mutex;
+  std::condition_variable ready;
+  int loaded = 0;
+  std::vector<std::thread> threads;
+  for (int i = 0; i < copies; ++i) {
+    threads.emplace_back([&, i] {
+      try {
+        World world(scene);  // its own copy of every model
+        EngineOptions options;
+        options.method = Method::sequential;
+        options.threads = 1;
+        Engine engine(world, options);
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          ++loaded;
+          ready.notify_all();
+          ready.wait(lock, [&] { return loaded == copies; });  // all start stepping together
+        }
+        const auto start = Clock::now();
+        for (int k = 0; k < scene.steps; ++k) static_cast<void>(engine.step(k));
+        ms[static_cast<std::size_t>(i)] = 1000.0 * seconds_since(start) / scene.steps;
+      } catch (...) {
+        errors[static_cast<std::size_t>(i)] = std::current_exception();
+        std::lock_guard<std::mutex> lock(mutex);
+        loaded = copies;  // nobody waits for a copy that failed
+        ready.notify_all();
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  return ms;
+}
+
+/// The load-balance simulation of every method but sequential at each simulated core count: tasks
+/// cut for P threads (the engine runs P threads, so calibration targets P), their node tests
+/// list-scheduled on P virtual cores; and the estimate's correlation at P = 8 (or the first P).
+void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
+  const Scene& sc = world.scene();
+  const int steps = simulated_steps(b.opt, sc);
+  for (const Variant& v : b.variants) {
+    if (v.method == Method::sequential) continue;
+    bool correlated = false;
+    for (const int p : b.opt.simulate) {
+      if (!b.fits(sequential_s * steps / sc.steps, sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores")) return;
+      Engine engine(world, engine_options(v, p));
+      double work = 0.0, span = 0.0;
+      std::vector<double> estimated, effective;
+      for (int k = 0; k < steps; ++k) {
+        const StepResult s = engine.step(k);
+        const double w = static_cast<double>(s.stats.node_tests);
+        work += w;
+        span += w / simulated_speedup(s, v.method, p);
+        if (p == 8 || p == b.opt.simulate.front()) {
+          const auto& r = s.schedule;
+          for (std::size_t i = 0; i < r.task_weights.size() && i < r.task_node_tests.size(); ++i) {
+            estimated.push_back(r.task_weights[i]);
+            effective.push_back(static_cast<double>(r.task_node_tests[i]));
+          }
+        }
+        ++b.done;
+        if (b.progress.terminal() || k + 1 == steps) {
+          char line[200];
+          std::snprintf(line, sizeof line, "%s: %s simulated on %d cores, step %d", sc.name.c_str(), v.name.c_str(), p, k);
+          b.progress.update(b.done, line);
+        }
+      }
+      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", span > 0 ? work / span : 1.0}};
+      if (!estimated.empty() && (p == 8 || !correlated)) {
+        // Keep at most 4000 points for the figure (evenly spaced); r uses all of them.
+        Json points = Json::array();
+        const std::size_t stride = std::max<std::size_t>(1, estimated.size() / 4000);
+        for (std::size_t i = 0; i < estimated.size(); i += stride) points.push_back({estimated[i], effective[i]});
+        record["correlation"] = {{"cores", p}, {"pearson", pearson(estimated, effective)}, {"tasks", estimated.size()}, {"points", points}};
+        correlated = true;
+      }
+      b.log.add(record);
+    }
+  }
+}
+
+/// Every measured run of one scene, in rounds: round r runs every configuration once, so that a
+/// slow spell of a shared machine spreads over all of them instead of landing on one
+/// configuration's repeats. Sequential comes first (the reference for the contact check); then
+/// the machine's ceiling at each thread count, then the simulation.
+void bench_scene(BenchRun& b, std::size_t si) {
+  const World& world = *b.worlds[si];
+  const Scene& sc = world.scene();
+  std::vector<Config> configs;
+  for (const Variant& v : b.variants) {
+    for (const int t : v.method == Method::sequential ? std::vector<int>{1} : b.opt.threads) configs.push_back(Config{&v, t, 0.0});
+  }
+  std::vector<std::uint64_t> reference;
+  for (int r = 0; r < b.opt.repeat; ++r) {
+    for (Config& c : configs) {
+      // A configuration not run yet is estimated at sequential's time (one thread, no calibration).
+      const double estimate = c.last_ms > 0 ? c.last_ms : configs.front().last_ms;
+      if (!b.fits(estimate / 1000.0, sc.name + " round " + std::to_string(r + 1) + " " + c.variant->name + " x" + std::to_string(c.threads))) {
+        return;
+      }
+      const Json record = measure_run(b, world, *c.variant, c.threads, r, reference);
+      c.last_ms = record["total_ms"].get<double>();
+      b.log.add(record);
+    }
+  }
+  const double sequential_s = configs.front().last_ms / 1000.0;
+  b.sequential_s[si] = sequential_s;
+  if (b.opt.ceiling) {
+    for (const int t : b.opt.threads) {
+      if (t < 2) continue;
+      // Each copy loads and builds its own world, then all step at once.
+      if (!b.fits(b.load_s[si] + 1.5 * sequential_s, sc.name + " ceiling at " + std::to_string(t) + " copies")) return;
+      std::fprintf(stderr, "%s: the machine's ceiling, %d sequential copies at once\n", sc.name.c_str(), t);
+      b.log.add({{"kind", "ceiling"}, {"scene", sc.name}, {"copies", t}, {"copy_step_ms", measure_ceiling(sc, t)}});
+    }
+  }
+  simulate_scene(b, world, sequential_s);
+}
+
+/// Timeline of one step (Gantt): exploitation vs hybrid on front_car (or the last scene), at the
+/// highest measured thread count.
+void record_gantt(BenchRun& b) {
+  std::size_t si = b.worlds.size() - 1;
+  for (std::size_t i = 0; i < b.worlds.size(); ++i) {
+    if (b.worlds[i]->scene().name == "front_car") si = i;
+  }
+  // Two engines step half the scene each, at the most threads: less than one sequential run.
+  if (!b.fits(b.sequential_s[si], "the timeline")) return;
+  const World& world = *b.worlds[si];
+  const int t = b.opt.threads.back();
+  const int step = world.scene().steps / 2;
+  Json gantt = {{"kind", "gantt"}, {"scene", world.scene().name}, {"threads", t}, {"step", step}, {"methods", Json::object()}};
+  for (const char* name : {"exploitation", "hybrid"}) {
+    EngineOptions o = engine_options(parse_variant(name), t);
+    o.timeline = true;
+    Engine engine(world, o);
+    StepResult s;
+    for (int k = 0; k <= step; ++k) s = engine.step(k);  // hybrid needs the previous steps' history
+    Json spans = Json::array();
+    for (const TaskSpan& span : s.schedule.timeline) {
+      spans.push_back({span.thread, span.start_ms, span.end_ms,
+                       span.phase == TaskSpan::Phase::stage ? "stage" : span.phase == TaskSpan::Phase::traverse ? "traverse" : "finalize"});
+    }
+    gantt["methods"][name] = {{"narrow_ms", s.narrow_ms}, {"spans", spans}};
+  }
+  b.log.add(gantt);
+}
+
+/// Peer comparison against FCL, by the bench program built beside this one (when FCL was found).
+std::string fcl_report(const BenchOptions& opt) {
+  const auto fcl_program = program_dir() / "bench_fcl_compare";
+  if (!opt.fcl) return "Not run: --no-fcl.\n";
+  if (!std::filesystem::exists(fcl_program)) return "Not run: bench_fcl_compare was not built (install libfcl-dev and rebuild).\n";
+  std::string scenes;
+  for (const std::string& s : opt.scenes) scenes += (scenes.empty() ? "" : ",") + s;
+  const auto fcl_md = std::filesystem::path(opt.out) / "fcl_compare.md";
+  std::fprintf(stderr, "peer comparison: %s\n", fcl_program.c_str());
+  const int rc = run_command(quote(fcl_program.string()) + " --repeat " + std::to_string(opt.fcl_repeat) + " --scenes " + quote(scenes) +
+                             " --steps 0,50,100 --out " + quote(fcl_md.string()) + " > /dev/null");
+  if (rc != 0 || !std::filesystem::exists(fcl_md)) return "bench_fcl_compare failed (exit " + std::to_string(rc) + ").\n";
+  std::ifstream in(fcl_md);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// results.json, the figures (scripts/plot_bench.py, matplotlib) and report.md in `out`, from the
+/// bench's records.
+void write_outputs(const std::vector<Json>& records, const std::filesystem::path& out, bool figures) {
+  Json results = results_from_records(records);
+  const auto json_path = out / "results.json";
+  const auto write_json = [&] {
+    std::ofstream file(json_path);
+    file << results.dump(1) << '\n';
+    if (!file) throw Error(ErrorCode::unreadable, json_path.string(), "cannot be written");
+  };
+  write_json();
+  std::string figures_note;
+  if (figures) {
+    std::filesystem::path script;
+    for (const auto& candidate : {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
+      if (std::filesystem::exists(candidate)) {
+        script = candidate;
+        break;
+      }
+    }
+    if (script.empty()) {
+      figures_note = "Figures not drawn: scripts/plot_bench.py not found.";
+    } else if (run_command(python() + " " + quote(script.string()) + " " + quote(out.string())) != 0) {
+      figures_note = "Figures not drawn: `python3 scripts/plot_bench.py` failed (is python3-matplotlib installed?).";
+    }
+  } else {
+    figures_note = "Figures not drawn (--no-figures).";
+  }
+  results["figures_note"] = figures_note;
+  write_json();
+  write_bench_report(results, out / "report.md");
+  std::printf("\nwrote %s/report.md and results.json%s\n", out.string().c_str(), figures_note.empty() ? " and figures" : "");
+  if (!figures_note.empty()) std::printf("%s\n", figures_note.c_str());
+}
+
+/// `caliber bench --from-log FILE`: the report of a bench run from its log, whole or cut short.
+int report_from_log(const BenchOptions& opt) {
+  const std::filesystem::path log_file = opt.from_log;
+  const std::vector<Json> records = read_bench_log(log_file);
+  const std::filesystem::path out = opt.out.empty() ? log_file.parent_path() : std::filesystem::path(opt.out);
+  if (!out.empty()) std::filesystem::create_directories(out);
+  write_outputs(records, out.empty() ? "." : out, opt.figures);
+  return 0;
+}
+
 int run_bench(BenchOptions opt) {
+  if (!opt.from_log.empty()) return report_from_log(opt);
+  const Budget budget(opt.budget_s);  // counts from here: loading the scenes is part of the run
   if (opt.scenes.empty()) {
     for (const char* name : {"two_large", "two_small", "funnel", "front_car"}) opt.scenes.push_back(std::string("scenes/") + name + ".json");
     for (const std::string& s : opt.scenes) {
@@ -189,6 +531,7 @@ int run_bench(BenchOptions opt) {
   if (opt.repeat < 1) throw Error(ErrorCode::bad_value, "--repeat", "must be >= 1");
   if (opt.steps < 0) throw Error(ErrorCode::bad_value, "--steps", "must be >= 1 (0: the scene's)");
   if (opt.simulate_steps < 0) throw Error(ErrorCode::bad_value, "--simulate-steps", "must be >= 1 (0: all the scene's steps)");
+  if (!(opt.budget_s >= 0.0)) throw Error(ErrorCode::bad_value, "--budget-s", "must be a number of seconds >= 0 (0: no budget)");
   std::vector<Variant> variants;
   for (const std::string& m : opt.methods) {
     Variant v = parse_variant(m);
@@ -199,269 +542,67 @@ int run_bench(BenchOptions opt) {
                  variants.end());
   variants.insert(variants.begin(), parse_variant("sequential"));
   if (opt.out.empty()) opt.out = "bench/results/" + machine_slug();
+  if (std::filesystem::exists(opt.out) && !std::filesystem::is_directory(opt.out)) {
+    throw Error(ErrorCode::bad_value, "--out", "'" + opt.out + "' exists and is not a folder");
+  }
   std::filesystem::create_directories(opt.out);
+  const std::filesystem::path log_path = opt.log.empty() ? std::filesystem::path(opt.out) / "runs.jsonl" : std::filesystem::path(opt.log);
+  BenchLog log(log_path);  // opened before the long work: an unwritable log fails now
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
   // Load every scene first: bad input fails before any long work starts.
   std::vector<std::unique_ptr<World>> worlds;
+  std::vector<double> load_s;
   for (const std::string& file : opt.scenes) {
+    const auto start = Clock::now();
     Scene scene = load_scene(file);
     if (opt.steps > 0) scene.steps = opt.steps;
     worlds.push_back(std::make_unique<World>(std::move(scene)));
+    load_s.push_back(seconds_since(start));
   }
-  std::size_t units = 0;
+  std::size_t units = 0, runs_planned = 0;
   for (const auto& w : worlds) {
     for (const Variant& v : variants) {
-      units += static_cast<std::size_t>(opt.repeat) * (v.method == Method::sequential ? 1 : opt.threads.size()) *
-               static_cast<std::size_t>(w->scene().steps);
+      const std::size_t configs = v.method == Method::sequential ? 1 : opt.threads.size();
+      runs_planned += static_cast<std::size_t>(opt.repeat) * configs;
+      units += static_cast<std::size_t>(opt.repeat) * configs * static_cast<std::size_t>(w->scene().steps);
       if (v.method != Method::sequential) units += opt.simulate.size() * static_cast<std::size_t>(simulated_steps(opt, w->scene()));
     }
   }
   std::printf("caliber bench on %s\n%zu scene(s), %zu method(s), threads {", bench::machine_description().c_str(), worlds.size(),
               variants.size());
   for (std::size_t i = 0; i < opt.threads.size(); ++i) std::printf("%s%d", i ? ", " : "", opt.threads[i]);
-  std::printf("}, %d repeat(s); results in %s\n", opt.repeat, opt.out.c_str());
+  std::printf("}, %d repeat(s); results in %s, each run logged to %s as it ends\n", opt.repeat, opt.out.c_str(), log_path.c_str());
   std::fflush(stdout);
-  const Progress progress(units);
-  std::size_t done = 0;
-  bool mismatch = false;
 
-  Json results = {{"machine", bench::machine_description()},
-                  {"cpu", bench::cpu_model()},
-                  {"hardware_threads", cores},
-                  {"compiler", bench::compiler()},
-                  {"repeat", opt.repeat},
-                  {"threads", opt.threads},
-                  {"simulate", opt.simulate},
-                  {"simulate_steps", opt.simulate_steps},
-                  {"scenes", Json::array()}};
-  for (std::size_t si = 0; si < worlds.size(); ++si) {
-    const World& world = *worlds[si];
-    const Scene& sc = world.scene();
-    Json scene_json = {{"name", sc.name}, {"file", opt.scenes[si]}, {"steps", sc.steps}, {"methods", Json::object()}};
-    std::vector<std::uint64_t> reference_hash;
-    double sequential_ms = 0.0;
-    // Measured runs in rounds: round r runs every configuration once, so that a slow spell of a
-    // shared machine spreads over all of them instead of landing on one configuration's repeats.
-    // Sequential comes first in every round (it is the reference for the contact check).
-    struct Config {
-      const Variant* variant;
-      int threads;
-      std::vector<double> totals;
-      std::vector<Json> phases;  // per run, in round order
-    };
-    std::vector<Config> configs;
-    for (const Variant& v : variants) {
-      for (const int t : v.method == Method::sequential ? std::vector<int>{1} : opt.threads) configs.push_back(Config{&v, t, {}, {}});
-    }
-    for (int r = 0; r < opt.repeat; ++r) {
-      for (Config& c : configs) {
-        const Variant& v = *c.variant;
-        const int t = c.threads;
-        Engine engine(world, engine_options(v, t));
-        RunStats stats;
-        double total = 0.0, calibrate = 0.0, traverse = 0.0, finalize = 0.0, broad = 0.0;
-        // The load-balance simulation of this very run: its tasks' node tests list-scheduled on as
-        // many virtual cores as it has threads (what the cut allows, whatever the clock says).
-        double sim_work = 0.0, sim_span = 0.0;
-        for (int k = 0; k < sc.steps; ++k) {
-          const StepResult s = engine.step(k);
-          const double ms = s.broad_ms + s.narrow_ms + s.reduce_ms;
-          total += ms;
-          broad += s.broad_ms;
-          calibrate += s.schedule.calibrate_ms;
-          traverse += s.schedule.traverse_ms;
-          finalize += s.schedule.finalize_ms;
-          if (v.method != Method::sequential && s.stats.node_tests > 0) {
-            const double w = static_cast<double>(s.stats.node_tests);
-            sim_work += w;
-            sim_span += w / simulated_speedup(s, v.method, t);
-          }
-          const std::uint64_t h = contacts_hash(s);
-          if (v.method == Method::sequential && r == 0) {
-            reference_hash.push_back(h);
-            stats.add(s);
-          } else if (reference_hash.size() > static_cast<std::size_t>(k) && reference_hash[k] != h) {
-            mismatch = true;
-            std::fprintf(stderr, "\nMISMATCH: %s, %s on %d threads, step %d: contacts differ from sequential's\n", sc.name.c_str(),
-                         v.name.c_str(), t, k);
-          }
-          ++done;
-          if (progress.terminal() || k + 1 == sc.steps) {  // plain output: one line per run
-            char line[200];
-            std::snprintf(line, sizeof line, "%s: round %d/%d, %s x%d, step %d", sc.name.c_str(), r + 1, opt.repeat, v.name.c_str(), t, k);
-            progress.update(done, line);
-          }
-        }
-        c.totals.push_back(total);
-        if (v.method == Method::sequential && r == 0) {
-          const auto [heavy, heavy_share] = stats.heaviest_pair();
-          const auto [second, second_share] = stats.second_heaviest_pair();
-          scene_json["table1"] = {{"objects", world.object_count()},
-                                  {"triangles", world.triangle_count()},
-                                  {"node_tests_per_step", stats.mean_node_tests()},
-                                  {"contacts_per_step", stats.mean_contacts()},
-                                  {"pairs_per_step", stats.mean_tasks()},
-                                  {"candidate_pairs", stats.candidate_pairs()},
-                                  {"heaviest_pair_share", heavy_share},
-                                  {"second_pair_share", second_share},
-                                  {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}};
-        }
-        {
-          c.phases.push_back({{"broad_ms", broad / sc.steps},
-                      {"calibrate_ms", calibrate / sc.steps},
-                      {"traverse_ms", traverse / sc.steps},
-                      {"finalize_ms", finalize / sc.steps},
-                      {"balance_speedup", sim_span > 0 ? sim_work / sim_span : 1.0}});
-        }
-      }
-    }
-    for (const Variant& v : variants) {
-      Json method_json = {{"threads", Json::object()}};
-      for (const Config& c : configs) {
-        if (c.variant != &v) continue;
-        const double step_ms = median(c.totals) / sc.steps;
-        if (v.method == Method::sequential) sequential_ms = step_ms;
-        // The phases of the median run (the lower middle one for an even count), so that they add up
-        // to the reported step time and not to a run that met a slow spell.
-        std::vector<std::size_t> order(c.totals.size());
-        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return c.totals[x] < c.totals[y]; });
-        const Json& phases = c.phases[order[(order.size() - 1) / 2]];
-        method_json["threads"][std::to_string(c.threads)] = {{"step_ms", step_ms}, {"runs_ms", c.totals}, {"phases_per_step", phases}};
-      }
-      // The load-balance simulation: tasks cut for P threads (the engine runs P threads here, so
-      // calibration targets P), node tests list-scheduled on P virtual cores.
-      if (v.method != Method::sequential) {
-        Json simulated = Json::object();
-        Json correlation = Json::object();
-        for (const int p : opt.simulate) {
-          Engine engine(world, engine_options(v, p));
-          double work = 0.0, span = 0.0;
-          std::vector<double> estimated, effective;
-          const int steps = simulated_steps(opt, sc);
-          for (int k = 0; k < steps; ++k) {
-            const StepResult s = engine.step(k);
-            const double w = static_cast<double>(s.stats.node_tests);
-            work += w;
-            span += w / simulated_speedup(s, v.method, p);
-            if (p == 8 || p == opt.simulate.front()) {
-              const auto& r = s.schedule;
-              for (std::size_t i = 0; i < r.task_weights.size() && i < r.task_node_tests.size(); ++i) {
-                estimated.push_back(r.task_weights[i]);
-                effective.push_back(static_cast<double>(r.task_node_tests[i]));
-              }
-            }
-            ++done;
-            if (progress.terminal() || k + 1 == steps) {
-              char line[200];
-              std::snprintf(line, sizeof line, "%s: %s simulated on %d cores, step %d", sc.name.c_str(), v.name.c_str(), p, k);
-              progress.update(done, line);
-            }
-          }
-          simulated[std::to_string(p)] = span > 0 ? work / span : 1.0;
-          if (!estimated.empty() && (p == 8 || correlation.empty())) {
-            // Keep at most 4000 points for the figure (evenly spaced); r uses all of them.
-            Json points = Json::array();
-            const std::size_t stride = std::max<std::size_t>(1, estimated.size() / 4000);
-            for (std::size_t i = 0; i < estimated.size(); i += stride) points.push_back({estimated[i], effective[i]});
-            correlation = {{"cores", p}, {"pearson", pearson(estimated, effective)}, {"tasks", estimated.size()}, {"points", points}};
-          }
-        }
-        method_json["simulated_speedup"] = simulated;
-        if (!correlation.empty()) method_json["correlation"] = correlation;
-      }
-      scene_json["methods"][v.name] = method_json;
-    }
-    scene_json["sequential_step_ms"] = sequential_ms;
-    results["scenes"].push_back(scene_json);
+  Json header = {{"kind", "header"},
+                 {"machine", bench::machine_description()},
+                 {"cpu", bench::cpu_model()},
+                 {"hardware_threads", cores},
+                 {"compiler", bench::compiler()},
+                 {"repeat", opt.repeat},
+                 {"threads", opt.threads},
+                 {"simulate", opt.simulate},
+                 {"simulate_steps", opt.simulate_steps},
+                 {"budget_s", opt.budget_s},
+                 {"runs_planned", runs_planned},
+                 {"methods", Json::array()},
+                 {"scenes", Json::array()}};
+  for (const Variant& v : variants) header["methods"].push_back(v.name);
+  for (std::size_t i = 0; i < worlds.size(); ++i) {
+    header["scenes"].push_back({{"name", worlds[i]->scene().name}, {"file", opt.scenes[i]}, {"steps", worlds[i]->scene().steps}});
   }
+  log.add(header);
 
-  // Timeline of one step (Gantt): exploitation vs hybrid on front_car (or the last scene), at the
-  // highest measured thread count.
-  {
-    std::size_t si = worlds.size() - 1;
-    for (std::size_t i = 0; i < worlds.size(); ++i) {
-      if (worlds[i]->scene().name == "front_car") si = i;
-    }
-    const World& world = *worlds[si];
-    const int t = opt.threads.back();
-    const int step = world.scene().steps / 2;
-    Json gantt = {{"scene", world.scene().name}, {"threads", t}, {"step", step}, {"methods", Json::object()}};
-    for (const char* name : {"exploitation", "hybrid"}) {
-      EngineOptions o = engine_options(parse_variant(name), t);
-      o.timeline = true;
-      Engine engine(world, o);
-      StepResult s;
-      for (int k = 0; k <= step; ++k) s = engine.step(k);  // hybrid needs the previous steps' history
-      Json spans = Json::array();
-      for (const TaskSpan& span : s.schedule.timeline) {
-        spans.push_back({span.thread, span.start_ms, span.end_ms,
-                         span.phase == TaskSpan::Phase::stage ? "stage" : span.phase == TaskSpan::Phase::traverse ? "traverse" : "finalize"});
-      }
-      gantt["methods"][name] = {{"narrow_ms", s.narrow_ms}, {"spans", spans}};
-    }
-    results["gantt"] = gantt;
-  }
+  BenchRun b{opt, worlds, load_s, variants, log, budget, Progress(units), 0, false, {}};
+  b.sequential_s.assign(worlds.size(), 0.0);
+  for (std::size_t si = 0; si < worlds.size() && !b.stopped; ++si) bench_scene(b, si);
+  record_gantt(b);
+  if (b.fits(opt.fcl ? 60.0 : 0.0, "the FCL comparison")) log.add({{"kind", "fcl"}, {"report", fcl_report(opt)}});
 
-  // Peer comparison against FCL, by the bench program built beside this one (when FCL was found).
-  std::string fcl_report;
-  const auto fcl_program = program_dir() / "bench_fcl_compare";
-  if (opt.fcl && std::filesystem::exists(fcl_program)) {
-    std::string scenes;
-    for (const std::string& s : opt.scenes) scenes += (scenes.empty() ? "" : ",") + s;
-    const auto fcl_md = std::filesystem::path(opt.out) / "fcl_compare.md";
-    std::fprintf(stderr, "peer comparison: %s\n", fcl_program.c_str());
-    const int rc = run_command(quote(fcl_program.string()) + " --repeat " + std::to_string(opt.fcl_repeat) + " --scenes " +
-                               quote(scenes) + " --steps 0,50,100 --out " + quote(fcl_md.string()) + " > /dev/null");
-    if (rc == 0 && std::filesystem::exists(fcl_md)) {
-      std::ifstream in(fcl_md);
-      std::stringstream ss;
-      ss << in.rdbuf();
-      fcl_report = ss.str();
-    } else {
-      fcl_report = "bench_fcl_compare failed (exit " + std::to_string(rc) + ").\n";
-    }
-  } else {
-    fcl_report = "Not run: " + std::string(opt.fcl ? "bench_fcl_compare was not built (install libfcl-dev and rebuild)" : "--no-fcl") + ".\n";
-  }
-  results["fcl_report"] = fcl_report;
-  results["contacts_identical"] = !mismatch;
-
-  const auto json_path = std::filesystem::path(opt.out) / "results.json";
-  {
-    std::ofstream out(json_path);
-    if (!out) throw Error(ErrorCode::unreadable, json_path.string(), "cannot be opened for writing");
-    out << results.dump(1) << '\n';
-  }
-
-  // Figures: scripts/plot_bench.py (matplotlib), found next to the build folder or here.
-  std::string figures_note;
-  if (opt.figures) {
-    std::filesystem::path script;
-    for (const auto& candidate : {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
-      if (std::filesystem::exists(candidate)) {
-        script = candidate;
-        break;
-      }
-    }
-    if (script.empty()) {
-      figures_note = "Figures not drawn: scripts/plot_bench.py not found.";
-    } else if (run_command(python() + " " + quote(script.string()) + " " + quote(opt.out)) != 0) {
-      figures_note = "Figures not drawn: `python3 scripts/plot_bench.py` failed (is python3-matplotlib installed?).";
-    }
-  } else {
-    figures_note = "Figures not drawn (--no-figures).";
-  }
-  results["figures_note"] = figures_note;
-  {
-    std::ofstream out(json_path);
-    out << results.dump(1) << '\n';
-  }
-  write_bench_report(results, std::filesystem::path(opt.out) / "report.md");
-  std::printf("\nwrote %s/report.md and results.json%s\n", opt.out.c_str(), figures_note.empty() ? " and figures" : "");
-  if (!figures_note.empty()) std::printf("%s\n", figures_note.c_str());
-  if (mismatch) {
+  write_outputs(log.records(), opt.out, opt.figures);
+  const Json results = results_from_records(log.records());
+  if (!results["contacts_identical"].get<bool>()) {
     std::fprintf(stderr, "caliber bench: some method returned contacts that differ from sequential's (see above)\n");
     return 1;
   }
@@ -487,6 +628,16 @@ Runner add_bench_command(CLI::App& app) {
   cmd->add_option("--fcl-repeat", opt->fcl_repeat, "Runs per FCL comparison")->capture_default_str();
   cmd->add_flag("!--no-figures", opt->figures, "Do not run scripts/plot_bench.py");
   cmd->add_flag("!--no-fcl", opt->fcl, "Do not run the FCL peer comparison");
+  cmd->add_flag("!--no-ceiling", opt->ceiling,
+                "Do not measure the machine's ceiling (P independent sequential copies at once, for each thread count P > 1)");
+  cmd->add_option("--budget-s", opt->budget_s,
+                  "Time budget in seconds: a run starts only if its estimated time still fits, and the report covers what ran "
+                  "(0: none)")
+      ->capture_default_str();
+  cmd->add_option("--log", opt->log, "JSON-lines log, one record per finished run, written as measured (default: OUT/runs.jsonl)");
+  cmd->add_option("--from-log", opt->from_log,
+                  "Measure nothing: rebuild results.json, the figures and report.md from a bench log (a run cut short "
+                  "included), into --out or the log's folder");
   return [cmd, opt]() { return cmd->parsed() ? run_bench(*opt) : -1; };
 }
 

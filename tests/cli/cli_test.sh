@@ -164,10 +164,50 @@ for m, v in s["methods"].items():
         assert set(v["simulated_speedup"]) == {"4"}, m
 assert s["table1"]["objects"] == 2
 assert set(r["gantt"]["methods"]) == {"exploitation", "hybrid"}
+assert set(s["ceiling"]) == {"2"} and len(s["ceiling"]["2"]["copy_step_ms"]) == 2 and s["ceiling"]["2"]["ceiling_speedup"] > 0
+assert r["runs_done"] == r["runs_planned"] == 2 * (1 + 5 * 2) and "stopped" not in r
 report = open(d + "/report.md").read()
-for heading in ("## Table 1", "## Table 2", "## One-thread overhead", "## Simulated speed-up", "## Targets", "**all identical**"):
+for heading in ("## Table 1", "## Table 2", "## The machine's ceiling", "## One-thread overhead", "## Simulated speed-up",
+                "## Targets", "**all identical**", "Runs done: 22 of 22"):
     assert heading in report, heading
+# The log: one record per line, as measured; every run is there.
+records = [json.loads(line) for line in open(d + "/runs.jsonl")]
+assert records[0]["kind"] == "header"
+assert sum(1 for x in records if x["kind"] == "run") == 22
 PY
+# The report rebuilt from the log alone is the same report; from a log cut in the middle of a line,
+# a report of the runs it holds.
+check bench-from-log 0 "$cli" bench --from-log "$tmp/bench/runs.jsonl" --out "$tmp/bench-again" --no-figures
+python3 - "$tmp/bench" "$tmp/bench-again" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-from-log-same"; failures=$((failures + 1)); }
+import sys
+a, b = (open(d + "/report.md").read() for d in sys.argv[1:])
+assert a == b
+PY
+head -c 2500 "$tmp/bench/runs.jsonl" > "$tmp/cut.jsonl"
+check bench-from-cut-log 0 "$cli" bench --from-log "$tmp/cut.jsonl" --out "$tmp/bench-cut" --no-figures
+contains bench-from-cut-log "wrote $tmp/bench-cut/report.md"
+grep -q "the log ends before the run did" "$tmp/bench-cut/report.md" && passes=$((passes + 1)) ||
+  { echo "FAIL bench-cut-report"; failures=$((failures + 1)); }
+# A budget too small for the whole run: it stops between runs, inside the budget, and says so.
+# (two_small: its runs take long enough; its meshes are extracted by scripts/fetch_meshes.sh before the tests)
+check bench-budget 0 "$cli" bench "$data/../../scenes/two_small.json" --steps 100 --repeat 3 --threads 1,2 --simulate 4 --no-fcl \
+  --no-figures --budget-s 1 --out "$tmp/bench-budget"
+contains bench-budget "--budget-s 1 reached"
+python3 - "$tmp/bench-budget" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-budget-files"; failures=$((failures + 1)); }
+import json, sys
+r = json.load(open(sys.argv[1] + "/results.json"))
+assert r["stopped"]["reason"] == "budget" and r["stopped"]["after_s"] <= 1.0, r["stopped"]
+assert 0 < r["runs_done"] < r["runs_planned"], (r["runs_done"], r["runs_planned"])
+assert "cut short by its time budget" in open(sys.argv[1] + "/report.md").read()
+PY
+echo "not json" > "$tmp/bad.jsonl"
+check bench-bad-log 2 "$cli" bench --from-log "$tmp/bad.jsonl" --out "$tmp/bench3"
+contains bench-bad-log "line 1 is not a bench record"
+check bench-missing-log 2 "$cli" bench --from-log "$tmp/none.jsonl"
+check bench-bad-budget 2 "$cli" bench "$data/scenes/tetras.json" --budget-s -5 --out "$tmp/bench2"
+touch "$tmp/a-file"
+check bench-out-file 2 "$cli" bench "$data/scenes/tetras.json" --out "$tmp/a-file"
+contains bench-out-file "not a folder"
 check bench-missing 2 "$cli" bench "$data/scenes/nope.json" --out "$tmp/bench2"
 contains bench-missing "nope.json"
 check bench-bad-method 2 "$cli" bench "$data/scenes/tetras.json" --methods sequential,turbo --out "$tmp/bench2"

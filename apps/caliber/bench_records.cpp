@@ -1,0 +1,170 @@
+// The JSON-lines log of `caliber bench` and results.json rebuilt from it (see bench_records.h).
+
+#include "bench_records.h"
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "caliber/error.h"
+
+namespace caliber::cli {
+
+using Json = nlohmann::json;
+
+BenchLog::BenchLog(std::filesystem::path file) : mFile(std::move(file)), mOut(mFile, std::ios::trunc) {
+  if (!mOut) throw Error(ErrorCode::unreadable, mFile.string(), "cannot be opened for writing");
+}
+
+void BenchLog::add(Json record) {
+  mOut << record.dump() << '\n';
+  mOut.flush();
+  if (!mOut) throw Error(ErrorCode::unreadable, mFile.string(), "write failed (disk full?)");
+  mRecords.push_back(std::move(record));
+}
+
+std::vector<Json> read_bench_log(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(ErrorCode::file_not_found, file.string(), "cannot be opened");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty()) lines.push_back(line);
+  }
+  std::vector<Json> records;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    Json r = Json::parse(lines[i], nullptr, /*allow_exceptions=*/false);
+    if (r.is_discarded() && i + 1 == lines.size() && i > 0) break;  // the line being written when the run was cut
+    if (!r.is_object() || !r.contains("kind") || !r["kind"].is_string()) {
+      throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + " is not a bench record");
+    }
+    records.push_back(std::move(r));
+  }
+  if (records.empty() || records.front()["kind"] != "header") {
+    throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber bench log)");
+  }
+  return records;
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+namespace {
+
+/// What the records say of one scene.
+struct SceneRecords {
+  Json info;  ///< name, file, steps (from the header)
+  Json table1;
+  std::map<std::pair<std::string, int>, std::vector<Json>> runs;  ///< (method, threads) -> run records
+  std::map<std::string, Json> simulated, correlation;              ///< method -> {cores: speedup}, correlation
+  std::map<int, std::vector<double>> ceiling;                      ///< copies -> each copy's ms/step
+};
+
+/// A configuration's entry: median step time, its runs in round order, the phases of the median
+/// run (the lower middle one for an even count), so the phases add up to the reported time.
+Json configuration(const std::vector<Json>& runs, int steps) {
+  std::vector<double> totals;
+  for (const Json& r : runs) totals.push_back(r["total_ms"].get<double>());
+  std::vector<std::size_t> order(totals.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return totals[x] < totals[y]; });
+  return {{"step_ms", median_of(totals) / steps}, {"runs_ms", totals}, {"phases_per_step", runs[order[(order.size() - 1) / 2]]["phases"]}};
+}
+
+Json scene_results(const SceneRecords& s, const std::vector<std::string>& methods) {
+  const int steps = s.info["steps"].get<int>();
+  Json scene = s.info;
+  scene["methods"] = Json::object();
+  scene["table1"] = s.table1;
+  double sequential = 0.0;
+  for (const std::string& m : methods) {
+    Json method = {{"threads", Json::object()}};
+    for (const auto& [key, runs] : s.runs) {
+      if (key.first == m) method["threads"][std::to_string(key.second)] = configuration(runs, steps);
+    }
+    if (method["threads"].empty()) continue;
+    if (m == "sequential") sequential = method["threads"]["1"]["step_ms"].get<double>();
+    if (s.simulated.count(m)) method["simulated_speedup"] = s.simulated.at(m);
+    if (s.correlation.count(m)) method["correlation"] = s.correlation.at(m);
+    scene["methods"][m] = method;
+  }
+  scene["sequential_step_ms"] = sequential;
+  Json ceiling = Json::object();
+  for (const auto& [copies, ms] : s.ceiling) {
+    const double copy = median_of(ms);
+    ceiling[std::to_string(copies)] = {{"copy_step_ms", ms}, {"ceiling_speedup", copy > 0 ? copies * sequential / copy : 0.0}};
+  }
+  scene["ceiling"] = ceiling;
+  return scene;
+}
+
+}  // namespace
+
+Json results_from_records(const std::vector<Json>& records) {
+  if (records.empty() || records.front()["kind"] != "header") {
+    throw Error(ErrorCode::unreadable, "bench log", "no header record");
+  }
+  const Json& h = records.front();
+  Json results = {{"machine", h["machine"]}, {"cpu", h["cpu"]},         {"hardware_threads", h["hardware_threads"]},
+                  {"compiler", h["compiler"]}, {"repeat", h["repeat"]}, {"threads", h["threads"]},
+                  {"simulate", h["simulate"]}, {"simulate_steps", h["simulate_steps"]}};
+  const auto methods = h["methods"].get<std::vector<std::string>>();
+  std::vector<SceneRecords> scenes;
+  std::map<std::string, std::size_t> index;
+  for (const Json& info : h["scenes"]) {
+    index[info["name"].get<std::string>()] = scenes.size();
+    scenes.push_back(SceneRecords{info, Json(), {}, {}, {}, {}});
+  }
+  const auto scene_of = [&](const Json& r) -> SceneRecords& {
+    const auto it = index.find(r.value("scene", std::string()));
+    if (it == index.end()) throw Error(ErrorCode::unreadable, "bench log", "a record names a scene the header does not list");
+    return scenes[it->second];
+  };
+  bool identical = true;
+  std::size_t runs_done = 0;
+  results["fcl_report"] = "Not run.\n";
+  for (const Json& r : records) {
+    const std::string kind = r["kind"].get<std::string>();
+    if (kind == "run") {
+      scene_of(r).runs[{r["method"].get<std::string>(), r["threads"].get<int>()}].push_back(r);
+      ++runs_done;
+    } else if (kind == "table1") {
+      Json t = r;
+      t.erase("kind");
+      t.erase("scene");
+      scene_of(r).table1 = t;
+    } else if (kind == "ceiling") {
+      scene_of(r).ceiling[r["copies"].get<int>()] = r["copy_step_ms"].get<std::vector<double>>();
+    } else if (kind == "simulation") {
+      SceneRecords& s = scene_of(r);
+      const std::string m = r["method"].get<std::string>();
+      s.simulated[m][std::to_string(r["cores"].get<int>())] = r["speedup"];
+      if (r.contains("correlation")) s.correlation[m] = r["correlation"];
+    } else if (kind == "mismatch") {
+      identical = false;
+    } else if (kind == "gantt") {
+      Json g = r;
+      g.erase("kind");
+      results["gantt"] = g;
+    } else if (kind == "fcl") {
+      results["fcl_report"] = r["report"];
+    } else if (kind == "stopped") {
+      results["stopped"] = {{"reason", r["reason"]}, {"after_s", r["after_s"]}};
+    }
+  }
+  results["scenes"] = Json::array();
+  for (const SceneRecords& s : scenes) {
+    if (s.table1.is_null() || !s.runs.count({"sequential", 1})) continue;  // no reference yet
+    results["scenes"].push_back(scene_results(s, methods));
+  }
+  results["contacts_identical"] = identical;
+  results["runs_done"] = runs_done;
+  results["runs_planned"] = h["runs_planned"];
+  return results;
+}
+
+}  // namespace caliber::cli

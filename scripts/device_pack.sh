@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Packs what the lent 16-core machine needs to run caliber, into .devicepack/ (git-ignored):
+# the Release binary, every shared library it loads except the C library's own (the device runs
+# Ubuntu 24.04, whose glibc is newer than Debian 12's, without our Debian packages), the four
+# scenes and the meshes they read, and run.sh, the one command to run there:
+#
+#   scripts/device_pack.sh            # here: build (Release) and pack; prints the pack's size
+#   bash .devicepack/run.sh ARGS...   # there (the device tool, carry [".devicepack"]): runs
+#                                     # `caliber ARGS...` with the packed libraries; results go
+#                                     # under $OUT when ARGS name $OUT
+#
+# For example, a bench that cannot lose its results when cut at the command's 10-minute limit:
+#
+#   bash .devicepack/run.sh bench --threads 1,4,8,16 --repeat 5 --budget-s 540 --no-figures \
+#        --no-fcl --out "$OUT/bench"
+#
+# The pack is checked before it is declared ready: its binary must start with only the packed
+# libraries and the C library (a clean environment, LD_LIBRARY_PATH set to the pack alone), and
+# the whole pack must stay under the device tool's 64 MiB carry limit.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+pack="$root/.devicepack"
+limit_mib=64
+
+"$root/scripts/build.sh" >/dev/null
+"$root/scripts/fetch_meshes.sh" >/dev/null
+
+rm -rf "$pack"
+mkdir -p "$pack/bin" "$pack/lib" "$pack/scenes" "$pack/data/meshes"
+cp "$root/build/caliber" "$pack/bin/"
+strip "$pack/bin/caliber"
+
+# Every library the binary loads, but the C library, the dynamic loader and the kernel's vDSO:
+# those come from the device's system (glibc is backward compatible, not forward).
+ldd "$root/build/caliber" | awk '/=> \// {print $3}' | while read -r lib; do
+  case "$(basename "$lib")" in
+    libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*) ;;
+    *) cp -L "$lib" "$pack/lib/" ;;
+  esac
+done
+strip --strip-unneeded "$pack"/lib/*.so* 2>/dev/null || true
+
+# The scenes keep their relative mesh paths (../data/meshes/..., meshes/...).
+cp "$root"/scenes/*.json "$pack/scenes/"
+cp -r "$root/scenes/meshes" "$pack/scenes/"
+python3 - "$root/scenes" <<'PY' | while read -r mesh; do cp "$root/scenes/$mesh" "$pack/scenes/$mesh"; done
+import json, pathlib, sys
+for scene in sorted(pathlib.Path(sys.argv[1]).glob("*.json")):
+    for obj in json.loads(scene.read_text())["objects"]:
+        if obj["mesh"].startswith("../data/"):
+            print(obj["mesh"])
+PY
+
+cat > "$pack/run.sh" <<'RUN'
+#!/usr/bin/env bash
+# Runs the packed caliber with the packed libraries (see scripts/device_pack.sh). Scenes are under
+# .devicepack/scenes; `bench` without scenes runs those four.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+cd "$here"
+if [ "${1:-}" = bench ] && ! printf '%s\n' "$@" | grep -q '\.json$'; then
+  shift
+  exec "$here/bin/caliber" bench scenes/two_large.json scenes/two_small.json scenes/funnel.json scenes/front_car.json "$@"
+fi
+exec "$here/bin/caliber" "$@"
+RUN
+chmod +x "$pack/run.sh"
+
+# The check: the packed binary runs a scene with nothing but the pack and the C library.
+missing="$(env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/caliber" | grep 'not found' || true)"
+if [ -n "$missing" ]; then
+  echo "device_pack: libraries missing from the pack:" >&2
+  echo "$missing" >&2
+  exit 1
+fi
+env -i PATH=/usr/bin:/bin bash "$pack/run.sh" run scenes/two_small.json --steps 2 --threads 2 --method hybrid >/dev/null 2>&1 ||
+  { echo "device_pack: the packed binary does not run a scene with the packed libraries alone" >&2; exit 1; }
+size_kib="$(du -sk "$pack" | cut -f1)"
+if [ "$size_kib" -gt $((limit_mib * 1024)) ]; then
+  echo "device_pack: the pack is $((size_kib / 1024)) MiB, over the device tool's ${limit_mib} MiB" >&2
+  exit 1
+fi
+echo "device_pack: $pack ready ($((size_kib / 1024)) MiB; commit $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+dirty'))"
