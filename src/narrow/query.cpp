@@ -1,6 +1,7 @@
 // The query front-end: one object pair, one traversal, and the brute-force oracle beside it.
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -59,21 +60,28 @@ bool by_ids(const Candidate& x, const Candidate& y) {
   return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
 }
 
-/// Where each candidate of a sorted list sits, by its triangle pair: an open-addressing hash table
-/// (linear probing, at most half full), so a neighbour lookup costs one or two probes whatever the
-/// list's length. Built once per finalization, then only read (safe to share between threads).
+/// Where each candidate of a list sits, by its triangle pair: an open-addressing hash table (linear
+/// probing, at most half full), so a neighbour lookup costs one or two probes whatever the list's
+/// length. Filled in parallel (each slot claimed by compare-and-swap; which slot a candidate gets
+/// may vary, what a lookup finds does not), then only read.
 class PairIndex {
  public:
-  explicit PairIndex(const std::vector<Candidate>& sorted) : mSorted(sorted) {
+  PairIndex(const std::vector<Candidate>& candidates, std::size_t grain) : mCandidates(candidates) {
     std::size_t capacity = 16;
-    while (capacity < 2 * sorted.size()) capacity *= 2;
+    while (capacity < 2 * candidates.size()) capacity *= 2;
     mMask = capacity - 1;
     mSlots.assign(capacity, kEmpty);
-    for (std::size_t i = 0; i < sorted.size(); ++i) {
-      std::size_t h = slot(key(sorted[i].tri_a, sorted[i].tri_b));
-      while (mSlots[h] != kEmpty) h = (h + 1) & mMask;
-      mSlots[h] = static_cast<std::uint32_t>(i);
-    }
+    parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) {
+        for (std::size_t h = slot(key(candidates[i].tri_a, candidates[i].tri_b));; h = (h + 1) & mMask) {
+          std::uint32_t expected = kEmpty;
+          if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
+                                                                                 std::memory_order_relaxed)) {
+            break;
+          }
+        }
+      }
+    });
   }
 
   /// The candidate (ta, tb), or nullptr.
@@ -81,7 +89,7 @@ class PairIndex {
     for (std::size_t h = slot(key(ta, tb));; h = (h + 1) & mMask) {
       const std::uint32_t i = mSlots[h];
       if (i == kEmpty) return nullptr;
-      const Candidate& c = mSorted[i];
+      const Candidate& c = mCandidates[i];
       if (c.tri_a == ta && c.tri_b == tb) return &c;
     }
   }
@@ -94,7 +102,7 @@ class PairIndex {
     return static_cast<std::size_t>((k * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
   }
 
-  const std::vector<Candidate>& mSorted;
+  const std::vector<Candidate>& mCandidates;
   /// Candidate positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
   std::vector<std::uint32_t> mSlots;
   std::size_t mMask = 0;
@@ -102,16 +110,17 @@ class PairIndex {
 
 /// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
-/// the candidates (times the adjacency's degree): each neighbour is one hash lookup.
-std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& sorted, std::size_t grain) {
-  const PairIndex index(sorted);
+/// the candidates (times the adjacency's degree): each neighbour is one hash lookup. Each verdict
+/// depends only on the set of candidates, not on their order, so they need no sorting first; the
+/// kept ones are returned in the input's order.
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
+  const PairIndex index(candidates, grain);
   const Model& ma = ctx.a();
   const Model& mb = ctx.b();
-  // Each candidate's verdict depends only on the sorted list: decided in parallel, kept in order.
-  std::vector<char> keep(sorted.size(), 0);
-  parallel::parallel_for(0, sorted.size(), grain, [&](std::size_t lo, std::size_t hi) {
+  std::vector<char> keep(candidates.size(), 0);
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i != hi; ++i) {
-      const Candidate& c = sorted[i];
+      const Candidate& c = candidates[i];
       bool dominated = false;
       for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
         const Candidate* other = index.find(ma.adjacency[k], c.tri_b);
@@ -125,8 +134,8 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
     }
   });
   std::vector<Candidate> kept;
-  for (std::size_t i = 0; i < sorted.size(); ++i) {
-    if (keep[i]) kept.push_back(sorted[i]);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (keep[i]) kept.push_back(candidates[i]);
   }
   return kept;
 }
@@ -139,17 +148,19 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
-  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
-  if (parallel && candidates.size() >= kParallelGrain) {
-    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
-  } else {
-    std::sort(candidates.begin(), candidates.end(), by_ids);
-  }
+  // Contacts: the local minima first (their verdicts do not depend on the order), so that only the
+  // few kept candidates are sorted, not every pair within the tolerance.
   if (result.kind == QueryKind::contact) {
     if (ctx.a().adjacency_offsets.empty() || ctx.b().adjacency_offsets.empty()) {
       throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
     }
     candidates = local_minima(ctx, candidates, grain);
+  }
+  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
+  if (parallel && candidates.size() >= kParallelGrain) {
+    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
+  } else {
+    std::sort(candidates.begin(), candidates.end(), by_ids);
   }
   result.pairs.reserve(candidates.size());
   for (const Candidate& c : candidates) result.pairs.push_back(TrianglePair{c.tri_a, c.tri_b});
