@@ -58,7 +58,7 @@ struct ScheduleRecord {
   std::size_t carted = 0;                      ///< items merged in the cart (light tasks and light nodes)
   std::size_t generated = 0;                   ///< run-time tasks
   std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
-  std::size_t queue_peak = 0;                  ///< longest priority queue of the weight-driven stage
+  std::size_t queue_peak = 0;                  ///< widest level of the weight-driven stage (nodes waiting at once)
   std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
   /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
   /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the

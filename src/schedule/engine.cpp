@@ -118,6 +118,7 @@ void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& w
     const std::size_t i = order[k];
     timeline.record(TaskSpan::Phase::finalize, [&] {
       std::vector<narrow::Candidate> all;
+      all.reserve(candidates[i]);
       QueryStats stats;
       start(i, all, stats);
       for (const WorkerSlots* w : slots) {

@@ -5,6 +5,7 @@
 #include <queue>
 
 #include "caliber/model.h"
+#include "parallel/executor.h"
 
 #include "tasks/weights.h"
 
@@ -43,6 +44,28 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
   return tasks;
 }
 
+namespace {
+
+/// Nodes of one level of the stage handed to a thread at a time (a node test is ~0.1-0.3 us).
+constexpr std::size_t kStageGrain = 32;
+
+/// A node waiting in the stage, with its weight.
+struct StageItem {
+  double weight;
+  narrow::NodePair node;
+};
+
+/// What the stage found at one node of a level (filled in parallel, read in the level's order).
+struct StageOutcome {
+  enum class Kind : std::uint8_t { pruned, leaf, split, root } kind = Kind::pruned;
+  bool reported = false;        ///< leaf: the leaf test kept the pair
+  std::uint8_t children = 0;    ///< split: how many children
+  StageItem child[4];           ///< split: the children and their weights
+  narrow::Candidate candidate;  ///< leaf, reported: the pair
+};
+
+}  // namespace
+
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
                        double omega, double eps, const NodeCounts* measured) {
   const auto weight_of = [&](narrow::NodePair n) {
@@ -53,55 +76,72 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
     }
     return scale * apriori_weight(ctx, n);
   };
-  struct Entry {
-    double weight;
-    narrow::NodePair node;
-    bool operator<(const Entry& o) const {  // max-heap on weight; ties: lower node ids first
-      if (weight != o.weight) return weight < o.weight;
-      if (node.a != o.node.a) return node.a > o.node.a;
-      return node.b > o.node.b;
-    }
-  };
+  // The paper pops the heaviest node of a priority queue until none is left. What happens to a node
+  // (tested; pruned, leaf-tested, split into its children, or made a root or a cart item by its
+  // weight) depends on the node alone, never on when it is popped, so the stage is the same cut
+  // when run level by level: every node of a level tested in parallel, their children the next
+  // level. Outcomes are gathered in the level's order, so the cut and its records do not depend on
+  // the thread count either.
   SplitResult out;
-  std::priority_queue<Entry> queue;
-  queue.push(Entry{root_weight, narrow::NodePair{0, 0}});
-  narrow::NodePair kids[4];
-  while (!queue.empty()) {
-    out.queue_peak = std::max(out.queue_peak, queue.size());
-    const Entry e = queue.top();
-    queue.pop();
-    ++out.stats.node_tests;
-    StageRecord popped{};
-    popped.node = e.node;
-    out.stage.push_back(popped);
-    if (!ctx.node_test(e.node.a, e.node.b)) continue;
-    const BvhNode& a = ctx.a().nodes[e.node.a];
-    const BvhNode& b = ctx.b().nodes[e.node.b];
-    if (a.is_leaf() && b.is_leaf()) {
-      ++out.stats.leaf_tests;
-      ctx.leaf_test(a.index, b.index, out.candidates);
-      continue;
-    }
-    switch (classify(e.weight, omega, eps)) {
-      case Verdict::split: {
-        const int count = narrow::cd_children(ctx.a(), ctx.b(), e.node, kids);
-        StageRecord& record = out.stage.back();
-        record.children = static_cast<std::uint8_t>(count);
-        for (int i = 0; i < count; ++i) {
-          record.child[i] = kids[i];
-          queue.push(Entry{weight_of(kids[i]), kids[i]});
+  std::vector<StageItem> level{StageItem{root_weight, narrow::NodePair{0, 0}}};
+  std::vector<StageOutcome> outcome;
+  while (!level.empty()) {
+    out.queue_peak = std::max(out.queue_peak, level.size());
+    outcome.assign(level.size(), StageOutcome{});
+    parallel::parallel_for(0, level.size(), kStageGrain, [&](std::size_t lo, std::size_t hi) {
+      std::vector<narrow::Candidate> found;
+      for (std::size_t i = lo; i != hi; ++i) {
+        const StageItem& e = level[i];
+        StageOutcome& o = outcome[i];
+        if (!ctx.node_test(e.node.a, e.node.b)) continue;
+        const BvhNode& a = ctx.a().nodes[e.node.a];
+        const BvhNode& b = ctx.b().nodes[e.node.b];
+        if (a.is_leaf() && b.is_leaf()) {
+          o.kind = StageOutcome::Kind::leaf;
+          found.clear();
+          o.reported = ctx.leaf_test(a.index, b.index, found);
+          if (o.reported) o.candidate = found.front();
+        } else if (classify(e.weight, omega, eps) == Verdict::split) {
+          o.kind = StageOutcome::Kind::split;
+          narrow::NodePair kids[4];
+          o.children = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, kids));
+          for (int k = 0; k < o.children; ++k) o.child[k] = StageItem{weight_of(kids[k]), kids[k]};
+        } else {
+          o.kind = StageOutcome::Kind::root;
         }
-        break;
       }
-      case Verdict::keep:
-      case Verdict::cart: {
-        out.stage.back().root = true;
-        Root r{pair, e.node, true, e.weight};
-        r.stage = static_cast<std::int32_t>(out.stage.size() - 1);
-        (classify(e.weight, omega, eps) == Verdict::keep ? out.roots : out.cart).push_back(r);
-        break;
+    });
+    std::vector<StageItem> next;
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      const StageItem& e = level[i];
+      const StageOutcome& o = outcome[i];
+      ++out.stats.node_tests;
+      StageRecord record{};
+      record.node = e.node;
+      switch (o.kind) {
+        case StageOutcome::Kind::pruned: break;
+        case StageOutcome::Kind::leaf:
+          ++out.stats.leaf_tests;
+          if (o.reported) out.candidates.push_back(o.candidate);
+          break;
+        case StageOutcome::Kind::split:
+          record.children = o.children;
+          for (int k = 0; k < o.children; ++k) {
+            record.child[k] = o.child[k].node;
+            next.push_back(o.child[k]);
+          }
+          break;
+        case StageOutcome::Kind::root: {
+          record.root = true;
+          Root r{pair, e.node, true, e.weight};
+          r.stage = static_cast<std::int32_t>(out.stage.size());
+          (classify(e.weight, omega, eps) == Verdict::keep ? out.roots : out.cart).push_back(r);
+          break;
+        }
       }
+      out.stage.push_back(record);
     }
+    level = std::move(next);
   }
   return out;
 }

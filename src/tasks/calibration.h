@@ -65,16 +65,19 @@ struct SplitResult {
   std::vector<Root> cart;                     ///< lighter tested nodes, for the cart
   std::vector<narrow::Candidate> candidates;  ///< leaf pairs found in the stage
   QueryStats stats;                           ///< node and leaf tests made in the stage
-  std::size_t queue_peak = 0;                 ///< longest the priority queue grew
-  std::vector<StageRecord> stage;             ///< every node popped, in pop order
+  std::size_t queue_peak = 0;                 ///< widest level of the stage (nodes waiting at once)
+  std::vector<StageRecord> stage;             ///< every node tested, level by level (parents first)
 };
 
 /// The weight-driven partial traversal of one pair's CD tree (the paper's alternate traversal):
-/// a priority queue of untested nodes keyed by weight; pop the heaviest, test it (a failed test
-/// prunes it; a leaf pair gets its leaf test here); if its weight meets omega it becomes a sub-task
-/// root, if heavier its children are pushed, if lighter it goes to the cart. The root enters with
-/// `root_weight`; a node's weight is `scale` times its a priori weight, or, when `measured` holds
-/// it, the node tests its subtree took at the previous step.
+/// every node reached is tested (a failed test prunes it; a leaf pair gets its leaf test here); if
+/// its weight meets omega it becomes a sub-task root, if heavier its children are reached, if
+/// lighter it goes to the cart. The root enters with `root_weight`; a node's weight is `scale`
+/// times its a priori weight, or, when `measured` holds it, the node tests its subtree took at the
+/// previous step. The paper pops nodes heaviest first from a priority queue; since what happens to
+/// a node does not depend on when, this runs the same cut level by level, each level's nodes in
+/// parallel on the current executor (one heavy pair's stage is no longer serial work), with the
+/// same result whatever the thread count.
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
                        double omega, double eps, const NodeCounts* measured = nullptr);
 

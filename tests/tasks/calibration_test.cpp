@@ -5,9 +5,14 @@
 #include "tasks/calibration.h"
 
 #include <algorithm>
+#include <queue>
+#include <tuple>
 
 #include "caliber/model.h"
+#include "caliber/pose.h"
 #include "caliber/procedural.h"
+#include "parallel/executor.h"
+#include "tasks/weights.h"
 
 namespace caliber::tasks {
 namespace {
@@ -106,6 +111,105 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   EXPECT_EQ(split.taboo.size(), split.roots.size() + split.cart.size());
   for (const narrow::NodePair& n : split.taboo) EXPECT_FALSE(n.a == 0 && n.b == 0);
   EXPECT_LE(split_aposteriori(summary, 0, 4000.0, 500.0, 50.0, 3).taboo.size(), 3u) << "the cap holds";
+}
+
+
+/// The paper's alternate traversal as written (and as split_task ran it until it went level by
+/// level): a max-heap of untested nodes keyed by weight; pop the heaviest, test it, leaf-test a leaf
+/// pair, push the children of a heavy node, keep or cart a light one. The reference for the cut.
+SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
+                                 double omega, double eps) {
+  struct Entry {
+    double weight;
+    narrow::NodePair node;
+    bool operator<(const Entry& o) const {
+      if (weight != o.weight) return weight < o.weight;
+      if (node.a != o.node.a) return node.a > o.node.a;
+      return node.b > o.node.b;
+    }
+  };
+  SplitResult out;
+  std::priority_queue<Entry> queue;
+  queue.push(Entry{root_weight, narrow::NodePair{0, 0}});
+  narrow::NodePair kids[4];
+  while (!queue.empty()) {
+    const Entry e = queue.top();
+    queue.pop();
+    ++out.stats.node_tests;
+    if (!ctx.node_test(e.node.a, e.node.b)) continue;
+    const BvhNode& a = ctx.a().nodes[e.node.a];
+    const BvhNode& b = ctx.b().nodes[e.node.b];
+    if (a.is_leaf() && b.is_leaf()) {
+      ++out.stats.leaf_tests;
+      ctx.leaf_test(a.index, b.index, out.candidates);
+      continue;
+    }
+    const Verdict v = classify(e.weight, omega, eps);
+    if (v == Verdict::split) {
+      const int count = narrow::cd_children(ctx.a(), ctx.b(), e.node, kids);
+      for (int i = 0; i < count; ++i) queue.push(Entry{scale * apriori_weight(ctx, kids[i]), kids[i]});
+    } else {
+      (v == Verdict::keep ? out.roots : out.cart).push_back(Root{pair, e.node, true, e.weight});
+    }
+  }
+  return out;
+}
+
+using RootKey = std::tuple<std::uint32_t, std::uint32_t, double, bool>;
+
+std::vector<RootKey> keys(const std::vector<Root>& roots) {
+  std::vector<RootKey> k;
+  for (const Root& r : roots) k.emplace_back(r.node.a, r.node.b, r.weight, r.tested);
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs(const std::vector<narrow::Candidate>& c) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> p;
+  for (const narrow::Candidate& x : c) p.emplace_back(x.tri_a, x.tri_b);
+  std::sort(p.begin(), p.end());
+  return p;
+}
+
+TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
+  const auto a = build_model(make_sphere(1.0, 24, 32));
+  const auto b = build_model(make_torus(1.0, 0.3, 40, 24));
+  QueryRequest request;
+  request.kind = QueryKind::contact;
+  request.tolerance = 0.05;
+  const narrow::PairContext ctx(*a, Pose{}, *b, Pose::from_values(0.2, 0.1, 0.9, 0.9, 0.3, 0.1, 0.2), request);
+  const double root = 40000.0;
+  const double scale = root / apriori_weight(ctx, narrow::NodePair{0, 0});
+  int compared = 0;
+  for (const double omega : {root / 4, root / 24, root / 96, root / 400}) {
+    const SplitResult want = priority_queue_stage(ctx, 0, root, scale, omega, 0.25 * omega);
+    ASSERT_GT(want.stats.node_tests, 1u);
+    for (const int threads : {1, 2, 4}) {
+      parallel::Executor executor(threads);
+      SplitResult got;
+      executor.execute([&] { got = split_task(ctx, 0, root, scale, omega, 0.25 * omega); });
+      EXPECT_EQ(keys(got.roots), keys(want.roots)) << "omega " << omega << ", " << threads << " threads";
+      EXPECT_EQ(keys(got.cart), keys(want.cart)) << "omega " << omega << ", " << threads << " threads";
+      EXPECT_EQ(pairs(got.candidates), pairs(want.candidates));
+      EXPECT_EQ(got.stats.node_tests, want.stats.node_tests);
+      EXPECT_EQ(got.stats.leaf_tests, want.stats.leaf_tests);
+      EXPECT_EQ(got.stage.size(), got.stats.node_tests) << "one record per tested node";
+      // Parents before children (what the node history adds up in reverse), every root's record
+      // marked, and the same records whatever the thread count.
+      for (const Root& r : got.roots) EXPECT_TRUE(got.stage[static_cast<std::size_t>(r.stage)].root);
+      if (threads == 1) continue;
+      SplitResult one;
+      parallel::Executor single(1);
+      single.execute([&] { one = split_task(ctx, 0, root, scale, omega, 0.25 * omega); });
+      ASSERT_EQ(one.stage.size(), got.stage.size());
+      for (std::size_t k = 0; k < one.stage.size(); ++k) {
+        EXPECT_EQ(one.stage[k].node, got.stage[k].node);
+        EXPECT_EQ(one.stage[k].children, got.stage[k].children);
+      }
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 8);
 }
 
 }  // namespace
