@@ -23,6 +23,7 @@ queries=1
 new_bin="$root/build/caliber"
 while [ $# -gt 0 ]; do
   case "$1" in
+    --rounds|--steps|--scenes|--new) [ $# -ge 2 ] || { echo "compare_commits: $1 needs a value" >&2; exit 2; } ;;&
     --rounds) rounds="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --scenes) scenes="$2"; shift 2 ;;
@@ -31,6 +32,8 @@ while [ $# -gt 0 ]; do
     *) echo "compare_commits: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
+[[ "$rounds" =~ ^[1-9][0-9]*$ ]] || { echo "compare_commits: --rounds must be a whole number >= 1" >&2; exit 2; }
+[[ "$steps" =~ ^[1-9][0-9]*$ ]] || { echo "compare_commits: --steps must be a whole number >= 1" >&2; exit 2; }
 sha="$(git -C "$root" rev-parse --verify "$rev^{commit}" 2>/dev/null)" || {
   echo "compare_commits: '$rev' is not a revision of this repository" >&2; exit 2; }
 short="${sha:0:10}"
@@ -94,21 +97,26 @@ if [ "$queries" = 1 ]; then
   done
 fi
 
-run_scene() {  # BIN SCENE TAG ROUND
+fail() { echo "compare_commits: $*" >&2; exit 1; }
+
+run_scene() {  # BIN SCENE TAG ROUND: prints the run's median ms/step; round 0 keeps the contacts
   local bin="$1" scene="$2" tag="$3" round="$4" k="$steps"
   [ "$scene" = two_large ] && k=$(( steps / 3 > 0 ? steps / 3 : 1 ))
-  local contacts=""
-  [ "$round" = 0 ] && contacts="--contacts $work/$scene.$tag.jsonl"
+  local extra=()
+  [ "$round" = 0 ] && extra=(--contacts "$work/$scene.$tag.jsonl")
+  rm -f "$work/run.json"
   "$bin" run "$root/scenes/$scene.json" --method sequential --threads 1 --steps "$k" \
-    --json "$work/run.json" $contacts >/dev/null 2>&1
+    --json "$work/run.json" "${extra[@]}" >/dev/null 2>"$work/err" || return 1
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['summary']['median_step_ms'])" "$work/run.json"
 }
 
 run_query() {  # BIN A B TAG ROUND: the query's own query_ms; round 0 keeps the pairs
-  "$1" query "$root/data/meshes/$2" "$root/data/meshes/$3" --pose-b "${poses[$2 x $3]}" --json 2>/dev/null \
-    > "$work/query.json"
-  [ "$5" = 0 ] && python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['pairs'])" "$work/query.json" \
-    > "$work/$2 x $3.$4.jsonl"
+  rm -f "$work/query.json"
+  "$1" query "$root/data/meshes/$2" "$root/data/meshes/$3" --pose-b "${poses[$2 x $3]}" --json 2>"$work/err" \
+    > "$work/query.json" || return 1
+  if [ "$5" = 0 ]; then
+    python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['pairs'])" "$work/query.json" > "$work/$2 x $3.$4.jsonl"
+  fi
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['stats']['query_ms'])" "$work/query.json"
 }
 
@@ -119,7 +127,8 @@ for ((r = 0; r < rounds; r++)); do
     # Alternate which binary goes first, so that neither always meets a warm or a cold machine.
     for tag in $([ $((r % 2)) = 0 ] && echo "old new" || echo "new old"); do
       bin="$old_bin"; [ "$tag" = new ] && bin="$new_bin"
-      times["$scene.$tag"]+="$(run_scene "$bin" "$scene" "$tag" "$r") "
+      ms="$(run_scene "$bin" "$scene" "$tag" "$r")" || fail "$tag binary failed on $scene: $(cat "$work/err")"
+      times["$scene.$tag"]+="$ms "
     done
   done
   if [ "$queries" = 1 ]; then
@@ -127,7 +136,8 @@ for ((r = 0; r < rounds; r++)); do
       read -r a b _ <<< "$p"
       for tag in $([ $((r % 2)) = 0 ] && echo "old new" || echo "new old"); do
         bin="$old_bin"; [ "$tag" = new ] && bin="$new_bin"
-        times["$a x $b.$tag"]+="$(run_query "$bin" "$a" "$b" "$tag" "$r") "
+        ms="$(run_query "$bin" "$a" "$b" "$tag" "$r")" || fail "$tag binary failed on $a x $b: $(cat "$work/err")"
+        times["$a x $b.$tag"]+="$ms "
       done
     done
   fi

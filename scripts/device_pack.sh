@@ -30,13 +30,22 @@ mkdir -p "$pack/bin" "$pack/lib" "$pack/scenes" "$pack/data/meshes"
 cp "$root/build/caliber" "$pack/bin/"
 strip "$pack/bin/caliber"
 
-# Every library the binary loads, but the C library, the dynamic loader and the kernel's vDSO:
-# those come from the device's system (glibc is backward compatible, not forward).
-ldd "$root/build/caliber" | awk '/=> \// {print $3}' | while read -r lib; do
-  case "$(basename "$lib")" in
-    libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*) ;;
-    *) cp -L "$lib" "$pack/lib/" ;;
+# Every library the binary loads, but glibc's own (the C library, its companions, the dynamic
+# loader): those come from the device's system (glibc is backward compatible, not forward).
+is_glibc() {
+  case "$(basename "$1")" in
+    libc.so.*|libm.so.*|libmvec.so.*|libpthread.so.*|libdl.so.*|librt.so.*|libresolv.so.*|libutil.so.*|libanl.so.*|\
+    libnsl.so.*|ld-linux*) return 0 ;;
+    *) return 1 ;;
   esac
+}
+ldd "$root/build/caliber" | awk '/=> \// {print $3}' | while read -r lib; do
+  is_glibc "$lib" || cp -L "$lib" "$pack/lib/"
+done
+# oneTBB opens its allocator at run time when present: the same one as here.
+tbb="$(ldd "$root/build/caliber" | awk '/libtbb\.so/ {print $3}')"
+for extra in "$(dirname "$tbb")"/libtbbmalloc.so.2 "$(dirname "$tbb")"/libtbbmalloc_proxy.so.2; do
+  [ -f "$extra" ] && cp -L "$extra" "$pack/lib/"
 done
 strip --strip-unneeded "$pack"/lib/*.so* 2>/dev/null || true
 
@@ -59,19 +68,30 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cd "$here"
-if [ "${1:-}" = bench ] && ! printf '%s\n' "$@" | grep -q '\.json$'; then
-  shift
-  exec "$here/bin/caliber" bench scenes/two_large.json scenes/two_small.json scenes/funnel.json scenes/front_car.json "$@"
+if [ "${1:-}" = bench ]; then
+  named=0
+  for arg in "$@"; do
+    case "$arg" in *.json) named=1 ;; esac
+  done
+  if [ "$named" = 0 ]; then
+    shift
+    exec "$here/bin/caliber" bench scenes/two_large.json scenes/two_small.json scenes/funnel.json scenes/front_car.json "$@"
+  fi
 fi
 exec "$here/bin/caliber" "$@"
 RUN
 chmod +x "$pack/run.sh"
 
-# The check: the packed binary runs a scene with nothing but the pack and the C library.
-missing="$(env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/caliber" | grep 'not found' || true)"
-if [ -n "$missing" ]; then
-  echo "device_pack: libraries missing from the pack:" >&2
-  echo "$missing" >&2
+# The check: with the pack's folder first, every library but glibc's must resolve inside the pack
+# (ldd would otherwise find this machine's copies and hide a library the device lacks).
+outside="$(env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/caliber" | awk '/=>/ {print $1, $3}' |
+  while read -r name path; do
+    is_glibc "$name" && continue
+    case "$path" in "$pack/lib/"*) ;; *) echo "$name -> $path" ;; esac
+  done)"
+if [ -n "$outside" ]; then
+  echo "device_pack: libraries not taken from the pack:" >&2
+  echo "$outside" >&2
   exit 1
 fi
 env -i PATH=/usr/bin:/bin bash "$pack/run.sh" run scenes/two_small.json --steps 2 --threads 2 --method hybrid >/dev/null 2>&1 ||

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -220,8 +221,11 @@ struct BenchRun {
 };
 
 /// One measured run: every step of the scene on a fresh engine; its record, and the contact check
-/// against the sequential reference (`reference` is filled by the first sequential run).
-Json measure_run(BenchRun& b, const World& world, const Variant& v, int t, int round, std::vector<std::uint64_t>& reference) {
+/// against the sequential reference (`reference` is filled by the first sequential run). Nothing
+/// when the budget ran out during the run (a run not measured before is estimated from its own
+/// first steps: after each step, the rest of the run must still fit).
+std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& v, int t, int round,
+                                std::vector<std::uint64_t>& reference) {
   const Scene& sc = world.scene();
   Engine engine(world, engine_options(v, t));
   RunStats stats;
@@ -230,7 +234,12 @@ Json measure_run(BenchRun& b, const World& world, const Variant& v, int t, int r
   // virtual cores as it has threads (what the cut allows, whatever the clock says).
   double sim_work = 0.0, sim_span = 0.0;
   const bool is_reference = v.method == Method::sequential && reference.empty();
+  const auto run_start = Clock::now();
   for (int k = 0; k < sc.steps; ++k) {
+    if (k > 0 && !b.fits(seconds_since(run_start) / k * (sc.steps - k),
+                         sc.name + " round " + std::to_string(round + 1) + " " + v.name + " x" + std::to_string(t))) {
+      return std::nullopt;
+    }
     const StepResult s = engine.step(k);
     total += s.broad_ms + s.narrow_ms + s.reduce_ms;
     broad += s.broad_ms;
@@ -274,7 +283,7 @@ Json measure_run(BenchRun& b, const World& world, const Variant& v, int t, int r
                {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}});
   }
   const double steps = sc.steps;
-  return {{"kind", "run"},
+  return Json{{"kind", "run"},
           {"scene", sc.name},
           {"method", v.name},
           {"threads", t},
@@ -311,7 +320,7 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
           std::unique_lock<std::mutex> lock(mutex);
           ++loaded;
           ready.notify_all();
-          ready.wait(lock, [&] { return loaded == copies; });  // all start stepping together
+          ready.wait(lock, [&] { return loaded >= copies; });  // all start stepping together
         }
         const auto start = Clock::now();
         for (int k = 0; k < scene.steps; ++k) static_cast<void>(engine.step(k));
@@ -319,7 +328,7 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
       } catch (...) {
         errors[static_cast<std::size_t>(i)] = std::current_exception();
         std::lock_guard<std::mutex> lock(mutex);
-        loaded = copies;  // nobody waits for a copy that failed
+        loaded += copies;  // nobody waits for a copy that failed
         ready.notify_all();
       }
     });
@@ -397,9 +406,10 @@ void bench_scene(BenchRun& b, std::size_t si) {
       if (!b.fits(estimate / 1000.0, sc.name + " round " + std::to_string(r + 1) + " " + c.variant->name + " x" + std::to_string(c.threads))) {
         return;
       }
-      const Json record = measure_run(b, world, *c.variant, c.threads, r, reference);
-      c.last_ms = record["total_ms"].get<double>();
-      b.log.add(record);
+      const std::optional<Json> record = measure_run(b, world, *c.variant, c.threads, r, reference);
+      if (!record) return;
+      c.last_ms = (*record)["total_ms"].get<double>();
+      b.log.add(*record);
     }
   }
   const double sequential_s = configs.front().last_ms / 1000.0;
@@ -502,9 +512,13 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
 int report_from_log(const BenchOptions& opt) {
   const std::filesystem::path log_file = opt.from_log;
   const std::vector<Json> records = read_bench_log(log_file);
-  const std::filesystem::path out = opt.out.empty() ? log_file.parent_path() : std::filesystem::path(opt.out);
-  if (!out.empty()) std::filesystem::create_directories(out);
-  write_outputs(records, out.empty() ? "." : out, opt.figures);
+  std::filesystem::path out = opt.out.empty() ? log_file.parent_path() : std::filesystem::path(opt.out);
+  if (out.empty()) out = ".";
+  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
+    throw Error(ErrorCode::bad_value, "--out", "'" + out.string() + "' exists and is not a folder");
+  }
+  std::filesystem::create_directories(out);
+  write_outputs(records, out, opt.figures);
   return 0;
 }
 

@@ -24,6 +24,98 @@ void BenchLog::add(Json record) {
   mRecords.push_back(std::move(record));
 }
 
+namespace {
+
+/// Why a record cannot be read (empty when it can): its kind's fields, with their types, and the
+/// scenes and methods it names against the header's.
+std::string record_problem(const Json& r, const Json* header) {
+  const auto need = [&](const char* key, bool (Json::*is)() const) -> std::string {
+    if (!r.contains(key)) return std::string("no \"") + key + "\"";
+    if (!(r[key].*is)()) return std::string("\"") + key + "\" has the wrong type";
+    return {};
+  };
+  const std::string kind = r["kind"].get<std::string>();
+  std::vector<std::pair<const char*, bool (Json::*)() const>> fields;
+  if (kind == "header") {
+    fields = {{"machine", &Json::is_string}, {"cpu", &Json::is_string}, {"hardware_threads", &Json::is_number_integer},
+              {"compiler", &Json::is_string}, {"repeat", &Json::is_number_integer}, {"threads", &Json::is_array},
+              {"simulate", &Json::is_array}, {"simulate_steps", &Json::is_number_integer}, {"methods", &Json::is_array},
+              {"scenes", &Json::is_array}, {"runs_planned", &Json::is_number_integer}};
+  } else if (kind == "run") {
+    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"threads", &Json::is_number_integer},
+              {"round", &Json::is_number_integer}, {"total_ms", &Json::is_number}, {"phases", &Json::is_object}};
+  } else if (kind == "table1") {
+    fields = {{"scene", &Json::is_string}, {"objects", &Json::is_number}, {"triangles", &Json::is_number},
+              {"node_tests_per_step", &Json::is_number}, {"contacts_per_step", &Json::is_number},
+              {"pairs_per_step", &Json::is_number}, {"candidate_pairs", &Json::is_number},
+              {"heaviest_pair_share", &Json::is_number}, {"second_pair_share", &Json::is_number},
+              {"exploitation_bound", &Json::is_number}};
+  } else if (kind == "ceiling") {
+    fields = {{"scene", &Json::is_string}, {"copies", &Json::is_number_integer}, {"copy_step_ms", &Json::is_array}};
+  } else if (kind == "simulation") {
+    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"cores", &Json::is_number_integer},
+              {"speedup", &Json::is_number}};
+  } else if (kind == "mismatch") {
+    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"threads", &Json::is_number_integer},
+              {"step", &Json::is_number_integer}};
+  } else if (kind == "gantt") {
+    fields = {{"scene", &Json::is_string}, {"threads", &Json::is_number_integer}, {"step", &Json::is_number_integer},
+              {"methods", &Json::is_object}};
+  } else if (kind == "fcl") {
+    fields = {{"report", &Json::is_string}};
+  } else if (kind == "stopped") {
+    fields = {{"reason", &Json::is_string}, {"after_s", &Json::is_number}};
+  } else {
+    return "unknown record kind \"" + kind + "\"";
+  }
+  for (const auto& [key, is] : fields) {
+    if (std::string p = need(key, is); !p.empty()) return p;
+  }
+  if (kind == "header") {
+    for (const Json& list : {r["threads"], r["simulate"]}) {
+      for (const Json& x : list) {
+        if (!x.is_number_integer()) return "a thread or core count is not a whole number";
+      }
+    }
+    for (const Json& m : r["methods"]) {
+      if (!m.is_string()) return "a method is not a name";
+    }
+    for (const Json& sc : r["scenes"]) {
+      if (!sc.is_object() || !sc.contains("name") || !sc["name"].is_string() || !sc.contains("file") || !sc["file"].is_string() ||
+          !sc.contains("steps") || !sc["steps"].is_number_integer() || sc["steps"].get<long long>() < 1) {
+        return "a scene needs a name, a file and steps >= 1";
+      }
+    }
+    return {};
+  }
+  if (header == nullptr) return "comes before the header";
+  if (r.contains("scene")) {
+    const auto& scenes = (*header)["scenes"];
+    if (std::none_of(scenes.begin(), scenes.end(), [&](const Json& sc) { return sc["name"] == r["scene"]; })) {
+      return "names a scene the header does not list";
+    }
+  }
+  if (r.contains("method") && kind != "gantt") {
+    const auto& methods = (*header)["methods"];
+    if (std::none_of(methods.begin(), methods.end(), [&](const Json& m) { return m == r["method"]; })) {
+      return "names a method the header does not list";
+    }
+  }
+  if (kind == "run") {
+    for (const auto& [key, value] : r["phases"].items()) {
+      if (!value.is_number()) return "phase \"" + key + "\" is not a number";
+    }
+  }
+  if (kind == "ceiling") {
+    for (const Json& x : r["copy_step_ms"]) {
+      if (!x.is_number()) return "a copy's time is not a number";
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 std::vector<Json> read_bench_log(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw Error(ErrorCode::file_not_found, file.string(), "cannot be opened");
@@ -38,11 +130,18 @@ std::vector<Json> read_bench_log(const std::filesystem::path& file) {
     if (!r.is_object() || !r.contains("kind") || !r["kind"].is_string()) {
       throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + " is not a bench record");
     }
+    if (records.empty() && r["kind"] != "header") {
+      throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber bench log)");
+    }
+    if (i > 0 && r["kind"] == "header") {
+      throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + ": a second header");
+    }
+    if (const std::string problem = record_problem(r, records.empty() ? nullptr : &records.front()); !problem.empty()) {
+      throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + ": " + problem);
+    }
     records.push_back(std::move(r));
   }
-  if (records.empty() || records.front()["kind"] != "header") {
-    throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber bench log)");
-  }
+  if (records.empty()) throw Error(ErrorCode::unreadable, file.string(), "empty (not a caliber bench log)");
   return records;
 }
 

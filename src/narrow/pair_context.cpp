@@ -50,8 +50,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
   const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
-  mMargin = kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
-  mReach = d + mMargin;
+  mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
   mSlabReach = mReach * (1.0 + 1e-6);
   mTheta = request.angle_deg * kPi / 180.0;
   mCosTheta = std::cos(mTheta);
@@ -105,17 +104,12 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     // true distance exceeds d, so the full computation below would reject the pair too.
     if (beyond_plane(a, b, mReach) || beyond_plane(b, a, mReach)) return false;
   }
+  const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
   if (mKind == QueryKind::interference) {
-    const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
     if (intersecting) out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
     return intersecting;
   }
   const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
-  // Intersecting triangles report distance 0. The closest-point distance is never below the true
-  // distance by more than rounding (far below the margin), so beyond the margin the triangles are
-  // apart and the exact intersection test would say so: it runs only at closer range.
-  const bool intersecting = closest.distance <= mMargin &&
-                            geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
   const double distance = intersecting ? 0.0 : closest.distance;
   if (!(distance <= mRequest.tolerance)) return false;
   out.push_back(Candidate{ta, tb, distance, closest.on_a, closest.on_b});

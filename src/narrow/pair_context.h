@@ -188,7 +188,6 @@ class PairContext {
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
   Eigen::Vector3d mTrans;
-  double mMargin;      ///< safety margin: far above the rounding of any distance or bound computed here
   double mReach;       ///< tolerance + safety margin added to the sum of radii
   double mSlabReach;   ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
   double mTheta;       ///< contact angle, radians

@@ -118,9 +118,9 @@ void finalize_pairs(const std::vector<narrow::PairContext>& contexts, Workers& w
     const std::size_t i = order[k];
     timeline.record(TaskSpan::Phase::finalize, [&] {
       std::vector<narrow::Candidate> all;
-      all.reserve(candidates[i]);
       QueryStats stats;
       start(i, all, stats);
+      all.reserve(all.size() + candidates[i]);
       for (const WorkerSlots* w : slots) {
         if (w->stats.size() != n) continue;
         all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());

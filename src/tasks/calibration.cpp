@@ -143,11 +143,21 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
     }
     level = std::move(next);
   }
+  // The priority queue popped every root and cart item after the last split node (from then on
+  // nothing heavier is pushed), so in order of weight, heaviest first, ties by node: the same
+  // order here, so that the run-time task list is the one the queue made, ties included.
+  const auto popped_before = [](const Root& x, const Root& y) {
+    if (x.weight != y.weight) return x.weight > y.weight;
+    if (x.node.a != y.node.a) return x.node.a < y.node.a;
+    return x.node.b < y.node.b;
+  };
+  std::sort(out.roots.begin(), out.roots.end(), popped_before);
+  std::sort(out.cart.begin(), out.cart.end(), popped_before);
   return out;
 }
 
 NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vector<std::uint64_t>& root_tests) {
-  // Children are popped after their parent: add up in reverse pop order.
+  // Children are recorded after their parent: add up in reverse record order.
   std::vector<std::pair<narrow::NodePair, std::uint64_t>> counts;
   std::map<narrow::NodePair, std::uint64_t> known;
   for (std::size_t k = stage.size(); k-- > 0;) {

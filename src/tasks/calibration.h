@@ -47,7 +47,7 @@ double caliber_threshold(double total, double beta, int threads);
 /// ones until their sum reaches omega; repeats until the cart is empty. No task comes out empty.
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 
-/// One node the weight-driven stage popped: what happened to it, so that its subtree's node tests
+/// One node the weight-driven stage tested: what happened to it, so that its subtree's node tests
 /// can be added up after the step (the node-history variant of hybrid reuses them).
 struct StageRecord {
   narrow::NodePair node;                 ///< the CD-tree node
@@ -81,7 +81,7 @@ struct SplitResult {
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
                        double omega, double eps, const NodeCounts* measured = nullptr);
 
-/// After a step: the node tests of every subtree the stage popped, from its records and the
+/// After a step: the node tests of every subtree the stage tested, from its records and the
 /// depth-first node tests of its roots (`root_tests[k]` for the root at record k). Sorted by node.
 NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vector<std::uint64_t>& root_tests);
 

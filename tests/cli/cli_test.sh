@@ -196,16 +196,39 @@ contains bench-budget "--budget-s 1 reached"
 python3 - "$tmp/bench-budget" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-budget-files"; failures=$((failures + 1)); }
 import json, sys
 r = json.load(open(sys.argv[1] + "/results.json"))
-assert r["stopped"]["reason"] == "budget" and r["stopped"]["after_s"] <= 1.0, r["stopped"]
-assert 0 < r["runs_done"] < r["runs_planned"], (r["runs_done"], r["runs_planned"])
+# Checked between runs and, within a run, after each step (a step is ~4 ms): the stop comes inside
+# the budget, give or take a step on a busy machine, unless loading the scene alone took longer
+# (as under AddressSanitizer), when it comes at the first check, before any run is finished.
+assert r["stopped"]["reason"] == "budget", r["stopped"]
+assert r["stopped"]["after_s"] <= 1.5 or r["runs_done"] == 0, (r["stopped"], r["runs_done"])
+assert r["runs_done"] < r["runs_planned"], (r["runs_done"], r["runs_planned"])
 assert "cut short by its time budget" in open(sys.argv[1] + "/report.md").read()
 PY
 echo "not json" > "$tmp/bad.jsonl"
+touch "$tmp/a-file"
 check bench-bad-log 2 "$cli" bench --from-log "$tmp/bad.jsonl" --out "$tmp/bench3"
 contains bench-bad-log "line 1 is not a bench record"
+# A record with a field missing or of the wrong type, or naming a scene the header lacks: exit 2,
+# naming the file and the line.
+python3 - "$tmp/bench/runs.jsonl" "$tmp" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+run = next(i for i, l in enumerate(lines) if json.loads(l)["kind"] == "run")
+for name, change in (("nofield", lambda r: r.pop("total_ms")), ("badtype", lambda r: r.__setitem__("threads", "two")),
+                     ("badscene", lambda r: r.__setitem__("scene", "elsewhere"))):
+    r = json.loads(lines[run])
+    change(r)
+    open(f"{sys.argv[2]}/{name}.jsonl", "w").write("\n".join(lines[:run] + [json.dumps(r)] + lines[run + 1:]) + "\n")
+PY
+check bench-log-nofield 2 "$cli" bench --from-log "$tmp/nofield.jsonl" --out "$tmp/bench3"
+contains bench-log-nofield 'no "total_ms"'
+check bench-log-badtype 2 "$cli" bench --from-log "$tmp/badtype.jsonl" --out "$tmp/bench3"
+contains bench-log-badtype '"threads" has the wrong type'
+check bench-log-badscene 2 "$cli" bench --from-log "$tmp/badscene.jsonl" --out "$tmp/bench3"
+contains bench-log-badscene "names a scene the header does not list"
+check bench-from-log-out-file 2 "$cli" bench --from-log "$tmp/bench/runs.jsonl" --out "$tmp/a-file"
 check bench-missing-log 2 "$cli" bench --from-log "$tmp/none.jsonl"
 check bench-bad-budget 2 "$cli" bench "$data/scenes/tetras.json" --budget-s -5 --out "$tmp/bench2"
-touch "$tmp/a-file"
 check bench-out-file 2 "$cli" bench "$data/scenes/tetras.json" --out "$tmp/a-file"
 contains bench-out-file "not a folder"
 check bench-missing 2 "$cli" bench "$data/scenes/nope.json" --out "$tmp/bench2"

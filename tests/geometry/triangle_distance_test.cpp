@@ -150,6 +150,7 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
     const bool same = same_bits(got.on_a, want.on_a) && same_bits(got.on_b, want.on_b) &&
                       std::memcmp(&got.distance, &want.distance, sizeof(double)) == 0;
     if (!same && ++differing <= 5) ADD_FAILURE() << "iteration " << iter << " kind " << k << ": " << got.distance << " vs " << want.distance;
+
     // The public single queries too (the leaf test does not call them, the build does not either).
     if (iter % 16 == 0) {
       const Vec3 x = random_point() * scale;

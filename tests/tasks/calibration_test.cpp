@@ -157,10 +157,10 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
 
 using RootKey = std::tuple<std::uint32_t, std::uint32_t, double, bool>;
 
+/// The roots in their order (the run-time task list keeps it for equal weights).
 std::vector<RootKey> keys(const std::vector<Root>& roots) {
   std::vector<RootKey> k;
   for (const Root& r : roots) k.emplace_back(r.node.a, r.node.b, r.weight, r.tested);
-  std::sort(k.begin(), k.end());
   return k;
 }
 
