@@ -9,6 +9,7 @@
 
 #include "caliber/error.h"
 #include "caliber/model.h"
+#include "parallel/executor.h"
 
 namespace caliber {
 namespace {
@@ -60,6 +61,12 @@ struct WorkNode {
   std::uint32_t first = 0;  ///< first position of its triangles in leaf order
 };
 
+/// Subtrees over more triangles than this build their two halves in parallel (on the executor the
+/// caller runs in); smaller ones, and every leaf-level pass, in a loop of their own.
+constexpr std::uint32_t kParallelBuildCount = 8192;
+/// Items per chunk for the build's per-triangle and per-node loops.
+constexpr std::size_t kBuildGrain = 4096;
+
 class Builder {
  public:
   Builder(const Mesh& mesh, const std::vector<Vec3>& normals) : mMesh(mesh), mNormals(normals) {
@@ -67,41 +74,55 @@ class Builder {
     mOrder.resize(n);
     std::iota(mOrder.begin(), mOrder.end(), 0u);
     mCentroids.resize(n);
-    for (std::size_t t = 0; t < n; ++t) {
-      const auto& tri = mesh.triangles[t];
-      mCentroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
-    }
-    mWork.reserve(2 * n - 1);
+    parallel::parallel_for(0, n, kBuildGrain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t t = lo; t != hi; ++t) {
+        const auto& tri = mesh.triangles[t];
+        mCentroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
+      }
+    });
+    mWork.resize(2 * n - 1);
   }
 
   void build(Model& model) {
-    mWork.emplace_back();
-    model.height = build_range(0, 0, static_cast<std::uint32_t>(mOrder.size()));
+    model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()));
     model.nodes.resize(mWork.size());
     model.filters.resize(mWork.size());
     model.first_leaf.resize(mWork.size());
     model.leaf_position.resize(mOrder.size());
-    for (std::size_t i = 0; i < mWork.size(); ++i) {
-      convert(mWork[i], model.nodes[i], model.filters[i]);
-      model.first_leaf[i] = mWork[i].first;
-    }
+    parallel::parallel_for(0, mWork.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) {
+        convert(mWork[i], model.nodes[i], model.filters[i]);
+        model.first_leaf[i] = mWork[i].first;
+      }
+    });
     for (std::uint32_t p = 0; p < mOrder.size(); ++p) model.leaf_position[mOrder[p]] = p;
   }
 
  private:
-  /// Builds the subtree over mOrder[begin, end) into mWork[slot]; returns its height.
-  int build_range(std::uint32_t slot, std::uint32_t begin, std::uint32_t end) {
+  /// Builds the subtree over mOrder[begin, end) into mWork[slot], its other nodes into mWork from
+  /// `next` on; returns its height. The layout is the one of a depth-first build that appends the
+  /// two children of a node, then builds the left subtree, then the right one: a subtree over m
+  /// triangles holds 2 m - 1 nodes, so the right subtree's nodes start 2 (left count) - 2 after the
+  /// left's, and both halves can be built at once, into the same places, whatever the threads.
+  int build_range(std::uint32_t slot, std::uint32_t next, std::uint32_t begin, std::uint32_t end) {
     if (end - begin == 1) {
       mWork[slot].first = begin;
       make_leaf(slot, mOrder[begin]);
       return 1;
     }
     const std::uint32_t mid = split(begin, end);
-    const auto first = static_cast<std::uint32_t>(mWork.size());
-    mWork.emplace_back();
-    mWork.emplace_back();
-    const int hl = build_range(first, begin, mid);
-    const int hr = build_range(first + 1, mid, end);
+    const std::uint32_t first = next;
+    const std::uint32_t left_next = first + 2, right_next = left_next + 2 * (mid - begin) - 2;
+    int hl = 0, hr = 0;
+    if (end - begin > kParallelBuildCount) {
+      parallel::TaskGroup halves;
+      halves.run([&] { hl = build_range(first, left_next, begin, mid); });
+      hr = build_range(first + 1, right_next, mid, end);
+      halves.wait();
+    } else {
+      hl = build_range(first, left_next, begin, mid);
+      hr = build_range(first + 1, right_next, mid, end);
+    }
     make_internal(slot, first, begin, end);
     mWork[slot].first = begin;
     return 1 + std::max(hl, hr);
@@ -285,12 +306,14 @@ class Builder {
 
 std::vector<Vec3> face_normals(const Mesh& mesh) {
   std::vector<Vec3> normals(mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Vec3 n = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    const double len = n.norm();
-    normals[t] = (len > 0.0 && std::isfinite(len)) ? Vec3(n / len) : Vec3::Zero();
-  }
+  parallel::parallel_for(0, mesh.triangles.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t t = lo; t != hi; ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3 n = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
+      const double len = n.norm();
+      normals[t] = (len > 0.0 && std::isfinite(len)) ? Vec3(n / len) : Vec3::Zero();
+    }
+  });
   return normals;
 }
 
@@ -308,7 +331,7 @@ void vertex_adjacency(const Mesh& mesh, std::vector<std::uint32_t>& offsets, std
     if (p.z() != q.z()) return p.z() < q.z();
     return a < b;
   };
-  std::sort(order.begin(), order.end(), less);
+  parallel::parallel_sort(order.begin(), order.end(), less);  // distinct keys (ties by index)
   std::vector<std::uint32_t> weld(nv);
   std::uint32_t next = 0;
   for (std::size_t i = 0; i < nv; ++i) {
@@ -327,22 +350,37 @@ void vertex_adjacency(const Mesh& mesh, std::vector<std::uint32_t>& offsets, std
   for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
     for (const std::uint32_t v : mesh.triangles[t]) incident[fill[weld[v]]++] = t;
   }
-  offsets.assign(mesh.triangles.size() + 1, 0);
-  adjacency.clear();
-  std::vector<std::uint32_t> around;
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    around.clear();
-    for (const std::uint32_t v : mesh.triangles[t]) {
-      const std::uint32_t w = weld[v];
-      for (std::uint32_t k = start[w]; k < start[w + 1]; ++k) {
-        if (incident[k] != t) around.push_back(incident[k]);
+  // Each triangle's neighbours, sorted and distinct, found in parallel chunks of triangles, then
+  // copied in parallel into their places: the same list a loop over the triangles would write.
+  const std::size_t nt = mesh.triangles.size();
+  const std::size_t chunks = (nt + kBuildGrain - 1) / kBuildGrain;
+  std::vector<std::vector<std::uint32_t>> found(chunks);
+  offsets.assign(nt + 1, 0);
+  parallel::parallel_for(0, chunks, 1, [&](std::size_t c_lo, std::size_t c_hi) {
+    std::vector<std::uint32_t> around;
+    for (std::size_t c = c_lo; c != c_hi; ++c) {
+      for (std::size_t t = c * kBuildGrain; t < std::min(nt, (c + 1) * kBuildGrain); ++t) {
+        around.clear();
+        for (const std::uint32_t v : mesh.triangles[t]) {
+          const std::uint32_t w = weld[v];
+          for (std::uint32_t k = start[w]; k < start[w + 1]; ++k) {
+            if (incident[k] != t) around.push_back(incident[k]);
+          }
+        }
+        std::sort(around.begin(), around.end());
+        around.erase(std::unique(around.begin(), around.end()), around.end());
+        found[c].insert(found[c].end(), around.begin(), around.end());
+        offsets[t + 1] = static_cast<std::uint32_t>(around.size());
       }
     }
-    std::sort(around.begin(), around.end());
-    around.erase(std::unique(around.begin(), around.end()), around.end());
-    adjacency.insert(adjacency.end(), around.begin(), around.end());
-    offsets[t + 1] = static_cast<std::uint32_t>(adjacency.size());
-  }
+  });
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  adjacency.resize(offsets.back());
+  parallel::parallel_for(0, chunks, 1, [&](std::size_t c_lo, std::size_t c_hi) {
+    for (std::size_t c = c_lo; c != c_hi; ++c) {
+      std::copy(found[c].begin(), found[c].end(), adjacency.begin() + offsets[c * kBuildGrain]);
+    }
+  });
 }
 
 }  // namespace

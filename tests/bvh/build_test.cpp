@@ -1,4 +1,5 @@
 #include <cmath>
+#include <memory>
 #include <functional>
 #include <random>
 
@@ -7,6 +8,7 @@
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
+#include "parallel/executor.h"
 
 namespace caliber {
 namespace {
@@ -120,6 +122,46 @@ TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
   EXPECT_EQ(neighbors(0), std::vector<std::uint32_t>{1});
   EXPECT_EQ(neighbors(1), std::vector<std::uint32_t>{0});
   EXPECT_TRUE(neighbors(2).empty());
+}
+
+/// The bytes of a vector, to compare two builds exactly.
+template <class T>
+std::vector<unsigned char> bytes(const std::vector<T>& v) {
+  const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+  return std::vector<unsigned char>(p, p + v.size() * sizeof(T));
+}
+
+TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
+  // Over 8192 triangles, so the two halves of the top subtrees are built at once.
+  const Mesh mesh = make_sphere(1.0, 120, 160);
+  ASSERT_GT(mesh.triangles.size(), 30000u);
+  std::shared_ptr<const Model> one;
+  parallel::Executor single(1);
+  single.execute([&] { one = build_model(mesh); });
+  for (const int threads : {2, 3, 8}) {
+    std::shared_ptr<const Model> many;
+    parallel::Executor executor(threads);
+    executor.execute([&] { many = build_model(mesh); });
+    EXPECT_EQ(bytes(many->nodes), bytes(one->nodes)) << threads << " threads";
+    EXPECT_EQ(bytes(many->filters), bytes(one->filters)) << threads << " threads";
+    EXPECT_EQ(many->first_leaf, one->first_leaf);
+    EXPECT_EQ(many->leaf_position, one->leaf_position);
+    EXPECT_EQ(bytes(many->normals), bytes(one->normals));
+    EXPECT_EQ(many->adjacency_offsets, one->adjacency_offsets);
+    EXPECT_EQ(many->adjacency, one->adjacency);
+    EXPECT_EQ(many->height, one->height);
+    EXPECT_EQ(many->extent, one->extent);
+  }
+  // The layout of a depth-first build that appends a node's two children, then builds the left
+  // subtree, then the right (the one every earlier version had): the left child's children come
+  // right after the pair, the right child's after the left subtree's 2 m - 2 further nodes.
+  const Model& m = *one;
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    if (m.nodes[i].is_leaf()) continue;
+    const std::uint32_t first = m.nodes[i].index;
+    if (!m.nodes[first].is_leaf()) EXPECT_EQ(m.nodes[first].index, first + 2) << "node " << i;
+    if (!m.nodes[first + 1].is_leaf()) EXPECT_EQ(m.nodes[first + 1].index, first + 2 * m.nodes[first].count) << "node " << i;
+  }
 }
 
 TEST(BuildModel, RejectsBadMesh) {
