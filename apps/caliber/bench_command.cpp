@@ -38,6 +38,7 @@
 #include "commands.h"
 #include "machine.h"
 #include "progress.h"
+#include "timing.h"
 
 namespace caliber::cli {
 namespace {
@@ -169,10 +170,6 @@ std::string quote(const std::string& s) {
   for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
 }
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// The time the bench may take (--budget-s): a run starts only if its estimated time still fits,
 /// so the bench ends inside the budget with every finished run in its log.

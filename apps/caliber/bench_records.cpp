@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "caliber/error.h"
+#include "timing.h"
 
 namespace caliber::cli {
 
@@ -143,13 +144,6 @@ std::vector<Json> read_bench_log(const std::filesystem::path& file) {
   }
   if (records.empty()) throw Error(ErrorCode::unreadable, file.string(), "empty (not a caliber bench log)");
   return records;
-}
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 namespace {

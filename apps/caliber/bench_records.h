@@ -54,7 +54,4 @@ class BenchLog {
 /// method once one of its runs has.
 [[nodiscard]] nlohmann::json results_from_records(const std::vector<nlohmann::json>& records);
 
-/// Median of a list (0 when empty).
-[[nodiscard]] double median_of(std::vector<double> values);
-
 }  // namespace caliber::cli

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "bench_records.h"
+#include "timing.h"
 #include "caliber/error.h"
 
 namespace caliber::cli {

@@ -18,15 +18,10 @@
 #include "caliber/query.h"
 #include "commands.h"
 #include "json_output.h"
+#include "timing.h"
 
 namespace caliber::cli {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 struct QueryOptions {
   std::string mesh_a, mesh_b;
@@ -40,12 +35,6 @@ struct QueryOptions {
   int threads = 0;
   int repeat = 1;
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
   if (x.pairs.size() != y.pairs.size() || x.contacts.size() != y.contacts.size()) return false;
@@ -132,7 +121,7 @@ int run_query(const QueryOptions& opt) {
   }
   // Warm: the median of the repetitions after the first (the first alone when there is one).
   const double cold_ms = query_ms.front();
-  const double warm_ms = query_ms.size() > 1 ? median({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
+  const double warm_ms = query_ms.size() > 1 ? median_of({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
   const caliber::Model& shown_a = world ? world->model(0) : *model_a;
   const caliber::Model& shown_b = world ? world->model(1) : *model_b;
 

@@ -59,6 +59,7 @@ struct StageItem {
 struct StageOutcome {
   enum class Kind : std::uint8_t { pruned, leaf, split, root } kind = Kind::pruned;
   bool reported = false;        ///< leaf: the leaf test kept the pair
+  bool keep = false;            ///< root: kept as a sub-task root (else it goes to the cart)
   std::uint8_t children = 0;    ///< split: how many children
   StageItem child[4];           ///< split: the children and their weights
   narrow::Candidate candidate;  ///< leaf, reported: the pair
@@ -108,6 +109,7 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
           for (int k = 0; k < o.children; ++k) o.child[k] = StageItem{weight_of(kids[k]), kids[k]};
         } else {
           o.kind = StageOutcome::Kind::root;
+          o.keep = classify(e.weight, omega, eps) == Verdict::keep;
         }
       }
     });
@@ -135,7 +137,7 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
           record.root = true;
           Root r{pair, e.node, true, e.weight};
           r.stage = static_cast<std::int32_t>(out.stage.size());
-          (classify(e.weight, omega, eps) == Verdict::keep ? out.roots : out.cart).push_back(r);
+          (o.keep ? out.roots : out.cart).push_back(r);
           break;
         }
       }
