@@ -6,6 +6,7 @@
 //                     [--no-mesh-pairs]
 // With --scenes, also every candidate pair of each scene's broad phase at the given steps.
 
+#include <numbers>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -94,7 +95,7 @@ caliber::Pose place(const Case& c, const caliber::Mesh& a, const caliber::Mesh& 
   double da, db;
   box(a, ca, da);
   box(b, cb, db);
-  const Eigen::Quaterniond q(Eigen::AngleAxisd(c.angle_deg * 3.14159265358979323846 / 180.0, c.axis.normalized()));
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(c.angle_deg * std::numbers::pi / 180.0, c.axis.normalized()));
   const Eigen::Vector3d t = ca + c.offset * da - q * cb;
   return caliber::Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
 }

@@ -38,6 +38,7 @@
 #include "commands.h"
 #include "machine.h"
 #include "progress.h"
+#include "run_stats.h"
 #include "timing.h"
 
 namespace caliber::cli {
@@ -224,12 +225,12 @@ struct BenchRun {
 std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& v, int t, int round,
                                 std::vector<std::uint64_t>& reference) {
   const Scene& sc = world.scene();
-  Engine engine(world, engine_options(v, t));
+  Engine engine(engine_options(v, t));
   RunStats stats;
   double total = 0.0, calibrate = 0.0, traverse = 0.0, finalize = 0.0, broad = 0.0;
   // The load-balance simulation of this very run: its tasks' node tests list-scheduled on as many
   // virtual cores as it has threads (what the cut allows, whatever the clock says).
-  double sim_work = 0.0, sim_span = 0.0;
+  SimulatedRun simulated(v.method, t);
   const bool is_reference = v.method == Method::sequential && reference.empty();
   const auto run_start = Clock::now();
   for (int k = 0; k < sc.steps; ++k) {
@@ -237,17 +238,13 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
                          sc.name + " round " + std::to_string(round + 1) + " " + v.name + " x" + std::to_string(t))) {
       return std::nullopt;
     }
-    const StepResult s = engine.step(k);
+    const StepResult s = step(world, engine, k);
     total += s.broad_ms + s.narrow_ms + s.reduce_ms;
     broad += s.broad_ms;
     calibrate += s.schedule.calibrate_ms;
     traverse += s.schedule.traverse_ms;
     finalize += s.schedule.finalize_ms;
-    if (v.method != Method::sequential && s.stats.node_tests > 0) {
-      const double w = static_cast<double>(s.stats.node_tests);
-      sim_work += w;
-      sim_span += w / simulated_speedup(s, v.method, t);
-    }
+    simulated.add(s);
     const std::uint64_t h = contacts_hash(s);
     if (is_reference) {
       reference.push_back(h);
@@ -291,7 +288,7 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
             {"calibrate_ms", calibrate / steps},
             {"traverse_ms", traverse / steps},
             {"finalize_ms", finalize / steps},
-            {"balance_speedup", sim_span > 0 ? sim_work / sim_span : 1.0}}}};
+            {"balance_speedup", simulated.speedup()}}}};
 }
 
 /// The machine's own ceiling at `copies` threads: that many independent sequential copies of the
@@ -312,7 +309,7 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
         EngineOptions options;
         options.method = Method::sequential;
         options.threads = 1;
-        Engine engine(world, options);
+        Engine engine(options);
         {
           std::unique_lock<std::mutex> lock(mutex);
           ++loaded;
@@ -320,7 +317,7 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
           ready.wait(lock, [&] { return loaded >= copies; });  // all start stepping together
         }
         const auto start = Clock::now();
-        for (int k = 0; k < scene.steps; ++k) static_cast<void>(engine.step(k));
+        for (int k = 0; k < scene.steps; ++k) static_cast<void>(step(world, engine, k));
         ms[static_cast<std::size_t>(i)] = 1000.0 * seconds_since(start) / scene.steps;
       } catch (...) {
         errors[static_cast<std::size_t>(i)] = std::current_exception();
@@ -348,14 +345,12 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
     bool correlated = false;
     for (const int p : b.opt.simulate) {
       if (!b.fits(sequential_s * steps / sc.steps, sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores")) return;
-      Engine engine(world, engine_options(v, p));
-      double work = 0.0, span = 0.0;
+      Engine engine(engine_options(v, p));
+      SimulatedRun simulated(v.method, p);
       std::vector<double> estimated, effective;
       for (int k = 0; k < steps; ++k) {
-        const StepResult s = engine.step(k);
-        const double w = static_cast<double>(s.stats.node_tests);
-        work += w;
-        span += w / simulated_speedup(s, v.method, p);
+        const StepResult s = step(world, engine, k);
+        simulated.add(s);
         if (p == 8 || p == b.opt.simulate.front()) {
           const auto& r = s.schedule;
           for (std::size_t i = 0; i < r.task_weights.size() && i < r.task_node_tests.size(); ++i) {
@@ -370,7 +365,7 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
           b.progress.update(b.done, line);
         }
       }
-      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", span > 0 ? work / span : 1.0}};
+      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", simulated.speedup()}};
       if (!estimated.empty() && (p == 8 || !correlated)) {
         // Keep at most 4000 points for the figure (evenly spaced); r uses all of them.
         Json points = Json::array();
@@ -439,9 +434,9 @@ void record_gantt(BenchRun& b) {
   for (const char* name : {"exploitation", "hybrid"}) {
     EngineOptions o = engine_options(parse_variant(name), t);
     o.timeline = true;
-    Engine engine(world, o);
+    Engine engine(o);
     StepResult s;
-    for (int k = 0; k <= step; ++k) s = engine.step(k);  // hybrid needs the previous steps' history
+    for (int k = 0; k <= step; ++k) s = caliber::step(world, engine, k);  // hybrid needs the previous steps' history
     Json spans = Json::array();
     for (const TaskSpan& span : s.schedule.timeline) {
       spans.push_back({span.thread, span.start_ms, span.end_ms,

@@ -5,14 +5,12 @@
 #include <stdexcept>
 #include <vector>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <iostream>
 #include <string>
 
 #include "caliber/engine.h"
 #include "caliber/mesh.h"
-#include "caliber/world.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
@@ -49,36 +47,16 @@ bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
   return true;
 }
 
-/// Runs the query as a one-step, two-object scene through the parallel engine (the same contacts as
-/// caliber::query, whatever the method). B is given a zero velocity so the pair is not skipped as
-/// static-static; the broad phase may still drop the pair when the objects are apart.
-caliber::QueryResult query_with_engine(const QueryOptions& opt, const caliber::QueryRequest& request, const caliber::Pose& pose_a,
-                                       const caliber::Pose& pose_b, std::unique_ptr<caliber::World>& world) {
-  caliber::Scene scene;
-  scene.name = "query";
-  scene.steps = 1;
-  scene.query = request;
-  caliber::SceneObject a, b;
-  a.name = "A";
-  a.mesh = std::filesystem::absolute(opt.mesh_a);
-  a.pose = pose_a;
-  b.name = "B";
-  b.mesh = std::filesystem::absolute(opt.mesh_b);
-  b.pose = pose_b;
-  b.motion.type = caliber::Motion::Type::velocity;
-  scene.objects = {a, b};
-  world = std::make_unique<caliber::World>(std::move(scene));
-  caliber::EngineOptions options;
-  options.method = caliber::parse_method(opt.method);
-  options.threads = opt.threads;
-  caliber::Engine engine(*world, options);
-  const caliber::StepResult step = engine.step(0);
+/// The pair's result from a step of the parallel engine on a two-object frame (the same contacts as
+/// caliber::query, whatever the method).
+caliber::QueryResult query_with_engine(caliber::Engine& engine, const caliber::Frame& frame) {
+  const caliber::StepResult step = engine.step(frame);
   caliber::QueryResult result;
-  result.kind = request.kind;
+  result.kind = frame.request.kind;
   result.stats = step.stats;
   for (const caliber::SceneContact& c : step.contacts) {
     result.pairs.push_back({c.contact.tri_a, c.contact.tri_b});
-    if (request.kind != caliber::QueryKind::interference) result.contacts.push_back(c.contact);
+    if (frame.request.kind != caliber::QueryKind::interference) result.contacts.push_back(c.contact);
   }
   return result;
 }
@@ -93,24 +71,32 @@ int run_query(const QueryOptions& opt) {
   const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
 
   const caliber::Method method = caliber::parse_method(opt.method);
-  std::shared_ptr<const caliber::Model> model_a, model_b;
-  std::unique_ptr<caliber::World> world;
-  caliber::QueryResult result;
-  double build_ms = 0.0;
-  std::vector<double> query_ms;  // one per repetition, the first one cold
-  if (method == caliber::Method::sequential) {
-    const auto build_start = Clock::now();
-    model_a = caliber::build_model(caliber::load_mesh(opt.mesh_a));
-    model_b = opt.mesh_b == opt.mesh_a ? model_a : caliber::build_model(caliber::load_mesh(opt.mesh_b));
-    build_ms = ms_since(build_start);
+  const auto build_start = Clock::now();
+  const std::shared_ptr<const caliber::Model> model_a = caliber::build_model(caliber::load_mesh(opt.mesh_a));
+  const std::shared_ptr<const caliber::Model> model_b =
+      opt.mesh_b == opt.mesh_a ? model_a : caliber::build_model(caliber::load_mesh(opt.mesh_b));
+  const double build_ms = ms_since(build_start);
+  std::unique_ptr<caliber::Engine> engine;
+  caliber::Frame frame;
+  if (method != caliber::Method::sequential) {
+    caliber::EngineOptions options;
+    options.method = method;
+    options.threads = opt.threads;
+    engine = std::make_unique<caliber::Engine>(options);
+    frame.models = {model_a, model_b};
+    frame.poses = {pose_a, pose_b};
+    frame.pairs = {caliber::Task{0, 1}};
+    frame.request = request;
   }
+  caliber::QueryResult result;
+  std::vector<double> query_ms;  // one per repetition, the first one cold
   for (int r = 0; r < opt.repeat; ++r) {
     caliber::QueryResult again;
     const auto start = Clock::now();
-    if (method == caliber::Method::sequential) {
-      again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
+    if (engine) {
+      again = query_with_engine(*engine, frame);
     } else {
-      again = query_with_engine(opt, request, pose_a, pose_b, world);  // loading and building included
+      again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
     }
     query_ms.push_back(ms_since(start));
     if (r == 0) {
@@ -122,8 +108,8 @@ int run_query(const QueryOptions& opt) {
   // Warm: the median of the repetitions after the first (the first alone when there is one).
   const double cold_ms = query_ms.front();
   const double warm_ms = query_ms.size() > 1 ? median_of({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
-  const caliber::Model& shown_a = world ? world->model(0) : *model_a;
-  const caliber::Model& shown_b = world ? world->model(1) : *model_b;
+  const caliber::Model& shown_a = *model_a;
+  const caliber::Model& shown_b = *model_b;
 
   if (opt.json) {
     nlohmann::json out = caliber::cli::to_json(result);

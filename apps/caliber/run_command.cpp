@@ -1,7 +1,6 @@
 // caliber run: a scene over its time steps, with a per-step summary, a final summary (the paper's
 // Table 1 characteristics), an optional JSON report and an optional JSON-lines contact log.
 
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -15,6 +14,8 @@
 #include "caliber/world.h"
 #include "commands.h"
 #include "progress.h"
+#include "run_stats.h"
+#include "timing.h"
 
 namespace caliber::cli {
 namespace {
@@ -96,7 +97,7 @@ int run_scene(const RunOptions& opt) {
   Scene scene = load_scene(opt.scene);
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
   if (opt.steps > 0) scene.steps = opt.steps;
-  const auto load_start = std::chrono::steady_clock::now();
+  const auto load_start = Clock::now();
   const World world(std::move(scene));
   EngineOptions engine_options;
   engine_options.method = parse_method(opt.method);
@@ -105,8 +106,8 @@ int run_scene(const RunOptions& opt) {
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
-  Engine engine(world, engine_options);
-  const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start).count();
+  Engine engine(engine_options);
+  const double load_ms = ms_since(load_start);
   const Scene& sc = world.scene();
   std::printf("scene %s: %zu objects (%zu distinct models), %zu triangles, %d steps of %g s, %s query (d = %g, angle %g)\n",
               sc.name.c_str(), world.object_count(), world.distinct_models(), world.triangle_count(), sc.steps, sc.dt,
@@ -125,17 +126,14 @@ int run_scene(const RunOptions& opt) {
   for (const int p : opt.simulate) {
     if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
   }
-  // Load-balance simulation, over the whole run: total node tests / total simulated makespan.
-  std::vector<double> simulated_time(opt.simulate.size(), 0.0);
-  double simulated_work = 0.0;
+  // Load-balance simulation, over the whole run.
+  std::vector<SimulatedRun> sims;
+  for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
   const Progress progress(static_cast<std::size_t>(sc.steps));
   for (int k = 0; k < sc.steps; ++k) {
-    const StepResult s = engine.step(k);
+    const StepResult s = step(world, engine, k);
     stats.add(s);
-    simulated_work += static_cast<double>(s.stats.node_tests);
-    for (std::size_t p = 0; p < opt.simulate.size(); ++p) {
-      simulated_time[p] += static_cast<double>(s.stats.node_tests) / simulated_speedup(s, engine.options().method, opt.simulate[p]);
-    }
+    for (SimulatedRun& sim : sims) sim.add(s);
     if (!opt.json.empty()) steps.push_back(step_record(s));
     if (contacts_out) *contacts_out << contacts_line(world, s).dump() << '\n';
     char line[256];
@@ -164,7 +162,7 @@ int run_scene(const RunOptions& opt) {
     std::printf("  simulated speed-up (%s; node tests, list scheduling on P virtual cores):\n   ",
                 std::string(to_string(engine.options().method)).c_str());
     for (std::size_t p = 0; p < opt.simulate.size(); ++p) {
-      const double speedup = simulated_time[p] > 0.0 ? simulated_work / simulated_time[p] : 1.0;
+      const double speedup = sims[p].speedup();
       std::printf(" P=%d: %.2fx", opt.simulate[p], speedup);
       simulated[std::to_string(opt.simulate[p])] = speedup;
     }

@@ -1,26 +1,13 @@
 #pragma once
-// Small measuring helpers the commands share: wall-clock time since a point, and a median.
+// The commands measure with the library's one clock (src/util/timing.h).
 
-#include <algorithm>
-#include <chrono>
-#include <vector>
+#include "util/timing.h"
 
 namespace caliber::cli {
 
-using Clock = std::chrono::steady_clock;
-
-/// Milliseconds since `start`.
-inline double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
-
-/// Seconds since `start`.
-inline double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-/// Median of a list (the mean of the middle two for an even count; 0 when empty).
-inline double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using util::Clock;
+using util::median_of;
+using util::ms_since;
+using util::seconds_since;
 
 }  // namespace caliber::cli

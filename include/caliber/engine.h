@@ -7,13 +7,111 @@
 #include <cstdint>
 #include <memory>
 #include <string_view>
+#include <vector>
 
-#include "caliber/world.h"
+#include "caliber/model.h"
+#include "caliber/pose.h"
+#include "caliber/query.h"
 
 namespace caliber {
-namespace narrow {
-class PairContext;
-}
+
+/// An object pair to test (a < b): one initial task of a step. Its two object indices are also
+/// its identity from frame to frame (the temporal state of aposteriori and hybrid is keyed by them).
+struct Task {
+  std::uint32_t a;  ///< object id
+  std::uint32_t b;  ///< object id, > a
+  friend bool operator==(const Task&, const Task&) = default;
+  friend auto operator<=>(const Task&, const Task&) = default;
+};
+
+/// A contact between two objects of a scene, in world coordinates.
+struct SceneContact {
+  std::uint32_t object_a;  ///< object id (lower)
+  std::uint32_t object_b;  ///< object id (higher)
+  Contact contact;         ///< triangle ids, points, normal, distance (points unset for interference)
+};
+
+/// The work and result of one task in one step.
+struct TaskRecord {
+  Task task;              ///< the object pair
+  QueryStats stats;       ///< node and leaf tests
+  std::size_t pairs = 0;  ///< triangle pairs reported
+};
+
+/// One piece of a step's work on one thread (EngineOptions::timeline): what a Gantt chart draws.
+struct TaskSpan {
+  /// Which part of the step: the weight-driven stage of one split task, one unit of depth-first
+  /// traversal (a run-time task, a pair, a stealing piece), or one pair's finalization.
+  enum class Phase : std::uint8_t { stage, traverse, finalize };
+  int thread = 0;         ///< the executor's thread index (0 .. threads-1)
+  double start_ms = 0.0;  ///< since the start of the step's narrow phase
+  double end_ms = 0.0;
+  Phase phase = Phase::traverse;
+};
+
+/// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
+/// that do not calibrate; `task_node_tests` is filled by every engine method.
+struct ScheduleRecord {
+  double omega = 0.0;                          ///< the caliber Omega (in weight units)
+  std::size_t kept = 0;                        ///< initial tasks run as they are
+  std::size_t split = 0;                       ///< initial tasks split by the weight-driven stage
+  std::size_t carted = 0;                      ///< items merged in the cart (light tasks and light nodes)
+  std::size_t generated = 0;                   ///< run-time tasks
+  std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
+  std::size_t queue_peak = 0;                  ///< widest level of the weight-driven stage (nodes waiting at once)
+  std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
+  /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
+  /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
+  /// cut-off and the single node tests above it (stealing). The load-balance simulation replays them.
+  std::vector<std::uint64_t> task_node_tests;
+  std::vector<double> task_weights;            ///< estimated weight of each run-time task (calibrated methods)
+  std::uint64_t split_node_tests = 0;          ///< stealing: node tests made above the cut-off, while splitting
+  std::size_t taboo = 0;                       ///< a posteriori: taboo nodes (sub-task roots) handed out
+  /// A posteriori: node tests of sub-tasks whose root the original task never reached (an ancestor
+  /// was pruned at this step): work the sequential traversal does not do. The other node tests add
+  /// up to sequential's exactly.
+  std::uint64_t taboo_unreached_node_tests = 0;
+  /// Depth-first node tests done by each worker thread (unordered; the weight-driven stage's tests
+  /// are in stage_task_node_tests).
+  std::vector<std::uint64_t> thread_node_tests;
+  double calibrate_ms = 0.0;  ///< calibrated methods: weights, keep/split/cart, weight-driven stage, cart
+  double traverse_ms = 0.0;   ///< depth-first traversals of the run-time tasks (or pairs, or pieces)
+  double finalize_ms = 0.0;   ///< per-pair merge, sort, local minima and world coordinates
+  /// Every piece of work with its thread and times, sorted by thread then start; empty unless
+  /// EngineOptions::timeline is on.
+  std::vector<TaskSpan> timeline;
+};
+
+/// Everything one step produced.
+struct StepResult {
+  int step = 0;                         ///< step index
+  double time = 0.0;                    ///< simulated time (step * dt)
+  double broad_ms = 0.0;                ///< broad-phase wall time
+  double narrow_ms = 0.0;               ///< narrow-phase wall time (all tasks)
+  double reduce_ms = 0.0;               ///< gathering and sorting the contacts
+  std::vector<TaskRecord> tasks;        ///< one per initial task, in task order
+  std::vector<SceneContact> contacts;   ///< sorted by (object a, object b, tri a, tri b)
+  QueryStats stats;                     ///< totals over the tasks
+  ScheduleRecord schedule;              ///< how the work was cut and scheduled
+};
+
+/// One moment of a set of rigid objects, as the engine takes it: whatever produced it (a scene's
+/// World, a physics engine, a planner), the engine needs nothing else, no file and no scene.
+struct Frame {
+  /// The model of each object; objects may share one. None is null. Immutable and shared, so a
+  /// program keeps its models from frame to frame and only the poses change.
+  std::vector<std::shared_ptr<const Model>> models;
+  /// The pose of each object (one per model).
+  std::vector<Pose> poses;
+  /// The object pairs to test: a < b < objects, sorted, each once (a broad phase's output, or every
+  /// pair a program wants tested). Keep an object's index from frame to frame so that the temporal
+  /// methods find a pair's history; Engine::forget() drops it.
+  std::vector<Task> pairs;
+  /// The query every pair runs (validated by Engine::step). A `groups` table it points to must
+  /// outlive the step.
+  QueryRequest request;
+};
+
 
 /// How a step's narrow phase is cut and scheduled.
 enum class Method : std::uint8_t {
@@ -66,18 +164,45 @@ struct EngineOptions {
 /// evenly (an optimistic model of stealing). Sequential: 1.
 [[nodiscard]] double simulated_speedup(const StepResult& step, Method method, int cores);
 
-/// Runs a world's steps with a method on a fixed number of threads (a oneTBB task arena of exactly
-/// that many). Not thread-safe itself: one step at a time.
+/// The load-balance simulation over a run: the run's predicted speed-up on `cores` virtual cores is
+/// its total node tests over the sum of its steps' simulated makespans.
+class SimulatedRun {
+ public:
+  SimulatedRun(Method method, int cores) : mMethod(method), mCores(cores) {}
+  /// Adds one step.
+  void add(const StepResult& step);
+  /// The predicted speed-up of the steps added (1 when they did no work).
+  [[nodiscard]] double speedup() const { return mSpan > 0.0 ? mWork / mSpan : 1.0; }
+  /// The core count simulated.
+  [[nodiscard]] int cores() const { return mCores; }
+
+ private:
+  Method mMethod;
+  int mCores;
+  double mWork = 0.0;
+  double mSpan = 0.0;
+};
+
+/// Runs frames with a method on a fixed number of threads (a oneTBB task arena of exactly that
+/// many). Keeps, between steps, what the temporal methods learn of each object pair. Not
+/// thread-safe itself: one step at a time (use one engine per thread to step several at once).
 class Engine {
  public:
-  /// Throws caliber::Error on a thread count outside 0..1024 or a negative stealing depth.
-  Engine(const World& world, const EngineOptions& options);
+  /// Throws caliber::Error on a thread count outside 0..1024, a negative stealing depth, a beta
+  /// that is not > 0, a negative epsilon or a taboo cap below 1.
+  explicit Engine(const EngineOptions& options = {});
   ~Engine();
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
 
-  /// Runs step k. The contacts are identical to World::step(k), whatever the method or threads.
-  [[nodiscard]] StepResult step(int k);
+  /// Tests every pair of the frame: the narrow phase and the reduction. The contacts are those of
+  /// caliber::query on each pair, whatever the method or threads; `step`, `time` and `broad_ms`
+  /// of the result are left to the caller (caliber::step fills them for a World).
+  /// Throws caliber::Error, naming the problem, on a frame that breaks Frame's rules.
+  [[nodiscard]] StepResult step(const Frame& frame);
+  /// Drops what the temporal methods remember of every pair (after a jump in the motion, or when
+  /// object indices start to denote other objects).
+  void forget();
   /// The number of worker threads.
   [[nodiscard]] int threads() const;
   /// The options in force (threads resolved).
@@ -85,11 +210,12 @@ class Engine {
 
  private:
   struct Impl;
-  void run_calibrated(const std::vector<Task>& tasks, const std::vector<narrow::PairContext>& contexts,
-                      std::vector<QueryResult>& results, ScheduleRecord& record);
-  const World& mWorld;
   EngineOptions mOptions;
   std::unique_ptr<Impl> mImpl;
 };
+
+/// Checks a frame against Frame's rules; throws caliber::Error (source "frame") naming the first
+/// problem. Engine::step calls it.
+void validate_frame(const Frame& frame);
 
 }  // namespace caliber

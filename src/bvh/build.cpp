@@ -1,5 +1,6 @@
 // Sphere-tree BVH build: top-down median split, exact covering radii, normal cones and slabs, group masks.
 
+#include <numbers>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,7 +17,6 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-constexpr double kPi = 3.14159265358979323846;
 /// Nodes with at most this many triangles get the exact covering radius (a pass over their vertices);
 /// larger ones bound it from their children's spheres.
 constexpr std::uint32_t kExactRadiusCount = 256;
@@ -228,7 +228,7 @@ class Builder {
       for (const WorkNode* kid : {&l, &r}) {
         if (kid->cone >= 0.0) angle = std::max(angle, angle_between(unit, kid->axis.normalized()) + kid->cone);
       }
-      node.cone = std::min(angle + kConeSlack, 2.0 * kPi);
+      node.cone = std::min(angle + kConeSlack, 2.0 * std::numbers::pi);
     }
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.

@@ -1,5 +1,6 @@
 #include "caliber/procedural.h"
 
+#include <numbers>
 #include <cmath>
 #include <string>
 
@@ -8,7 +9,6 @@
 namespace caliber {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 /// Triangles over a (rows+1) x (cols+1) vertex grid starting at `base`; the last column wraps
 /// to the first when `wrap` is set.
@@ -38,9 +38,9 @@ Mesh make_sphere(double radius, int rings, int segments) {
   Mesh mesh;
   mesh.source = "sphere";
   for (int i = 0; i <= rings; ++i) {
-    const double phi = kPi * i / rings;
+    const double phi = std::numbers::pi * i / rings;
     for (int j = 0; j < segments; ++j) {
-      const double theta = 2.0 * kPi * j / segments;
+      const double theta = 2.0 * std::numbers::pi * j / segments;
       mesh.vertices.emplace_back(radius * std::sin(phi) * std::cos(theta), radius * std::sin(phi) * std::sin(theta),
                                  radius * std::cos(phi));
     }
@@ -56,9 +56,9 @@ Mesh make_torus(double major, double minor, int rings, int segments) {
   Mesh mesh;
   mesh.source = "torus";
   for (int i = 0; i <= rings; ++i) {
-    const double u = 2.0 * kPi * (i % rings) / rings;
+    const double u = 2.0 * std::numbers::pi * (i % rings) / rings;
     for (int j = 0; j < segments; ++j) {
-      const double v = 2.0 * kPi * j / segments;
+      const double v = 2.0 * std::numbers::pi * j / segments;
       const double r = major + minor * std::cos(v);
       mesh.vertices.emplace_back(r * std::cos(u), r * std::sin(u), minor * std::sin(v));
     }

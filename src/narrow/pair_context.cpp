@@ -1,5 +1,6 @@
 #include "narrow/pair_context.h"
 
+#include <numbers>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -9,7 +10,6 @@
 
 namespace caliber::narrow {
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 /// Relative safety margin on sphere tests. Rounding in the transformed centers and vertices is a few
 /// ulps (~1e-16 relative) of the coordinates' magnitude; 1e-9 of it is far above that and far below
 /// any size that changes how much the prune prunes.
@@ -52,7 +52,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
   mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
   mSlabReach = mReach * (1.0 + 1e-6);
-  mTheta = request.angle_deg * kPi / 180.0;
+  mTheta = request.angle_deg * std::numbers::pi / 180.0;
   mCosTheta = std::cos(mTheta);
   mSinTheta = std::sin(mTheta);
 }
@@ -62,7 +62,7 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   // the triangle inequality angle(axis_a, -axis_b) <= alpha_a + alpha_b + theta for any passing leaf.
   if (na.cone_angle < 0.0f || nb.cone_angle < 0.0f) return false;  // only degenerate triangles below
   const double total = static_cast<double>(na.cone_angle) + static_cast<double>(nb.cone_angle) + mTheta;
-  if (total >= kPi) return true;
+  if (total >= std::numbers::pi) return true;
   const Eigen::Vector3d axis_a(na.cone_axis[0], na.cone_axis[1], na.cone_axis[2]);
   const Eigen::Vector3d axis_b(nb.cone_axis[0], nb.cone_axis[1], nb.cone_axis[2]);
   const double facing = -axis_a.dot(mRot * axis_b);

@@ -10,6 +10,7 @@
 
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
+#include "util/assert.h"
 
 namespace caliber::narrow {
 
@@ -22,16 +23,22 @@ struct NodePair {
 };
 
 /// The a posteriori method's taboo list: CD-tree nodes that sub-tasks own. A traversal that meets
-/// one skips it without testing it (its sub-task tests it) and records that it met it.
+/// one skips it without testing it (its sub-task tests it) and says so in its "reached" output.
 struct Taboo {
-  std::vector<NodePair> nodes;         ///< sorted, distinct
-  mutable std::vector<char> reached;   ///< reached[i]: the traversal met nodes[i] (one thread writes it)
+  std::vector<NodePair> nodes;  ///< sorted, distinct
 
   /// Index of n in the list, or -1.
   [[nodiscard]] int find(NodePair n) const {
     const auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
     return (it != nodes.end() && *it == n) ? static_cast<int>(it - nodes.begin()) : -1;
   }
+};
+
+/// What a traversal skips, and where it records that it met them: `reached[i]` is set when the
+/// traversal meets taboo->nodes[i] (the caller sizes it; one thread writes it). Empty: skip nothing.
+struct TabooView {
+  const Taboo* taboo = nullptr;
+  char* reached = nullptr;
 };
 
 /// A node whose sphere is more than this many times larger than its partner's descends alone.
@@ -60,71 +67,83 @@ inline int cd_children(const Model& ma, const Model& mb, NodePair n, NodePair ou
   return count;
 }
 
+/// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root).
+inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
+  ++stats.node_tests;
+  return ctx.node_test(n.a, n.b);
+}
+
+/// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
+/// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
+/// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
+/// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
+/// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
+/// Each child node of A and of B is prepared once for the (up to) four pairs it takes part in.
+/// So every CD node below a root is tested exactly once, by its parent's visit.
+inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats, NodePair passed[4],
+                 TabooView taboo = {}) {
+  const BvhNode& a = ctx.a().nodes[n.a];
+  const BvhNode& b = ctx.b().nodes[n.b];
+  if (a.is_leaf() && b.is_leaf()) {
+    ++stats.leaf_tests;
+    ctx.leaf_test(a.index, b.index, out);
+    return -1;
+  }
+  bool split_a, split_b;
+  cd_split(a, b, split_a, split_b);
+  PairContext::SideA sa[2];
+  PairContext::SideB sb[2];
+  const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
+  for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
+  for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
+  int count = 0;
+  for (int i = 0; i < na; ++i) {
+    for (int j = 0; j < nb; ++j) {
+      const NodePair child{sa[i].index, sb[j].index};
+      if (taboo.taboo != nullptr) {
+        const int t = taboo.taboo->find(child);
+        if (t >= 0) {
+          taboo.reached[t] = 1;
+          continue;
+        }
+      }
+      ++stats.node_tests;
+      if (ctx.node_test(sa[i], sb[j])) passed[count++] = child;
+    }
+  }
+  return count;
+}
+
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
 };
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
-/// was tested, and passed, earlier) and every node below it whose parent passed; runs the leaf
-/// test on passing leaf pairs; appends the kept pairs to `out` and counts the work in `stats`
-/// (every node test, every leaf test). With a taboo list, a child on the list is neither tested nor
-/// entered, only marked as reached.
-/// Children are tested when their parent is expanded, so each child node of A and of B is
-/// prepared once for the (up to) four pairs it takes part in; only passing children are pushed.
+/// was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
+/// on passing leaf pairs, the kept pairs appended to `out`, every node and leaf test counted in
+/// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
                                  std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false,
-                                 const Taboo* taboo = nullptr) {
-  const Model& ma = ctx.a();
-  const Model& mb = ctx.b();
-  // Each expansion pops one node and pushes at most four, one level deeper: the stack never holds
+                                 TabooView taboo = {}) {
+  // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
   // more than 3 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
-  const auto bound = static_cast<std::size_t>(3 * (ma.height + mb.height) + 4);
+  const auto bound = static_cast<std::size_t>(3 * (ctx.a().height + ctx.b().height) + 4);
   if (stack.size() < bound) stack.resize(bound);
   NodePair* const base = stack.data();
   NodePair* top = base;
-  std::uint64_t node_tests = root_tested ? 0 : 1, leaf_tests = 0;
-  if (root_tested || ctx.node_test(root.a, root.b)) *top++ = root;
+  QueryStats counted;
+  if (root_tested || test_root(ctx, root, counted)) *top++ = root;
+  NodePair passed[4];
   while (top != base) {
-    const NodePair n = *--top;
-    const BvhNode& a = ma.nodes[n.a];
-    const BvhNode& b = mb.nodes[n.b];
-    if (a.is_leaf() && b.is_leaf()) {
-      ++leaf_tests;
-      ctx.leaf_test(a.index, b.index, out);
-      continue;
-    }
-    bool split_a, split_b;
-    cd_split(a, b, split_a, split_b);
-    PairContext::SideA sa[2];
-    PairContext::SideB sb[2];
-    const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-    for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
-    for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
-    // Pushed in reverse so that the first child is popped first (the same order as cd_children).
-    for (int i = na - 1; i >= 0; --i) {
-      for (int j = nb - 1; j >= 0; --j) {
-        if (taboo != nullptr) {
-          const int t = taboo->find(NodePair{sa[i].index, sb[j].index});
-          if (t >= 0) {
-            taboo->reached[static_cast<std::size_t>(t)] = 1;
-            continue;
-          }
-        }
-        ++node_tests;
-        if (ctx.node_test(sa[i], sb[j])) *top++ = NodePair{sa[i].index, sb[j].index};
-      }
-    }
+    const int count = visit(ctx, *--top, out, counted, passed, taboo);
+    // Pushed in reverse so that the first child is popped first (the order of cd_children).
+    for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
+    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
-  stats.node_tests += node_tests;
-  stats.leaf_tests += leaf_tests;
+  stats.node_tests += counted.node_tests;
+  stats.leaf_tests += counted.leaf_tests;
 }
-
-/// Sorts the candidates of one object pair canonically, applies the contact reduction (local
-/// minima) for contact queries, and converts them to world coordinates. With `parallel`, a large
-/// candidate list is processed by several tasks of the current oneTBB arena (same result).
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats,
-                     bool parallel = false);
 
 }  // namespace caliber::narrow

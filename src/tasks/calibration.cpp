@@ -6,6 +6,7 @@
 
 #include "caliber/model.h"
 #include "parallel/executor.h"
+#include "util/assert.h"
 
 #include "tasks/weights.h"
 
@@ -56,12 +57,16 @@ struct StageItem {
 };
 
 /// What the stage found at one node of a level (filled in parallel, read in the level's order).
+/// Every node of a level has passed its node test (made by its parent's visit, or the root's).
 struct StageOutcome {
-  enum class Kind : std::uint8_t { pruned, leaf, split, root } kind = Kind::pruned;
+  enum class Kind : std::uint8_t { leaf, split, root } kind = Kind::root;
   bool reported = false;        ///< leaf: the leaf test kept the pair
   bool keep = false;            ///< root: kept as a sub-task root (else it goes to the cart)
-  std::uint8_t children = 0;    ///< split: how many children
-  StageItem child[4];           ///< split: the children and their weights
+  std::uint8_t children = 0;    ///< split: how many children passed their test
+  std::uint8_t tested = 0;      ///< split: how many children were tested
+  StageItem child[4];           ///< split: the children that passed, and their weights
+  narrow::NodePair all[4];      ///< split: every child tested (cd_children order)
+  QueryStats stats;             ///< the visit's node and leaf tests
   narrow::Candidate candidate;  ///< leaf, reported: the pair
 };
 
@@ -78,13 +83,14 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
     return scale * apriori_weight(ctx, n);
   };
   // The paper pops the heaviest node of a priority queue until none is left. What happens to a node
-  // (tested; pruned, leaf-tested, split into its children, or made a root or a cart item by its
-  // weight) depends on the node alone, never on when it is popped, so the stage is the same cut
-  // when run level by level: every node of a level tested in parallel, their children the next
-  // level. Outcomes are gathered in the level's order, so the cut and its records do not depend on
-  // the thread count either.
+  // (pruned, leaf-tested, split into its children, or made a root or a cart item by its weight)
+  // depends on the node alone, never on when it is popped, so the stage is the same cut when run
+  // level by level: every node of a level visited in parallel (narrow::visit, which tests its
+  // children), the children that pass the next level. Outcomes are gathered in the level's order,
+  // so the cut and its records do not depend on the thread count either.
   SplitResult out;
-  std::vector<StageItem> level{StageItem{root_weight, narrow::NodePair{0, 0}}};
+  std::vector<StageItem> level;
+  if (narrow::test_root(ctx, narrow::NodePair{0, 0}, out.stats)) level.push_back(StageItem{root_weight, narrow::NodePair{0, 0}});
   std::vector<StageOutcome> outcome;
   while (!level.empty()) {
     out.queue_peak = std::max(out.queue_peak, level.size());
@@ -94,43 +100,48 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
       for (std::size_t i = lo; i != hi; ++i) {
         const StageItem& e = level[i];
         StageOutcome& o = outcome[i];
-        if (!ctx.node_test(e.node.a, e.node.b)) continue;
-        const BvhNode& a = ctx.a().nodes[e.node.a];
-        const BvhNode& b = ctx.b().nodes[e.node.b];
-        if (a.is_leaf() && b.is_leaf()) {
-          o.kind = StageOutcome::Kind::leaf;
-          found.clear();
-          o.reported = ctx.leaf_test(a.index, b.index, found);
-          if (o.reported) o.candidate = found.front();
-        } else if (classify(e.weight, omega, eps) == Verdict::split) {
-          o.kind = StageOutcome::Kind::split;
-          narrow::NodePair kids[4];
-          o.children = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, kids));
-          for (int k = 0; k < o.children; ++k) o.child[k] = StageItem{weight_of(kids[k]), kids[k]};
-        } else {
+        const bool leaves = ctx.a().nodes[e.node.a].is_leaf() && ctx.b().nodes[e.node.b].is_leaf();
+        const Verdict verdict = classify(e.weight, omega, eps);
+        if (!leaves && verdict != Verdict::split) {
           o.kind = StageOutcome::Kind::root;
-          o.keep = classify(e.weight, omega, eps) == Verdict::keep;
+          o.keep = verdict == Verdict::keep;
+          continue;
         }
+        found.clear();
+        narrow::NodePair passed[4];
+        const int count = narrow::visit(ctx, e.node, found, o.stats, passed);
+        if (count < 0) {
+          o.kind = StageOutcome::Kind::leaf;
+          o.reported = !found.empty();
+          if (o.reported) o.candidate = found.front();
+          continue;
+        }
+        o.kind = StageOutcome::Kind::split;
+        o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, o.all));
+        o.children = static_cast<std::uint8_t>(count);
+        for (int k = 0; k < count; ++k) o.child[k] = StageItem{weight_of(passed[k]), passed[k]};
       }
     });
     std::vector<StageItem> next;
     for (std::size_t i = 0; i < level.size(); ++i) {
       const StageItem& e = level[i];
       const StageOutcome& o = outcome[i];
-      ++out.stats.node_tests;
+      out.stats.node_tests += o.stats.node_tests;
+      out.stats.leaf_tests += o.stats.leaf_tests;
       StageRecord record{};
       record.node = e.node;
       switch (o.kind) {
-        case StageOutcome::Kind::pruned: break;
         case StageOutcome::Kind::leaf:
-          ++out.stats.leaf_tests;
           if (o.reported) out.candidates.push_back(o.candidate);
           break;
         case StageOutcome::Kind::split:
-          record.children = o.children;
-          for (int k = 0; k < o.children; ++k) {
-            record.child[k] = o.child[k].node;
-            next.push_back(o.child[k]);
+          record.children = o.tested;
+          for (int k = 0, p = 0; k < o.tested; ++k) {
+            record.child[k] = o.all[k];
+            if (p < o.children && o.child[p].node == o.all[k]) {
+              record.passed |= static_cast<std::uint8_t>(1u << k);
+              next.push_back(o.child[p++]);
+            }
           }
           break;
         case StageOutcome::Kind::root: {
@@ -167,8 +178,14 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
     std::uint64_t total = 1;  // its own test
     if (r.root) total += root_tests[k];
     for (int c = 0; c < r.children; ++c) {
+      if ((r.passed >> c & 1u) == 0) {
+        known[r.child[c]] = 1;  // tested by this visit, failed: its subtree is its one test
+        ++total;
+        continue;
+      }
       const auto it = known.find(r.child[c]);
-      if (it != known.end()) total += it->second;
+      CALIBER_ASSERT(it != known.end(), "a child that passed has its record after its parent's");
+      total += it->second;
     }
     known[r.node] = total;
   }

@@ -47,12 +47,14 @@ double caliber_threshold(double total, double beta, int threads);
 /// ones until their sum reaches omega; repeats until the cart is empty. No task comes out empty.
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 
-/// One node the weight-driven stage tested: what happened to it, so that its subtree's node tests
-/// can be added up after the step (the node-history variant of hybrid reuses them).
+/// One node the weight-driven stage visited (every one passed its node test): what happened to it,
+/// so that its subtree's node tests can be added up after the step (the node-history variant of
+/// hybrid reuses them).
 struct StageRecord {
   narrow::NodePair node;                 ///< the CD-tree node
-  std::uint8_t children = 0;             ///< expanded: how many children were pushed
-  narrow::NodePair child[4];             ///< expanded: the children
+  std::uint8_t children = 0;             ///< expanded: how many children its visit tested
+  std::uint8_t passed = 0;               ///< expanded: bit k set when child k passed (and has a record)
+  narrow::NodePair child[4];             ///< expanded: the children tested
   bool root = false;                     ///< became a sub-task root or a cart item (tested)
 };
 
@@ -66,7 +68,7 @@ struct SplitResult {
   std::vector<narrow::Candidate> candidates;  ///< leaf pairs found in the stage
   QueryStats stats;                           ///< node and leaf tests made in the stage
   std::size_t queue_peak = 0;                 ///< widest level of the stage (nodes waiting at once)
-  std::vector<StageRecord> stage;             ///< every node tested, level by level (parents first)
+  std::vector<StageRecord> stage;             ///< every node that passed, level by level (parents first)
 };
 
 /// The weight-driven partial traversal of one pair's CD tree (the paper's alternate traversal):

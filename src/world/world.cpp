@@ -1,20 +1,19 @@
-// The world: shared models, poses per step, broad phase (sweep and prune), the sequential step.
+// The world: shared models, poses per step, broad phase (sweep and prune), the frames it makes.
 
 #include "caliber/world.h"
 
 #include <algorithm>
-#include <chrono>
 #include <map>
 #include <tuple>
 
 #include "caliber/error.h"
+#include "util/timing.h"
 
 namespace caliber {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
+using util::Clock;
+using util::ms_since;
 
 /// A world-space box of an object: its root box moved by its pose (conservative: |R| h).
 struct WorldBox {
@@ -132,101 +131,24 @@ std::vector<Task> World::broad_phase(const std::vector<Pose>& poses) const {
   return tasks;
 }
 
-StepResult World::step(int step) const {
-  StepResult out;
-  out.step = step;
-  out.time = step * mScene.dt;
-  auto start = Clock::now();
-  const std::vector<Pose> poses = poses_at(step);
-  const std::vector<Task> tasks = broad_phase(poses);
-  out.broad_ms = ms_since(start);
+Frame World::frame(int step) const {
+  Frame frame;
+  frame.poses = poses_at(step);
+  frame.pairs = broad_phase(frame.poses);
+  frame.models = mModels;
+  frame.request = mRequest;
+  return frame;
+}
 
-  start = Clock::now();
-  std::vector<QueryResult> results;
-  results.reserve(tasks.size());
-  for (const Task& t : tasks) results.push_back(query(*mModels[t.a], poses[t.a], *mModels[t.b], poses[t.b], mRequest));
-  out.narrow_ms = ms_since(start);
-
-  start = Clock::now();
-  gather_step(tasks, results, out);
-  out.reduce_ms = ms_since(start);
+StepResult step(const World& world, Engine& engine, int k) {
+  const auto start = Clock::now();
+  const Frame frame = world.frame(k);
+  const double broad_ms = ms_since(start);
+  StepResult out = engine.step(frame);
+  out.step = k;
+  out.time = k * world.scene().dt;
+  out.broad_ms = broad_ms;
   return out;
-}
-
-void gather_step(const std::vector<Task>& tasks, const std::vector<QueryResult>& results, StepResult& out) {
-  out.tasks.clear();
-  out.contacts.clear();
-  out.stats = QueryStats{};
-  std::size_t total = 0;
-  for (const QueryResult& r : results) total += r.pairs.size();
-  out.contacts.reserve(total);
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    const QueryResult& r = results[i];
-    out.tasks.push_back(TaskRecord{tasks[i], r.stats, r.pairs.size()});
-    out.stats.node_tests += r.stats.node_tests;
-    out.stats.leaf_tests += r.stats.leaf_tests;
-    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
-      SceneContact c{tasks[i].a, tasks[i].b, {}};
-      if (r.contacts.empty()) {
-        c.contact.tri_a = r.pairs[k].tri_a;
-        c.contact.tri_b = r.pairs[k].tri_b;
-        c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
-      } else {
-        c.contact = r.contacts[k];
-      }
-      out.contacts.push_back(c);
-    }
-  }
-}
-
-}  // namespace caliber
-
-namespace caliber {
-
-void RunStats::add(const StepResult& step) {
-  mStepMs.push_back(step.broad_ms + step.narrow_ms + step.reduce_ms);
-  mNodeTests += step.stats.node_tests;
-  mContacts += step.contacts.size();
-  mTasks += step.tasks.size();
-  if (!step.contacts.empty()) ++mStepsWithContacts;
-  for (const TaskRecord& t : step.tasks) mPairWork[t.task] += t.stats.node_tests;
-}
-
-double RunStats::median_step_ms() const {
-  if (mStepMs.empty()) return 0.0;
-  std::vector<double> sorted = mStepMs;
-  std::sort(sorted.begin(), sorted.end());
-  const std::size_t n = sorted.size();
-  return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-}
-
-double RunStats::mean_step_ms() const {
-  double sum = 0.0;
-  for (const double t : mStepMs) sum += t;
-  return mStepMs.empty() ? 0.0 : sum / static_cast<double>(mStepMs.size());
-}
-
-double RunStats::mean_node_tests() const { return steps() ? double(mNodeTests) / double(steps()) : 0.0; }
-double RunStats::mean_contacts() const { return steps() ? double(mContacts) / double(steps()) : 0.0; }
-double RunStats::mean_tasks() const { return steps() ? double(mTasks) / double(steps()) : 0.0; }
-
-std::vector<std::pair<std::uint64_t, Task>> RunStats::ranked() const {
-  std::vector<std::pair<std::uint64_t, Task>> r;
-  for (const auto& [task, work] : mPairWork) r.emplace_back(work, task);
-  std::sort(r.begin(), r.end(), [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
-  return r;
-}
-
-std::pair<Task, double> RunStats::heaviest_pair() const {
-  const auto r = ranked();
-  if (r.empty() || mNodeTests == 0) return {Task{0, 0}, 0.0};
-  return {r[0].second, double(r[0].first) / double(mNodeTests)};
-}
-
-std::pair<Task, double> RunStats::second_heaviest_pair() const {
-  const auto r = ranked();
-  if (r.size() < 2 || mNodeTests == 0) return {Task{0, 0}, 0.0};
-  return {r[1].second, double(r[1].first) / double(mNodeTests)};
 }
 
 }  // namespace caliber

@@ -17,8 +17,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (o.refine > 3) return 0;
     }
     const caliber::World world(std::move(scene));
-    (void)world.step(0);
-    (void)world.step(world.scene().steps - 1);
+    caliber::Engine engine;
+    (void)caliber::step(world, engine, 0);
+    (void)caliber::step(world, engine, world.scene().steps - 1);
   } catch (const caliber::Error&) {
     // the documented answer to bad input
   }

@@ -16,6 +16,7 @@
 #include "caliber/world.h"
 #include "support/random_poses.h"
 #include "support/temp_dir.h"
+#include "support/reference_step.h"
 
 namespace caliber {
 namespace {
@@ -73,7 +74,7 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
                                 temp.path(), "concurrency.json"));
   const int steps = world.scene().steps;
   std::vector<StepResult> reference;
-  for (int k = 0; k < steps; ++k) reference.push_back(world.step(k));
+  for (int k = 0; k < steps; ++k) reference.push_back(test::reference_step(world, k));
   std::size_t contacts = 0;
   for (const StepResult& r : reference) contacts += r.contacts.size();
   ASSERT_GT(contacts, 0u);
@@ -89,12 +90,12 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
       options.method = methods[m];
       options.threads = 2;
       options.stealing_depth = 2;
-      Engine engine(world, options);  // each thread its own engine, all over one world
-      for (int k = 0; k < steps; ++k) got[m].push_back(engine.step(k));
+      Engine engine(options);  // each thread its own engine, all over one world
+      for (int k = 0; k < steps; ++k) got[m].push_back(step(world, engine, k));
     });
   }
   threads.emplace_back([&] {  // and World::step itself from one more thread
-    for (int k = 0; k < steps; ++k) got[kMethods].push_back(world.step(k));
+    for (int k = 0; k < steps; ++k) got[kMethods].push_back(test::reference_step(world, k));
   });
   for (std::thread& th : threads) th.join();
   for (std::size_t m = 0; m < got.size(); ++m) {

@@ -2,6 +2,7 @@
 // vertices, non-manifold edges, only degenerate triangles. Documented behaviour: all are accepted,
 // and queries on them are exact (identical to the brute-force oracle).
 
+#include <numbers>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -33,7 +34,7 @@ Mesh book(int pages) {
   m.source = "book";
   m.vertices = {{0, 0, 0}, {0, 0, 1}};
   for (int p = 0; p < pages; ++p) {
-    const double a = 2.0 * 3.141592653589793 * p / pages;
+    const double a = 2.0 * std::numbers::pi * p / pages;
     m.vertices.emplace_back(0.8 * std::cos(a), 0.8 * std::sin(a), 0.5);
     m.triangles.push_back({0, 1, static_cast<std::uint32_t>(m.vertices.size() - 1)});
   }

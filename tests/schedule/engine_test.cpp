@@ -10,6 +10,7 @@
 #include "caliber/procedural.h"
 #include "caliber/world.h"
 #include "support/temp_dir.h"
+#include "support/reference_step.h"
 
 namespace caliber {
 namespace {
@@ -42,10 +43,11 @@ void expect_same_step(const StepResult& got, const StepResult& want, const std::
   }
 }
 
-/// Runs `steps` steps of the world with every method and thread count against World::step.
+/// Runs `steps` steps of the world with every method and thread count against the pairwise
+/// reference (test::reference_step).
 void expect_all_methods_identical(const World& world, int steps) {
   std::vector<StepResult> reference;
-  for (int k = 0; k < steps; ++k) reference.push_back(world.step(k));
+  for (int k = 0; k < steps; ++k) reference.push_back(test::reference_step(world, k));
   std::size_t contacts = 0;
   for (const auto& r : reference) contacts += r.contacts.size();
   EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
@@ -60,9 +62,9 @@ void expect_all_methods_identical(const World& world, int steps) {
       options.node_history = node_history;
       options.threads = threads;
       options.stealing_depth = 3;  // shallow: many tasks, much stealing
-      Engine engine(world, options);
+      Engine engine(options);
       for (int k = 0; k < steps; ++k) {
-        const StepResult got = engine.step(k);
+        const StepResult got = step(world, engine, k);
         const std::string what = std::string(to_string(method)) + (node_history ? "+history" : "") + " x" +
                                  std::to_string(threads) + " step " + std::to_string(k);
         expect_same_step(got, reference[k], what, method != Method::aposteriori);
@@ -145,17 +147,17 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
   EngineOptions options;
   options.method = Method::apriori;
   options.threads = 2;
-  Engine engine(single, options);
-  const StepResult s = engine.step(0);
+  Engine engine(options);
+  const StepResult s = step(single, engine, 0);
   EXPECT_EQ(s.schedule.split, 1u);
   EXPECT_GT(s.schedule.generated, 1u);
   // A posteriori has nothing to go on at the first step; from the second, last step's contacts
   // give sub-task roots and the taboo list.
   options.method = Method::aposteriori;
-  Engine temporal(single, options);
-  const StepResult first = temporal.step(0);
+  Engine temporal(options);
+  const StepResult first = step(single, temporal, 0);
   EXPECT_EQ(first.schedule.taboo, 0u);
-  const StepResult second = temporal.step(1);
+  const StepResult second = step(single, temporal, 1);
   EXPECT_GT(second.schedule.taboo, 0u);
   EXPECT_GT(second.schedule.generated, 1u);
 }
@@ -183,15 +185,15 @@ TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
     GTEST_SKIP() << "run scripts/fetch_meshes.sh first";
   }
   const World world(load_scene(std::filesystem::path(CALIBER_SCENES) / "two_large.json"));
-  const StepResult reference = world.step(3);
+  const StepResult reference = test::reference_step(world, 3);
   ASSERT_GT(reference.contacts.size(), 100u);
   for (const Method method : {Method::stealing, Method::hybrid}) {
     for (const int threads : {2, 8}) {
       EngineOptions options;
       options.method = method;
       options.threads = threads;
-      Engine engine(world, options);
-      expect_same_step(engine.step(3), reference, std::string(to_string(method)) + " x" + std::to_string(threads));
+      Engine engine(options);
+      expect_same_step(step(world, engine, 3), reference, std::string(to_string(method)) + " x" + std::to_string(threads));
     }
   }
 }
@@ -201,14 +203,14 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
       {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}},
       {"name": "c", "mesh": "cube.off", "position": [-0.6, 0.5, 0], "motion": {"type": "velocity"}}]})",
                                 dir, "timeline.json"));
-  const StepResult reference = world.step(0);
+  const StepResult reference = test::reference_step(world, 0);
   for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::apriori, Method::hybrid}) {
     EngineOptions options;
     options.method = method;
     options.threads = 3;
     options.timeline = true;
-    Engine engine(world, options);
-    const StepResult got = engine.step(0);
+    Engine engine(options);
+    const StepResult got = step(world, engine, 0);
     const std::string what(to_string(method));
     expect_same_step(got, reference, what);
     const ScheduleRecord& r = got.schedule;
@@ -225,8 +227,9 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
     const std::size_t pairs = got.tasks.size();
     ASSERT_GT(pairs, 0u);
     if (method == Method::sequential || method == Method::exploitation) {
-      EXPECT_EQ(traverse, pairs) << what << ": one span per pair (traversal and finalization)";
-      EXPECT_EQ(stage + finalize, 0u) << what;
+      EXPECT_EQ(traverse, pairs) << what << ": one traversal span per pair";
+      EXPECT_EQ(stage, 0u) << what;
+      EXPECT_EQ(finalize, pairs) << what;
     } else if (method == Method::stealing) {
       EXPECT_EQ(traverse, r.task_node_tests.size()) << what << ": one span per depth-first piece";
       EXPECT_EQ(finalize, pairs) << what;
@@ -239,29 +242,152 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
   EngineOptions off;
   off.method = Method::hybrid;
   off.threads = 2;
-  EXPECT_TRUE(Engine(world, off).step(0).schedule.timeline.empty()) << "off by default";
+  Engine quiet(off);
+  EXPECT_TRUE(step(world, quiet, 0).schedule.timeline.empty()) << "off by default";
 }
 
 TEST(EngineOptionsValidation, RejectsBadValues) {
-  const World world(parse_scene(R"({"objects": [{"mesh": "tetra.off"}]})", CALIBER_TEST_DATA, "x.json"));
   EngineOptions options;
   options.threads = -1;
-  EXPECT_THROW(Engine(world, options), Error);
+  EXPECT_THROW(Engine{options}, Error);
   options.threads = 5000;
-  EXPECT_THROW(Engine(world, options), Error);
+  EXPECT_THROW(Engine{options}, Error);
   options.threads = 0;
-  EXPECT_GE(Engine(world, options).threads(), 1);
+  EXPECT_GE(Engine{options}.threads(), 1);
   options.method = Method::sequential;
   options.threads = 4;
-  EXPECT_EQ(Engine(world, options).threads(), 1) << "sequential runs on one thread";
+  EXPECT_EQ(Engine{options}.threads(), 1) << "sequential runs on one thread";
   options.method = Method::hybrid;
   options.beta = 0;
-  EXPECT_THROW(Engine(world, options), Error);
+  EXPECT_THROW(Engine{options}, Error);
   options.beta = 2;
   options.epsilon = -0.1;
-  EXPECT_THROW(Engine(world, options), Error);
+  EXPECT_THROW(Engine{options}, Error);
   EXPECT_THROW((void)parse_method("calibrated"), Error);
   EXPECT_EQ(parse_method("stealing"), Method::stealing);
+}
+
+/// Three in-memory objects (no file): a torus, a sphere moving through it, a box beside them.
+Frame memory_frame(double t) {
+  Frame frame;
+  frame.models = {build_model(make_torus(0.8, 0.25, 24, 12)), build_model(make_sphere(0.5, 12, 16)),
+                  build_model(make_box(0.3, 0.3, 0.3, 2))};
+  frame.poses = {Pose{}, Pose::from_values(-1.2 + t, 0.1, 0.0, 1, 0, 0, 0), Pose::from_values(1.0, 0.9, 0.0, 1, 0, 0, 0)};
+  frame.pairs = {Task{0, 1}, Task{0, 2}, Task{1, 2}};
+  frame.request.kind = QueryKind::contact;
+  frame.request.tolerance = 0.05;
+  return frame;
+}
+
+TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
+  const Frame base = memory_frame(0.0);
+  std::size_t contacts = 0;
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
+                              Method::apriori, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 3;
+    options.stealing_depth = 2;
+    Engine engine(options);
+    for (int k = 0; k < 6; ++k) {
+      Frame frame = base;  // the same models every frame; only the sphere's pose changes
+      frame.poses[1] = Pose::from_values(-1.2 + 0.4 * k, 0.1, 0.0, 1, 0, 0, 0);
+      const StepResult got = engine.step(frame);
+      ASSERT_EQ(got.tasks.size(), frame.pairs.size());
+      std::size_t at = 0;
+      for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
+        const Task t = frame.pairs[i];
+        const QueryResult want = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+        ASSERT_EQ(got.tasks[i].pairs, want.pairs.size()) << to_string(method) << " frame " << k << " pair " << i;
+        for (const Contact& c : want.contacts) {
+          const SceneContact& g = got.contacts[at++];
+          ASSERT_EQ(g.object_a, t.a);
+          ASSERT_EQ(g.object_b, t.b);
+          ASSERT_EQ(g.contact.tri_a, c.tri_a);
+          ASSERT_EQ(g.contact.tri_b, c.tri_b);
+          ASSERT_EQ(g.contact.point_a, c.point_a);
+          ASSERT_EQ(g.contact.normal, c.normal);
+          ASSERT_EQ(g.contact.distance, c.distance);
+        }
+      }
+      ASSERT_EQ(at, got.contacts.size());
+      contacts += at;
+    }
+  }
+  EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
+}
+
+TEST(EngineFrames, EveryMethodRecordsItsTraversalAndFinalization) {
+  const Frame frame = memory_frame(0.8);
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
+                              Method::apriori, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 2;
+    Engine engine(options);
+    for (int k = 0; k < 2; ++k) {  // the second step: a posteriori and hybrid have history
+      const StepResult got = engine.step(frame);
+      const ScheduleRecord& r = got.schedule;
+      ASSERT_GT(got.stats.node_tests, 0u);
+      EXPECT_GT(r.traverse_ms, 0.0) << to_string(method);
+      EXPECT_GT(r.finalize_ms, 0.0) << to_string(method);
+      EXPECT_FALSE(r.task_node_tests.empty()) << to_string(method);
+      EXPECT_FALSE(r.thread_node_tests.empty()) << to_string(method);
+      if (method != Method::stealing) {
+        EXPECT_GT(r.calibrate_ms, 0.0) << to_string(method) << ": planning is timed too";
+        EXPECT_EQ(r.generated, r.task_node_tests.size()) << to_string(method);
+      }
+    }
+  }
+}
+
+TEST(EngineFrames, ForgetDropsTheTemporalState) {
+  EngineOptions options;
+  options.method = Method::aposteriori;
+  options.threads = 2;
+  options.beta = 8;
+  Engine engine(options);
+  Frame frame = memory_frame(0.9);
+  frame.pairs = {Task{0, 1}};
+  EXPECT_EQ(engine.step(frame).schedule.taboo, 0u) << "nothing to go on at the first step";
+  EXPECT_GT(engine.step(frame).schedule.taboo, 0u) << "last step's contacts give sub-task roots";
+  engine.forget();
+  EXPECT_EQ(engine.step(frame).schedule.taboo, 0u) << "forgotten";
+}
+
+TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {
+  Engine engine;
+  const auto message = [&](const Frame& f) {
+    try {
+      (void)engine.step(f);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.source(), "frame") << e.what();
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  Frame f = memory_frame(0.0);
+  f.poses.pop_back();
+  EXPECT_NE(message(f).find("3 models but 2 poses"), std::string::npos) << message(f);
+  f = memory_frame(0.0);
+  f.models[2] = nullptr;
+  EXPECT_NE(message(f).find("object 2 has no model"), std::string::npos) << message(f);
+  f = memory_frame(0.0);
+  f.pairs = {Task{0, 3}};
+  EXPECT_NE(message(f).find("a < b < 3"), std::string::npos) << message(f);
+  f.pairs = {Task{1, 1}};
+  EXPECT_NE(message(f).find("a < b < 3"), std::string::npos) << message(f);
+  f.pairs = {Task{1, 2}, Task{0, 1}};
+  EXPECT_NE(message(f).find("sorted and distinct"), std::string::npos) << message(f);
+  f.pairs = {Task{0, 1}, Task{0, 1}};
+  EXPECT_NE(message(f).find("sorted and distinct"), std::string::npos) << message(f);
+  f = memory_frame(0.0);
+  f.request.tolerance = -1;
+  EXPECT_THROW((void)engine.step(f), Error);
+  f = memory_frame(0.0);
+  f.pairs.clear();
+  const StepResult none = engine.step(f);
+  EXPECT_TRUE(none.contacts.empty()) << "no pairs: an empty step, not an error";
 }
 
 }  // namespace

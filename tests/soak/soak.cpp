@@ -96,17 +96,18 @@ int main(int argc, char** argv) {
                                                   dir, "soak.json"));
   std::filesystem::remove_all(dir);
 
-  caliber::Engine engine(world, options);
+  caliber::Engine engine(options);
   const auto start = std::chrono::steady_clock::now();
   long hwm_1000 = -1;
   std::size_t contacts = 0, mismatches = 0, samples = 0;
   for (int k = 0; k < steps; ++k) {
-    const caliber::StepResult got = engine.step(k);
+    const caliber::StepResult got = caliber::step(world, engine, k);
     contacts += got.contacts.size();
     if (k % 1000 == 999 || k == steps - 1) {
       caliber::EngineOptions fresh_options = options;
-      caliber::Engine fresh(world, fresh_options);
-      const bool ok = same(got, fresh.step(k)) && same(got, world.step(k));
+      caliber::Engine fresh(fresh_options);
+      caliber::Engine sequential{caliber::EngineOptions{}};
+      const bool ok = same(got, caliber::step(world, fresh, k)) && same(got, caliber::step(world, sequential, k));
       ++samples;
       if (!ok) ++mismatches;
       std::printf("step %5d: %zu contacts, VmRSS %ld KiB, VmHWM %ld KiB%s\n", k + 1, got.contacts.size(),

@@ -69,17 +69,17 @@ TEST(Calibration, CartEdgeCases) {
 }
 
 TEST(Calibration, SubtreeCountsAddUpTheStage) {
-  // Popped in this order: the root (expanded into two children), child 1 (a sub-task root whose
-  // depth-first traversal took 10 node tests), child 2 (failed its test).
-  std::vector<StageRecord> stage(3);
+  // The root's visit tested two children: child 1 passed and became a sub-task root (its
+  // depth-first traversal took 10 node tests), child 2 failed (no record of its own).
+  std::vector<StageRecord> stage(2);
   stage[0].node = {0, 0};
   stage[0].children = 2;
+  stage[0].passed = 0b01;
   stage[0].child[0] = {1, 1};
   stage[0].child[1] = {2, 1};
   stage[1].node = {1, 1};
   stage[1].root = true;
-  stage[2].node = {2, 1};
-  const NodeCounts counts = subtree_counts(stage, {0, 10, 0});
+  const NodeCounts counts = subtree_counts(stage, {0, 10});
   ASSERT_EQ(counts.size(), 3u);
   EXPECT_EQ(counts[0], std::make_pair(narrow::NodePair{0, 0}, std::uint64_t{13}));
   EXPECT_EQ(counts[1], std::make_pair(narrow::NodePair{1, 1}, std::uint64_t{11}));
@@ -193,7 +193,10 @@ TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
       EXPECT_EQ(pairs(got.candidates), pairs(want.candidates));
       EXPECT_EQ(got.stats.node_tests, want.stats.node_tests);
       EXPECT_EQ(got.stats.leaf_tests, want.stats.leaf_tests);
-      EXPECT_EQ(got.stage.size(), got.stats.node_tests) << "one record per tested node";
+      // One record per node that passed; every node tested is the root or a child some visit tested.
+      std::uint64_t tested = 1;
+      for (const StageRecord& r : got.stage) tested += r.children;
+      EXPECT_EQ(tested, got.stats.node_tests) << "every node tested once, by the root's test or its parent's visit";
       // Parents before children (what the node history adds up in reverse), every root's record
       // marked, and the same records whatever the thread count.
       for (const Root& r : got.roots) EXPECT_TRUE(got.stage[static_cast<std::size_t>(r.stage)].root);
@@ -205,6 +208,7 @@ TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
       for (std::size_t k = 0; k < one.stage.size(); ++k) {
         EXPECT_EQ(one.stage[k].node, got.stage[k].node);
         EXPECT_EQ(one.stage[k].children, got.stage[k].children);
+        EXPECT_EQ(one.stage[k].passed, got.stage[k].passed);
       }
       ++compared;
     }

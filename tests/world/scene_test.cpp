@@ -1,5 +1,6 @@
 // Scene files: every error names the file and the key; motions interpolate as documented.
 
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 
@@ -119,7 +120,7 @@ TEST(Motion, VelocityMovesAndTurns) {
   Motion m;
   m.type = Motion::Type::velocity;
   m.linear = Eigen::Vector3d(1, 2, 3);
-  m.angular = Eigen::Vector3d(0, 0, 3.14159265358979323846 / 2);  // a quarter turn per second
+  m.angular = Eigen::Vector3d(0, 0, std::numbers::pi / 2);  // a quarter turn per second
   const Pose p = pose_at(Pose{}, m, 2.0);
   EXPECT_EQ(p.translation, Eigen::Vector3d(2, 4, 6));
   const Eigen::Vector3d x = p.rotation * Eigen::Vector3d::UnitX();
@@ -148,14 +149,14 @@ TEST(Motion, KeyframesInterpolateWithSlerpAndHold) {
   k0.position = Eigen::Vector3d(0, 0, 0);
   k1.time = 3.0;
   k1.position = Eigen::Vector3d(4, 0, 0);
-  k1.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(3.14159265358979323846 / 2, Eigen::Vector3d::UnitZ()));
+  k1.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()));
   m.keys = {k0, k1};
   EXPECT_EQ(pose_at(Pose{}, m, 0.0).translation, Eigen::Vector3d(0, 0, 0)) << "holds before the first key";
   EXPECT_EQ(pose_at(Pose{}, m, 5.0).translation, Eigen::Vector3d(4, 0, 0)) << "holds after the last key";
   const Pose mid = pose_at(Pose{}, m, 2.0);
   EXPECT_NEAR(mid.translation.x(), 2.0, 1e-15);
   const Eigen::Vector3d x = mid.rotation * Eigen::Vector3d::UnitX();
-  EXPECT_NEAR(std::atan2(x.y(), x.x()), 3.14159265358979323846 / 4, 1e-12) << "slerp: half of a quarter turn";
+  EXPECT_NEAR(std::atan2(x.y(), x.x()), std::numbers::pi / 4, 1e-12) << "slerp: half of a quarter turn";
   EXPECT_NEAR(mid.rotation.norm(), 1.0, 1e-15);
 }
 
@@ -165,7 +166,7 @@ TEST(Motion, MovingBeyondTheCoordinateLimitIsAnErrorNamingTheObject) {
                                 CALIBER_TEST_DATA, "runaway.json"));
   EXPECT_NO_THROW((void)world.poses_at(10));
   try {
-    (void)world.step(20);
+    (void)world.frame(20);
     FAIL() << "2e15 is beyond the limit";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("'rocket'"), std::string::npos) << e.what();

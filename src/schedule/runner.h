@@ -1,0 +1,29 @@
+#pragma once
+/// \file
+/// The two runners of the engine. The plan runner executes any method's plan (tasks/plan.h): the
+/// run-time tasks handed out in order, each traversed depth first by one thread, then the one
+/// finalization per pair. Stealing has its own runner (recursive splitting on work stealing). Both
+/// fill the same ScheduleRecord.
+
+#include <cstdint>
+#include <vector>
+
+#include "caliber/engine.h"
+#include "schedule/workers.h"
+#include "tasks/plan.h"
+
+namespace caliber::schedule {
+
+/// Runs `plan` on the current executor; fills state.results and, in `record`, the plan's counts,
+/// the node tests and weight of every run-time task, the stage's counts, traverse_ms and
+/// finalize_ms. Returns, per split of the plan, the depth-first node tests of each stage record's
+/// root (tasks::subtree_counts reads them).
+std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepState& state, ScheduleRecord& record);
+
+/// Stealing: every pair's CD tree split recursively into tasks down to `cutoff` depth, then each
+/// subtree traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
+/// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
+/// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.
+void run_stealing(int cutoff, StepState& state, ScheduleRecord& record);
+
+}  // namespace caliber::schedule

@@ -1,0 +1,72 @@
+// The stealing runner: recursive splitting of every pair's CD tree on oneTBB's work stealing.
+
+#include <algorithm>
+#include <functional>
+
+#include "schedule/runner.h"
+
+namespace caliber::schedule {
+namespace {
+
+/// Above the cut-off depth, visits CD-tree node n of pair `pair` (it passed its test, made by its
+/// parent's visit or before the first call) and spawns one task per child that passes; from the
+/// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
+/// exactly those of a single depth-first traversal of the tree.
+void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested) {
+  const std::size_t pairs = state.contexts.size();
+  const narrow::PairContext& ctx = state.contexts[pair];
+  narrow::NodePair kids[4];
+  int count = 0;
+  {
+    WorkerSlots& w = local_slots(state.workers, pairs);
+    if (depth >= cutoff) {
+      state.timeline.record(TaskSpan::Phase::traverse, [&] {
+        const std::uint64_t before = w.stats[pair].node_tests;
+        narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair], tested);
+        w.pieces.push_back(w.stats[pair].node_tests - before);
+      });
+      return;
+    }
+    const std::uint64_t before = w.stats[pair].node_tests;
+    count = narrow::visit(ctx, n, w.candidates[pair], w.stats[pair], kids);
+    w.split_node_tests += w.stats[pair].node_tests - before;
+  }
+  parallel::TaskGroup group;
+  for (int i = 1; i < count; ++i) {
+    const narrow::NodePair kid = kids[i];
+    group.run([&state, pair, kid, depth, cutoff] { steal(state, pair, kid, depth + 1, cutoff, true); });
+  }
+  if (count > 0) steal(state, pair, kids[0], depth + 1, cutoff, true);
+  group.wait();
+}
+
+}  // namespace
+
+void run_stealing(int cutoff, StepState& state, ScheduleRecord& record) {
+  const auto start = util::Clock::now();
+  const std::size_t n = state.contexts.size();
+  parallel::TaskGroup group;
+  for (std::size_t i = 0; i < n; ++i) {
+    group.run([&state, i, cutoff] {
+      if (cutoff > 0) {  // the root is tested above the cut-off: splitting work
+        WorkerSlots& w = local_slots(state.workers, state.contexts.size());
+        ++w.split_node_tests;
+        if (!narrow::test_root(state.contexts[i], narrow::NodePair{0, 0}, w.stats[i])) return;
+      }
+      steal(state, i, narrow::NodePair{0, 0}, 0, cutoff, /*tested=*/cutoff > 0);
+    });
+  }
+  group.wait();
+  record.traverse_ms = util::ms_since(start);
+  const auto finalize_start = util::Clock::now();
+  finalize_pairs(state, {});
+  record.finalize_ms = util::ms_since(finalize_start);
+  state.workers.for_each([&](const WorkerSlots& w) {
+    record.task_node_tests.insert(record.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
+    record.split_node_tests += w.split_node_tests;
+  });
+  // Pieces were collected per worker; sort them so the record does not depend on who ran what.
+  std::sort(record.task_node_tests.begin(), record.task_node_tests.end(), std::greater<>());
+}
+
+}  // namespace caliber::schedule

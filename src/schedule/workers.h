@@ -1,0 +1,104 @@
+#pragma once
+/// \file
+/// What every runner of the engine writes into during a step: each worker thread's candidates and
+/// counts per pair (merged by the one finalization), and the optional timeline of who ran what when.
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "caliber/engine.h"
+#include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+#include "parallel/executor.h"
+#include "util/timing.h"
+
+namespace caliber::schedule {
+
+/// One worker's output for a step: candidates and work per pair, and its traversal stack.
+struct WorkerSlots {
+  narrow::TraversalScratch scratch;
+  std::vector<std::vector<narrow::Candidate>> candidates;  ///< per pair
+  std::vector<QueryStats> stats;                           ///< per pair
+  std::vector<std::uint64_t> pieces;                       ///< stealing: node tests of each depth-first piece
+  std::uint64_t split_node_tests = 0;                      ///< stealing: node tests above the cut-off
+
+  void reset(std::size_t pairs) {
+    candidates.resize(pairs);
+    stats.assign(pairs, QueryStats{});
+    for (auto& c : candidates) c.clear();
+    pieces.clear();
+    split_node_tests = 0;
+  }
+};
+
+using Workers = parallel::PerThread<WorkerSlots>;
+
+/// This thread's slots, sized for `pairs` (a thread that joins mid-step starts with empty slots).
+inline WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
+  WorkerSlots& w = workers.local();
+  if (w.stats.size() != pairs) w.reset(pairs);
+  return w;
+}
+
+/// Optional record of who ran what when (EngineOptions::timeline), for Gantt charts.
+struct Timeline {
+  bool on = false;
+  util::Clock::time_point origin;
+  parallel::PerThread<std::vector<TaskSpan>> spans;
+
+  /// Runs f(), recording its span on this thread when the timeline is on.
+  template <class F>
+  void record(TaskSpan::Phase phase, F&& f) {
+    if (!on) {
+      f();
+      return;
+    }
+    const auto start = util::Clock::now();
+    f();
+    const auto end = util::Clock::now();
+    const int thread = std::max(parallel::current_thread_index(), 0);
+    spans.local().push_back(TaskSpan{thread, util::ms_between(origin, start), util::ms_between(origin, end), phase});
+  }
+
+  /// Starts a step: clears the spans and sets the time origin.
+  void begin(bool enabled) {
+    on = enabled;
+    spans.for_each([](std::vector<TaskSpan>& s) { s.clear(); });
+    origin = util::Clock::now();
+  }
+
+  /// All spans, sorted by thread then start.
+  std::vector<TaskSpan> collect() {
+    std::vector<TaskSpan> all;
+    spans.for_each([&](const std::vector<TaskSpan>& s) { all.insert(all.end(), s.begin(), s.end()); });
+    std::sort(all.begin(), all.end(), [](const TaskSpan& a, const TaskSpan& b) {
+      return a.thread != b.thread ? a.thread < b.thread : a.start_ms < b.start_ms;
+    });
+    return all;
+  }
+};
+
+/// What a runner works on in one step: the pairs' contexts, the workers' slots, the timeline, and
+/// where each pair's finalized result goes.
+struct StepState {
+  const std::vector<narrow::PairContext>& contexts;
+  Workers& workers;
+  Timeline& timeline;
+  std::vector<QueryResult>& results;
+  bool parallel_finalize = true;  ///< let one heavy pair's finalization use several threads
+};
+
+/// Per pair, in parallel, most candidates first: `start` seeds the pair's candidates and counts
+/// (work done outside the workers' slots), every worker's slots are added, and the pair goes through
+/// the one finalization (narrow/finalize.h) into state.results.
+void finalize_pairs(StepState& state,
+                    const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start);
+
+/// The reduction of a step: per-pair records and the contacts of every pair, in pair order (pairs
+/// are sorted and each result is sorted, so the concatenation is canonical). Fills out.tasks,
+/// out.contacts and out.stats.
+void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>& results, StepResult& out);
+
+}  // namespace caliber::schedule

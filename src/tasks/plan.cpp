@@ -1,0 +1,155 @@
+// Methods as plans: what each method hands the runner. The cut of a calibrated method is decided
+// here, before any depth-first traversal starts.
+
+#include "tasks/plan.h"
+
+#include <algorithm>
+
+#include "parallel/executor.h"
+#include "tasks/weights.h"
+
+namespace caliber::tasks {
+
+Plan plan_pairs(std::size_t pairs) {
+  Plan plan;
+  plan.run.reserve(pairs);
+  for (std::size_t i = 0; i < pairs; ++i) {
+    plan.run.push_back(RunTask{{Root{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, 0.0}}, 0.0});
+  }
+  plan.kept = pairs;
+  return plan;
+}
+
+InitialWeights initial_weights(Method method, const std::vector<Task>& pairs, const std::vector<narrow::PairContext>& contexts,
+                               const History& history) {
+  const std::size_t n = pairs.size();
+  std::vector<double> root(n);
+  parallel::parallel_for_each(0, n, [&](std::size_t i) { root[i] = apriori_weight(contexts[i], {0, 0}); });
+  InitialWeights w;
+  w.scale.assign(n, 1.0);
+  if (method == Method::hybrid || method == Method::aposteriori) {
+    const auto last = [&](std::size_t i) -> std::uint64_t {
+      const auto it = history.node_tests.find(pairs[i]);
+      return it == history.node_tests.end() ? 0 : it->second;
+    };
+    double measured = 0.0, estimated = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (last(i) > 0) {
+        measured += static_cast<double>(last(i));
+        estimated += root[i];
+      }
+    }
+    const double fallback = estimated > 0.0 ? measured / estimated : 1.0;
+    for (std::size_t i = 0; i < n; ++i) w.scale[i] = last(i) > 0 ? static_cast<double>(last(i)) / root[i] : fallback;
+  }
+  w.weight.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    w.weight[i] = w.scale[i] * root[i];
+    w.total += w.weight[i];
+  }
+  return w;
+}
+
+namespace {
+
+/// A posteriori: the sub-task roots of each heavy pair from last step's summary tree; nothing is
+/// tested here. A pair without reported pairs last step cannot be split (the metric's known blind
+/// spot) and runs whole. Its original task keeps the rest of the tree, the roots on its taboo list.
+void split_by_summary(const EngineOptions& options, const std::vector<Task>& pairs,
+                      const std::vector<narrow::PairContext>& contexts, const History& history,
+                      const std::vector<std::size_t>& to_split, const std::vector<double>& weight, Plan& plan,
+                      std::vector<Root>& cart) {
+  std::vector<PosterioriSplit> chosen(to_split.size());
+  parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
+    const std::size_t i = to_split[s];
+    const auto it = history.reported.find(pairs[i]);
+    if (it == history.reported.end()) return;
+    const auto summary = build_summary(contexts[i].a(), contexts[i].b(), it->second);
+    chosen[s] = split_aposteriori(summary, static_cast<std::uint32_t>(i), weight[i], plan.omega, options.epsilon * plan.omega,
+                                  static_cast<std::size_t>(options.taboo_cap));
+    chosen[s].rest = chosen[s].taboo.empty() ? weight[i] : chosen[s].rest;
+  });
+  for (std::size_t s = 0; s < to_split.size(); ++s) {
+    PosterioriSplit& ps = chosen[s];
+    Root original{static_cast<std::uint32_t>(to_split[s]), narrow::NodePair{0, 0}, false, ps.rest};
+    if (!ps.taboo.empty()) {
+      original.taboo = static_cast<std::int32_t>(plan.taboos.size());
+      plan.taboos.push_back(narrow::Taboo{ps.taboo});
+      for (std::vector<Root>* list : {&ps.roots, &ps.cart}) {
+        for (Root& r : *list) {
+          r.owner = original.taboo;
+          r.slot = plan.taboos.back().find(r.node);
+        }
+      }
+    }
+    plan.run.push_back(RunTask{{original}, original.weight});
+    for (const Root& r : ps.roots) plan.run.push_back(RunTask{{r}, r.weight});
+    cart.insert(cart.end(), ps.cart.begin(), ps.cart.end());
+    plan.taboo_nodes += ps.taboo.size();
+  }
+}
+
+/// A priori and hybrid: the weight-driven stage of each heavy pair, the pairs in parallel (and each
+/// pair's levels in parallel inside).
+void split_by_stage(const EngineOptions& options, const std::vector<Task>& pairs, const std::vector<narrow::PairContext>& contexts,
+                    const History& history, const std::vector<std::size_t>& to_split, const InitialWeights& w,
+                    const StageWrapper& around_stage, Plan& plan, std::vector<Root>& cart) {
+  const bool node_history = options.method == Method::hybrid && options.node_history;
+  plan.splits.resize(to_split.size());
+  parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
+    const std::size_t i = to_split[s];
+    const NodeCounts* measured = nullptr;
+    if (node_history) {
+      const auto it = history.node_counts.find(pairs[i]);
+      if (it != history.node_counts.end()) measured = &it->second;
+    }
+    const auto stage = [&] {
+      plan.splits[s] = split_task(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], w.scale[i], plan.omega,
+                                  options.epsilon * plan.omega, measured);
+    };
+    if (around_stage) {
+      around_stage(stage);
+    } else {
+      stage();
+    }
+  });
+  for (std::size_t s = 0; s < to_split.size(); ++s) {
+    plan.split_pairs.push_back(static_cast<std::uint32_t>(to_split[s]));
+    for (const Root& r : plan.splits[s].roots) plan.run.push_back(RunTask{{r}, r.weight});
+    cart.insert(cart.end(), plan.splits[s].cart.begin(), plan.splits[s].cart.end());
+  }
+}
+
+}  // namespace
+
+Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs, const std::vector<narrow::PairContext>& contexts,
+                     const History& history, const StageWrapper& around_stage) {
+  const InitialWeights w = initial_weights(options.method, pairs, contexts, history);
+  Plan plan;
+  plan.weighted = true;
+  plan.omega = caliber_threshold(w.total, options.beta, options.threads);
+  const double eps = options.epsilon * plan.omega;
+  std::vector<Root> cart;
+  std::vector<std::size_t> to_split;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Root whole{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, w.weight[i]};
+    switch (classify(w.weight[i], plan.omega, eps)) {
+      case Verdict::keep: plan.run.push_back(RunTask{{whole}, w.weight[i]}); ++plan.kept; break;
+      case Verdict::cart: cart.push_back(whole); break;
+      case Verdict::split: to_split.push_back(i); break;
+    }
+  }
+  plan.split = to_split.size();
+  if (options.method == Method::aposteriori) {
+    split_by_summary(options, pairs, contexts, history, to_split, w.weight, plan, cart);
+  } else {
+    split_by_stage(options, pairs, contexts, history, to_split, w, around_stage, plan, cart);
+  }
+  plan.carted = cart.size();
+  for (RunTask& t : merge_cart(std::move(cart), plan.omega)) plan.run.push_back(std::move(t));
+  // Heaviest first, so that the ordered hand-out does not end on a heavy straggler.
+  std::stable_sort(plan.run.begin(), plan.run.end(), [](const RunTask& x, const RunTask& y) { return x.weight > y.weight; });
+  return plan;
+}
+
+}  // namespace caliber::tasks

@@ -1,0 +1,66 @@
+#pragma once
+/// \file
+/// Methods as plans: each method is a function from the step's pairs (and what the engine remembers
+/// of them) to the run-time tasks, in the order they are handed out. One runner
+/// (schedule/runner.h) executes any plan; plans need no threads to be tested (the weight-driven
+/// stage uses the executor it is called in, with the same result on any number of threads).
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "caliber/engine.h"
+#include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+#include "tasks/calibration.h"
+
+namespace caliber::tasks {
+
+/// What the engine remembers of each object pair from the last step it was tested (keyed by the
+/// pair's object indices, Frame::pairs). Changes only how work is cut, never the contacts.
+struct History {
+  std::map<Task, std::uint64_t> node_tests;             ///< node tests at its last step
+  std::map<Task, std::vector<TrianglePair>> reported;   ///< a posteriori: the triangle pairs it reported
+  std::map<Task, NodeCounts> node_counts;               ///< hybrid with node history: stage subtrees' node tests
+};
+
+/// A method's plan for one step.
+struct Plan {
+  std::vector<RunTask> run;                 ///< run-time tasks, in hand-out order
+  std::vector<SplitResult> splits;          ///< the weight-driven stage of each split pair
+  std::vector<std::uint32_t> split_pairs;   ///< the pair of each entry of `splits`
+  std::vector<narrow::Taboo> taboos;        ///< a posteriori taboo lists (Root::taboo and Root::owner index them)
+  bool weighted = false;                    ///< the tasks carry weight estimates (calibrated methods)
+  double omega = 0.0;                       ///< the caliber (0 for a plan of whole pairs)
+  std::size_t kept = 0;                     ///< initial tasks run as they are
+  std::size_t split = 0;                    ///< initial tasks split
+  std::size_t carted = 0;                   ///< items merged in the cart
+  std::size_t taboo_nodes = 0;              ///< a posteriori: sub-task roots handed out
+};
+
+/// Sequential and exploitation: one run-time task per pair, whole, in pair order.
+[[nodiscard]] Plan plan_pairs(std::size_t pairs);
+
+/// The weights of the initial tasks (DESIGN.md section 3): the root's a priori estimate times a
+/// per-pair scale. A priori: scale 1. Hybrid and a posteriori: the pair's node tests at the previous
+/// step over its estimate; a pair with no history takes the ratio measured over the pairs that have
+/// one (1 if none has).
+struct InitialWeights {
+  std::vector<double> weight;  ///< per pair
+  std::vector<double> scale;   ///< per pair: what node weights are multiplied by
+  double total = 0.0;
+};
+[[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<Task>& pairs,
+                                             const std::vector<narrow::PairContext>& contexts, const History& history);
+
+/// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
+/// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
+/// each initial task, merge the cart, and hand the run-time tasks out heaviest first. `around_stage`,
+/// if set, is called with each pair's weight-driven stage and must run it (the engine times it).
+using StageWrapper = std::function<void(const std::function<void()>&)>;
+[[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs,
+                                   const std::vector<narrow::PairContext>& contexts, const History& history,
+                                   const StageWrapper& around_stage = {});
+
+}  // namespace caliber::tasks

@@ -1,0 +1,143 @@
+// Methods as plans, tested without the runner: a plan covers each pair's CD tree exactly once
+// (its stage and its run-time tasks, traversed here one after another, find what caliber::query
+// finds with the same node tests), in hand-out order heaviest first.
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+#include "tasks/plan.h"
+
+namespace caliber::tasks {
+namespace {
+
+struct Pairs {
+  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.3, 40, 24));
+  std::shared_ptr<const Model> sphere = build_model(make_sphere(1.0, 24, 32));
+  std::shared_ptr<const Model> box = build_model(make_box(0.2, 0.2, 0.2, 2));
+  std::vector<Task> pairs{Task{0, 1}, Task{0, 2}};
+  std::vector<Pose> poses{Pose{}, Pose::from_values(0.2, 0.1, 0.3, 0.9, 0.3, 0.1, 0.2), Pose::from_values(1.0, 0.0, 0.0, 1, 0, 0, 0)};
+  QueryRequest request;
+  std::vector<narrow::PairContext> contexts;
+  Pairs() {
+    request.kind = QueryKind::proximity;
+    request.tolerance = 0.05;
+    contexts.emplace_back(*torus, poses[0], *sphere, poses[1], request);
+    contexts.emplace_back(*torus, poses[0], *box, poses[2], request);
+  }
+};
+
+/// Runs a plan's tasks one after another on this thread and returns, per pair, the sorted triangle
+/// pairs found and the node tests made (the stage's included).
+std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(const Plan& plan, const Pairs& p) {
+  std::vector<std::vector<narrow::Candidate>> found(p.pairs.size());
+  std::vector<QueryStats> stats(p.pairs.size());
+  for (std::size_t s = 0; s < plan.splits.size(); ++s) {
+    const std::uint32_t i = plan.split_pairs[s];
+    found[i] = plan.splits[s].candidates;
+    stats[i] = plan.splits[s].stats;
+  }
+  narrow::TraversalScratch scratch;
+  for (const RunTask& t : plan.run) {
+    EXPECT_FALSE(t.roots.empty());
+    for (const Root& r : t.roots) {
+      std::vector<char> reached(r.taboo >= 0 ? plan.taboos[r.taboo].nodes.size() : 0);
+      const narrow::TabooView taboo = r.taboo >= 0 ? narrow::TabooView{&plan.taboos[r.taboo], reached.data()} : narrow::TabooView{};
+      narrow::traverse_depth_first(p.contexts[r.pair], r.node, scratch, found[r.pair], stats[r.pair], r.tested, taboo);
+    }
+  }
+  std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> out;
+  for (std::size_t i = 0; i < p.pairs.size(); ++i) {
+    std::vector<TrianglePair> pairs;
+    for (const narrow::Candidate& c : found[i]) pairs.push_back({c.tri_a, c.tri_b});
+    std::sort(pairs.begin(), pairs.end(), [](auto x, auto y) { return std::pair(x.tri_a, x.tri_b) < std::pair(y.tri_a, y.tri_b); });
+    out.emplace_back(pairs, stats[i].node_tests);
+  }
+  return out;
+}
+
+void expect_covers_like_query(const Plan& plan, const Pairs& p, const std::string& what) {
+  const auto got = run_serially(plan, p);
+  for (std::size_t i = 0; i < p.pairs.size(); ++i) {
+    const Task t = p.pairs[i];
+    const Model& b = t.b == 1 ? *p.sphere : *p.box;
+    const QueryResult want = query(*p.torus, p.poses[t.a], b, p.poses[t.b], p.request);
+    ASSERT_EQ(got[i].first.size(), want.pairs.size()) << what << " pair " << i;
+    for (std::size_t k = 0; k < want.pairs.size(); ++k) {
+      EXPECT_EQ(got[i].first[k].tri_a, want.pairs[k].tri_a) << what;
+      EXPECT_EQ(got[i].first[k].tri_b, want.pairs[k].tri_b) << what;
+    }
+    EXPECT_EQ(got[i].second, want.stats.node_tests) << what << " pair " << i << ": each CD node tested once";
+  }
+}
+
+TEST(Plans, WholePairsInPairOrder) {
+  const Plan plan = plan_pairs(3);
+  ASSERT_EQ(plan.run.size(), 3u);
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    ASSERT_EQ(plan.run[i].roots.size(), 1u);
+    EXPECT_EQ(plan.run[i].roots[0].pair, i);
+    EXPECT_FALSE(plan.run[i].roots[0].tested);
+  }
+  EXPECT_FALSE(plan.weighted);
+  const Pairs p;
+  expect_covers_like_query(plan_pairs(p.pairs.size()), p, "whole pairs");
+}
+
+TEST(Plans, APrioriSplitsTheHeavyPairAndCoversItOnce) {
+  const Pairs p;
+  EngineOptions options;
+  options.method = Method::apriori;
+  options.threads = 8;
+  const Plan plan = plan_calibrated(options, p.pairs, p.contexts, History{});
+  ASSERT_GE(plan.split, 1u);
+  EXPECT_EQ(plan.split_pairs.front(), 0u) << "the torus-sphere pair is heavy";
+  EXPECT_EQ(plan.splits.size(), plan.split);
+  EXPECT_GT(plan.run.size(), 8u);
+  EXPECT_TRUE(std::is_sorted(plan.run.begin(), plan.run.end(), [](const RunTask& x, const RunTask& y) { return x.weight > y.weight; }))
+      << "handed out heaviest first";
+  expect_covers_like_query(plan, p, "apriori");
+}
+
+TEST(Plans, HybridScalesByLastStepsNodeTests) {
+  const Pairs p;
+  EngineOptions options;
+  options.method = Method::hybrid;
+  options.threads = 4;
+  History history;
+  history.node_tests[p.pairs[0]] = 1000;
+  const InitialWeights w = initial_weights(Method::hybrid, p.pairs, p.contexts, history);
+  EXPECT_DOUBLE_EQ(w.weight[0], 1000.0) << "a pair with history weighs what it took";
+  EXPECT_DOUBLE_EQ(w.scale[1], w.scale[0]) << "a pair without takes the measured ratio";
+  expect_covers_like_query(plan_calibrated(options, p.pairs, p.contexts, history), p, "hybrid");
+}
+
+TEST(Plans, APosterioriSplitsOnLastStepsContactsWithTabooLists) {
+  const Pairs p;
+  EngineOptions options;
+  options.method = Method::aposteriori;
+  options.threads = 8;
+  History history;
+  const QueryResult last = query(*p.torus, p.poses[0], *p.sphere, p.poses[1], p.request);
+  ASSERT_GT(last.pairs.size(), 10u);
+  history.reported[p.pairs[0]] = last.pairs;
+  history.node_tests[p.pairs[0]] = last.stats.node_tests;
+  const Plan plan = plan_calibrated(options, p.pairs, p.contexts, history);
+  ASSERT_EQ(plan.taboos.size(), 1u);
+  EXPECT_GT(plan.taboo_nodes, 0u);
+  EXPECT_TRUE(std::is_sorted(plan.taboos[0].nodes.begin(), plan.taboos[0].nodes.end()));
+  // The sub-tasks may test below a node the original task prunes: the contacts are the same, the
+  // node tests at least query's.
+  const auto got = run_serially(plan, p);
+  EXPECT_EQ(got[0].first.size(), last.pairs.size());
+  EXPECT_GE(got[0].second, last.stats.node_tests);
+}
+
+}  // namespace
+}  // namespace caliber::tasks
