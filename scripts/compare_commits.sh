@@ -5,10 +5,10 @@
 # the ratio new / old. Every speed claim between two versions is such a ratio, measured in one run.
 #
 #   scripts/compare_commits.sh REV [--rounds R] [--steps K] [--scenes two_small,funnel,...]
-#                                  [--no-queries] [--new BINARY]
+#                                  [--no-queries] [--new BINARY] [--method M] [--threads T]
 #
-# Cases: each scene's sequential step (median ms/step of `caliber run --method sequential
-# --threads 1 --steps K`; two_large runs K/3 steps), and the interference query of the FCL
+# Cases: each scene's step (median ms/step of `caliber run --method M --threads T --steps K`,
+# sequential on 1 thread unless told; two_large runs K/3 steps), and the interference query of the FCL
 # comparison's mesh pairs (`caliber query`'s query_ms; the median of R rounds). The contacts of
 # every scene and the pairs of every query are compared too (the `--contacts` files of old and new, byte for byte): a speed-up
 # that changed a contact is reported as a mismatch and the script exits 1.
@@ -20,19 +20,24 @@ rounds=5
 steps=60
 scenes="two_large,two_small,funnel,front_car"
 queries=1
+method=sequential
+threads=1
 new_bin="$root/build/caliber"
 while [ $# -gt 0 ]; do
   case "$1" in
-    --rounds|--steps|--scenes|--new) [ $# -ge 2 ] || { echo "compare_commits: $1 needs a value" >&2; exit 2; } ;;&
+    --rounds|--steps|--scenes|--new|--method|--threads) [ $# -ge 2 ] || { echo "compare_commits: $1 needs a value" >&2; exit 2; } ;;&
     --rounds) rounds="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --scenes) scenes="$2"; shift 2 ;;
     --no-queries) queries=0; shift ;;
     --new) new_bin="$2"; shift 2 ;;
+    --method) method="$2"; shift 2 ;;
+    --threads) threads="$2"; shift 2 ;;
     *) echo "compare_commits: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 [[ "$rounds" =~ ^[1-9][0-9]*$ ]] || { echo "compare_commits: --rounds must be a whole number >= 1" >&2; exit 2; }
+[[ "$threads" =~ ^[1-9][0-9]*$ ]] || { echo "compare_commits: --threads must be a whole number >= 1" >&2; exit 2; }
 [[ "$steps" =~ ^[1-9][0-9]*$ ]] || { echo "compare_commits: --steps must be a whole number >= 1" >&2; exit 2; }
 sha="$(git -C "$root" rev-parse --verify "$rev^{commit}" 2>/dev/null)" || {
   echo "compare_commits: '$rev' is not a revision of this repository" >&2; exit 2; }
@@ -105,7 +110,7 @@ run_scene() {  # BIN SCENE TAG ROUND: prints the run's median ms/step; round 0 k
   local extra=()
   [ "$round" = 0 ] && extra=(--contacts "$work/$scene.$tag.jsonl")
   rm -f "$work/run.json"
-  "$bin" run "$root/scenes/$scene.json" --method sequential --threads 1 --steps "$k" \
+  "$bin" run "$root/scenes/$scene.json" --method "$method" --threads "$threads" --steps "$k" \
     --json "$work/run.json" "${extra[@]}" >/dev/null 2>"$work/err" || return 1
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['summary']['median_step_ms'])" "$work/run.json"
 }
@@ -144,7 +149,7 @@ for ((r = 0; r < rounds; r++)); do
 done
 
 status=0
-echo "# $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+dirty') (new) vs $short (old), $rounds interleaved rounds, medians"
+echo "# $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+dirty') (new) vs $short (old), $rounds interleaved rounds, medians; steps: $method on $threads thread(s)"
 echo "# machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) hardware threads"
 printf '%-44s %12s %12s %8s  %s\n' case "old ms" "new ms" "new/old" contacts
 cases=("${scene_list[@]}")

@@ -129,15 +129,45 @@ class Reader {
 
 bool looks_like_ply(const std::string& head) { return head.rfind("ply\n", 0) == 0 || head.rfind("ply\r\n", 0) == 0; }
 
-Mesh read_ply(const std::filesystem::path& file) {
-  const std::string path = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto fail = [&](const std::string& why) -> void { throw Error(ErrorCode::unreadable, path, "cannot parse mesh: " + why); };
-  if (!looks_like_ply(data)) fail("a PLY file starts with the line 'ply'");
+namespace {
 
-  // Header: one line at a time up to end_header.
+/// PLY's header, read up to end_header.
+struct Header {
+  Format format;
+  std::vector<Element> elements;
+  std::size_t body = 0;  ///< offset of the first byte after the header
+};
+
+[[noreturn]] void parse_failure(const std::string& path, const std::string& why) {
+  throw Error(ErrorCode::unreadable, path, "cannot parse mesh: " + why);
+}
+
+/// Reads one header line's property declaration into e.
+void read_property(std::istringstream& words, const std::string& where, const std::string& path, Element& e) {
+  const auto fail = [&](const std::string& why) { parse_failure(path, why); };
+  Property p;
+  std::string type;
+  words >> type;
+  if (type == "list") {
+    std::string count_type, item_type;
+    words >> count_type >> item_type >> p.name;
+    const auto ct = parse_type(count_type), it = parse_type(item_type);
+    if (!ct || !it || !is_integer(*ct)) fail(where + ": bad list property (expected 'property list <int type> <type> <name>')");
+    p.list = true;
+    p.count_type = *ct;
+    p.type = *it;
+  } else {
+    const auto t = parse_type(type);
+    if (!t) fail(where + ": unknown property type '" + type + "'");
+    p.type = *t;
+    words >> p.name;
+  }
+  if (p.name.empty()) fail(where + ": a property needs a name");
+  e.properties.push_back(std::move(p));
+}
+
+Header read_header(const std::string& data, const std::string& path) {
+  const auto fail = [&](const std::string& why) { parse_failure(path, why); };
   std::optional<Format> format;
   std::vector<Element> elements;
   std::size_t pos = 0, line_no = 0;
@@ -174,25 +204,7 @@ Mesh read_ply(const std::filesystem::path& file) {
       elements.push_back(std::move(e));
     } else if (keyword == "property") {
       if (elements.empty()) fail(where + ": a property before any element");
-      Property p;
-      std::string type;
-      words >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> p.name;
-        const auto ct = parse_type(count_type), it = parse_type(item_type);
-        if (!ct || !it || !is_integer(*ct)) fail(where + ": bad list property (expected 'property list <int type> <type> <name>')");
-        p.list = true;
-        p.count_type = *ct;
-        p.type = *it;
-      } else {
-        const auto t = parse_type(type);
-        if (!t) fail(where + ": unknown property type '" + type + "'");
-        p.type = *t;
-        words >> p.name;
-      }
-      if (p.name.empty()) fail(where + ": a property needs a name");
-      elements.back().properties.push_back(std::move(p));
+      read_property(words, where, path, elements.back());
     } else if (keyword == "end_header") {
       ended = true;
       continue;
@@ -202,84 +214,113 @@ Mesh read_ply(const std::filesystem::path& file) {
     if (words >> extra) fail(where + ": unexpected '" + extra + "'");
   }
   if (!format) fail("the header has no 'format' line");
+  return Header{*format, std::move(elements), pos};
+}
 
-  Reader reader(path, *format, data, pos);
+/// Reads one face's vertex index list (kept when `keep`) into corners.
+void read_indices(Reader& reader, const Property& p, Format format, const std::string& what, bool keep, std::uint64_t face,
+                  const Mesh& mesh, const std::string& path, std::vector<std::uint32_t>& corners) {
+  const double count = reader.next(p.count_type, what);
+  if (count < 0) parse_failure(path, what + ": negative list length");
+  const std::size_t item = format == Format::ascii ? 2 : size_of(p.type);
+  if (count > static_cast<double>((reader.remaining() + 1) / item)) {
+    parse_failure(path, what + ": list longer than the rest of the file (truncated file?)");
+  }
+  for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(count); ++j) {
+    const double index = reader.next(p.type, what);
+    if (!keep) continue;
+    if (index < 0 || index >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())) {
+      throw Error(ErrorCode::bad_index, path, "face " + std::to_string(face) + " refers to vertex " + std::to_string(static_cast<long long>(index)) +
+                                                 " but there are only " + std::to_string(mesh.vertices.size()));
+    }
+    corners.push_back(static_cast<std::uint32_t>(index));
+  }
+}
+
+/// Adds a face's triangles (a fan over its corners) to the mesh, its corners checked.
+void add_face(const std::vector<std::uint32_t>& corners, std::uint64_t i, const std::string& path, Mesh& mesh) {
+  if (corners.size() < 3) {
+    throw Error(ErrorCode::bad_index, path,
+                "face " + std::to_string(i) + " has " + std::to_string(corners.size()) + " corner(s); a face needs at least 3");
+  }
+  for (const std::uint32_t c : corners) {
+    if (c >= mesh.vertices.size()) {
+      throw Error(ErrorCode::bad_index, path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(c) +
+                                                 " but there are only " + std::to_string(mesh.vertices.size()));
+    }
+  }
+  for (std::size_t c = 1; c + 1 < corners.size(); ++c) mesh.triangles.push_back({corners[0], corners[c], corners[c + 1]});
+}
+
+/// Reads every entry of one element; the first 'vertex' element gives the vertices, the first
+/// 'face' element the faces, the others are read past.
+void read_element(Reader& reader, const Element& e, Format format, bool is_vertex, bool is_face, const std::string& path,
+                  Mesh& mesh) {
+  const auto fail = [&](const std::string& why) { parse_failure(path, why); };
+  // Every element takes at least one byte (binary) or two characters (ascii): a count the file
+  // cannot hold is an error before anything is allocated.
+  // (ascii: a value and its separator; the file's last value may go without one.)
+  if (e.properties.empty() && e.count > 0) fail("element '" + e.name + "' has entries but no properties");
+  std::size_t min_size = 0;
+  for (const Property& p : e.properties) min_size += format == Format::ascii ? 2 : size_of(p.list ? p.count_type : p.type);
+  if (min_size > 0 && e.count > (reader.remaining() + 1) / min_size) {
+    fail("element '" + e.name + "' declares " + std::to_string(e.count) + " entries, more than the file holds (truncated file?)");
+  }
+  int xyz[3] = {-1, -1, -1};
+  int indices = -1;
+  for (std::size_t k = 0; k < e.properties.size(); ++k) {
+    const Property& p = e.properties[k];
+    if (is_vertex && !p.list && (p.name == "x" || p.name == "y" || p.name == "z")) xyz[p.name[0] - 'x'] = static_cast<int>(k);
+    if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = static_cast<int>(k);
+  }
+  if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)) fail("element 'vertex' needs properties x, y and z");
+  if (is_face && indices < 0) fail("element 'face' needs a list property 'vertex_indices'");
+  if (is_vertex) mesh.vertices.reserve(e.count);
+  std::vector<std::uint32_t> corners;
+  for (std::uint64_t i = 0; i < e.count; ++i) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    corners.clear();
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      const std::string what = e.name + " " + std::to_string(i) + ", property '" + p.name + "'";
+      if (p.list) {
+        read_indices(reader, p, format, what, is_face && indices == static_cast<int>(k), i, mesh, path, corners);
+        continue;
+      }
+      const double value = reader.next(p.type, what);
+      for (int c = 0; c < 3; ++c) {
+        if (is_vertex && xyz[c] == static_cast<int>(k)) v[c] = value;
+      }
+    }
+    if (is_vertex) {
+      if (!v.allFinite()) throw Error(ErrorCode::bad_value, path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+      mesh.vertices.push_back(v);
+    }
+    if (is_face) add_face(corners, i, path, mesh);
+  }
+}
+
+}  // namespace
+
+Mesh read_ply(const std::filesystem::path& file) {
+  const std::string path = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!looks_like_ply(data)) parse_failure(path, "a PLY file starts with the line 'ply'");
+  const Header header = read_header(data, path);
+  Reader reader(path, header.format, data, header.body);
   Mesh mesh;
   mesh.source = path;
   bool have_vertices = false, have_faces = false;
-  for (const Element& e : elements) {
-    // Every element takes at least one byte (binary) or two characters (ascii): a count the file
-    // cannot hold is an error before anything is allocated.
-    // (ascii: a value and its separator; the file's last value may go without one.)
-    if (e.properties.empty() && e.count > 0) fail("element '" + e.name + "' has entries but no properties");
-    std::size_t min_size = 0;
-    for (const Property& p : e.properties) min_size += *format == Format::ascii ? 2 : size_of(p.list ? p.count_type : p.type);
-    if (min_size > 0 && e.count > (reader.remaining() + 1) / min_size) {
-      fail("element '" + e.name + "' declares " + std::to_string(e.count) + " entries, more than the file holds (truncated file?)");
-    }
+  for (const Element& e : header.elements) {
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;
-    int xyz[3] = {-1, -1, -1};
-    int indices = -1;
-    for (std::size_t k = 0; k < e.properties.size(); ++k) {
-      const Property& p = e.properties[k];
-      if (is_vertex && !p.list && (p.name == "x" || p.name == "y" || p.name == "z")) xyz[p.name[0] - 'x'] = static_cast<int>(k);
-      if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = static_cast<int>(k);
-    }
-    if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)) fail("element 'vertex' needs properties x, y and z");
-    if (is_face && indices < 0) fail("element 'face' needs a list property 'vertex_indices'");
-    if (is_vertex) mesh.vertices.reserve(e.count);
-    std::vector<std::uint32_t> corners;
-    for (std::uint64_t i = 0; i < e.count; ++i) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      corners.clear();
-      for (std::size_t k = 0; k < e.properties.size(); ++k) {
-        const Property& p = e.properties[k];
-        const std::string what = e.name + " " + std::to_string(i) + ", property '" + p.name + "'";
-        if (!p.list) {
-          const double value = reader.next(p.type, what);
-          for (int c = 0; c < 3; ++c) {
-            if (is_vertex && xyz[c] == static_cast<int>(k)) v[c] = value;
-          }
-          continue;
-        }
-        const double count = reader.next(p.count_type, what);
-        if (count < 0) fail(what + ": negative list length");
-        const std::size_t item = *format == Format::ascii ? 2 : size_of(p.type);
-        if (count > static_cast<double>((reader.remaining() + 1) / item)) fail(what + ": list longer than the rest of the file (truncated file?)");
-        const bool keep = is_face && indices == static_cast<int>(k);
-        for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(count); ++j) {
-          const double index = reader.next(p.type, what);
-          if (!keep) continue;
-          if (index < 0 || index >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())) {
-            throw Error(ErrorCode::bad_index, path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(static_cast<long long>(index)) +
-                                                       " but there are only " + std::to_string(mesh.vertices.size()));
-          }
-          corners.push_back(static_cast<std::uint32_t>(index));
-        }
-      }
-      if (is_vertex) {
-        if (!v.allFinite()) throw Error(ErrorCode::bad_value, path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
-        mesh.vertices.push_back(v);
-      }
-      if (is_face) {
-        if (corners.size() < 3) {
-          throw Error(ErrorCode::bad_index, path,
-                      "face " + std::to_string(i) + " has " + std::to_string(corners.size()) + " corner(s); a face needs at least 3");
-        }
-        for (const std::uint32_t c : corners) {
-          if (c >= mesh.vertices.size()) {
-            throw Error(ErrorCode::bad_index, path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(c) +
-                                                       " but there are only " + std::to_string(mesh.vertices.size()));
-          }
-        }
-        for (std::size_t c = 1; c + 1 < corners.size(); ++c) mesh.triangles.push_back({corners[0], corners[c], corners[c + 1]});
-      }
-    }
+    read_element(reader, e, header.format, is_vertex, is_face, path, mesh);
     have_vertices = have_vertices || is_vertex;
     have_faces = have_faces || is_face;
   }
-  if (!have_vertices) fail("no 'vertex' element");
+  if (!have_vertices) parse_failure(path, "no 'vertex' element");
   if (!have_faces) throw Error(ErrorCode::empty_mesh, path, "mesh has no triangles (no 'face' element)");
   return mesh;
 }

@@ -80,7 +80,7 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
 /// Each child node of A and of B is prepared once for the (up to) four pairs it takes part in.
 /// So every CD node below a root is tested exactly once, by its parent's visit.
-inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats, NodePair passed[4],
+[[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats, NodePair passed[4],
                  TabooView taboo = {}) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];

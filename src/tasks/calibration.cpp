@@ -1,6 +1,7 @@
 #include "tasks/calibration.h"
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <queue>
 
@@ -70,6 +71,81 @@ struct StageOutcome {
   narrow::Candidate candidate;  ///< leaf, reported: the pair
 };
 
+/// Visits every node of one level (in parallel; each node's outcome in its slot). A pair of leaves
+/// gets its leaf test, a heavy node is split (its children tested, those that pass weighed), any
+/// other becomes a root or a cart item by its weight.
+void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& level, double omega, double eps,
+                 const std::function<double(narrow::NodePair)>& weight_of, std::vector<StageOutcome>& outcome) {
+  outcome.assign(level.size(), StageOutcome{});
+  parallel::parallel_for(0, level.size(), kStageGrain, [&](std::size_t lo, std::size_t hi) {
+    std::vector<narrow::Candidate> found;
+    for (std::size_t i = lo; i != hi; ++i) {
+      const StageItem& e = level[i];
+      StageOutcome& o = outcome[i];
+      const bool leaves = ctx.a().nodes[e.node.a].is_leaf() && ctx.b().nodes[e.node.b].is_leaf();
+      const Verdict verdict = classify(e.weight, omega, eps);
+      if (!leaves && verdict != Verdict::split) {
+        o.kind = StageOutcome::Kind::root;
+        o.keep = verdict == Verdict::keep;
+        continue;
+      }
+      found.clear();
+      narrow::NodePair passed[4];
+      const int count = narrow::visit(ctx, e.node, found, o.stats, passed);
+      if (count < 0) {
+        o.kind = StageOutcome::Kind::leaf;
+        o.reported = !found.empty();
+        if (o.reported) o.candidate = found.front();
+        continue;
+      }
+      o.kind = StageOutcome::Kind::split;
+      o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, o.all));
+      CALIBER_ASSERT(o.stats.node_tests == o.tested, "a visit tests each child once");
+      o.children = static_cast<std::uint8_t>(count);
+      for (int k = 0; k < count; ++k) o.child[k] = StageItem{weight_of(passed[k]), passed[k]};
+    }
+  });
+}
+
+/// Takes one level's outcomes in the level's order (so the cut does not depend on the thread
+/// count): the counts, candidates, roots, cart items and records; returns the next level.
+std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const std::vector<StageOutcome>& outcome,
+                                    std::uint32_t pair, SplitResult& out) {
+  std::vector<StageItem> next;
+  for (std::size_t i = 0; i < level.size(); ++i) {
+    const StageItem& e = level[i];
+    const StageOutcome& o = outcome[i];
+    out.stats.node_tests += o.stats.node_tests;
+    out.stats.leaf_tests += o.stats.leaf_tests;
+    StageRecord record{};
+    record.node = e.node;
+    switch (o.kind) {
+      case StageOutcome::Kind::leaf:
+        if (o.reported) out.candidates.push_back(o.candidate);
+        break;
+      case StageOutcome::Kind::split:
+        record.children = o.tested;
+        for (int k = 0, p = 0; k < o.tested; ++k) {
+          record.child[k] = o.all[k];
+          if (p < o.children && o.child[p].node == o.all[k]) {
+            record.passed |= static_cast<std::uint8_t>(1u << k);
+            next.push_back(o.child[p++]);
+          }
+        }
+        break;
+      case StageOutcome::Kind::root: {
+        record.root = true;
+        Root r{pair, e.node, true, e.weight};
+        r.stage = static_cast<std::int32_t>(out.stage.size());
+        (o.keep ? out.roots : out.cart).push_back(r);
+        break;
+      }
+    }
+    out.stage.push_back(record);
+  }
+  return next;
+}
+
 }  // namespace
 
 SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
@@ -86,75 +162,15 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
   // (pruned, leaf-tested, split into its children, or made a root or a cart item by its weight)
   // depends on the node alone, never on when it is popped, so the stage is the same cut when run
   // level by level: every node of a level visited in parallel (narrow::visit, which tests its
-  // children), the children that pass the next level. Outcomes are gathered in the level's order,
-  // so the cut and its records do not depend on the thread count either.
+  // children), the children that pass the next level.
   SplitResult out;
   std::vector<StageItem> level;
   if (narrow::test_root(ctx, narrow::NodePair{0, 0}, out.stats)) level.push_back(StageItem{root_weight, narrow::NodePair{0, 0}});
   std::vector<StageOutcome> outcome;
   while (!level.empty()) {
     out.queue_peak = std::max(out.queue_peak, level.size());
-    outcome.assign(level.size(), StageOutcome{});
-    parallel::parallel_for(0, level.size(), kStageGrain, [&](std::size_t lo, std::size_t hi) {
-      std::vector<narrow::Candidate> found;
-      for (std::size_t i = lo; i != hi; ++i) {
-        const StageItem& e = level[i];
-        StageOutcome& o = outcome[i];
-        const bool leaves = ctx.a().nodes[e.node.a].is_leaf() && ctx.b().nodes[e.node.b].is_leaf();
-        const Verdict verdict = classify(e.weight, omega, eps);
-        if (!leaves && verdict != Verdict::split) {
-          o.kind = StageOutcome::Kind::root;
-          o.keep = verdict == Verdict::keep;
-          continue;
-        }
-        found.clear();
-        narrow::NodePair passed[4];
-        const int count = narrow::visit(ctx, e.node, found, o.stats, passed);
-        if (count < 0) {
-          o.kind = StageOutcome::Kind::leaf;
-          o.reported = !found.empty();
-          if (o.reported) o.candidate = found.front();
-          continue;
-        }
-        o.kind = StageOutcome::Kind::split;
-        o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, o.all));
-        o.children = static_cast<std::uint8_t>(count);
-        for (int k = 0; k < count; ++k) o.child[k] = StageItem{weight_of(passed[k]), passed[k]};
-      }
-    });
-    std::vector<StageItem> next;
-    for (std::size_t i = 0; i < level.size(); ++i) {
-      const StageItem& e = level[i];
-      const StageOutcome& o = outcome[i];
-      out.stats.node_tests += o.stats.node_tests;
-      out.stats.leaf_tests += o.stats.leaf_tests;
-      StageRecord record{};
-      record.node = e.node;
-      switch (o.kind) {
-        case StageOutcome::Kind::leaf:
-          if (o.reported) out.candidates.push_back(o.candidate);
-          break;
-        case StageOutcome::Kind::split:
-          record.children = o.tested;
-          for (int k = 0, p = 0; k < o.tested; ++k) {
-            record.child[k] = o.all[k];
-            if (p < o.children && o.child[p].node == o.all[k]) {
-              record.passed |= static_cast<std::uint8_t>(1u << k);
-              next.push_back(o.child[p++]);
-            }
-          }
-          break;
-        case StageOutcome::Kind::root: {
-          record.root = true;
-          Root r{pair, e.node, true, e.weight};
-          r.stage = static_cast<std::int32_t>(out.stage.size());
-          (o.keep ? out.roots : out.cart).push_back(r);
-          break;
-        }
-      }
-      out.stage.push_back(record);
-    }
-    level = std::move(next);
+    visit_level(ctx, level, omega, eps, weight_of, outcome);
+    level = gather_level(level, outcome, pair, out);
   }
   // The priority queue popped every root and cart item after the last split node (from then on
   // nothing heavier is pushed), so in order of weight, heaviest first, ties by node: the same

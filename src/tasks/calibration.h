@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// Task calibration (DESIGN.md section 3): from the step's initial tasks and their weights, a
+/// Task calibration (docs/design.md section 3): from the step's initial tasks and their weights, a
 /// run-time task list whose tasks all have about the same weight, the caliber Omega.
 ///   Omega = sum of weights / (beta * threads); a task within [Omega - eps, Omega + eps] runs as is,
 ///   a heavier one is split by the weight-driven stage, a lighter one goes to the cart; the cart is

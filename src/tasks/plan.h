@@ -42,7 +42,7 @@ struct Plan {
 /// Sequential and exploitation: one run-time task per pair, whole, in pair order.
 [[nodiscard]] Plan plan_pairs(std::size_t pairs);
 
-/// The weights of the initial tasks (DESIGN.md section 3): the root's a priori estimate times a
+/// The weights of the initial tasks (docs/design.md section 3): the root's a priori estimate times a
 /// per-pair scale. A priori: scale 1. Hybrid and a posteriori: the pair's node tests at the previous
 /// step over its estimate; a pair with no history takes the ratio measured over the pairs that have
 /// one (1 if none has).

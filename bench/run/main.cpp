@@ -1,0 +1,37 @@
+// caliber-bench: the benchmark of the six methods as a program of its own (the same as
+// `caliber bench`, which the caliber program keeps as a thin entry to this code).
+// Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
+
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "caliber/error.h"
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"caliber-bench: every method on every scene, medians, report.md and results.json"};
+  app.require_subcommand(1);
+  const caliber::cli::Runner bench = caliber::cli::add_bench_command(app);
+  // `caliber-bench bench ...` reads oddly: the options go straight after the program's name.
+  std::vector<std::string> args{argv[0], "bench"};
+  for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
+  std::vector<char*> argp;
+  for (std::string& a : args) argp.push_back(a.data());
+  try {
+    app.parse(static_cast<int>(argp.size()), argp.data());
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "caliber-bench: " << e.what() << "\n";
+    return 2;
+  }
+  try {
+    return bench();
+  } catch (const caliber::Error& e) {
+    std::cerr << "caliber-bench: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "caliber-bench: internal error: " << e.what() << "\n";
+    return 1;
+  }
+}
