@@ -52,6 +52,12 @@ struct QueryRequest {
 /// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or an angle outside [0, 180].
 void validate_request(const QueryRequest& request);
 
+/// The distance within which a request reports triangle pairs: 0 for interference (the triangles
+/// must meet), the tolerance for proximity and contact.
+[[nodiscard]] inline double reach(const QueryRequest& request) {
+  return request.kind == QueryKind::interference ? 0.0 : request.tolerance;
+}
+
 /// A triangle pair: triangle of A, triangle of B.
 struct TrianglePair {
   std::uint32_t tri_a;  ///< triangle id in model A

@@ -49,7 +49,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
-  const double d = mKind == QueryKind::interference ? 0.0 : request.tolerance;
+  const double d = reach(request);
   mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
   mSlabReach = mReach * (1.0 + 1e-6);
   mTheta = request.angle_deg * std::numbers::pi / 180.0;

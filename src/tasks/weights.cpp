@@ -10,7 +10,7 @@ double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n) {
   const narrow::PairContext::SideB b = ctx.prepare_b(n.b);
   double dist2 = 0.0;
   for (int i = 0; i < 3; ++i) dist2 += (a.center[i] - b.center[i]) * (a.center[i] - b.center[i]);
-  const double d = ctx.request().kind == QueryKind::interference ? 0.0 : ctx.request().tolerance;
+  const double d = reach(ctx.request());
   // Overlap depth: the smaller of the spheres' and the boxes' (on the six face axes, the least
   // penetration); thin parts have loose spheres but tight boxes.
   double overlap = std::max(0.0, a.radius + b.radius + d - std::sqrt(dist2));

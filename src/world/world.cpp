@@ -104,7 +104,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> World::bounds(std::size_t i, const P
 
 std::vector<Task> World::broad_phase(const std::vector<Pose>& poses) const {
   const std::size_t n = mScene.objects.size();
-  const double grow = mRequest.kind == QueryKind::interference ? 0.0 : 0.5 * mRequest.tolerance;
+  const double grow = 0.5 * reach(mRequest);
   std::vector<WorldBox> boxes;
   boxes.reserve(n);
   for (std::size_t i = 0; i < n; ++i) boxes.push_back(world_box(*mModels[i], poses[i], grow));
