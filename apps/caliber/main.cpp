@@ -3,9 +3,11 @@
 //   caliber run SCENE [...]      a scene over its time steps
 //   caliber refine IN OUT -l K   1-to-4 subdivision
 //   caliber bench [SCENES...]    every method on every scene: report.md, results.json, figures
-// Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
+// Exit codes: 0 success, 2 bad input or not enough memory for it (message on stderr), 130 a run
+// stopped by SIGINT (what it measured is written), 1 unexpected internal error.
 
 #include <iostream>
+#include <new>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -40,6 +42,9 @@ int main(int argc, char** argv) {
     }
   } catch (const caliber::Error& e) {
     std::cerr << "caliber: " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "caliber: out of memory (the input needs more memory than this machine or its limits give)\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "caliber: internal error: " << e.what() << "\n";

@@ -6,16 +6,19 @@
 #include <vector>
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <iostream>
 #include <string>
 
 #include "caliber/engine.h"
+#include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
 #include "commands.h"
 #include "json_output.h"
+#include "output_file.h"
 #include "timing.h"
 
 namespace caliber::cli {
@@ -72,9 +75,17 @@ int run_query(const QueryOptions& opt) {
 
   const caliber::Method method = caliber::parse_method(opt.method);
   const auto build_start = Clock::now();
-  const std::shared_ptr<const caliber::Model> model_a = caliber::build_model(caliber::load_mesh(opt.mesh_a));
-  const std::shared_ptr<const caliber::Model> model_b =
-      opt.mesh_b == opt.mesh_a ? model_a : caliber::build_model(caliber::load_mesh(opt.mesh_b));
+  caliber::BuildOptions build;
+  build.adjacency = request.kind == caliber::QueryKind::contact;  // only the contact reduction reads it
+  const auto model_of = [&](const std::string& path) {
+    try {
+      return caliber::build_model(caliber::load_mesh(path), build);
+    } catch (const std::bad_alloc&) {
+      throw caliber::Error(caliber::ErrorCode::out_of_memory, path, "out of memory while loading and building its model");
+    }
+  };
+  const std::shared_ptr<const caliber::Model> model_a = model_of(opt.mesh_a);
+  const std::shared_ptr<const caliber::Model> model_b = opt.mesh_b == opt.mesh_a ? model_a : model_of(opt.mesh_b);
   const double build_ms = ms_since(build_start);
   std::unique_ptr<caliber::Engine> engine;
   caliber::Frame frame;
@@ -118,6 +129,7 @@ int run_query(const QueryOptions& opt) {
     out["stats"]["query_ms_warm"] = warm_ms;
     out["stats"]["repeat"] = opt.repeat;
     std::cout << out.dump() << "\n";
+    check_stdout();
     return 0;
   }
   const char* what = request.kind == caliber::QueryKind::interference ? "intersecting triangle pairs"
@@ -144,6 +156,7 @@ int run_query(const QueryOptions& opt) {
     }
   }
   if (shown < result.pairs.size()) std::printf("  ... %zu more (use --json for all)\n", result.pairs.size() - shown);
+  check_stdout();
   return 0;
 }
 

@@ -2,10 +2,13 @@
 
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <string>
 
 #include "caliber/mesh.h"
+#include "caliber/error.h"
 #include "commands.h"
+#include "output_file.h"
 
 namespace caliber::cli {
 
@@ -23,9 +26,17 @@ Runner add_refine_command(CLI::App& app) {
       ->check(CLI::Range(0, 8));
   return [cmd, opt]() {
     if (!cmd->parsed()) return -1;
+    check_distinct_files({{"OUT", opt->out}}, {{"IN", opt->in}});
+    OutputFile file(opt->out, "OUT");
     const Mesh in = load_mesh(opt->in);
-    const Mesh out = refine_mesh(in, opt->levels);
-    save_off(out, opt->out);
+    Mesh out;
+    try {
+      out = refine_mesh(in, opt->levels);
+    } catch (const std::bad_alloc&) {
+      throw Error(ErrorCode::out_of_memory, opt->in, "out of memory while refining it " + std::to_string(opt->levels) + " times");
+    }
+    write_off(out, file.stream());
+    file.commit();
     std::printf("%s: %zu triangles -> %s: %zu triangles\n", opt->in.c_str(), in.triangles.size(), opt->out.c_str(),
                 out.triangles.size());
     return 0;

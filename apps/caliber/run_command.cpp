@@ -1,10 +1,14 @@
 // caliber run: a scene over its time steps, with a per-step summary, a final summary (the paper's
 // Table 1 characteristics), an optional JSON report and an optional JSON-lines contact log.
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <memory>
+#include <new>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -13,6 +17,7 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "commands.h"
+#include "output_file.h"
 #include "progress.h"
 #include "run_stats.h"
 #include "timing.h"
@@ -93,12 +98,28 @@ std::string pair_name(const World& world, const Task& t) {
   return world.scene().objects[t.a].name + " / " + world.scene().objects[t.b].name;
 }
 
+/// Set by SIGINT during a run: the run stops after the step in progress and writes what it measured.
+std::atomic<bool> gInterrupted{false};
+
+extern "C" void on_interrupt(int) { gInterrupted.store(true); }
+
+/// SIGINT handled for the lifetime of the object (the previous handler restored after).
+struct InterruptGuard {
+  InterruptGuard() {
+    gInterrupted.store(false);
+    previous = std::signal(SIGINT, on_interrupt);
+  }
+  ~InterruptGuard() { std::signal(SIGINT, previous); }
+  void (*previous)(int) = SIG_DFL;
+};
+
 int run_scene(const RunOptions& opt) {
   Scene scene = load_scene(opt.scene);
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
   if (opt.steps > 0) scene.steps = opt.steps;
-  const auto load_start = Clock::now();
-  const World world(std::move(scene));
+  for (const int p : opt.simulate) {
+    if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
+  }
   EngineOptions engine_options;
   engine_options.method = parse_method(opt.method);
   engine_options.threads = opt.threads;
@@ -106,6 +127,16 @@ int run_scene(const RunOptions& opt) {
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
+  // Every output is checked, and kept apart from every input, before any work is done.
+  std::vector<std::pair<std::string, std::string>> inputs{{"the scene", opt.scene}};
+  for (const SceneObject& o : scene.objects) inputs.emplace_back("mesh of object '" + o.name + "'", o.mesh.string());
+  check_distinct_files({{"--json", opt.json}, {"--contacts", opt.contacts}}, inputs);
+  std::unique_ptr<OutputFile> json_out, contacts_out;
+  if (!opt.json.empty()) json_out = std::make_unique<OutputFile>(opt.json, "--json");
+  if (!opt.contacts.empty()) contacts_out = std::make_unique<OutputFile>(opt.contacts, "--contacts");
+
+  const auto load_start = Clock::now();
+  const World world(std::move(scene));
   Engine engine(engine_options);
   const double load_ms = ms_since(load_start);
   const Scene& sc = world.scene();
@@ -116,32 +147,32 @@ int run_scene(const RunOptions& opt) {
               std::string(to_string(engine.options().method)).c_str(), engine.threads());
   std::fflush(stdout);
 
-  std::unique_ptr<std::ofstream> contacts_out;
-  if (!opt.contacts.empty()) {
-    contacts_out = std::make_unique<std::ofstream>(opt.contacts);
-    if (!*contacts_out) throw Error(ErrorCode::unreadable, opt.contacts, "cannot be opened for writing");
-  }
   nlohmann::json steps = nlohmann::json::array();
   RunStats stats;
-  for (const int p : opt.simulate) {
-    if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
-  }
   // Load-balance simulation, over the whole run.
   std::vector<SimulatedRun> sims;
   for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
   const Progress progress(static_cast<std::size_t>(sc.steps));
-  for (int k = 0; k < sc.steps; ++k) {
-    const StepResult s = step(world, engine, k);
+  const InterruptGuard interrupt;
+  for (int k = 0; k < sc.steps && !gInterrupted.load(); ++k) {
+    StepResult s;
+    try {
+      s = step(world, engine, k);
+    } catch (const std::bad_alloc&) {
+      throw Error(ErrorCode::out_of_memory, sc.file.string(), "out of memory while running step " + std::to_string(k));
+    }
     stats.add(s);
     for (SimulatedRun& sim : sims) sim.add(s);
-    if (!opt.json.empty()) steps.push_back(step_record(s));
-    if (contacts_out) *contacts_out << contacts_line(world, s).dump() << '\n';
+    if (json_out) steps.push_back(step_record(s));
+    if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
     char line[256];
     std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.tasks.size(),
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
-  if (contacts_out && !*contacts_out) throw Error(ErrorCode::unreadable, opt.contacts, "write failed");
+  const bool interrupted = gInterrupted.load();
+  if (interrupted) std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
+  if (contacts_out) contacts_out->commit();
 
   const auto [heavy, heavy_share] = stats.heaviest_pair();
   const auto [second, second_share] = stats.second_heaviest_pair();
@@ -169,7 +200,7 @@ int run_scene(const RunOptions& opt) {
     std::printf("\n");
   }
 
-  if (!opt.json.empty()) {
+  if (json_out) {
     nlohmann::json report = {
         {"scene", sc.name},
         {"file", sc.file.string()},
@@ -192,12 +223,12 @@ int run_scene(const RunOptions& opt) {
           {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
           {"simulated_speedup", simulated}}},
         {"steps", steps}};
-    std::ofstream out(opt.json);
-    if (!out) throw Error(ErrorCode::unreadable, opt.json, "cannot be opened for writing");
-    out << report.dump(1) << '\n';
-    if (!out) throw Error(ErrorCode::unreadable, opt.json, "write failed");
+    if (interrupted) report["interrupted"] = true;
+    json_out->stream() << report.dump(1) << '\n';
+    json_out->commit();
   }
-  return 0;
+  check_stdout();
+  return interrupted ? 130 : 0;
 }
 
 }  // namespace

@@ -547,6 +547,12 @@ int run_bench(BenchOptions opt) {
   variants.erase(std::remove_if(variants.begin(), variants.end(), [](const Variant& v) { return v.method == Method::sequential; }),
                  variants.end());
   variants.insert(variants.begin(), parse_variant("sequential"));
+  // Every scene file parsed (and its meshes checked to exist) before anything is created on disk.
+  std::vector<Scene> scenes;
+  for (const std::string& file : opt.scenes) {
+    scenes.push_back(load_scene(file));
+    if (opt.steps > 0) scenes.back().steps = opt.steps;
+  }
   if (opt.out.empty()) opt.out = "bench/results/" + machine_slug();
   if (std::filesystem::exists(opt.out) && !std::filesystem::is_directory(opt.out)) {
     throw Error(ErrorCode::bad_value, "--out", "'" + opt.out + "' exists and is not a folder");
@@ -559,10 +565,8 @@ int run_bench(BenchOptions opt) {
   // Load every scene first: bad input fails before any long work starts.
   std::vector<std::unique_ptr<World>> worlds;
   std::vector<double> load_s;
-  for (const std::string& file : opt.scenes) {
+  for (Scene& scene : scenes) {
     const auto start = Clock::now();
-    Scene scene = load_scene(file);
-    if (opt.steps > 0) scene.steps = opt.steps;
     worlds.push_back(std::make_unique<World>(std::move(scene)));
     load_s.push_back(seconds_since(start));
   }

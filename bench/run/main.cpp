@@ -3,6 +3,7 @@
 // Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
 
 #include <iostream>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -29,6 +30,9 @@ int main(int argc, char** argv) {
     return bench();
   } catch (const caliber::Error& e) {
     std::cerr << "caliber-bench: " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "caliber-bench: out of memory (the input needs more memory than this machine or its limits give)\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "caliber-bench: internal error: " << e.what() << "\n";

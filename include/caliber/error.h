@@ -15,6 +15,7 @@ enum class ErrorCode {
   bad_index,        ///< a face refers to a vertex that does not exist
   empty_mesh,       ///< the input holds no triangle at all
   bad_argument,     ///< an API argument is invalid (for example a null model)
+  out_of_memory,    ///< the input needs more memory than there is (the message says what was being done)
 };
 
 /// Thrown for every bad input: missing or malformed files, non-finite values, bad options.

@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <ostream>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -34,15 +36,29 @@ inline constexpr int kMaxGroups = 64;
 /// BVH far from overflow, so that no input can turn into infinities and a silent wrong answer.
 inline constexpr double kMaxCoordinate = 1e15;
 
-/// Loads OFF, OBJ, STL (ascii and binary) or PLY through assimp.
-/// Triangle ids follow the file's face order; a polygon with n > 3 corners becomes n-2 triangles
+/// Smallest magnitude caliber accepts for a non-zero vertex coordinate (after scaling), pose
+/// translation or tolerance: 2^-120, about 7.5e-37. Between it and kMaxCoordinate, every product the
+/// exact predicates and the closest-point routines form (up to the fourth power of a coordinate
+/// difference) stays a normal double and every float bound of the BVH a normal float, so answers do
+/// not depend on scale: a mesh scaled by a power of two 2^k gives the same pairs and 2^k times the
+/// points and distances. Smaller values would be rounded to zero or to subnormals and answers
+/// could go wrong silently, so they are refused.
+inline constexpr double kMinCoordinate = 0x1p-120;
+
+/// The formats load_mesh reads, for messages: ".off, .ply, .obj and .stl".
+[[nodiscard]] std::string_view supported_mesh_formats();
+
+/// Loads a mesh, the reader chosen by the file's extension (any case) and never by its content:
+/// .off and .ply by caliber's own strict readers, .obj and .stl (ascii and binary) by assimp's
+/// importer of that format. Any other extension, or none, is refused. Triangle ids follow the
+/// file's face order; a polygon with n > 3 corners becomes n-2 triangles
 /// fanned from its first corner, in place. Vertices are not merged or reordered.
 /// Throws caliber::Error naming the file on a missing file, a parse error, a non-finite coordinate,
 /// an index out of range, a face with fewer than 3 corners, or a mesh without triangles.
 [[nodiscard]] Mesh load_mesh(const std::filesystem::path& path);
 
 /// Checks the invariants every routine relies on: at least one triangle, finite coordinates of
-/// magnitude <= kMaxCoordinate, indices in range, groups (if any) one per triangle and below kMaxGroups.
+/// magnitude 0 or in [kMinCoordinate, kMaxCoordinate], indices in range, groups (if any) one per triangle and below kMaxGroups.
 /// Throws caliber::Error naming `mesh.source` and the first problem found.
 void validate_mesh(const Mesh& mesh);
 
@@ -50,6 +66,9 @@ void validate_mesh(const Mesh& mesh);
 /// vertex 0, at vertex 1, at vertex 2, then the middle one), so ids stay predictable. The surface
 /// does not change, only its triangle count; groups are inherited.
 [[nodiscard]] Mesh refine_mesh(const Mesh& mesh, int levels);
+
+/// Writes the mesh as OFF text to a stream (17 significant digits: the doubles come back exactly).
+void write_off(const Mesh& mesh, std::ostream& out);
 
 /// Writes the mesh as an OFF file. Throws caliber::Error if the file cannot be written.
 void save_off(const Mesh& mesh, const std::filesystem::path& path);

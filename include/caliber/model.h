@@ -89,11 +89,28 @@ struct Model {
   }
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
   std::vector<Eigen::Vector3d> normals;
-  /// Triangles sharing a vertex position with triangle t are
-  /// adjacency[adjacency_offsets[t] .. adjacency_offsets[t+1]) (sorted, t excluded).
-  std::vector<std::uint32_t> adjacency_offsets;
-  /// See adjacency_offsets.
-  std::vector<std::uint32_t> adjacency;
+  /// Vertex adjacency (BuildOptions::adjacency), linear in the corners whatever a vertex's degree:
+  /// the welded vertex of each corner (corner t*3 + k of triangle t; vertices are welded by exact
+  /// position, so files that repeat vertices per face still get their topology) ...
+  std::vector<std::uint32_t> corner_vertex;
+  /// ... and the triangles around each welded vertex w, ascending:
+  /// vertex_triangles[vertex_offsets[w] .. vertex_offsets[w + 1]).
+  std::vector<std::uint64_t> vertex_offsets;
+  /// See vertex_offsets.
+  std::vector<std::uint32_t> vertex_triangles;
+  /// Whether the vertex adjacency was built.
+  [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }
+  /// Calls f(u) for every triangle u that shares a vertex position with triangle t (u != t; a
+  /// triangle sharing two or three positions with t comes two or three times).
+  template <class F>
+  void for_each_neighbour(std::uint32_t t, F&& f) const {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t w = corner_vertex[std::size_t{t} * 3 + k];
+      for (std::uint64_t i = vertex_offsets[w]; i < vertex_offsets[w + 1]; ++i) {
+        if (vertex_triangles[i] != t) f(vertex_triangles[i]);
+      }
+    }
+  }
   /// Largest distance of a vertex from the object-space origin (used to bound rounding error).
   double extent = 0.0;
   /// Height of the BVH (a root-only tree has height 1).

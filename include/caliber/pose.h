@@ -28,6 +28,13 @@ struct Pose {
   [[nodiscard]] Eigen::Vector3d apply(const Eigen::Vector3d& p) const { return rotation * p + translation; }
 };
 
+/// The unit quaternion of (w, x, y, z), scaled by its largest component before it is squared, so
+/// that neither a huge nor a tiny quaternion overflows or underflows into the wrong rotation
+/// ([1e200, 0, 0, 1e200] is [1, 0, 0, 1]). Throws caliber::Error (bad_value) naming `source` when a
+/// value is not finite or the quaternion is (nearly) zero: no component above 1e-9. The one
+/// normalization of the CLI and scene files.
+[[nodiscard]] Eigen::Quaterniond unit_quaternion(double w, double x, double y, double z, std::string_view source = "quaternion");
+
 /// Parses "tx ty tz qw qx qy qz" (spaces or commas). Throws caliber::Error naming `source`
 /// when the text does not hold exactly seven finite numbers or the quaternion is zero.
 [[nodiscard]] Pose parse_pose(std::string_view text, std::string_view source = "pose");

@@ -27,8 +27,9 @@ std::vector<Vec3> face_normals(const Mesh& mesh, std::size_t grain) {
   return normals;
 }
 
-void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint32_t>& offsets,
-                      std::vector<std::uint32_t>& adjacency) {
+void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint32_t>& corner_vertex,
+                      std::vector<std::uint64_t>& offsets, std::vector<std::uint32_t>& triangles) {
+  static_cast<void>(grain);
   const std::size_t nv = mesh.vertices.size();
   std::vector<std::uint32_t> order(nv);
   std::iota(order.begin(), order.end(), 0u);
@@ -47,49 +48,20 @@ void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint
     if (i > 0 && mesh.vertices[order[i]] != mesh.vertices[order[i - 1]]) ++next;
     weld[order[i]] = next;
   }
-  const std::uint32_t nw = nv == 0 ? 0 : next + 1;
-  // Triangles around each welded vertex (CSR).
-  std::vector<std::uint32_t> start(nw + 1, 0);
-  for (const auto& tri : mesh.triangles) {
-    for (const std::uint32_t v : tri) ++start[weld[v] + 1];
-  }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<std::uint32_t> incident(start.back());
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    for (const std::uint32_t v : mesh.triangles[t]) incident[fill[weld[v]]++] = t;
-  }
-  // Each triangle's neighbours, sorted and distinct, found in parallel chunks of triangles, then
-  // copied in parallel into their places: the same list a loop over the triangles would write.
+  const std::size_t nw = nv == 0 ? 0 : std::size_t{next} + 1;
   const std::size_t nt = mesh.triangles.size();
-  const std::size_t chunks = (nt + grain - 1) / grain;
-  std::vector<std::vector<std::uint32_t>> found(chunks);
-  offsets.assign(nt + 1, 0);
-  parallel::parallel_for(0, chunks, 1, [&](std::size_t c_lo, std::size_t c_hi) {
-    std::vector<std::uint32_t> around;
-    for (std::size_t c = c_lo; c != c_hi; ++c) {
-      for (std::size_t t = c * grain; t < std::min(nt, (c + 1) * grain); ++t) {
-        around.clear();
-        for (const std::uint32_t v : mesh.triangles[t]) {
-          const std::uint32_t w = weld[v];
-          for (std::uint32_t k = start[w]; k < start[w + 1]; ++k) {
-            if (incident[k] != t) around.push_back(incident[k]);
-          }
-        }
-        std::sort(around.begin(), around.end());
-        around.erase(std::unique(around.begin(), around.end()), around.end());
-        found[c].insert(found[c].end(), around.begin(), around.end());
-        offsets[t + 1] = static_cast<std::uint32_t>(around.size());
-      }
-    }
-  });
+  corner_vertex.resize(3 * nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    for (std::size_t k = 0; k < 3; ++k) corner_vertex[3 * t + k] = weld[mesh.triangles[t][k]];
+  }
+  // Triangles around each welded vertex (CSR, 64-bit offsets), filled in triangle order: ascending.
+  // A triangle with a repeated corner position is listed once per corner there.
+  offsets.assign(nw + 1, 0);
+  for (const std::uint32_t w : corner_vertex) ++offsets[w + 1];
   std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  adjacency.resize(offsets.back());
-  parallel::parallel_for(0, chunks, 1, [&](std::size_t c_lo, std::size_t c_hi) {
-    for (std::size_t c = c_lo; c != c_hi; ++c) {
-      std::copy(found[c].begin(), found[c].end(), adjacency.begin() + offsets[c * grain]);
-    }
-  });
+  triangles.resize(corner_vertex.size());
+  std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
+  for (std::size_t c = 0; c < corner_vertex.size(); ++c) triangles[fill[corner_vertex[c]]++] = static_cast<std::uint32_t>(c / 3);
 }
 
 }  // namespace caliber::bvh

@@ -318,7 +318,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].norm());
   }
   model->extent = extent;
-  if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->adjacency_offsets, model->adjacency);
+  if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;
 }

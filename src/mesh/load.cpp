@@ -1,13 +1,17 @@
-// Mesh loading through assimp, keeping the file's face order as triangle ids.
+// Mesh loading: the reader chosen by the file's extension (caliber's own for OFF and PLY, assimp's
+// for OBJ and STL), keeping the file's face order as triangle ids.
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <system_error>
 
+#include <assimp/BaseImporter.h>
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
@@ -66,50 +70,16 @@ std::string strip_log_prefix(const std::string& message) {
   return (message.rfind("Error", 0) == 0 && colon != std::string::npos) ? message.substr(colon + 2) : message;
 }
 
-}  // namespace
-
-Mesh load_mesh(const std::filesystem::path& path) {
-  check_file(path);
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::string head(64, '\0');
-    in.read(head.data(), 64);
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    // PLY and OFF: caliber's own readers (src/mesh/readers.h); assimp crashes or hangs on some bad
-    // files of both formats. Everything else goes to assimp.
-    if (mesh_io::looks_like_ply(head) || mesh_io::looks_like_off(head) || ext == ".ply" || ext == ".off") {
-      Mesh mesh = (mesh_io::looks_like_ply(head) || (ext == ".ply" && !mesh_io::looks_like_off(head))) ? mesh_io::read_ply(path)
-                                                                                                      : mesh_io::read_off(path);
-      validate_mesh(mesh);
-      return mesh;
-    }
-  }
-  std::lock_guard<std::mutex> lock(logger_mutex());
-  Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
-  auto* errors = new ErrorCollector();  // owned by the logger once attached
-  Assimp::DefaultLogger::get()->attachStream(errors, Assimp::Logger::Err);
-  struct KillLogger {
-    ~KillLogger() { Assimp::DefaultLogger::kill(); }
-  } kill_logger;
-
-  Assimp::Importer importer;
-  // No post-processing: triangulation, vertex joining or sorting by primitive type would change
-  // triangle ids. Polygons are fanned below, in place.
-  const aiScene* scene = importer.ReadFile(path.string(), 0);
-  if (scene == nullptr) {
-    std::string why = importer.GetErrorString();
-    if (why.empty()) why = "unknown error";
-    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + why);
-  }
-  if (!errors->first().empty()) {
-    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + strip_log_prefix(errors->first()));
-  }
+/// The meshes of an assimp scene, one after another, as one caliber mesh (faces fanned in place).
+Mesh convert(const aiScene& scene_ref, const std::filesystem::path& path) {
+  const aiScene* scene = &scene_ref;
   Mesh mesh;
   mesh.source = path.string();
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* in = scene->mMeshes[m];
+    if (in == nullptr || (in->mNumVertices > 0 && in->mVertices == nullptr) || (in->mNumFaces > 0 && in->mFaces == nullptr)) {
+      throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: the importer returned an incomplete mesh");
+    }
     const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
     for (unsigned v = 0; v < in->mNumVertices; ++v) {
       const aiVector3D& p = in->mVertices[v];
@@ -137,6 +107,61 @@ Mesh load_mesh(const std::filesystem::path& path) {
         mesh.triangles.push_back({base + face.mIndices[0], base + face.mIndices[k], base + face.mIndices[k + 1]});
       }
     }
+  }
+  return mesh;
+}
+
+/// OBJ and STL through assimp, the importer chosen by the extension and never by sniffing the
+/// content: a file is only ever read by the reader its name asks for. Neither format has a scene
+/// graph with transforms, so the meshes' vertices are the object's.
+Mesh read_with_assimp(const std::filesystem::path& path, const char* format) {
+  std::lock_guard<std::mutex> lock(logger_mutex());
+  Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
+  auto* errors = new ErrorCollector();  // owned by the logger once attached
+  Assimp::DefaultLogger::get()->attachStream(errors, Assimp::Logger::Err);
+  struct KillLogger {
+    ~KillLogger() { Assimp::DefaultLogger::kill(); }
+  } kill_logger;
+
+  Assimp::Importer importer;
+  Assimp::BaseImporter* reader = importer.GetImporter(format);
+  if (reader == nullptr) throw Error(ErrorCode::unreadable, path.string(), std::string("this assimp has no ") + format + " importer");
+  // No post-processing: triangulation, vertex joining or sorting by primitive type would change
+  // triangle ids. Polygons are fanned below, in place.
+  reader->SetupProperties(&importer);
+  const std::unique_ptr<aiScene> scene(reader->ReadFile(&importer, path.string(), importer.GetIOHandler()));
+  if (scene == nullptr) {
+    std::string why = reader->GetErrorText();
+    if (why.empty()) why = "unknown error";
+    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + why);
+  }
+  if (!errors->first().empty()) {
+    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + strip_log_prefix(errors->first()));
+  }
+  return convert(*scene, path);
+}
+
+}  // namespace
+
+std::string_view supported_mesh_formats() { return ".off, .ply, .obj and .stl"; }
+
+Mesh load_mesh(const std::filesystem::path& path) {
+  check_file(path);
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  // The extension alone chooses the reader. OFF and PLY: caliber's own strict readers
+  // (src/mesh/readers.h); assimp crashes or hangs on some bad files of both formats.
+  Mesh mesh;
+  if (ext == ".off") {
+    mesh = mesh_io::read_off(path);
+  } else if (ext == ".ply") {
+    mesh = mesh_io::read_ply(path);
+  } else if (ext == ".obj" || ext == ".stl") {
+    mesh = read_with_assimp(path, ext.c_str() + 1);
+  } else {
+    throw Error(ErrorCode::unreadable, path.string(),
+                (ext.empty() ? std::string("has no extension") : "extension '" + path.extension().string() + "' is not a mesh format caliber reads") +
+                    " (caliber reads " + std::string(supported_mesh_formats()) + " files, chosen by extension)");
   }
   validate_mesh(mesh);
   return mesh;

@@ -1,10 +1,23 @@
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
+#include "mesh/readers.h"
 
 namespace caliber {
+namespace {
+
+std::string tiny_coordinate(std::size_t v, double x) {
+  char value[32];
+  std::snprintf(value, sizeof value, "%.3g", x);
+  return "vertex " + std::to_string(v) + " has a coordinate of magnitude " + value +
+         ", below 2^-120 (about 7.5e-37), the smallest non-zero coordinate caliber's exact predicates take; "
+         "scale the mesh up (coordinates 0 or between 7.5e-37 and 1e15 are accepted)";
+}
+
+}  // namespace
 
 void validate_mesh(const Mesh& mesh) {
   const std::string& src = mesh.source.empty() ? std::string("mesh") : mesh.source;
@@ -17,6 +30,10 @@ void validate_mesh(const Mesh& mesh) {
     if (mesh.vertices[v].cwiseAbs().maxCoeff() > kMaxCoordinate) {
       throw Error(ErrorCode::bad_value, src,
                   "vertex " + std::to_string(v) + " has a coordinate beyond +-1e15 (caliber's limit on coordinates)");
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double x = std::abs(mesh.vertices[v][c]);
+      if (x != 0.0 && x < kMinCoordinate) throw Error(ErrorCode::bad_value, src, tiny_coordinate(v, mesh.vertices[v][c]));
     }
   }
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -53,8 +70,35 @@ void scale_mesh(Mesh& mesh, double factor) {
                   "scaling by " + std::to_string(factor) + " puts vertex " + std::to_string(v) +
                       " beyond +-1e15 (caliber's limit on coordinates)");
     }
+    for (int c = 0; c < 3; ++c) {
+      const double x = std::abs(scaled[c]);
+      if (x != 0.0 && x < kMinCoordinate) {
+        char f[32];
+        std::snprintf(f, sizeof f, "%g", factor);
+        throw Error(ErrorCode::bad_value, mesh.source, std::string("scaled by ") + f + ", " + tiny_coordinate(v, scaled[c]));
+      }
+    }
   }
   for (auto& v : mesh.vertices) v *= factor;
 }
 
+namespace mesh_io {
+
+std::string quote_token(std::string_view token) {
+  std::string out = "'";
+  for (std::size_t i = 0; i < token.size() && i < 40; ++i) {
+    const auto c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      out += hex;
+    }
+  }
+  if (token.size() > 40) out += "...";
+  return out + "'";
+}
+
+}  // namespace mesh_io
 }  // namespace caliber

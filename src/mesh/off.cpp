@@ -36,9 +36,12 @@ Lines tokenize(const std::string& data) {
   Lines lines;
   lines.first.push_back(0);
   std::size_t pos = 0, number = 0;
+  if (data.rfind("\xEF\xBB\xBF", 0) == 0) pos = 3;  // a UTF-8 byte order mark says nothing about the mesh
   while (pos < data.size()) {
-    std::size_t eol = data.find('\n', pos);
+    // Lines end with LF, CR LF or a lone CR (old Mac files).
+    std::size_t eol = data.find_first_of("\r\n", pos);
     if (eol == std::string::npos) eol = data.size();
+    const std::size_t next = (eol + 1 < data.size() && data[eol] == '\r' && data[eol + 1] == '\n') ? eol + 2 : eol + 1;
     ++number;
     std::string_view text(data.data() + pos, eol - pos);
     if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
@@ -55,7 +58,7 @@ Lines tokenize(const std::string& data) {
       lines.first.push_back(lines.tokens.size());
       lines.number.push_back(number);
     }
-    pos = eol + 1;
+    pos = next;
   }
   return lines;
 }
@@ -95,13 +98,13 @@ Mesh read_off(const std::filesystem::path& file) {
     double v = 0.0;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
     if (ec != std::errc() || end != t.data() + t.size()) {
-      fail(where(l) + ": '" + std::string(lines.token(l, k)) + "' is not " + what);
+      fail(where(l) + ": " + quote_token(lines.token(l, k)) + " is not " + what);
     }
     return v;
   };
   const auto count = [&](std::size_t l, std::size_t k, const char* what) -> std::uint64_t {
     const double v = number(l, k, what);
-    if (!(v >= 0) || v != std::floor(v) || v > 4e9) fail(where(l) + ": '" + std::string(lines.token(l, k)) + "' is not " + what);
+    if (!(v >= 0) || v != std::floor(v) || v > 4e9) fail(where(l) + ": " + quote_token(lines.token(l, k)) + " is not " + what);
     return static_cast<std::uint64_t>(v);
   };
 
@@ -111,7 +114,7 @@ Mesh read_off(const std::filesystem::path& file) {
     if (lines.count(0) > 1 && lines.token(0, 1) == "BINARY") fail("binary OFF is not supported");
     if (lines.count(0) == 1) l = 1; else k = 1;  // counts may follow the header on its line
   } else if (lines.token(0, 0).find("OFF") != std::string_view::npos) {
-    fail("unsupported OFF variant '" + std::string(lines.token(0, 0)) + "'");
+    fail("unsupported OFF variant " + quote_token(lines.token(0, 0)) + " (caliber reads OFF, COFF, NOFF, CNOFF, STOFF and the like, ascii)");
   }
   if (l >= lines.size()) fail("no vertex and face counts after the header (truncated file?)");
   if (lines.count(l) < k + 2) fail(where(l) + ": expected the vertex and face counts");

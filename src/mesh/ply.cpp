@@ -127,7 +127,7 @@ class Reader {
 
 }  // namespace
 
-bool looks_like_ply(const std::string& head) { return head.rfind("ply\n", 0) == 0 || head.rfind("ply\r\n", 0) == 0; }
+bool looks_like_ply(const std::string& head) { return head.rfind("ply\n", 0) == 0 || head.rfind("ply\r", 0) == 0; }
 
 namespace {
 
@@ -158,7 +158,7 @@ void read_property(std::istringstream& words, const std::string& where, const st
     p.type = *it;
   } else {
     const auto t = parse_type(type);
-    if (!t) fail(where + ": unknown property type '" + type + "'");
+    if (!t) fail(where + ": unknown property type " + quote_token(type));
     p.type = *t;
     words >> p.name;
   }
@@ -173,12 +173,12 @@ Header read_header(const std::string& data, const std::string& path) {
   std::size_t pos = 0, line_no = 0;
   bool ended = false;
   while (!ended) {
-    const std::size_t eol = data.find('\n', pos);
+    // Header lines end with LF, CR LF or a lone CR.
+    const std::size_t eol = data.find_first_of("\r\n", pos);
     if (eol == std::string::npos) fail("the header has no 'end_header' line (truncated file?)");
     std::string line = data.substr(pos, eol - pos);
-    pos = eol + 1;
+    pos = (data[eol] == '\r' && eol + 1 < data.size() && data[eol + 1] == '\n') ? eol + 2 : eol + 1;
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
@@ -191,8 +191,8 @@ Header read_header(const std::string& data, const std::string& path) {
       if (name == "ascii") format = Format::ascii;
       else if (name == "binary_little_endian") format = Format::little;
       else if (name == "binary_big_endian") format = Format::big;
-      else fail(where + ": unknown format '" + name + "'");
-      if (version != "1.0") fail(where + ": unsupported version '" + version + "'");
+      else fail(where + ": unknown format " + quote_token(name));
+      if (version != "1.0") fail(where + ": unsupported version " + quote_token(version));
     } else if (keyword == "element") {
       Element e;
       std::string count;
@@ -209,9 +209,9 @@ Header read_header(const std::string& data, const std::string& path) {
       ended = true;
       continue;
     } else {
-      fail(where + ": unknown header keyword '" + keyword + "'");
+      fail(where + ": unknown header keyword " + quote_token(keyword));
     }
-    if (words >> extra) fail(where + ": unexpected '" + extra + "'");
+    if (words >> extra) fail(where + ": unexpected " + quote_token(extra));
   }
   if (!format) fail("the header has no 'format' line");
   return Header{*format, std::move(elements), pos};
@@ -275,6 +275,10 @@ void read_element(Reader& reader, const Element& e, Format format, bool is_verte
   }
   if (is_vertex && (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)) fail("element 'vertex' needs properties x, y and z");
   if (is_face && indices < 0) fail("element 'face' needs a list property 'vertex_indices'");
+  if (is_face && !is_integer(e.properties[static_cast<std::size_t>(indices)].type)) {
+    fail("property '" + e.properties[static_cast<std::size_t>(indices)].name +
+         "' of element 'face' holds floating-point values; vertex indices must have an integer type");
+  }
   if (is_vertex) mesh.vertices.reserve(e.count);
   std::vector<std::uint32_t> corners;
   for (std::uint64_t i = 0; i < e.count; ++i) {

@@ -9,6 +9,37 @@
 #include "caliber/pose.h"
 
 namespace caliber {
+namespace {
+
+/// A translation's components must be 0 or of magnitude in [kMinCoordinate, kMaxCoordinate].
+void check_translation(const Eigen::Vector3d& t, std::string_view source) {
+  for (int c = 0; c < 3; ++c) {
+    const double x = std::abs(t[c]);
+    if (x > kMaxCoordinate) {
+      throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
+    }
+    if (x != 0.0 && x < kMinCoordinate) {
+      throw Error(ErrorCode::bad_value, std::string(source),
+                  "translation component below 2^-120 (about 7.5e-37), the smallest non-zero value caliber's exact predicates take");
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::Quaterniond unit_quaternion(double w, double x, double y, double z, std::string_view source) {
+  for (const double v : {w, x, y, z}) {
+    if (!std::isfinite(v)) throw Error(ErrorCode::bad_value, std::string(source), "quaternion has a non-finite value");
+  }
+  const double largest = std::max({std::abs(w), std::abs(x), std::abs(y), std::abs(z)});
+  // (Nearly) zero: no rotation is meant, or the numbers are noise. Refused, like exactly zero.
+  if (!(largest > 1e-9)) {
+    throw Error(ErrorCode::bad_value, std::string(source), "quaternion is (nearly) zero; a rotation needs a non-zero quaternion");
+  }
+  w /= largest, x /= largest, y /= largest, z /= largest;
+  const double norm = std::sqrt(w * w + x * x + y * y + z * z);  // in [1, 2]
+  return Eigen::Quaterniond(w / norm, x / norm, y / norm, z / norm);
+}
 
 Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, double qy, double qz,
                        std::string_view source) {
@@ -16,23 +47,9 @@ Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, do
   for (const double v : values) {
     if (!std::isfinite(v)) throw Error(ErrorCode::bad_value, std::string(source), "pose has a non-finite value");
   }
-  for (const double v : {tx, ty, tz}) {
-    if (std::abs(v) > kMaxCoordinate) {
-      throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
-    }
-  }
-  // Scaled before squaring, so that a huge quaternion does not overflow into a zero rotation.
-  const double largest = std::max({std::abs(qw), std::abs(qx), std::abs(qy), std::abs(qz)});
-  if (largest > 0.0) {
-    qw /= largest, qx /= largest, qy /= largest, qz /= largest;
-  }
-  const double unit_norm = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-  const double norm = largest * unit_norm;
-  if (!(norm > 1e-9)) {
-    throw Error(ErrorCode::bad_value, std::string(source), "quaternion is zero; a rotation needs a non-zero quaternion");
-  }
+  check_translation(Eigen::Vector3d(tx, ty, tz), source);
   Pose pose;
-  pose.rotation = Eigen::Quaterniond(qw / unit_norm, qx / unit_norm, qy / unit_norm, qz / unit_norm);
+  pose.rotation = unit_quaternion(qw, qx, qy, qz, source);
   pose.translation = Eigen::Vector3d(tx, ty, tz);
   return pose;
 }
@@ -69,9 +86,7 @@ void validate_pose(const Pose& pose, std::string_view source) {
   if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite()) {
     throw Error(ErrorCode::bad_value, std::string(source), "pose has a non-finite value");
   }
-  if (pose.translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
-    throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
-  }
+  check_translation(pose.translation, source);
   if (std::abs(pose.rotation.norm() - 1.0) > 1e-9) {
     throw Error(ErrorCode::bad_value, std::string(source), "quaternion is not unit length");
   }

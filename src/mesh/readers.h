@@ -5,10 +5,15 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "caliber/mesh.h"
 
 namespace caliber::mesh_io {
+
+/// A token of a file, for a message: in single quotes, bytes that do not print (NUL, control
+/// characters, non-ASCII) written as \xNN, at most 40 bytes of it (then "...").
+[[nodiscard]] std::string quote_token(std::string_view token);
 
 /// True when `head` (the file's first bytes) starts with the PLY magic line.
 [[nodiscard]] bool looks_like_ply(const std::string& head);

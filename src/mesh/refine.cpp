@@ -6,6 +6,7 @@
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
+#include "util/memory.h"
 
 namespace caliber {
 namespace {
@@ -43,21 +44,40 @@ Mesh refine_once(const Mesh& in) {
 
 Mesh refine_mesh(const Mesh& mesh, int levels) {
   if (levels < 0 || levels > 8) throw Error(ErrorCode::bad_value, "refine", "levels must be in [0, 8]");
-  if (mesh.triangles.size() << (2 * levels) >= 0x7fffffffu) {
-    throw Error(ErrorCode::bad_value, mesh.source, "refining this mesh " + std::to_string(levels) + " times makes too many triangles");
+  const std::uint64_t triangles = std::uint64_t{mesh.triangles.size()} << (2 * levels);
+  if (triangles >= 0x7fffffffu) {
+    throw Error(ErrorCode::bad_value, mesh.source,
+                "refining this mesh " + std::to_string(levels) + " times makes " + std::to_string(triangles) +
+                    " triangles, more than caliber's limit of 2^31 - 1");
+  }
+  // The last level holds its input and its output (12 bytes a triangle, 24 a vertex, about half a
+  // vertex a triangle) and a map entry per edge (about 64 bytes, 3/8 of an edge per new triangle).
+  const double needed = static_cast<double>(triangles) * (12.0 + 12.0 + 0.375 * 64.0 + 0.25 * 24.0) +
+                        static_cast<double>(mesh.vertices.size()) * 24.0;
+  const std::uint64_t available = util::available_memory();
+  if (levels > 0 && needed > static_cast<double>(available)) {
+    throw Error(ErrorCode::out_of_memory, mesh.source,
+                "refining this mesh " + std::to_string(levels) + " times makes " + std::to_string(triangles) + " triangles and needs about " +
+                    util::format_bytes(needed) + ", more than the " + util::format_bytes(static_cast<double>(available)) +
+                    " of memory available");
   }
   Mesh out = mesh;
   for (int i = 0; i < levels; ++i) out = refine_once(out);
   return out;
 }
 
-void save_off(const Mesh& mesh, const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw Error(ErrorCode::unreadable, path.string(), "cannot be opened for writing");
+void write_off(const Mesh& mesh, std::ostream& out) {
   out.precision(17);
   out << "OFF\n" << mesh.vertices.size() << ' ' << mesh.triangles.size() << " 0\n";
   for (const auto& v : mesh.vertices) out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
   for (const auto& t : mesh.triangles) out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+}
+
+void save_off(const Mesh& mesh, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(ErrorCode::unreadable, path.string(), "cannot be opened for writing");
+  write_off(mesh, out);
+  out.flush();
   if (!out) throw Error(ErrorCode::unreadable, path.string(), "write failed");
 }
 

@@ -90,14 +90,16 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
     for (std::size_t i = lo; i != hi; ++i) {
       const Candidate& c = candidates[i];
       bool dominated = false;
-      for (std::uint32_t k = ma.adjacency_offsets[c.tri_a]; !dominated && k < ma.adjacency_offsets[c.tri_a + 1]; ++k) {
-        const Candidate* other = index.find(ma.adjacency[k], c.tri_b);
+      ma.for_each_neighbour(c.tri_a, [&](std::uint32_t u) {
+        if (dominated) return;
+        const Candidate* other = index.find(u, c.tri_b);
         dominated = other != nullptr && closer(*other, c);
-      }
-      for (std::uint32_t k = mb.adjacency_offsets[c.tri_b]; !dominated && k < mb.adjacency_offsets[c.tri_b + 1]; ++k) {
-        const Candidate* other = index.find(c.tri_a, mb.adjacency[k]);
+      });
+      mb.for_each_neighbour(c.tri_b, [&](std::uint32_t u) {
+        if (dominated) return;
+        const Candidate* other = index.find(c.tri_a, u);
         dominated = other != nullptr && closer(*other, c);
-      }
+      });
       keep[i] = dominated ? 0 : 1;
     }
   });
@@ -119,7 +121,7 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   // Contacts: the local minima first (their verdicts do not depend on the order), so that only the
   // few kept candidates are sorted, not every pair within the tolerance.
   if (result.kind == QueryKind::contact) {
-    if (ctx.a().adjacency_offsets.empty() || ctx.b().adjacency_offsets.empty()) {
+    if (!ctx.a().has_adjacency() || !ctx.b().has_adjacency()) {
       throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
     }
     candidates = local_minima(ctx, candidates, grain);

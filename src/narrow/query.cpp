@@ -36,6 +36,9 @@ void validate_request(const QueryRequest& request) {
   if (request.tolerance > kMaxCoordinate) {
     throw Error(ErrorCode::bad_value, "tolerance", "must be at most 1e15 (caliber's limit on coordinates)");
   }
+  if (request.tolerance > 0.0 && request.tolerance < kMinCoordinate) {
+    throw Error(ErrorCode::bad_value, "tolerance", "must be 0 or at least 2^-120 (about 7.5e-37; caliber's exact predicates need no smaller)");
+  }
   if (!std::isfinite(request.angle_deg) || request.angle_deg < 0.0 || request.angle_deg > 180.0) {
     throw Error(ErrorCode::bad_value, "angle", "must be a number of degrees in [0, 180]");
   }

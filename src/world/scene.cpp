@@ -75,9 +75,11 @@ class Reader {
     if (!j.is_array() || j.size() != 4) fail(key, "must be an array of 4 numbers [w, x, y, z]");
     double q[4];
     for (int i = 0; i < 4; ++i) q[i] = number(j[i], key + "[" + std::to_string(i) + "]");
-    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (!(n > 1e-9)) fail(key, "quaternion is zero");
-    return Eigen::Quaterniond(q[0] / n, q[1] / n, q[2] / n, q[3] / n);
+    try {
+      return unit_quaternion(q[0], q[1], q[2], q[3], "");
+    } catch (const Error& e) {
+      fail(key, e.what());
+    }
   }
 
   const Json& required(const Json& obj, const std::string& where, const char* key) const {
@@ -159,6 +161,27 @@ SceneObject read_object(const Reader& r, const Json& j, const std::string& where
   return o;
 }
 
+QueryRequest read_query(const Reader& r, const Json& q) {
+  r.only_keys(q, "query", {"kind", "tolerance", "angle"});
+  QueryRequest query;
+  if (q.contains("kind")) {
+    try {
+      query.kind = parse_query_kind(r.string(q.at("kind"), "query.kind"));
+    } catch (const Error& e) {
+      r.fail("query.kind", e.what());
+    }
+  }
+  query.tolerance = r.number(q, "query", "tolerance", 0.0);
+  if (query.tolerance < 0.0) r.fail("query.tolerance", "must be >= 0");
+  if (query.tolerance > kMaxCoordinate) r.fail("query.tolerance", "must be at most 1e15 (caliber's limit on coordinates)");
+  if (query.tolerance > 0.0 && query.tolerance < kMinCoordinate) {
+    r.fail("query.tolerance", "must be 0 or at least 2^-120 (about 7.5e-37; caliber's exact predicates need no smaller)");
+  }
+  query.angle_deg = r.number(q, "query", "angle", query.angle_deg);
+  if (query.angle_deg < 0.0 || query.angle_deg > 180.0) r.fail("query.angle", "must be in [0, 180] degrees");
+  return query;
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir, const std::string& source) {
@@ -176,21 +199,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
   scene.dt = r.number(root, "", "dt", scene.dt);
   if (!(scene.dt > 0.0)) r.fail("dt", "must be > 0");
 
-  if (root.contains("query")) {
-    const Json& q = root.at("query");
-    r.only_keys(q, "query", {"kind", "tolerance", "angle"});
-    if (q.contains("kind")) {
-      try {
-        scene.query.kind = parse_query_kind(r.string(q.at("kind"), "query.kind"));
-      } catch (const Error& e) {
-        r.fail("query.kind", e.what());
-      }
-    }
-    scene.query.tolerance = r.number(q, "query", "tolerance", 0.0);
-    if (scene.query.tolerance < 0.0) r.fail("query.tolerance", "must be >= 0");
-    scene.query.angle_deg = r.number(q, "query", "angle", scene.query.angle_deg);
-    if (scene.query.angle_deg < 0.0 || scene.query.angle_deg > 180.0) r.fail("query.angle", "must be in [0, 180] degrees");
-  }
+  if (root.contains("query")) scene.query = read_query(r, root.at("query"));
 
   const Json& objects = r.required(root, "", "objects");
   if (!objects.is_array() || objects.empty()) r.fail("objects", "must be a non-empty array");

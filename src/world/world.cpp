@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <new>
 #include <tuple>
 
 #include "caliber/error.h"
@@ -47,7 +48,7 @@ World::World(Scene scene) : mScene(std::move(scene)) {
     for (const GroupRange& g : o.groups) ranges.emplace_back(g.first, g.count, g.group);
     const Key key{o.mesh.string(), o.scale, o.refine, o.group, ranges};
     auto it = cache.find(key);
-    if (it == cache.end()) {
+    if (it == cache.end()) try {
       auto file = loaded.find(o.mesh.string());
       if (file == loaded.end()) file = loaded.emplace(o.mesh.string(), load_mesh(o.mesh)).first;
       Mesh mesh = refine_mesh(file->second, o.refine);
@@ -62,7 +63,12 @@ World::World(Scene scene) : mScene(std::move(scene)) {
           std::fill_n(mesh.groups.begin() + g.first, g.count, g.group);
         }
       }
-      it = cache.emplace(key, build_model(std::move(mesh))).first;
+      BuildOptions build;
+      build.adjacency = mRequest.kind == QueryKind::contact;  // only the contact reduction reads it
+      it = cache.emplace(key, build_model(std::move(mesh), build)).first;
+    } catch (const std::bad_alloc&) {
+      throw Error(ErrorCode::out_of_memory, o.mesh.string(),
+                  "out of memory while loading and building the model of object '" + o.name + "'");
     }
     mModels.push_back(it->second);
     mStatic.push_back(o.motion.type == Motion::Type::fixed);

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <functional>
@@ -108,6 +109,15 @@ TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
   check_model(*model);
 }
 
+/// The triangles sharing a vertex position with t, sorted and distinct.
+std::vector<std::uint32_t> neighbours(const Model& model, std::uint32_t t) {
+  std::vector<std::uint32_t> out;
+  model.for_each_neighbour(t, [&](std::uint32_t u) { out.push_back(u); });
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
   // Two triangles sharing an edge, with the shared vertices repeated (as STL stores them),
   // and a third far away.
@@ -115,10 +125,7 @@ TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
   mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {5, 5, 5}, {6, 5, 5}, {5, 6, 5}};
   mesh.triangles = {{0, 1, 2}, {3, 5, 4}, {6, 7, 8}};
   const auto model = build_model(mesh);
-  const auto neighbors = [&](std::uint32_t t) {
-    return std::vector<std::uint32_t>(model->adjacency.begin() + model->adjacency_offsets[t],
-                                      model->adjacency.begin() + model->adjacency_offsets[t + 1]);
-  };
+  const auto neighbors = [&](std::uint32_t t) { return neighbours(*model, t); };
   EXPECT_EQ(neighbors(0), std::vector<std::uint32_t>{1});
   EXPECT_EQ(neighbors(1), std::vector<std::uint32_t>{0});
   EXPECT_TRUE(neighbors(2).empty());
@@ -147,8 +154,9 @@ TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
     EXPECT_EQ(many->first_leaf, one->first_leaf);
     EXPECT_EQ(many->leaf_position, one->leaf_position);
     EXPECT_EQ(bytes(many->normals), bytes(one->normals));
-    EXPECT_EQ(many->adjacency_offsets, one->adjacency_offsets);
-    EXPECT_EQ(many->adjacency, one->adjacency);
+    EXPECT_EQ(many->corner_vertex, one->corner_vertex);
+    EXPECT_EQ(many->vertex_offsets, one->vertex_offsets);
+    EXPECT_EQ(many->vertex_triangles, one->vertex_triangles);
     EXPECT_EQ(many->height, one->height);
     EXPECT_EQ(many->extent, one->extent);
   }
@@ -174,9 +182,26 @@ TEST(BuildModel, BoxAdjacencyIsVertexAdjacency) {
   const auto model = build_model(make_box(1, 1, 1, 1));
   // A cube of 12 triangles: faces are separate grids, so adjacency comes from welding positions.
   for (std::uint32_t t = 0; t < 12; ++t) {
-    const auto count = model->adjacency_offsets[t + 1] - model->adjacency_offsets[t];
-    EXPECT_GE(count, 5u) << "triangle " << t;
+    EXPECT_GE(neighbours(*model, t).size(), 5u) << "triangle " << t;
   }
+}
+
+TEST(BuildModel, AdjacencyIsLinearInTheCornersOfAHugeFan) {
+  // One polygon of 200,000 corners fanned from its first: the fan's hub touches every triangle.
+  // The old per-triangle neighbour lists held the square of that degree (4e10 entries); the
+  // per-vertex lists hold three entries a triangle.
+  Mesh mesh;
+  const int n = 200000;
+  mesh.vertices.emplace_back(0, 0, 0);
+  for (int i = 0; i < n; ++i) {
+    const double a = 6.283185307179586 * i / n;
+    mesh.vertices.emplace_back(std::cos(a), std::sin(a), 0.0);
+  }
+  for (std::uint32_t i = 1; i + 1 <= static_cast<std::uint32_t>(n); ++i) mesh.triangles.push_back({0, i, i + 1});
+  const auto model = build_model(mesh);
+  EXPECT_EQ(model->vertex_triangles.size(), 3 * mesh.triangles.size());
+  EXPECT_EQ(model->corner_vertex.size(), 3 * mesh.triangles.size());
+  EXPECT_EQ(neighbours(*model, 5).size(), mesh.triangles.size() - 1) << "the hub: every other triangle";
 }
 
 }  // namespace

@@ -123,7 +123,7 @@ check run-directory 2 "$cli" run "$data/scenes"
 selfdir=$(mktemp -d)
 echo '{"objects": [{"mesh": "self.json"}, {"mesh": "self.json", "position": [0.1, 0, 0]}]}' > "$selfdir/self.json"
 check run-self 2 "$cli" run "$selfdir/self.json"
-contains run-self "self.json: cannot parse mesh"
+contains run-self "self.json: extension '.json' is not a mesh format caliber reads"
 rm -rf "$selfdir"
 check run-threads-negative 2 "$cli" run "$data/scenes/tetras.json" --threads -1
 contains run-threads-negative "threads: must be between 1 and 1024"
