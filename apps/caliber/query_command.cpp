@@ -104,10 +104,15 @@ int run_query(const QueryOptions& opt) {
   for (int r = 0; r < opt.repeat; ++r) {
     caliber::QueryResult again;
     const auto start = Clock::now();
-    if (engine) {
-      again = query_with_engine(*engine, frame);
-    } else {
-      again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
+    try {
+      if (engine) {
+        again = query_with_engine(*engine, frame);
+      } else {
+        again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
+      }
+    } catch (const std::bad_alloc&) {
+      throw caliber::Error(caliber::ErrorCode::out_of_memory, opt.mesh_a + " x " + opt.mesh_b,
+                           "out of memory while running the query (a smaller tolerance reports fewer pairs)");
     }
     query_ms.push_back(ms_since(start));
     if (r == 0) {

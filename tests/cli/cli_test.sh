@@ -238,5 +238,137 @@ check bench-bad-threads 2 "$cli" bench "$data/scenes/tetras.json" --threads 0 --
 check bench-bad-repeat 2 "$cli" bench "$data/scenes/tetras.json" --repeat 0 --out "$tmp/bench2"
 rm -rf "$tmp"
 
+# Reliability round 2 (docs/bad_input.md): readers by extension, linear adjacency, exact range,
+# memory, outputs that are never lost, SIGINT.
+r2=$(mktemp -d)
+asan=0
+ldd "$cli" 2>/dev/null | grep -q libasan && asan=1
+cp "$data/tetra.off" "$r2/tetra.ase"
+check ext-ase 2 "$cli" query "$r2/tetra.ase" "$data/tetra.off"
+contains ext-ase "extension '.ase' is not a mesh format caliber reads"
+contains ext-ase ".off, .ply, .obj and .stl"
+cp "$data/tetra.off" "$r2/noext"
+check ext-none 2 "$cli" query "$r2/noext" "$data/tetra.off"
+contains ext-none "has no extension"
+cp "$data/tetra.off" "$r2/UPPER.OFF"
+check ext-upper 0 "$cli" query "$r2/UPPER.OFF" "$data/tetra.off"
+printf 'OFF3 2 0\n0 0 0\n1 1 1\n' > "$r2/variant.off"
+check off-variant 2 "$cli" query "$r2/variant.off" "$data/tetra.off"
+contains off-variant "unsupported OFF variant 'OFF3'"
+printf 'PLY\nformat ascii 1.0\nend_header\n' > "$r2/upper.ply"
+check ply-upper-magic 2 "$cli" query "$r2/upper.ply" "$data/tetra.off"
+contains ply-upper-magic "starts with the line 'ply'"
+printf '<?xml version="1.0"?><COLLADA></COLLADA>\n' > "$r2/scene.dae"
+check ext-dae 2 "$cli" query "$r2/scene.dae" "$data/tetra.off"
+printf '\xef\xbb\xbfOFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n' > "$r2/bom.off"
+check off-bom 0 "$cli" query "$r2/bom.off" "$data/tetra.off"
+printf 'OFF\r4 4 0\r0 0 0\r1 0 0\r0 1 0\r0 0 1\r3 0 1 2\r3 0 1 3\r3 0 2 3\r3 1 2 3\r' > "$r2/cr.off"
+check off-cr-only 0 "$cli" query "$r2/cr.off" "$data/tetra.off"
+printf 'OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 x\0y\n' > "$r2/nul.off"
+check off-nul 2 "$cli" query "$r2/nul.off" "$data/tetra.off"
+contains off-nul "'x\x00y' is not a vertex index"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar float vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0.9 1 2\n' > "$r2/float_index.ply"
+check ply-float-index 2 "$cli" query "$r2/float_index.ply" "$data/tetra.off"
+contains ply-float-index "vertex indices must have an integer type"
+# One polygon of 100,000 corners: linear adjacency, answered (was quadratic: ~40 GB).
+python3 - "$r2/fan.off" <<'PY'
+import math, sys
+n = 100000
+with open(sys.argv[1], "w") as f:
+    f.write(f"OFF\n{n} 1 0\n")
+    for i in range(n):
+        a = 2 * math.pi * i / n
+        f.write(f"{math.cos(a)!r} {math.sin(a)!r} 0\n")
+    f.write(f"{n} " + " ".join(map(str, range(n))) + "\n")
+PY
+if [ "$asan" = 0 ]; then
+  check huge-polygon 0 bash -c "ulimit -v 2000000; exec \"\$0\" query \"\$1\" \"\$1\" --kind contact --tolerance 0.01 --pose-b '0 0 0.005 1 0 0 0'" "$cli" "$r2/fan.off"
+else
+  check huge-polygon 0 "$cli" query "$r2/fan.off" "$r2/fan.off" --kind contact --tolerance 0.01 --pose-b "0 0 0.005 1 0 0 0"
+fi
+contains huge-polygon "contacts"
+# Coordinates below 2^-120: refused, naming the file and the range.
+printf 'OFF\n3 1 0\n0 0 0\n1e-40 0 0\n0 1e-40 0\n3 0 1 2\n' > "$r2/tiny.off"
+check tiny-coordinates 2 "$cli" query "$r2/tiny.off" "$r2/tiny.off"
+contains tiny-coordinates "tiny.off: vertex 1 has a coordinate of magnitude 1e-40, below 2^-120"
+check tiny-tolerance 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind proximity --tolerance 1e-40
+# Scene: a huge tolerance names the file and the key; a huge quaternion is the same rotation.
+mkdir -p "$r2/s"
+cp "$data/tetra.off" "$r2/s/tetra.off"
+echo '{"query": {"kind": "proximity", "tolerance": 1e16}, "objects": [{"mesh": "tetra.off"}]}' > "$r2/s/tol.json"
+check scene-huge-tolerance 2 "$cli" run "$r2/s/tol.json"
+contains scene-huge-tolerance "tol.json: 'query.tolerance': must be at most 1e15"
+for q in "1, 0, 0, 1" "1e200, 0, 0, 1e200"; do
+  echo '{"steps": 1, "objects": [{"mesh": "tetra.off"}, {"mesh": "tetra.off", "position": [0.3, 0.1, 0.1], "orientation": ['"$q"'], "motion": {"type": "velocity"}}]}' > "$r2/s/q.json"
+  "$cli" run "$r2/s/q.json" --contacts "$r2/q-$(echo "$q" | cut -c1-3).jsonl" > /dev/null 2>&1
+done
+if cmp -s "$r2/q-1, .jsonl" "$r2/q-1e2.jsonl" && grep -q '"tri_a"' "$r2/q-1, .jsonl"; then passes=$((passes + 1)); else
+  echo "FAIL huge-quaternion: [1e200, 0, 0, 1e200] did not give [1, 0, 0, 1]'s contacts"; failures=$((failures + 1)); fi
+# Refinement that cannot fit: refused before allocating.
+python3 - "$r2/grid.off" <<'PY'
+import sys
+n = 200
+with open(sys.argv[1], "w") as f:
+    f.write(f"OFF\n{(n + 1) ** 2} {2 * n * n} 0\n")
+    for i in range(n + 1):
+        for j in range(n + 1):
+            f.write(f"{i} {j} 0\n")
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = i * (n + 1) + j, i * (n + 1) + j + 1, (i + 1) * (n + 1) + j, (i + 1) * (n + 1) + j + 1
+            f.write(f"3 {a} {b} {d}\n3 {a} {d} {c}\n")
+PY
+check refine-too-big 2 "$cli" refine "$r2/grid.off" "$r2/grid7.off" --levels 7
+contains refine-too-big "of memory available"
+[ -e "$r2/grid7.off" ] && { echo "FAIL refine-too-big: wrote an output"; failures=$((failures + 1)); }
+if [ "$asan" = 0 ]; then
+  check out-of-memory 2 bash -c "ulimit -v 400000; exec \"\$0\" query \"\$1\" \"\$1\" --kind proximity --tolerance 5" "$cli" "$r2/grid.off"
+  contains out-of-memory "grid.off: out of memory while running the query"
+fi
+# Outputs: checked before the work, never two in one file, never over an input, never half-written.
+check out-same-file 2 "$cli" run "$data/scenes/tetras.json" --json "$r2/o.json" --contacts "$r2/o.json"
+contains out-same-file "names the same file as --json"
+check out-over-input 2 "$cli" run "$r2/s/q.json" --contacts "$r2/s/q.json"
+contains out-over-input "would overwrite the input the scene"
+check out-over-mesh 2 "$cli" run "$r2/s/q.json" --json "$r2/s/tetra.off"
+check out-no-folder 2 "$cli" run "$data/scenes/tetras.json" --json /nonexistent/r.json
+contains out-no-folder "no folder /nonexistent"
+contains out-no-folder "/nonexistent/r.json"
+if [ -w /dev/full ]; then
+  check out-full-contacts 2 "$cli" run "$data/scenes/tetras.json" --contacts /dev/full
+  contains out-full-contacts "/dev/full: could not be written"
+  check out-full-refine 2 "$cli" refine "$data/tetra.off" /dev/full --levels 6
+  check out-full-stdout 2 bash -c 'exec "$0" query "$1" "$1" --json > /dev/full' "$cli" "$data/tetra.off"
+  contains out-full-stdout "standard output: could not be written"
+fi
+check refine-over-input 2 "$cli" refine "$r2/s/tetra.off" "$r2/s/tetra.off"
+contains refine-over-input "would overwrite the input IN"
+# Two runs writing one report at once: each write is whole (temporary file, then rename).
+"$cli" run "$data/scenes/tetras.json" --json "$r2/same.json" > /dev/null 2>&1 &
+"$cli" run "$data/scenes/tetras.json" --json "$r2/same.json" > /dev/null 2>&1
+wait
+python3 -c "import json, sys; json.load(open(sys.argv[1]))" "$r2/same.json" && passes=$((passes + 1)) || {
+  echo "FAIL out-concurrent: invalid JSON"; failures=$((failures + 1)); }
+ls "$r2"/.same.json.* > /dev/null 2>&1 && { echo "FAIL out-concurrent: temporary file left"; failures=$((failures + 1)); }
+# bench checks its scenes before it creates a folder.
+check bench-bad-scene-no-folder 2 "$cli" bench "$r2/s/tol.json" --out "$r2/benchdir"
+[ -e "$r2/benchdir" ] && { echo "FAIL bench-bad-scene-no-folder: created $r2/benchdir"; failures=$((failures + 1)); }
+# SIGINT: the step in progress ends, what was measured is written, exit 130.
+"$cli" run "$data/scenes/tetras.json" --steps 100000000 --json "$r2/int.json" --contacts "$r2/int.jsonl" > /dev/null 2>&1 &
+pid=$!
+for _ in $(seq 100); do [ -s "$r2/.int.jsonl.caliber-$pid.tmp" ] && break; sleep 0.1; done
+sleep 0.5
+kill -INT "$pid"
+wait "$pid"
+rc=$?
+if [ "$rc" = 130 ] && python3 - "$r2/int.json" "$r2/int.jsonl" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["interrupted"] is True and 0 < r["summary"]["steps"] < 100000000, r["summary"]
+assert len(open(sys.argv[2]).read().splitlines()) == r["summary"]["steps"]
+PY
+then passes=$((passes + 1)); else echo "FAIL sigint: exit $rc"; failures=$((failures + 1)); fi
+rm -rf "$r2"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -88,7 +88,7 @@ TEST(SceneFile, ErrorsNameTheKey) {
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "scale": "big"}]})", "'objects[0].scale': must be a number");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "refine": 9}]})", "'objects[0].refine': must be in [0, 6]");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "position": [1, 2]}]})", "'objects[0].position': must be an array of 3");
-  expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "orientation": [0, 0, 0, 0]}]})", "quaternion is zero");
+  expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "orientation": [0, 0, 0, 0]}]})", "quaternion is (nearly) zero");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "teleport"}}]})", "unknown motion 'teleport'");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "keyframes", "keys": []}}]})",
                      "'objects[0].motion.keys': must be a non-empty array");
