@@ -287,6 +287,19 @@ else
   check huge-polygon 0 "$cli" query "$r2/fan.off" "$r2/fan.off" --kind contact --tolerance 0.01 --pose-b "0 0 0.005 1 0 0 0"
 fi
 contains huge-polygon "contacts"
+# Every reader under a small address space: the test files load; files that announce billions of
+# elements fail before allocating them.
+printf 'OFF\n2000000000 2000000000 0\n0 0 0\n' > "$r2/bomb.off"
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n' > "$r2/bomb.ply"
+python3 -c "import struct, sys; open(sys.argv[1], 'wb').write(b'\0' * 80 + struct.pack('<I', 4000000000))" "$r2/bomb.stl"
+if [ "$asan" = 0 ]; then
+  for f in tetra.off tetra.ply tetra.obj tetra_ascii.stl tetra_binary.stl; do
+    check "reader-ulimit-$f" 0 bash -c "ulimit -v 400000; exec \"\$0\" query \"\$1\" \"\$1\" --kind contact --tolerance 0.1" "$cli" "$data/$f"
+  done
+  for f in bomb.off bomb.ply bomb.stl; do
+    check "reader-bomb-$f" 2 bash -c "ulimit -v 400000; exec \"\$0\" query \"\$1\" \"\$1\"" "$cli" "$r2/$f"
+  done
+fi
 # Coordinates below 2^-120: refused, naming the file and the range.
 printf 'OFF\n3 1 0\n0 0 0\n1e-40 0 0\n0 1e-40 0\n3 0 1 2\n' > "$r2/tiny.off"
 check tiny-coordinates 2 "$cli" query "$r2/tiny.off" "$r2/tiny.off"

@@ -1,7 +1,8 @@
 // Fuzz target: the mesh loaders (OFF, OBJ, PLY, STL through assimp), then a BVH build and a
 // contact query of the mesh against itself, so that whatever a loader lets through (huge, tiny,
 // degenerate coordinates) also goes through the BVH and the exact predicates.
-// Input: first byte picks the format, the rest is the file's content.
+// Input: first byte picks the file's extension (the format, or one caliber refuses), the rest is
+// the file's content.
 
 #include <filesystem>
 #include <fstream>
@@ -32,8 +33,10 @@ const std::filesystem::path& scratch_dir() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  static const char* const kExtensions[] = {".off", ".obj", ".ply", ".stl"};
-  const std::filesystem::path path = scratch_dir() / (std::string("input") + kExtensions[data[0] % 4]);
+  // The four formats, the same in capitals, and names caliber must refuse whatever they hold (no
+  // extension, formats assimp knows but caliber does not read).
+  static const char* const kExtensions[] = {".off", ".obj", ".ply", ".stl", "", ".ase", ".dae", ".OFF", ".PLY", ".nff", ".raw", ".smd"};
+  const std::filesystem::path path = scratch_dir() / (std::string("input") + kExtensions[data[0] % 12]);
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
