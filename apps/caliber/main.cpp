@@ -7,18 +7,20 @@
 // stopped by SIGINT (what it measured is written), 1 unexpected internal error.
 
 #include <iostream>
+#include <string>
 #include <new>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "caliber/error.h"
+#include "caliber/version.h"
 #include "commands.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"caliber: exact collision detection between rigid triangle meshes"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "caliber 0.1.0");
+  app.set_version_flag("--version", std::string("caliber ") + caliber::kVersion);
   const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app),
                                                       caliber::cli::add_run_command(app),
                                                       caliber::cli::add_refine_command(app),

@@ -4,6 +4,7 @@
 /// runs the same traversal and returns byte-identical contacts; they differ only in the task list
 /// and the schedule.
 
+#include "caliber/export.h"
 #include <cstdint>
 #include <memory>
 #include <string_view>
@@ -124,9 +125,9 @@ enum class Method : std::uint8_t {
 };
 
 /// "sequential", "exploitation", "stealing", "aposteriori", "apriori" or "hybrid".
-[[nodiscard]] std::string_view to_string(Method method);
+[[nodiscard]] CALIBER_EXPORT std::string_view to_string(Method method);
 /// Parses a method name; throws caliber::Error on an unknown one.
-[[nodiscard]] Method parse_method(std::string_view name);
+[[nodiscard]] CALIBER_EXPORT Method parse_method(std::string_view name);
 
 /// Options of the engine.
 struct EngineOptions {
@@ -155,18 +156,18 @@ struct EngineOptions {
 
 /// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded
 /// of `cores` virtual cores (the policy of a dynamic parallel loop with grain 1).
-[[nodiscard]] double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores);
+[[nodiscard]] CALIBER_EXPORT double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores);
 
 /// The load-balance simulation: the speed-up on `cores` virtual cores that the step's recorded
 /// work units predict for `method` (total node tests / simulated makespan). Calibrated methods: the
 /// weight-driven stage, then a barrier, then the run-time tasks in handout order. Exploitation: the
 /// pairs in order. Stealing: its depth-first pieces, largest first, plus the splitting work spread
 /// evenly (an optimistic model of stealing). Sequential: 1.
-[[nodiscard]] double simulated_speedup(const StepResult& step, Method method, int cores);
+[[nodiscard]] CALIBER_EXPORT double simulated_speedup(const StepResult& step, Method method, int cores);
 
 /// The load-balance simulation over a run: the run's predicted speed-up on `cores` virtual cores is
 /// its total node tests over the sum of its steps' simulated makespans.
-class SimulatedRun {
+class CALIBER_EXPORT SimulatedRun {
  public:
   SimulatedRun(Method method, int cores) : mMethod(method), mCores(cores) {}
   /// Adds one step.
@@ -186,7 +187,7 @@ class SimulatedRun {
 /// Runs frames with a method on a fixed number of threads (a oneTBB task arena of exactly that
 /// many). Keeps, between steps, what the temporal methods learn of each object pair. Not
 /// thread-safe itself: one step at a time (use one engine per thread to step several at once).
-class Engine {
+class CALIBER_EXPORT Engine {
  public:
   /// Throws caliber::Error on a thread count outside 0..1024, a negative stealing depth, a beta
   /// that is not > 0, a negative epsilon or a taboo cap below 1.
@@ -216,6 +217,6 @@ class Engine {
 
 /// Checks a frame against Frame's rules; throws caliber::Error (source "frame") naming the first
 /// problem. Engine::step calls it.
-void validate_frame(const Frame& frame);
+CALIBER_EXPORT void validate_frame(const Frame& frame);
 
 }  // namespace caliber

@@ -2,6 +2,7 @@
 /// \file
 /// The one exception type the library throws for bad input.
 
+#include "caliber/export.h"
 #include <stdexcept>
 #include <string>
 
@@ -21,7 +22,7 @@ enum class ErrorCode {
 /// Thrown for every bad input: missing or malformed files, non-finite values, bad options.
 /// `what()` is a complete message that names the source (file path or option) and the problem.
 /// Nothing in the library crashes or returns a silent wrong answer on such input instead.
-class Error : public std::runtime_error {
+class CALIBER_EXPORT Error : public std::runtime_error {
  public:
   /// `source` names where the problem is (a file path, an option name); may be empty.
   Error(ErrorCode code, std::string source, const std::string& problem)

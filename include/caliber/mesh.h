@@ -2,6 +2,7 @@
 /// \file
 /// Triangle meshes: the geometry of one rigid object, in its own (object) frame.
 
+#include "caliber/export.h"
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -46,7 +47,7 @@ inline constexpr double kMaxCoordinate = 1e15;
 inline constexpr double kMinCoordinate = 0x1p-120;
 
 /// The formats load_mesh reads, for messages: ".off, .ply, .obj and .stl".
-[[nodiscard]] std::string_view supported_mesh_formats();
+[[nodiscard]] CALIBER_EXPORT std::string_view supported_mesh_formats();
 
 /// Loads a mesh, the reader chosen by the file's extension (any case) and never by its content:
 /// .off and .ply by caliber's own strict readers, .obj and .stl (ascii and binary) by assimp's
@@ -55,25 +56,25 @@ inline constexpr double kMinCoordinate = 0x1p-120;
 /// fanned from its first corner, in place. Vertices are not merged or reordered.
 /// Throws caliber::Error naming the file on a missing file, a parse error, a non-finite coordinate,
 /// an index out of range, a face with fewer than 3 corners, or a mesh without triangles.
-[[nodiscard]] Mesh load_mesh(const std::filesystem::path& path);
+[[nodiscard]] CALIBER_EXPORT Mesh load_mesh(const std::filesystem::path& path);
 
 /// Checks the invariants every routine relies on: at least one triangle, finite coordinates of
 /// magnitude 0 or in [kMinCoordinate, kMaxCoordinate], indices in range, groups (if any) one per triangle and below kMaxGroups.
 /// Throws caliber::Error naming `mesh.source` and the first problem found.
-void validate_mesh(const Mesh& mesh);
+CALIBER_EXPORT void validate_mesh(const Mesh& mesh);
 
 /// 1-to-4 midpoint subdivision, `levels` times: triangle t becomes triangles 4t .. 4t+3 (corner at
 /// vertex 0, at vertex 1, at vertex 2, then the middle one), so ids stay predictable. The surface
 /// does not change, only its triangle count; groups are inherited.
-[[nodiscard]] Mesh refine_mesh(const Mesh& mesh, int levels);
+[[nodiscard]] CALIBER_EXPORT Mesh refine_mesh(const Mesh& mesh, int levels);
 
 /// Writes the mesh as OFF text to a stream (17 significant digits: the doubles come back exactly).
-void write_off(const Mesh& mesh, std::ostream& out);
+CALIBER_EXPORT void write_off(const Mesh& mesh, std::ostream& out);
 
 /// Writes the mesh as an OFF file. Throws caliber::Error if the file cannot be written.
-void save_off(const Mesh& mesh, const std::filesystem::path& path);
+CALIBER_EXPORT void save_off(const Mesh& mesh, const std::filesystem::path& path);
 
 /// Applies a uniform scale to every vertex (scene files scale meshes). `factor` must be finite and > 0.
-void scale_mesh(Mesh& mesh, double factor);
+CALIBER_EXPORT void scale_mesh(Mesh& mesh, double factor);
 
 }  // namespace caliber

@@ -4,6 +4,7 @@
 /// normals and the triangle adjacency. Built once in object space, immutable afterwards, and safe
 /// to share between threads and between objects that use the same mesh.
 
+#include "caliber/export.h"
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -118,6 +119,6 @@ struct Model {
 };
 
 /// Validates the mesh and builds its model in O(n log n). Throws caliber::Error on a bad mesh.
-[[nodiscard]] std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options = {});
+[[nodiscard]] CALIBER_EXPORT std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options = {});
 
 }  // namespace caliber

@@ -2,6 +2,7 @@
 /// \file
 /// The narrow-phase query between two posed models: interference, proximity and contact.
 
+#include "caliber/export.h"
 #include <array>
 #include <cstdint>
 #include <string_view>
@@ -22,9 +23,9 @@ enum class QueryKind : std::uint8_t {
 };
 
 /// "interference", "proximity" or "contact".
-[[nodiscard]] std::string_view to_string(QueryKind kind);
+[[nodiscard]] CALIBER_EXPORT std::string_view to_string(QueryKind kind);
 /// Parses a kind name; throws caliber::Error on an unknown name.
-[[nodiscard]] QueryKind parse_query_kind(std::string_view name);
+[[nodiscard]] CALIBER_EXPORT QueryKind parse_query_kind(std::string_view name);
 
 /// Which primitive groups may touch: group g may touch group h iff bit h of compatible[g] is set.
 /// The matrix should be symmetric; the default lets every group touch every group.
@@ -50,7 +51,7 @@ struct QueryRequest {
 };
 
 /// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or an angle outside [0, 180].
-void validate_request(const QueryRequest& request);
+CALIBER_EXPORT void validate_request(const QueryRequest& request);
 
 /// The distance within which a request reports triangle pairs: 0 for interference (the triangles
 /// must meet), the tolerance for proximity and contact.
@@ -93,11 +94,11 @@ struct QueryResult {
 
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
 /// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.
-[[nodiscard]] QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+[[nodiscard]] CALIBER_EXPORT QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
                                 const QueryRequest& request);
 
 /// The O(n*m) oracle: runs the leaf test on every triangle pair. For tests.
-[[nodiscard]] QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b,
+[[nodiscard]] CALIBER_EXPORT QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b,
                                             const Pose& pose_b, const QueryRequest& request);
 
 }  // namespace caliber

@@ -3,6 +3,7 @@
 /// Scene descriptions: objects (mesh, scale, pose, motion), the query, the time steps. Read from
 /// JSON scene files (see docs/scenes.md) or built by hand.
 
+#include "caliber/export.h"
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -39,7 +40,7 @@ struct Motion {
 
 /// The pose at time t of an object that starts at `initial` and moves by `motion`.
 /// (Keyframes ignore `initial`: the keys are absolute poses.)
-[[nodiscard]] Pose pose_at(const Pose& initial, const Motion& motion, double t);
+[[nodiscard]] CALIBER_EXPORT Pose pose_at(const Pose& initial, const Motion& motion, double t);
 
 /// A run of triangles (by id) put in one primitive group.
 struct GroupRange {
@@ -76,10 +77,10 @@ struct Scene {
 /// Reads a JSON scene file. Throws caliber::Error naming the file and the key on a missing file,
 /// a JSON syntax error, an unknown key, a missing or ill-typed value, a value out of range, a
 /// missing mesh file, or a duplicate object name. Meshes are not loaded here.
-[[nodiscard]] Scene load_scene(const std::filesystem::path& file);
+[[nodiscard]] CALIBER_EXPORT Scene load_scene(const std::filesystem::path& file);
 
 /// Parses scene JSON text; mesh paths are relative to `base_dir`. `source` names it in errors.
-[[nodiscard]] Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir,
+[[nodiscard]] CALIBER_EXPORT Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir,
                                 const std::string& source);
 
 }  // namespace caliber

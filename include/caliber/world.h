@@ -3,6 +3,7 @@
 /// The world: a scene's meshes loaded once, models shared between objects that use the same mesh,
 /// poses per step and the broad phase, which together make each step's Frame for the engine.
 
+#include "caliber/export.h"
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -16,7 +17,7 @@
 namespace caliber {
 
 /// A loaded scene. Immutable after construction: `frame` may be called from any thread.
-class World {
+class CALIBER_EXPORT World {
  public:
   /// Loads every mesh once (objects that share file, scale and refinement share one Model) and
   /// builds the models. Throws caliber::Error on bad meshes (naming the object and file).
@@ -56,6 +57,6 @@ class World {
 
 /// Step k of a world on an engine: its frame (poses and broad phase, timed as broad_ms), then
 /// engine.step; fills the result's step, time and broad_ms.
-[[nodiscard]] StepResult step(const World& world, Engine& engine, int k);
+[[nodiscard]] CALIBER_EXPORT StepResult step(const World& world, Engine& engine, int k);
 
 }  // namespace caliber
