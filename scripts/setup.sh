@@ -10,6 +10,7 @@ packages=(
   libcgal-demo    # CGAL's mesh collection, extracted by scripts/fetch_meshes.sh
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
   python3-matplotlib        # caliber bench: figures (scripts/plot_bench.py)
+  python3-dev python3-pybind11 python3-numpy python3-pytest  # the Python module and its tests
 )
 missing=()
 for p in "${packages[@]}"; do

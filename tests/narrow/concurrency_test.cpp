@@ -94,7 +94,7 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
       for (int k = 0; k < steps; ++k) got[m].push_back(step(world, engine, k));
     });
   }
-  threads.emplace_back([&] {  // and World::step itself from one more thread
+  threads.emplace_back([&] {  // and the pairwise reference from one more thread
     for (int k = 0; k < steps; ++k) got[kMethods].push_back(test::reference_step(world, k));
   });
   for (std::thread& th : threads) th.join();

@@ -1,7 +1,7 @@
 // Soak: runs one engine over many steps of a world whose objects keep touching (pure rotations),
 // and checks that (1) peak memory stays flat: VmHWM after the last step is within 2 % + 1 MiB of
 // VmHWM after step 1,000, and (2) the engine's answer at sampled steps, after thousands of steps
-// of temporal state, is byte-identical to a fresh engine's and to World::step at the same step.
+// of temporal state, is byte-identical to a fresh engine's and to a fresh sequential engine's at the same step.
 //   caliber_soak [--steps N] [--method NAME] [--threads T] [--node-history]
 // Exit 0: flat and identical; 1: a check failed; 2: bad arguments.
 

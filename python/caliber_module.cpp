@@ -1,0 +1,309 @@
+// Python bindings (pybind11): meshes from files or numpy arrays, models that pickle, poses, the
+// three query kinds with numpy results, and the parallel engine over in-memory frames or scenes.
+// Every query and step releases the GIL, so Python threads can query at once.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "caliber/caliber.h"
+
+namespace py = pybind11;
+
+namespace {
+
+using Vertices = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Faces = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+/// A built model, shared (the C++ side holds it as shared_ptr<const Model>).
+struct PyModel {
+  std::shared_ptr<const caliber::Model> model;
+};
+
+caliber::Mesh mesh_from_arrays(const Vertices& vertices, const Faces& faces) {
+  if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices", "must be an n x 3 array");
+  if (faces.ndim() != 2 || faces.shape(1) != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "faces", "must be an m x 3 array");
+  caliber::Mesh mesh;
+  mesh.source = "arrays";
+  const auto v = vertices.unchecked<2>();
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) mesh.vertices.emplace_back(v(i, 0), v(i, 1), v(i, 2));
+  const auto f = faces.unchecked<2>();
+  for (py::ssize_t i = 0; i < f.shape(0); ++i) {
+    std::array<std::uint32_t, 3> t{};
+    for (int k = 0; k < 3; ++k) {
+      const std::int64_t index = f(i, k);
+      if (index < 0 || index >= static_cast<std::int64_t>(mesh.vertices.size())) {
+        throw caliber::Error(caliber::ErrorCode::bad_index, "faces",
+                             "face " + std::to_string(i) + " refers to vertex " + std::to_string(index) + " but there are only " +
+                                 std::to_string(mesh.vertices.size()));
+      }
+      t[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(index);
+    }
+    mesh.triangles.push_back(t);
+  }
+  caliber::validate_mesh(mesh);
+  return mesh;
+}
+
+py::array_t<double> vertices_of(const caliber::Mesh& mesh) {
+  py::array_t<double> out({static_cast<py::ssize_t>(mesh.vertices.size()), py::ssize_t{3}});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(i), k) = mesh.vertices[i][k];
+  }
+  return out;
+}
+
+py::array_t<std::int64_t> faces_of(const caliber::Mesh& mesh) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(i), k) = mesh.triangles[i][static_cast<std::size_t>(k)];
+  }
+  return out;
+}
+
+caliber::QueryRequest make_request(const std::string& kind, double tolerance, double angle) {
+  caliber::QueryRequest request;
+  request.kind = caliber::parse_query_kind(kind);
+  request.tolerance = tolerance;
+  request.angle_deg = angle;
+  caliber::validate_request(request);
+  return request;
+}
+
+/// A query's or a step's answer as numpy arrays (one row per reported triangle pair).
+struct PyResult {
+  py::array_t<std::uint32_t> objects;  ///< k x 2 object ids (steps only)
+  py::array_t<std::uint32_t> pairs;    ///< k x 2 triangle ids
+  py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
+  py::array_t<double> distances;       ///< k
+  std::uint64_t node_tests = 0, leaf_tests = 0;
+};
+
+PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const caliber::QueryStats& stats) {
+  const auto k = static_cast<py::ssize_t>(contacts.size());
+  PyResult r;
+  r.objects = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
+  r.pairs = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
+  r.points_a = py::array_t<double>({k, py::ssize_t{3}});
+  r.points_b = py::array_t<double>({k, py::ssize_t{3}});
+  r.normals = py::array_t<double>({k, py::ssize_t{3}});
+  r.distances = py::array_t<double>(k);
+  auto obj = r.objects.mutable_unchecked<2>();
+  auto tri = r.pairs.mutable_unchecked<2>();
+  auto pa = r.points_a.mutable_unchecked<2>();
+  auto pb = r.points_b.mutable_unchecked<2>();
+  auto nn = r.normals.mutable_unchecked<2>();
+  auto dd = r.distances.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < k; ++i) {
+    const caliber::SceneContact& c = contacts[static_cast<std::size_t>(i)];
+    obj(i, 0) = c.object_a;
+    obj(i, 1) = c.object_b;
+    tri(i, 0) = c.contact.tri_a;
+    tri(i, 1) = c.contact.tri_b;
+    for (int d = 0; d < 3; ++d) {
+      pa(i, d) = c.contact.point_a[d];
+      pb(i, d) = c.contact.point_b[d];
+      nn(i, d) = c.contact.normal[d];
+    }
+    dd(i) = c.contact.distance;
+  }
+  r.node_tests = stats.node_tests;
+  r.leaf_tests = stats.leaf_tests;
+  return r;
+}
+
+PyResult query_result(const caliber::QueryResult& q) {
+  std::vector<caliber::SceneContact> contacts;
+  contacts.reserve(q.pairs.size());
+  for (std::size_t i = 0; i < q.pairs.size(); ++i) {
+    caliber::SceneContact c{0, 1, {}};
+    if (q.contacts.empty()) {
+      c.contact.tri_a = q.pairs[i].tri_a;
+      c.contact.tri_b = q.pairs[i].tri_b;
+      c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
+    } else {
+      c.contact = q.contacts[i];
+    }
+    contacts.push_back(c);
+  }
+  return to_result(contacts, q.stats);
+}
+
+caliber::Pose pose_from_matrix(const py::array_t<double, py::array::c_style | py::array::forcecast>& m) {
+  if (m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
+  const auto a = m.unchecked<2>();
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = a(i, j);
+  }
+  if (!r.allFinite() || (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 || r.determinant() < 0.0 ||
+      a(3, 0) != 0.0 || a(3, 1) != 0.0 || a(3, 2) != 0.0 || a(3, 3) != 1.0) {
+    throw caliber::Error(caliber::ErrorCode::bad_value, "matrix", "is not a rigid transform (a rotation within 1e-9, then a translation; last row 0 0 0 1)");
+  }
+  const Eigen::Quaterniond q(r);
+  return caliber::Pose::from_values(a(0, 3), a(1, 3), a(2, 3), q.w(), q.x(), q.y(), q.z(), "matrix");
+}
+
+caliber::Frame make_frame(const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
+                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const caliber::QueryRequest& request) {
+  caliber::Frame frame;
+  for (const PyModel& m : models) frame.models.push_back(m.model);
+  frame.poses = poses;
+  for (const auto& [a, b] : pairs) frame.pairs.push_back(caliber::Task{a, b});
+  frame.request = request;
+  return frame;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(caliber, m) {
+  m.doc() = "caliber: exact collision detection between rigid triangle meshes, parallelized by task calibration";
+  m.attr("__version__") = caliber::kVersion;
+  static py::exception<caliber::Error> error(m, "Error", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const caliber::Error& e) {
+      error(e.what());
+    }
+  });
+
+  py::class_<caliber::Mesh>(m, "Mesh", "Vertices (n x 3 float64) and triangles (m x 3 int); triangle ids are row numbers.")
+      .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("faces"))
+      .def_static("load", [](const std::string& path) { return caliber::load_mesh(path); }, py::arg("path"),
+                  "Reads .off, .ply, .obj or .stl (the extension chooses the reader).")
+      .def_property_readonly("vertices", &vertices_of)
+      .def_property_readonly("faces", &faces_of)
+      .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); });
+
+  py::class_<PyModel>(m, "Model", "A mesh with its BVH, built once; immutable, shareable between threads, picklable.")
+      .def(py::init([](const caliber::Mesh& mesh, bool adjacency) {
+             caliber::BuildOptions options;
+             options.adjacency = adjacency;
+             py::gil_scoped_release release;
+             return PyModel{caliber::build_model(mesh, options)};
+           }),
+           py::arg("mesh"), py::arg("adjacency") = true)
+      .def_static("load", [](const std::string& path) {
+             caliber::Mesh mesh = caliber::load_mesh(path);
+             py::gil_scoped_release release;
+             return PyModel{caliber::build_model(std::move(mesh))};
+           }, py::arg("path"))
+      .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh; })
+      .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh.triangles.size(); })
+      .def_property_readonly("height", [](const PyModel& p) { return p.model->height; })
+      .def(py::pickle(
+          [](const PyModel& p) { return py::make_tuple(vertices_of(p.model->mesh), faces_of(p.model->mesh), p.model->has_adjacency()); },
+          [](const py::tuple& t) {
+            if (t.size() != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
+            caliber::BuildOptions options;
+            options.adjacency = t[2].cast<bool>();
+            return PyModel{caliber::build_model(mesh_from_arrays(t[0].cast<Vertices>(), t[1].cast<Faces>()), options)};
+          }));
+
+  py::class_<caliber::Pose>(m, "Pose", "A rigid transform: x_world = R x + t.")
+      .def(py::init([](std::array<double, 3> t, std::array<double, 4> q) {
+             return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3]);
+           }),
+           py::arg("translation") = std::array<double, 3>{0, 0, 0}, py::arg("quaternion") = std::array<double, 4>{1, 0, 0, 0},
+           "translation (x, y, z), quaternion (w, x, y, z), normalized")
+      .def_static("from_matrix", &pose_from_matrix, py::arg("matrix"), "from a 4 x 4 rigid transform")
+      .def_property_readonly("translation", [](const caliber::Pose& p) { return std::array<double, 3>{p.translation.x(), p.translation.y(), p.translation.z()}; })
+      .def_property_readonly("quaternion", [](const caliber::Pose& p) {
+        return std::array<double, 4>{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
+      })
+      .def("matrix", [](const caliber::Pose& p) {
+        py::array_t<double> out({py::ssize_t{4}, py::ssize_t{4}});
+        auto o = out.mutable_unchecked<2>();
+        const Eigen::Matrix3d r = p.rotation_matrix();
+        for (int i = 0; i < 4; ++i) {
+          for (int j = 0; j < 4; ++j) o(i, j) = i < 3 ? (j < 3 ? r(i, j) : p.translation[i]) : (j == 3 ? 1.0 : 0.0);
+        }
+        return out;
+      });
+
+  py::class_<PyResult>(m, "Result", "Reported triangle pairs, sorted, with points, normals and distances (zero for interference).")
+      .def_readonly("objects", &PyResult::objects, "k x 2 object ids (steps; 0 and 1 for a query)")
+      .def_readonly("pairs", &PyResult::pairs, "k x 2 triangle ids")
+      .def_readonly("points_a", &PyResult::points_a)
+      .def_readonly("points_b", &PyResult::points_b)
+      .def_readonly("normals", &PyResult::normals)
+      .def_readonly("distances", &PyResult::distances)
+      .def_readonly("node_tests", &PyResult::node_tests)
+      .def_readonly("leaf_tests", &PyResult::leaf_tests)
+      .def("__len__", [](const PyResult& r) { return static_cast<std::size_t>(r.distances.shape(0)); });
+
+  m.def(
+      "query",
+      [](const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b, const std::string& kind,
+         double tolerance, double angle) {
+        const caliber::QueryRequest request = make_request(kind, tolerance, angle);
+        caliber::QueryResult q;
+        {
+          py::gil_scoped_release release;
+          q = caliber::query(*a.model, pose_a, *b.model, pose_b, request);
+        }
+        return query_result(q);
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference", py::arg("tolerance") = 0.0,
+      py::arg("angle") = 30.0, "One pair: kind is 'interference', 'proximity' or 'contact'.");
+
+  py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on a fixed number of threads; keeps temporal state.")
+      .def(py::init([](const std::string& method, int threads) {
+             caliber::EngineOptions options;
+             options.method = caliber::parse_method(method);
+             options.threads = threads;
+             return std::make_unique<caliber::Engine>(options);
+           }),
+           py::arg("method") = "hybrid", py::arg("threads") = 0)
+      .def_property_readonly("threads", &caliber::Engine::threads)
+      .def("forget", &caliber::Engine::forget)
+      .def(
+          "step",
+          [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind, double tolerance, double angle) {
+            const caliber::Frame frame = make_frame(models, poses, pairs, make_request(kind, tolerance, angle));
+            caliber::StepResult s;
+            {
+              py::gil_scoped_release release;
+              s = engine.step(frame);
+            }
+            return to_result(s.contacts, s.stats);
+          },
+          py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference", py::arg("tolerance") = 0.0,
+          py::arg("angle") = 30.0, "One frame: every listed object pair (a < b, sorted) tested.");
+
+  py::class_<caliber::World>(m, "World", "A scene file's objects, poses and broad phase.")
+      .def(py::init([](const std::string& path) {
+             caliber::Scene scene = caliber::load_scene(path);
+             py::gil_scoped_release release;
+             return std::make_unique<caliber::World>(std::move(scene));
+           }),
+           py::arg("path"))
+      .def_property_readonly("steps", [](const caliber::World& w) { return w.scene().steps; })
+      .def_property_readonly("objects", [](const caliber::World& w) {
+        std::vector<std::string> names;
+        for (const caliber::SceneObject& o : w.scene().objects) names.push_back(o.name);
+        return names;
+      })
+      .def(
+          "step",
+          [](const caliber::World& world, caliber::Engine& engine, int k) {
+            caliber::StepResult s;
+            {
+              py::gil_scoped_release release;
+              s = caliber::step(world, engine, k);
+            }
+            return to_result(s.contacts, s.stats);
+          },
+          py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.");
+}

@@ -1,0 +1,127 @@
+"""The Python bindings: the same pairs and contacts as the C++ API (through the caliber CLI's JSON,
+which prints every double exactly), bit for bit; meshes from arrays; poses from matrices; the
+engine over in-memory frames and scenes; pickled models; errors as caliber.Error."""
+import json
+import os
+import pickle
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import caliber
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DATA = os.path.join(ROOT, "tests", "data")
+CLI = os.environ.get("CALIBER_CLI", os.path.join(ROOT, "build", "caliber"))
+TETRA = os.path.join(DATA, "tetra.off")
+FAN = os.path.join(DATA, "quad_fan.off")
+POSE = (0.3, 0.2, -0.2, 0.9, 0.1, 0.3, 0.2)
+
+
+def pose(values):
+    return caliber.Pose(values[:3], values[3:])
+
+
+def cli_query(a, b, values, kind, tolerance):
+    out = subprocess.run([CLI, "query", a, b, "--pose-b", " ".join(repr(v) for v in values), "--kind", kind,
+                          "--tolerance", repr(tolerance), "--json"], check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("kind", ["interference", "proximity", "contact"])
+def test_query_equals_the_cpp_api_bit_for_bit(kind):
+    a, b = caliber.Model.load(TETRA), caliber.Model.load(FAN)
+    r = caliber.query(a, caliber.Pose(), b, pose(POSE), kind=kind, tolerance=0.3)
+    want = cli_query(TETRA, FAN, POSE, kind, 0.3)
+    assert len(want["pairs"]) > 0
+    assert r.pairs.tolist() == want["pairs"]
+    assert r.node_tests == want["stats"]["node_tests"] and r.leaf_tests == want["stats"]["leaf_tests"]
+    if kind == "interference":
+        assert not r.distances.any()
+        return
+    for i, c in enumerate(want["contacts"]):
+        assert r.points_a[i].tolist() == c["point_a"]
+        assert r.points_b[i].tolist() == c["point_b"]
+        assert r.normals[i].tolist() == c["normal"]
+        assert r.distances[i] == c["distance"]
+
+
+def test_meshes_from_arrays_equal_meshes_from_files():
+    m = caliber.Mesh.load(FAN)
+    again = caliber.Mesh(m.vertices, m.faces)
+    assert np.array_equal(again.vertices, m.vertices) and np.array_equal(again.faces, m.faces)
+    a = caliber.query(caliber.Model(m), caliber.Pose(), caliber.Model.load(TETRA), pose(POSE), kind="proximity", tolerance=0.3)
+    b = caliber.query(caliber.Model(again), caliber.Pose(), caliber.Model.load(TETRA), pose(POSE), kind="proximity", tolerance=0.3)
+    assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.points_a, b.points_a)
+    with pytest.raises(caliber.Error, match="faces: face 0 refers to vertex 9"):
+        caliber.Mesh(m.vertices, np.array([[0, 1, 9]]))
+    with pytest.raises(ValueError, match="n x 3"):
+        caliber.Mesh(np.zeros((3, 2)), m.faces)
+
+
+def test_pose_from_a_matrix_round_trips():
+    p = pose(POSE)
+    q = caliber.Pose.from_matrix(p.matrix())
+    assert np.allclose(q.matrix(), p.matrix(), atol=1e-15)
+    with pytest.raises(caliber.Error, match="not a rigid transform"):
+        caliber.Pose.from_matrix(np.diag([2.0, 1.0, 1.0, 1.0]))
+
+
+def test_pickled_models_answer_the_same():
+    a = caliber.Model.load(FAN)
+    b = pickle.loads(pickle.dumps(a))
+    assert b.triangles == a.triangles and b.height == a.height
+    r1 = caliber.query(a, caliber.Pose(), a, pose(POSE), kind="contact", tolerance=0.3)
+    r2 = caliber.query(b, caliber.Pose(), b, pose(POSE), kind="contact", tolerance=0.3)
+    assert r1.pairs.tolist() == r2.pairs.tolist() and np.array_equal(r1.normals, r2.normals)
+
+
+@pytest.mark.parametrize("method", ["sequential", "exploitation", "stealing", "aposteriori", "apriori", "hybrid"])
+def test_engine_frames_give_the_query_answer(method):
+    models = [caliber.Model.load(TETRA), caliber.Model.load(FAN), caliber.Model.load(TETRA)]
+    engine = caliber.Engine(method, threads=2)
+    for k in range(4):
+        poses = [caliber.Pose(), pose(POSE), caliber.Pose((0.1 * k, 0.5, 0.0))]
+        got = engine.step(models, poses, [(0, 1), (0, 2), (1, 2)], kind="proximity", tolerance=0.3)
+        rows = []
+        for a, b in [(0, 1), (0, 2), (1, 2)]:
+            r = caliber.query(models[a], poses[a], models[b], poses[b], kind="proximity", tolerance=0.3)
+            rows += [[a, b] + p for p in r.pairs.tolist()]
+        assert got.objects.tolist() and [o + p for o, p in zip(got.objects.tolist(), got.pairs.tolist())] == rows
+
+
+def test_a_scene_steps_through_the_engine():
+    world = caliber.World(os.path.join(DATA, "scenes", "tetras.json"))
+    assert world.objects == ["fixed", "mover"] and world.steps == 12
+    engine = caliber.Engine("hybrid", threads=2)
+    seq = caliber.Engine("sequential")
+    for k in range(world.steps):
+        a, b = world.step(engine, k), world.step(seq, k)
+        assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.distances, b.distances)
+
+
+def test_bad_input_is_a_caliber_error_naming_the_file():
+    with pytest.raises(caliber.Error, match="nope.off: no such file"):
+        caliber.Model.load(os.path.join(DATA, "nope.off"))
+    with pytest.raises(caliber.Error, match="unknown query kind"):
+        caliber.query(caliber.Model.load(TETRA), caliber.Pose(), caliber.Model.load(TETRA), caliber.Pose(), kind="touch")
+    with pytest.raises(caliber.Error, match="frame"):
+        caliber.Engine("sequential").step([caliber.Model.load(TETRA)], [caliber.Pose()], [(0, 1)])
+
+
+def test_threads_query_at_once_with_the_same_answers():
+    a = caliber.Model.load(FAN)
+    want = caliber.query(a, caliber.Pose(), a, pose(POSE), kind="contact", tolerance=0.3).pairs.tolist()
+    got = [None] * 4
+
+    def run(i):
+        got[i] = caliber.query(a, caliber.Pose(), a, pose(POSE), kind="contact", tolerance=0.3).pairs.tolist()
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert got == [want] * 4
