@@ -17,7 +17,7 @@ DATA = os.path.join(ROOT, "tests", "data")
 CLI = os.environ.get("CALIBER_CLI", os.path.join(ROOT, "build", "caliber"))
 TETRA = os.path.join(DATA, "tetra.off")
 FAN = os.path.join(DATA, "quad_fan.off")
-POSE = (0.3, 0.2, -0.2, 0.9, 0.1, 0.3, 0.2)
+POSE = (0.2, 0.2, 0.3, 0.0, 1.0, 0.0, 0.0)  # B turned over and pushed into A: pairs of every kind
 
 
 def pose(values):
