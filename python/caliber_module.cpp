@@ -124,17 +124,7 @@ PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const cal
 PyResult query_result(const caliber::QueryResult& q) {
   std::vector<caliber::SceneContact> contacts;
   contacts.reserve(q.pairs.size());
-  for (std::size_t i = 0; i < q.pairs.size(); ++i) {
-    caliber::SceneContact c{0, 1, {}};
-    if (q.contacts.empty()) {
-      c.contact.tri_a = q.pairs[i].tri_a;
-      c.contact.tri_b = q.pairs[i].tri_b;
-      c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
-    } else {
-      c.contact = q.contacts[i];
-    }
-    contacts.push_back(c);
-  }
+  for (std::size_t i = 0; i < q.pairs.size(); ++i) contacts.push_back(caliber::SceneContact{0, 1, caliber::contact_at(q, i)});
   return to_result(contacts, q.stats);
 }
 

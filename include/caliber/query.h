@@ -92,6 +92,17 @@ struct QueryResult {
   QueryStats stats;                          ///< work done
 };
 
+/// Reported pair k of a result as a Contact: the result's contact for proximity and contact
+/// queries; for interference, the triangle ids with zero points, normal and distance.
+[[nodiscard]] inline Contact contact_at(const QueryResult& result, std::size_t k) {
+  if (!result.contacts.empty()) return result.contacts[k];
+  Contact c;
+  c.tri_a = result.pairs[k].tri_a;
+  c.tri_b = result.pairs[k].tri_b;
+  c.point_a = c.point_b = c.normal = Eigen::Vector3d::Zero();
+  return c;
+}
+
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
 /// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.
 [[nodiscard]] CALIBER_EXPORT QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,

@@ -116,17 +116,7 @@ void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>&
     out.tasks.push_back(TaskRecord{pairs[i], r.stats, r.pairs.size()});
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
-    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
-      SceneContact c{pairs[i].a, pairs[i].b, {}};
-      if (r.contacts.empty()) {
-        c.contact.tri_a = r.pairs[k].tri_a;
-        c.contact.tri_b = r.pairs[k].tri_b;
-        c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
-      } else {
-        c.contact = r.contacts[k];
-      }
-      out.contacts.push_back(c);
-    }
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) out.contacts.push_back(SceneContact{pairs[i].a, pairs[i].b, contact_at(r, k)});
   }
 }
 

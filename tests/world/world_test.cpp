@@ -45,17 +45,7 @@ void expect_steps_match_oracle(const World& world, int steps) {
           continue;
         }
         const QueryResult r = query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request());
-        for (std::size_t i = 0; i < r.pairs.size(); ++i) {
-          SceneContact c{a, b, {}};
-          if (r.contacts.empty()) {
-            c.contact.tri_a = r.pairs[i].tri_a;
-            c.contact.tri_b = r.pairs[i].tri_b;
-            c.contact.point_a = c.contact.point_b = c.contact.normal = Eigen::Vector3d::Zero();
-          } else {
-            c.contact = r.contacts[i];
-          }
-          want.push_back(c);
-        }
+        for (std::size_t i = 0; i < r.pairs.size(); ++i) want.push_back(SceneContact{a, b, contact_at(r, i)});
       }
     }
     ASSERT_EQ(s.contacts.size(), want.size()) << "step " << k;
