@@ -37,6 +37,7 @@
 #include "bench_report.h"
 #include "commands.h"
 #include "machine.h"
+#include "output_file.h"
 #include "progress.h"
 #include "run_stats.h"
 #include "timing.h"
@@ -471,9 +472,9 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
   Json results = results_from_records(records);
   const auto json_path = out / "results.json";
   const auto write_json = [&] {
-    std::ofstream file(json_path);
-    file << results.dump(1) << '\n';
-    if (!file) throw Error(ErrorCode::unreadable, json_path.string(), "cannot be written");
+    OutputFile file(json_path.string(), "results.json");  // written whole, or not at all
+    file.stream() << results.dump(1) << '\n';
+    file.commit();
   };
   write_json();
   std::string figures_note;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "output_file.h"
 #include "timing.h"
 #include "caliber/error.h"
 
@@ -61,8 +62,8 @@ std::string verdict(double measured, double target, bool at_least = true) {
 }  // namespace
 
 void write_bench_report(const Json& r, const std::filesystem::path& file) {
-  std::ofstream out(file);
-  if (!out) throw Error(ErrorCode::unreadable, file.string(), "cannot be opened for writing");
+  cli::OutputFile output(file.string(), "report.md");  // written whole, or not at all
+  std::ostream& out = output.stream();
   const std::vector<int> threads = r["threads"].get<std::vector<int>>();
   const std::vector<int> simulate = r["simulate"].get<std::vector<int>>();
   const int cores = r["hardware_threads"].get<int>();
@@ -335,7 +336,7 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
          "Correlation: estimated vs effective node tests per run-time task (log-log). Gantt: one step of "
       << (r.contains("gantt") ? r["gantt"]["scene"].get<std::string>() : std::string("a scene")) << ", exploitation vs hybrid, "
       << "one row per thread (stage, depth-first, finalization).\n";
-  if (!out) throw Error(ErrorCode::unreadable, file.string(), "write failed");
+  output.commit();
 }
 
 }  // namespace caliber::cli
