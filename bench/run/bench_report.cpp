@@ -89,7 +89,7 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   }
   if (r["scenes"].empty()) {
     out << "No scene finished its sequential reference run: nothing to report yet.\n";
-    if (!out) throw Error(ErrorCode::unreadable, file.string(), "write failed");
+    output.commit();
     return;
   }
   out << "Real (measured) figures stop at this machine's " << cores << " hardware thread(s); the columns P = ";

@@ -204,6 +204,11 @@ assert r["stopped"]["after_s"] <= 1.5 or r["runs_done"] == 0, (r["stopped"], r["
 assert r["runs_done"] < r["runs_planned"], (r["runs_done"], r["runs_planned"])
 assert "cut short by its time budget" in open(sys.argv[1] + "/report.md").read()
 PY
+# A budget spent before the sequential reference finished: the report still says so (written whole).
+check bench-budget-nothing 0 "$cli" bench "$data/scenes/tetras.json" --steps 100000 --repeat 1 --threads 1 --simulate 2 --no-fcl \
+  --no-figures --budget-s 0.001 --out "$tmp/bench-nothing"
+grep -q "nothing to report yet" "$tmp/bench-nothing/report.md" && passes=$((passes + 1)) ||
+  { echo "FAIL bench-budget-nothing-report"; failures=$((failures + 1)); }
 echo "not json" > "$tmp/bad.jsonl"
 touch "$tmp/a-file"
 check bench-bad-log 2 "$cli" bench --from-log "$tmp/bad.jsonl" --out "$tmp/bench3"
