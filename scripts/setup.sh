@@ -11,17 +11,29 @@ packages=(
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
   python3-matplotlib        # caliber bench: figures (scripts/plot_bench.py)
   python3-dev python3-pybind11 python3-numpy python3-pytest  # the Python module and its tests
+  chromium                  # the viewer's test: the page in a headless browser
 )
+# The viewer is bundled at build time from npm packages (three.js, esbuild; puppeteer-core for its
+# test), installed into viewer/node_modules below: Debian's nodejs and npm unless a node is there.
+command -v npm > /dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "setup: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-SUDO=""
-[ "$(id -u)" -ne 0 ] && SUDO="sudo"
-echo "setup: installing ${missing[*]}"
-$SUDO apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# The viewer's npm packages, at the versions of viewer/package-lock.json (from the npm registry;
+# once, and again when the lock file changes). The build only reads them.
+viewer="$(cd "$(dirname "$0")/.." && pwd)/viewer"
+if [ ! -f "$viewer/node_modules/.package-lock.json" ] || [ "$viewer/package-lock.json" -nt "$viewer/node_modules/.package-lock.json" ]; then
+  echo "setup: installing the viewer's npm packages (three.js, esbuild, puppeteer-core) into viewer/node_modules"
+  (cd "$viewer" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
+fi

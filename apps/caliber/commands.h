@@ -14,5 +14,6 @@ Runner add_query_command(CLI::App& app);
 Runner add_run_command(CLI::App& app);
 Runner add_refine_command(CLI::App& app);
 Runner add_bench_command(CLI::App& app);
+Runner add_view_command(CLI::App& app);
 
 }  // namespace caliber::cli

@@ -3,6 +3,7 @@
 //   caliber run SCENE [...]      a scene over its time steps
 //   caliber refine IN OUT -l K   1-to-4 subdivision
 //   caliber bench [SCENES...]    every method on every scene: report.md, results.json, figures
+//   caliber view SCENE --out F   an HTML page showing the scene's steps, contacts and tasks
 // Exit codes: 0 success, 2 bad input or not enough memory for it (message on stderr), 130 a run
 // stopped by SIGINT (what it measured is written), 1 unexpected internal error.
 
@@ -24,7 +25,8 @@ int main(int argc, char** argv) {
   const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app),
                                                       caliber::cli::add_run_command(app),
                                                       caliber::cli::add_refine_command(app),
-                                                      caliber::cli::add_bench_command(app)};
+                                                      caliber::cli::add_bench_command(app),
+                                                      caliber::cli::add_view_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

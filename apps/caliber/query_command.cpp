@@ -129,6 +129,7 @@ int run_query(const QueryOptions& opt) {
 
   if (opt.json) {
     nlohmann::json out = caliber::cli::to_json(result);
+    out["schema_version"] = caliber::cli::kSchemaVersion;
     out["stats"]["build_ms"] = build_ms;
     out["stats"]["query_ms"] = cold_ms;
     out["stats"]["query_ms_warm"] = warm_ms;

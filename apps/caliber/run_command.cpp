@@ -17,6 +17,8 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "commands.h"
+#include "export_files.h"
+#include "json_output.h"
 #include "output_file.h"
 #include "progress.h"
 #include "run_stats.h"
@@ -37,6 +39,7 @@ struct RunOptions {
   int steps = -1;
   std::string json;
   std::string contacts;
+  ExportOptions exports;
 };
 
 nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
@@ -82,7 +85,8 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
   nlohmann::json list = nlohmann::json::array();
   const bool points = world.request().kind != QueryKind::interference;
   for (const SceneContact& c : s.contacts) {
-    nlohmann::json j = {{"object_a", c.object_a}, {"object_b", c.object_b}, {"tri_a", c.contact.tri_a}, {"tri_b", c.contact.tri_b}};
+    nlohmann::json j = {{"object_a", c.object_a}, {"object_b", c.object_b}, {"name_a", world.scene().objects[c.object_a].name},
+                        {"name_b", world.scene().objects[c.object_b].name}, {"tri_a", c.contact.tri_a}, {"tri_b", c.contact.tri_b}};
     if (points) {
       j["point_a"] = vec(c.contact.point_a);
       j["point_b"] = vec(c.contact.point_b);
@@ -91,7 +95,7 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
     }
     list.push_back(std::move(j));
   }
-  return {{"step", s.step}, {"contacts", list}};
+  return {{"schema_version", kSchemaVersion}, {"step", s.step}, {"contacts", list}};
 }
 
 std::string pair_name(const World& world, const Task& t) {
@@ -130,7 +134,11 @@ int run_scene(const RunOptions& opt) {
   // Every output is checked, and kept apart from every input, before any work is done.
   std::vector<std::pair<std::string, std::string>> inputs{{"the scene", opt.scene}};
   for (const SceneObject& o : scene.objects) inputs.emplace_back("mesh of object '" + o.name + "'", o.mesh.string());
-  check_distinct_files({{"--json", opt.json}, {"--contacts", opt.contacts}}, inputs);
+  std::vector<std::pair<std::string, std::string>> outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
+  for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
+  check_distinct_files(outputs, inputs);
+  std::unique_ptr<Exporter> exporter;
+  if (!opt.exports.dir.empty()) exporter = std::make_unique<Exporter>(opt.exports, scene.steps);
   std::unique_ptr<OutputFile> json_out, contacts_out;
   if (!opt.json.empty()) json_out = std::make_unique<OutputFile>(opt.json, "--json");
   if (!opt.contacts.empty()) contacts_out = std::make_unique<OutputFile>(opt.contacts, "--contacts");
@@ -165,6 +173,7 @@ int run_scene(const RunOptions& opt) {
     for (SimulatedRun& sim : sims) sim.add(s);
     if (json_out) steps.push_back(step_record(s));
     if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
+    if (exporter && exporter->wants(k)) exporter->write(world, s);
     char line[256];
     std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.tasks.size(),
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
@@ -201,8 +210,14 @@ int run_scene(const RunOptions& opt) {
   }
 
   if (json_out) {
+    nlohmann::json objects = nlohmann::json::array();
+    for (std::size_t i = 0; i < world.object_count(); ++i) {
+      objects.push_back({{"id", i}, {"name", sc.objects[i].name}, {"mesh", sc.objects[i].mesh.string()}});
+    }
     nlohmann::json report = {
+        {"schema_version", kSchemaVersion},
         {"scene", sc.name},
+        {"objects", objects},
         {"file", sc.file.string()},
         {"query", {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}}},
         {"dt", sc.dt},
@@ -252,6 +267,10 @@ Runner add_run_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");
   cmd->add_option("--contacts", opt->contacts, "Write each step's contacts, one JSON line per step, to this file");
+  cmd->add_option("--export", opt->exports.dir, "Write PLY files of chosen steps into this folder (docs/exports.md)");
+  cmd->add_option("--export-steps", opt->exports.steps, "The steps --export writes")->delimiter(',')->capture_default_str();
+  cmd->add_option("--bvh-depth", opt->exports.bvh_depth, "--export also writes every BVH's boxes down to this depth (-1: none)")
+      ->capture_default_str();
   return [cmd, opt]() { return cmd->parsed() ? run_scene(*opt) : -1; };
 }
 

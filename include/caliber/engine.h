@@ -48,6 +48,18 @@ struct TaskSpan {
   double start_ms = 0.0;  ///< since the start of the step's narrow phase
   double end_ms = 0.0;
   Phase phase = Phase::traverse;
+  /// What was run: stage and finalize, the pair's index in the frame's pairs (StepResult::tasks);
+  /// traverse, the run-time task's index in ScheduleRecord::task_node_tests (and task_roots), or,
+  /// for stealing, the pair of the depth-first piece.
+  std::uint32_t unit = 0;
+};
+
+/// Where a run-time task starts: a node of the CD tree of one of the step's pairs (a node of A's
+/// BVH against a node of B's). A task traverses depth first from each of its roots.
+struct TaskRoot {
+  std::uint32_t pair = 0;    ///< index in the frame's pairs (StepResult::tasks)
+  std::uint32_t node_a = 0;  ///< node of A's BVH (Model::nodes)
+  std::uint32_t node_b = 0;  ///< node of B's BVH
 };
 
 /// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
@@ -81,6 +93,9 @@ struct ScheduleRecord {
   /// Every piece of work with its thread and times, sorted by thread then start; empty unless
   /// EngineOptions::timeline is on.
   std::vector<TaskSpan> timeline;
+  /// The roots of each run-time task, in the order of task_node_tests (every method but stealing,
+  /// whose pieces are cut while it runs); empty unless EngineOptions::timeline is on.
+  std::vector<std::vector<TaskRoot>> task_roots;
 };
 
 /// Everything one step produced.
@@ -149,8 +164,8 @@ struct EngineOptions {
   /// Hybrid: weigh a CD node by the node tests its subtree took at the previous step when the
   /// weight-driven stage popped it then (a priori, rescaled, otherwise). Not in the paper.
   bool node_history = false;
-  /// Record ScheduleRecord::timeline (thread and times of every piece of work). Costs two clock
-  /// reads per piece; off by default.
+  /// Record ScheduleRecord::timeline (thread and times of every piece of work) and
+  /// ScheduleRecord::task_roots. Costs two clock reads per piece; off by default.
   bool timeline = false;
 };
 

@@ -149,8 +149,8 @@ StepResult Engine::step(const Frame& frame) {
     if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
       plan = tasks::plan_pairs(n);
     } else {
-      plan = tasks::plan_calibrated(mOptions, frame.pairs, contexts, mImpl->history, [&](const std::function<void()>& stage) {
-        mImpl->timeline.record(TaskSpan::Phase::stage, stage);
+      plan = tasks::plan_calibrated(mOptions, frame.pairs, contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
+        mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
       });
     }
     record.calibrate_ms = util::ms_since(planning);

@@ -25,7 +25,7 @@ void finalize_pairs(StepState& state,
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
   parallel::for_each_in_order(n, [&](std::size_t k) {
     const std::size_t i = order[k];
-    state.timeline.record(TaskSpan::Phase::finalize, [&] {
+    state.timeline.record(TaskSpan::Phase::finalize, i, [&] {
       std::vector<narrow::Candidate> all;
       QueryStats stats;
       if (start) start(i, all, stats);
@@ -52,6 +52,12 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   record.generated = plan.run.size();
   record.task_node_tests.assign(plan.run.size(), 0);
   if (plan.weighted) record.task_weights.resize(plan.run.size());
+  if (state.timeline.on) {
+    record.task_roots.resize(plan.run.size());
+    for (std::size_t t = 0; t < plan.run.size(); ++t) {
+      for (const tasks::Root& root : plan.run[t].roots) record.task_roots[t].push_back(TaskRoot{root.pair, root.node.a, root.node.b});
+    }
+  }
   std::vector<std::size_t> split_of(n, SIZE_MAX);
   std::vector<std::vector<std::uint64_t>> stage_root_tests(plan.splits.size());
   for (std::size_t s = 0; s < plan.splits.size(); ++s) {
@@ -69,7 +75,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   }
   // In plan order, each task to the next free thread: the list schedule the simulation replays.
   parallel::for_each_in_order(plan.run.size(), [&](std::size_t t) {
-    state.timeline.record(TaskSpan::Phase::traverse, [&] {
+    state.timeline.record(TaskSpan::Phase::traverse, t, [&] {
       WorkerSlots& w = local_slots(state.workers, n);
       std::uint64_t tests = 0;
       for (const tasks::Root& root : plan.run[t].roots) {

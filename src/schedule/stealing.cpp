@@ -20,7 +20,7 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
   {
     WorkerSlots& w = local_slots(state.workers, pairs);
     if (depth >= cutoff) {
-      state.timeline.record(TaskSpan::Phase::traverse, [&] {
+      state.timeline.record(TaskSpan::Phase::traverse, pair, [&] {
         const std::uint64_t before = w.stats[pair].node_tests;
         narrow::traverse_depth_first(ctx, n, w.scratch, w.candidates[pair], w.stats[pair], tested);
         w.pieces.push_back(w.stats[pair].node_tests - before);

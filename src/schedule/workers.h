@@ -48,9 +48,9 @@ struct Timeline {
   util::Clock::time_point origin;
   parallel::PerThread<std::vector<TaskSpan>> spans;
 
-  /// Runs f(), recording its span on this thread when the timeline is on.
+  /// Runs f(), recording its span on this thread when the timeline is on (`unit`: TaskSpan::unit).
   template <class F>
-  void record(TaskSpan::Phase phase, F&& f) {
+  void record(TaskSpan::Phase phase, std::size_t unit, F&& f) {
     if (!on) {
       f();
       return;
@@ -59,7 +59,8 @@ struct Timeline {
     f();
     const auto end = util::Clock::now();
     const int thread = std::max(parallel::current_thread_index(), 0);
-    spans.local().push_back(TaskSpan{thread, util::ms_between(origin, start), util::ms_between(origin, end), phase});
+    spans.local().push_back(TaskSpan{thread, util::ms_between(origin, start), util::ms_between(origin, end), phase,
+                                     static_cast<std::uint32_t>(unit)});
   }
 
   /// Starts a step: clears the spans and sets the time origin.

@@ -108,7 +108,7 @@ void split_by_stage(const EngineOptions& options, const std::vector<Task>& pairs
                                   options.epsilon * plan.omega, measured);
     };
     if (around_stage) {
-      around_stage(stage);
+      around_stage(i, stage);
     } else {
       stage();
     }

@@ -57,8 +57,9 @@ struct InitialWeights {
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
 /// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
 /// each initial task, merge the cart, and hand the run-time tasks out heaviest first. `around_stage`,
-/// if set, is called with each pair's weight-driven stage and must run it (the engine times it).
-using StageWrapper = std::function<void(const std::function<void()>&)>;
+/// if set, is called with each split pair's index and its weight-driven stage, and must run it
+/// (the engine times it).
+using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;
 [[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs,
                                    const std::vector<narrow::PairContext>& contexts, const History& history,
                                    const StageWrapper& around_stage = {});

@@ -215,7 +215,18 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
     expect_same_step(got, reference, what);
     const ScheduleRecord& r = got.schedule;
     std::size_t stage = 0, traverse = 0, finalize = 0;
+    const std::size_t pairs = got.tasks.size();
+    std::vector<int> finalized(pairs, 0), traversed(r.task_node_tests.size(), 0);
     for (const TaskSpan& s : r.timeline) {
+      if (s.phase == TaskSpan::Phase::finalize) {
+        ASSERT_LT(s.unit, pairs) << what;
+        ++finalized[s.unit];
+      } else if (s.phase == TaskSpan::Phase::stage || method == Method::stealing) {
+        EXPECT_LT(s.unit, pairs) << what << ": a stage or stealing piece names its pair";
+      } else {
+        ASSERT_LT(s.unit, traversed.size()) << what;
+        ++traversed[s.unit];
+      }
       EXPECT_GE(s.thread, 0) << what;
       EXPECT_LT(s.thread, engine.threads()) << what;
       EXPECT_LE(0.0, s.start_ms) << what;
@@ -224,8 +235,23 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
       traverse += s.phase == TaskSpan::Phase::traverse;
       finalize += s.phase == TaskSpan::Phase::finalize;
     }
-    const std::size_t pairs = got.tasks.size();
     ASSERT_GT(pairs, 0u);
+    EXPECT_EQ(finalized, std::vector<int>(pairs, 1)) << what << ": each pair finalized once";
+    if (method == Method::stealing) {
+      EXPECT_TRUE(r.task_roots.empty()) << what << ": pieces are cut while it runs";
+    } else {
+      EXPECT_EQ(traversed, std::vector<int>(r.task_node_tests.size(), 1)) << what << ": each run-time task once";
+      ASSERT_EQ(r.task_roots.size(), r.task_node_tests.size()) << what;
+      for (const std::vector<TaskRoot>& roots : r.task_roots) {
+        ASSERT_FALSE(roots.empty()) << what;
+        for (const TaskRoot& root : roots) {
+          ASSERT_LT(root.pair, pairs) << what;
+          const Task& pair = got.tasks[root.pair].task;
+          EXPECT_LT(root.node_a, world.model(pair.a).nodes.size()) << what;
+          EXPECT_LT(root.node_b, world.model(pair.b).nodes.size()) << what;
+        }
+      }
+    }
     if (method == Method::sequential || method == Method::exploitation) {
       EXPECT_EQ(traverse, pairs) << what << ": one traversal span per pair";
       EXPECT_EQ(stage, 0u) << what;
@@ -243,7 +269,9 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
   off.method = Method::hybrid;
   off.threads = 2;
   Engine quiet(off);
-  EXPECT_TRUE(step(world, quiet, 0).schedule.timeline.empty()) << "off by default";
+  const StepResult plain = step(world, quiet, 0);
+  EXPECT_TRUE(plain.schedule.timeline.empty()) << "off by default";
+  EXPECT_TRUE(plain.schedule.task_roots.empty()) << "off by default";
 }
 
 TEST(EngineOptionsValidation, RejectsBadValues) {

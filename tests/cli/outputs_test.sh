@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# End-to-end checks of what the CLI writes for other tools: the JSON schema version and object
+# names, `caliber run --export` (PLY files read back and compared with the contacts), and
+# `caliber view`'s page and its refusals. The page in a browser: tests/viewer/view_test.sh.
+# usage: outputs_test.sh CALIBER TEST_DATA_DIR
+set -u
+cli="$1"
+data="$(cd "$2" && pwd)"
+source "$(dirname "$0")/check_lib.sh"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+scene="$data/scenes/view_tetras.json"
+
+# JSON: schema version everywhere, object names in the report and in each contact.
+check schema-run 0 "$cli" run "$scene" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
+check schema-query 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.2 0 0 1 0 0 0" --json
+python3 - "$tmp/report.json" "$tmp/contacts.jsonl" "$out" <<'PY' || { echo "FAIL schema"; failures=$((failures + 1)); }
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["schema_version"] == 1
+assert [o["name"] for o in r["objects"]] == ["fixed", "mover", "third"] and r["objects"][1]["id"] == 1
+names = {o["id"]: o["name"] for o in r["objects"]}
+seen = 0
+for line in open(sys.argv[2]):
+    j = json.loads(line)
+    assert j["schema_version"] == 1
+    for c in j["contacts"]:
+        assert c["name_a"] == names[c["object_a"]] and c["name_b"] == names[c["object_b"]]
+        seen += 1
+assert seen > 0
+assert json.loads(sys.argv[3])["schema_version"] == 1
+PY
+
+# --export: the chosen steps' PLY files, read back. Objects: every vertex posed; contacts: the
+# points of --contacts exactly, each with a unit-direction segment; BVH: 8 corners per box.
+check export 0 "$cli" run "$scene" --export "$tmp/ply" --export-steps 0,8 --bvh-depth 2 --contacts "$tmp/c2.jsonl"
+for k in 0 8; do
+  for f in objects contacts bvh; do [ -s "$tmp/ply/step${k}_$f.ply" ] || { echo "FAIL export: no step${k}_$f.ply"; failures=$((failures + 1)); }; done
+done
+[ "$(ls "$tmp/ply" | wc -l)" = 6 ] || { echo "FAIL export: $(ls "$tmp/ply")"; failures=$((failures + 1)); }
+python3 - "$tmp/ply" "$tmp/c2.jsonl" <<'PY' || { echo "FAIL export-contents"; failures=$((failures + 1)); }
+import json, math, sys
+def ply(path):
+    lines = open(path).read().splitlines()
+    end = lines.index("end_header")
+    counts = {l.split()[1]: int(l.split()[2]) for l in lines[:end] if l.startswith("element")}
+    body = [l.split() for l in lines[end + 1:]]
+    return counts, body
+steps = [json.loads(l) for l in open(sys.argv[2])]
+for k in (0, 8):
+    counts, body = ply(f"{sys.argv[1]}/step{k}_objects.ply")
+    assert counts["vertex"] > 0 and counts["face"] > 0 and len(body) == counts["vertex"] + counts["face"]
+    faces = body[counts["vertex"]:]
+    assert {f[4] for f in faces} == {"0", "1", "2"}, "every object's faces, tagged"
+    counts, body = ply(f"{sys.argv[1]}/step{k}_contacts.ply")
+    contacts = steps[k]["contacts"]
+    assert counts["vertex"] == 2 * len(contacts) and counts["edge"] == len(contacts)
+    for i, c in enumerate(contacts):
+        p = [float(x) for x in body[2 * i]]
+        assert p == c["point_a"], (p, c["point_a"])
+        q = [float(x) for x in body[2 * i + 1]]
+        d = [b - a for a, b in zip(p, q)]
+        n = math.sqrt(sum(x * x for x in d))
+        assert all(abs(x / n - m) < 1e-9 for x, m in zip(d, c["normal"]))
+        assert body[2 * len(contacts) + i][2:] == [str(c["object_a"]), str(c["object_b"])]
+    counts, body = ply(f"{sys.argv[1]}/step{k}_bvh.ply")
+    assert counts["vertex"] == 8 * counts["edge"] // 12 and counts["vertex"] == 8 * 3 * 7, counts
+assert len(steps[8]["contacts"]) > 0
+PY
+check export-read-back 0 "$cli" query "$tmp/ply/step8_objects.ply" "$data/tetra.off"
+check export-step-out-of-range 2 "$cli" run "$scene" --export "$tmp/bad" --export-steps 12
+contains export-step-out-of-range "--export-steps"
+check export-bad-depth 2 "$cli" run "$scene" --export "$tmp/bad" --bvh-depth -2
+touch "$tmp/file"
+check export-into-file 2 "$cli" run "$scene" --export "$tmp/file"
+contains export-into-file "needs a folder"
+
+# caliber view: the page (the data, the script, and nothing that ends a script early).
+check view 0 "$cli" view "$scene" --out "$tmp/view.html" --steps 3
+contains view "3 steps, 3 objects, hybrid"
+grep -q '"schema_version":1' "$tmp/view.html" && passes=$((passes + 1)) || { echo "FAIL view: no schema"; failures=$((failures + 1)); }
+sed 's/"name": "third"/"name": "<\/script><b>third"/; s#"\.\./tetra.off"#"'"$data"'/tetra.off"#g' "$scene" > "$tmp/named.json"
+check view-script-name 0 "$cli" view "$tmp/named.json" --out "$tmp/named.html" --steps 2
+python3 - "$tmp/named.html" <<'PY' || { echo "FAIL view-script-name: the page"; failures=$((failures + 1)); }
+import json, re, sys
+page = open(sys.argv[1]).read()
+assert page.lower().count("</script") == 2, "the data and the script each end once"
+data = json.loads(re.search(r'<script id="caliber-data" type="application/json">(.*?)</script>', page, re.S).group(1))
+assert data["objects"][2]["name"] == "</script><b>third" and len(data["steps"]) == 2
+PY
+check view-no-out 2 "$cli" view "$scene"
+check view-missing-scene 2 "$cli" view "$tmp/nope.json" --out "$tmp/v.html"
+check view-zero-steps 2 "$cli" view "$scene" --out "$tmp/v.html" --steps 0
+check view-over-scene 2 "$cli" view "$scene" --out "$scene"
+check view-bad-method 2 "$cli" view "$scene" --out "$tmp/v.html" --method fastest
+check view-no-folder 2 "$cli" view "$scene" --out "$tmp/no/such/v.html"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
