@@ -81,6 +81,7 @@ try {
   if (shot) {
     const k = Number(option('--step') ?? 0);
     await page.evaluate((s) => { document.getElementById('step').value = String(s); window.caliberView.showStep(s); }, k);
+    await page.click('#frame-heaviest');  // framed at that step's poses
     await page.screenshot({ path: shot });
     console.log(`screenshot of step ${k}: ${shot}`);
   }
