@@ -32,43 +32,16 @@
 #include "caliber/query.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
+#include "fcl_support.h"
 #include "machine.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-using FclModel = fcl::BVHModel<fcl::OBBRSSd>;
-
-/// Median wall time of `repeat` runs of f, in milliseconds.
-double median_ms(int repeat, const std::function<void()>& f) {
-  std::vector<double> times;
-  for (int i = 0; i < repeat; ++i) {
-    const auto start = Clock::now();
-    f();
-    times.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
-}
-
-std::shared_ptr<FclModel> build_fcl(const caliber::Mesh& mesh) {
-  auto model = std::make_shared<FclModel>();
-  std::vector<fcl::Vector3d> vertices(mesh.vertices.begin(), mesh.vertices.end());
-  std::vector<fcl::Triangle> triangles;
-  triangles.reserve(mesh.triangles.size());
-  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size()));
-  model->addSubModel(vertices, triangles);
-  model->endModel();
-  return model;
-}
-
-fcl::Transform3d to_fcl(const caliber::Pose& pose) {
-  fcl::Transform3d tf = fcl::Transform3d::Identity();
-  tf.linear() = pose.rotation_matrix();
-  tf.translation() = pose.translation;
-  return tf;
-}
+using caliber::bench::box_center;
+using caliber::bench::build_fcl;
+using caliber::bench::FclModel;
+using caliber::bench::median_ms;
+using caliber::bench::to_fcl;
 
 /// Rotation of B about its own box center, and where that center goes, as a fraction of A's box
 /// diagonal away from A's box center. A stays at the identity.
@@ -80,21 +53,11 @@ struct Case {
   Eigen::Vector3d offset;
 };
 
-void box(const caliber::Mesh& m, Eigen::Vector3d& center, double& diagonal) {
-  Eigen::Vector3d lo = m.vertices[0], hi = lo;
-  for (const auto& v : m.vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
-  center = 0.5 * (lo + hi);
-  diagonal = (hi - lo).norm();
-}
-
 caliber::Pose place(const Case& c, const caliber::Mesh& a, const caliber::Mesh& b) {
   Eigen::Vector3d ca, cb;
   double da, db;
-  box(a, ca, da);
-  box(b, cb, db);
+  box_center(a, ca, da);
+  box_center(b, cb, db);
   const Eigen::Quaterniond q(Eigen::AngleAxisd(c.angle_deg * std::numbers::pi / 180.0, c.axis.normalized()));
   const Eigen::Vector3d t = ca + c.offset * da - q * cb;
   return caliber::Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());

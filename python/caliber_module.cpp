@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,10 +71,11 @@ py::array_t<std::int64_t> faces_of(const caliber::Mesh& mesh) {
   return out;
 }
 
-caliber::QueryRequest make_request(const std::string& kind, double tolerance, double angle) {
+/// `tolerance` None: 0, or for a distance query, any distance (caliber::kUnbounded).
+caliber::QueryRequest make_request(const std::string& kind, std::optional<double> tolerance, double angle) {
   caliber::QueryRequest request;
   request.kind = caliber::parse_query_kind(kind);
-  request.tolerance = tolerance;
+  request.tolerance = tolerance ? *tolerance : request.kind == caliber::QueryKind::distance ? caliber::kUnbounded : 0.0;
   request.angle_deg = angle;
   caliber::validate_request(request);
   return request;
@@ -235,7 +237,7 @@ PYBIND11_MODULE(caliber, m) {
   m.def(
       "query",
       [](const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b, const std::string& kind,
-         double tolerance, double angle) {
+         std::optional<double> tolerance, double angle) {
         const caliber::QueryRequest request = make_request(kind, tolerance, angle);
         caliber::QueryResult q;
         {
@@ -244,8 +246,10 @@ PYBIND11_MODULE(caliber, m) {
         }
         return query_result(q);
       },
-      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference", py::arg("tolerance") = 0.0,
-      py::arg("angle") = 30.0, "One pair: kind is 'interference', 'proximity' or 'contact'.");
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
+      py::arg("angle") = 30.0,
+      "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
+      "beyond the tolerance; no tolerance: any distance).");
 
   py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on a fixed number of threads; keeps temporal state.")
       .def(py::init([](const std::string& method, int threads) {
@@ -260,7 +264,8 @@ PYBIND11_MODULE(caliber, m) {
       .def(
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
-             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind, double tolerance, double angle) {
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind,
+             std::optional<double> tolerance, double angle) {
             const caliber::Frame frame = make_frame(models, poses, pairs, make_request(kind, tolerance, angle));
             caliber::StepResult s;
             {
@@ -269,7 +274,7 @@ PYBIND11_MODULE(caliber, m) {
             }
             return to_result(s.contacts, s.stats);
           },
-          py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference", py::arg("tolerance") = 0.0,
+          py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
           py::arg("angle") = 30.0, "One frame: every listed object pair (a < b, sorted) tested.");
 
   py::class_<caliber::World>(m, "World", "A scene file's objects, poses and broad phase.")

@@ -29,6 +29,7 @@ struct QueryOptions {
   std::string pose_a = "0 0 0 1 0 0 0", pose_b = "0 0 0 1 0 0 0";
   std::string kind = "interference";
   double tolerance = 0.0;
+  bool tolerance_given = false;  ///< distance: without --tolerance, any distance will do
   double angle = 30.0;
   bool json = false;
   int show = 10;
@@ -68,6 +69,7 @@ int run_query(const QueryOptions& opt) {
   caliber::QueryRequest request;
   request.kind = caliber::parse_query_kind(opt.kind);
   request.tolerance = opt.tolerance;
+  if (request.kind == caliber::QueryKind::distance && !opt.tolerance_given) request.tolerance = caliber::kUnbounded;
   request.angle_deg = opt.angle;
   caliber::validate_request(request);
   const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
@@ -138,8 +140,19 @@ int run_query(const QueryOptions& opt) {
     check_stdout();
     return 0;
   }
+  if (request.kind == caliber::QueryKind::distance) {
+    if (result.contacts.empty()) {
+      std::printf("distance: none within the tolerance %g\n", request.tolerance);
+    } else {
+      const caliber::Contact& c = result.contacts.front();
+      std::printf("distance: %.17g between triangle %u of A and triangle %u of B\n", c.distance, c.tri_a, c.tri_b);
+      std::printf("  nearest points (%.17g %.17g %.17g) on A, (%.17g %.17g %.17g) on B\n", c.point_a.x(), c.point_a.y(),
+                  c.point_a.z(), c.point_b.x(), c.point_b.y(), c.point_b.z());
+    }
+  }
   const char* what = request.kind == caliber::QueryKind::interference ? "intersecting triangle pairs"
                      : request.kind == caliber::QueryKind::proximity  ? "triangle pairs within the tolerance"
+                     : request.kind == caliber::QueryKind::distance   ? "closest triangle pair"
                                                                        : "contacts (local minima)";
   std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.pairs.size(), what);
   std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh.triangles.size(),
@@ -171,13 +184,17 @@ int run_query(const QueryOptions& opt) {
 
 Runner add_query_command(CLI::App& app) {
   auto opt = std::make_shared<QueryOptions>();
-  CLI::App* cmd = app.add_subcommand("query", "Query two meshes: interference, proximity or contact");
+  CLI::App* cmd = app.add_subcommand("query", "Query two meshes: interference, proximity, contact or distance");
   cmd->add_option("A", opt->mesh_a, "Mesh A (OFF, OBJ, STL or PLY)")->required();
   cmd->add_option("B", opt->mesh_b, "Mesh B (OFF, OBJ, STL or PLY)")->required();
   cmd->add_option("--pose-a", opt->pose_a, "Pose of A: \"tx ty tz qw qx qy qz\"")->capture_default_str();
   cmd->add_option("--pose-b", opt->pose_b, "Pose of B: \"tx ty tz qw qx qy qz\"")->capture_default_str();
-  cmd->add_option("--kind", opt->kind, "interference | proximity | contact")->capture_default_str();
-  cmd->add_option("--tolerance", opt->tolerance, "Distance d for proximity and contact (>= 0)")->capture_default_str();
+  cmd->add_option("--kind", opt->kind, "interference | proximity | contact | distance")->capture_default_str();
+  cmd->add_option("--tolerance", opt->tolerance,
+                  "Distance d for proximity and contact (>= 0); for distance, the largest distance of interest "
+                  "(default: any)")
+      ->capture_default_str()
+      ->each([opt](const std::string&) { opt->tolerance_given = true; });
   cmd->add_option("--angle", opt->angle, "Contact angle theta in degrees, [0, 180]")->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print one JSON object with every pair and contact");
   cmd->add_option("--show", opt->show, "How many pairs the summary lists")->capture_default_str();

@@ -5,6 +5,7 @@
 #include "caliber/export.h"
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string_view>
 #include <vector>
 
@@ -20,9 +21,10 @@ enum class QueryKind : std::uint8_t {
   interference,  ///< every intersecting triangle pair (exact predicates)
   proximity,     ///< every triangle pair at distance <= tolerance, with closest points
   contact,       ///< quasi-LMD: proximity pairs whose normals face each other, reduced to local minima
+  distance,      ///< the minimum distance: the closest triangle pair (0 when the meshes intersect), if within the tolerance
 };
 
-/// "interference", "proximity" or "contact".
+/// "interference", "proximity", "contact" or "distance".
 [[nodiscard]] CALIBER_EXPORT std::string_view to_string(QueryKind kind);
 /// Parses a kind name; throws caliber::Error on an unknown name.
 [[nodiscard]] CALIBER_EXPORT QueryKind parse_query_kind(std::string_view name);
@@ -42,7 +44,9 @@ struct GroupCompatibility {
 struct QueryRequest {
   /// What to report.
   QueryKind kind = QueryKind::interference;
-  /// Distance d (world units) for proximity and contact; must be finite and >= 0. Ignored by interference.
+  /// Distance d (world units) for proximity and contact; must be finite and >= 0. Ignored by
+  /// interference. For distance, the largest distance of interest ("not closer than d" is answered
+  /// without looking further): may be kUnbounded there, and only there.
   double tolerance = 0.0;
   /// Angle theta in degrees, [0, 180], for contact: normals must face each other within it.
   double angle_deg = 30.0;
@@ -50,11 +54,15 @@ struct QueryRequest {
   const GroupCompatibility* groups = nullptr;
 };
 
-/// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or an angle outside [0, 180].
+/// A distance query's tolerance when any distance will do.
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+/// Throws caliber::Error (bad_value) on a negative or non-finite tolerance (but kUnbounded for a
+/// distance query) or an angle outside [0, 180].
 CALIBER_EXPORT void validate_request(const QueryRequest& request);
 
 /// The distance within which a request reports triangle pairs: 0 for interference (the triangles
-/// must meet), the tolerance for proximity and contact.
+/// must meet), the tolerance for proximity, contact and distance.
 [[nodiscard]] inline double reach(const QueryRequest& request) {
   return request.kind == QueryKind::interference ? 0.0 : request.tolerance;
 }
@@ -84,7 +92,9 @@ struct QueryStats {
 };
 
 /// The result of a query. `pairs` is sorted and holds every reported triangle pair; `contacts`
-/// (proximity and contact only; empty for interference) holds one entry per pair, same order.
+/// (proximity, contact and distance; empty for interference) holds one entry per pair, same order.
+/// A distance query reports one pair, the closest (ties: the lowest triangle ids), or none when
+/// the meshes are farther apart than the tolerance.
 struct QueryResult {
   QueryKind kind = QueryKind::interference;  ///< the kind that produced it
   std::vector<TrianglePair> pairs;           ///< sorted by (tri_a, tri_b)

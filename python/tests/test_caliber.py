@@ -30,7 +30,7 @@ def cli_query(a, b, values, kind, tolerance):
     return json.loads(out.stdout)
 
 
-@pytest.mark.parametrize("kind", ["interference", "proximity", "contact"])
+@pytest.mark.parametrize("kind", ["interference", "proximity", "contact", "distance"])
 def test_query_equals_the_cpp_api_bit_for_bit(kind):
     a, b = caliber.Model.load(TETRA), caliber.Model.load(FAN)
     r = caliber.query(a, caliber.Pose(), b, pose(POSE), kind=kind, tolerance=0.3)
@@ -125,3 +125,13 @@ def test_threads_query_at_once_with_the_same_answers():
     for t in threads:
         t.join()
     assert got == [want] * 4
+
+
+def test_distance_without_a_tolerance_takes_any_distance():
+    a = caliber.Model.load(TETRA)
+    far = caliber.Pose((3.0, 0.5, 0.0), (1.0, 0.0, 0.0, 0.0))
+    r = caliber.query(a, caliber.Pose(), a, far, kind="distance")
+    assert len(r) == 1 and 2.0 < r.distances[0] < 4.0
+    assert len(caliber.query(a, caliber.Pose(), a, far, kind="distance", tolerance=1.0)) == 0
+    with pytest.raises(caliber.Error):
+        caliber.query(a, caliber.Pose(), a, far, kind="proximity", tolerance=float("inf"))

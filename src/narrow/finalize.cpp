@@ -126,6 +126,11 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     }
     candidates = local_minima(ctx, candidates, grain);
   }
+  // Distance: each traversal (a whole pair, or one task of it) brought its closest pair; the
+  // closest of those, ties to the lowest ids, is the pair's answer whatever the cut.
+  if (result.kind == QueryKind::distance && !candidates.empty()) {
+    candidates = {*std::min_element(candidates.begin(), candidates.end(), closer)};
+  }
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && candidates.size() >= kParallelGrain) {
     parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);

@@ -10,10 +10,6 @@
 
 namespace caliber::narrow {
 namespace {
-/// Relative safety margin on sphere tests. Rounding in the transformed centers and vertices is a few
-/// ulps (~1e-16 relative) of the coordinates' magnitude; 1e-9 of it is far above that and far below
-/// any size that changes how much the prune prunes.
-constexpr double kRelativeMargin = 1e-9;
 /// Margin on the cosine in the cone test: covers float-rounded cone axes (|axis| = 1 +- 2e-7).
 constexpr double kConeCosMargin = 1e-6;
 /// True when every vertex of q lies on one side of the plane of p, farther than `reach` from it,
@@ -49,8 +45,8 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
-  const double d = reach(request);
-  mReach = d + kRelativeMargin * (a.extent + b.extent + mTrans.norm() + d);
+  mScale = a.extent + b.extent + mTrans.norm();
+  mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
   mTheta = request.angle_deg * std::numbers::pi / 180.0;
   mCosTheta = std::cos(mTheta);
@@ -113,6 +109,29 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   const double distance = intersecting ? 0.0 : closest.distance;
   if (!(distance <= mRequest.tolerance)) return false;
   out.push_back(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
+  return true;
+}
+
+}  // namespace caliber::narrow
+
+namespace caliber::narrow {
+
+bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {
+  if (mGroups != nullptr) {
+    const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
+    const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
+    if (!mGroups->allows(ga, gb)) return false;
+  }
+  const auto& tri_a = mA.mesh.triangles[ta];
+  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
+  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  const double reach = reach_for(bound);
+  if (beyond_plane(a, b, reach) || beyond_plane(b, a, reach)) return false;
+  const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
+  const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
+  const double distance = intersecting ? 0.0 : closest.distance;
+  if (!(distance <= bound)) return false;
+  out = Candidate{ta, tb, distance, closest.on_a, closest.on_b};
   return true;
 }
 

@@ -4,6 +4,7 @@
 /// node-node and leaf tests. The leaf test is the single source of truth for what a query reports;
 /// the node test only prunes, and must never prune a pair the leaf test would keep.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -120,36 +121,51 @@ class PairContext {
   }
 
   /// The node-node test on prepared nodes: spheres within the tolerance, boxes not separated by a
-  /// face axis, each box not separated from the other node's slab, normal cones able to face each
-  /// other (contact only), some compatible groups.
+  /// face axis, each box not separated from the other node's slab, some compatible groups, normal
+  /// cones able to face each other (contact only).
   /// Conservative: every bound carries the safety margin (see the constructor).
   [[nodiscard]] bool node_test(const SideA& a, const SideB& b) const {
-    double dist2 = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      const double d = a.center[i] - b.center[i];
-      dist2 += d * d;
-    }
-    const double reach = a.radius + b.radius + mReach;
-    if (dist2 > reach * reach) return false;
-    for (int i = 0; i < 3; ++i) {  // A's axes
-      if (std::abs(b.box_in_a[i] - a.box[i]) > a.half[i] + b.reach_on_a[i] + mReach) return false;
-    }
-    for (int j = 0; j < 3; ++j) {  // B's axes
-      if (std::abs(b.box[j] - a.box_in_b[j]) > b.half[j] + a.reach_on_b[j] + mReach) return false;
-    }
-    if (box_beyond_slab(a.slab_axis, a.slab_on_b, a.slab_lo, a.slab_hi, b.box_in_a, b.half)) return false;
-    if (box_beyond_slab(b.slab_axis, b.slab_on_a, b.slab_lo, b.slab_hi, a.box_in_b, a.half)) return false;
+    if (!node_within(a, b, mReach, mSlabReach)) return false;
     if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
-    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
     return true;
   }
 
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 
+  /// The distance within which the node and leaf tests keep what a distance d keeps: d plus the
+  /// safety margin (rounding in the transformed centers and vertices, certified far below it).
+  [[nodiscard]] double reach_for(double d) const { return d + kRelativeMargin * (mScale + d); }
+
+  /// The geometric part of the node test (no cones), within `reach` (reach_for of a distance):
+  /// false only when no triangle pair below the two nodes can be within it, or none may touch.
+  [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach) const {
+    return node_within(a, b, reach, reach * (1.0 + 1e-6));
+  }
+
+  /// A lower bound on the distance between any triangles below the two nodes, before the safety
+  /// margin: the gap between their spheres, or the widest gap between their boxes along one of
+  /// the six face axes, whichever is larger (the quantities node_within compares with its reach).
+  [[nodiscard]] static double gap(const SideA& a, const SideB& b) {
+    double dist2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = a.center[i] - b.center[i];
+      dist2 += d * d;
+    }
+    double g = std::sqrt(dist2) - a.radius - b.radius;
+    for (int i = 0; i < 3; ++i) g = std::max(g, std::abs(b.box_in_a[i] - a.box[i]) - a.half[i] - b.reach_on_a[i]);
+    for (int j = 0; j < 3; ++j) g = std::max(g, std::abs(b.box[j] - a.box_in_b[j]) - b.half[j] - a.reach_on_b[j]);
+    return std::max(g, 0.0);
+  }
+
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
+
+  /// The leaf test of a distance traversal: when the triangles are within `bound` (and allowed by
+  /// groups), writes their distance and closest points to `out` and returns true. The arithmetic of
+  /// leaf_test, so a pair has the same distance whichever of the two computed it.
+  bool leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const;
 
   /// Model A.
   [[nodiscard]] const Model& a() const { return mA; }
@@ -167,16 +183,41 @@ class PairContext {
   }
 
  private:
+  /// Relative safety margin on every bound: rounding in the transformed centers and vertices is a
+  /// few ulps (~1e-16 relative) of the coordinates' magnitude; 1e-9 of it is far above that and far
+  /// below any size that changes how much the prune prunes.
+  static constexpr double kRelativeMargin = 1e-9;
+
+  /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
+  [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
+    double dist2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = a.center[i] - b.center[i];
+      dist2 += d * d;
+    }
+    const double spheres = a.radius + b.radius + reach;
+    if (dist2 > spheres * spheres) return false;
+    for (int i = 0; i < 3; ++i) {  // A's axes
+      if (std::abs(b.box_in_a[i] - a.box[i]) > a.half[i] + b.reach_on_a[i] + reach) return false;
+    }
+    for (int j = 0; j < 3; ++j) {  // B's axes
+      if (std::abs(b.box[j] - a.box_in_b[j]) > b.half[j] + a.reach_on_b[j] + reach) return false;
+    }
+    if (box_beyond_slab(a.slab_axis, a.slab_on_b, a.slab_lo, a.slab_hi, b.box_in_a, b.half, slab_reach)) return false;
+    if (box_beyond_slab(b.slab_axis, b.slab_on_a, b.slab_lo, b.slab_hi, a.box_in_b, a.half, slab_reach)) return false;
+    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
+    return true;
+  }
   bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   /// Whether a box lies beyond the slab lo <= axis . x <= hi by more than the reach: `center` is the
   /// box's center in the slab's frame, `half` its half-extents along its own axes, and `on[k]` is
   /// |axis . box axis k|. A gap g along an axis up to 1 + 1e-6 long is a distance >= g / |axis|.
   [[nodiscard]] bool box_beyond_slab(const double axis[3], const double on[3], double lo, double hi, const double center[3],
-                                     const double half[3]) const {
+                                     const double half[3], double slab_reach) const {
     const double at = axis[0] * center[0] + axis[1] * center[1] + axis[2] * center[2];
     const double reach = on[0] * half[0] + on[1] * half[1] + on[2] * half[2];
-    return at - reach > hi + mSlabReach || at + reach < lo - mSlabReach;
+    return at - reach > hi + slab_reach || at + reach < lo - slab_reach;
   }
 
   const Model& mA;
@@ -188,6 +229,7 @@ class PairContext {
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
   Eigen::Vector3d mTrans;
+  double mScale;       ///< extents of A and B plus their distance: what the safety margin is relative to
   double mReach;       ///< tolerance + safety margin added to the sum of radii
   double mSlabReach;   ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
   double mTheta;       ///< contact angle, radians

@@ -17,6 +17,7 @@ std::string_view to_string(QueryKind kind) {
     case QueryKind::interference: return "interference";
     case QueryKind::proximity: return "proximity";
     case QueryKind::contact: return "contact";
+    case QueryKind::distance: return "distance";
   }
   return "unknown";
 }
@@ -25,15 +26,18 @@ QueryKind parse_query_kind(std::string_view name) {
   if (name == "interference") return QueryKind::interference;
   if (name == "proximity") return QueryKind::proximity;
   if (name == "contact") return QueryKind::contact;
+  if (name == "distance") return QueryKind::distance;
   throw Error(ErrorCode::bad_value, "kind",
-              "unknown query kind '" + std::string(name) + "' (expected interference, proximity or contact)");
+              "unknown query kind '" + std::string(name) + "' (expected interference, proximity, contact or distance)");
 }
 
 void validate_request(const QueryRequest& request) {
-  if (!std::isfinite(request.tolerance) || request.tolerance < 0.0) {
-    throw Error(ErrorCode::bad_value, "tolerance", "must be a finite number >= 0");
+  const bool unbounded = request.kind == QueryKind::distance && request.tolerance == kUnbounded;
+  if (!unbounded && (!std::isfinite(request.tolerance) || request.tolerance < 0.0)) {
+    throw Error(ErrorCode::bad_value, "tolerance",
+                request.kind == QueryKind::distance ? "must be a number >= 0, or unbounded" : "must be a finite number >= 0");
   }
-  if (request.tolerance > kMaxCoordinate) {
+  if (request.tolerance > kMaxCoordinate && !unbounded) {
     throw Error(ErrorCode::bad_value, "tolerance", "must be at most 1e15 (caliber's limit on coordinates)");
   }
   if (request.tolerance > 0.0 && request.tolerance < kMinCoordinate) {
@@ -49,7 +53,7 @@ QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose
   narrow::TraversalScratch scratch;
   std::vector<narrow::Candidate> candidates;
   QueryStats stats;
-  narrow::traverse_depth_first(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats);
+  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats);
   return narrow::finalize(ctx, candidates, stats);
 }
 
@@ -60,12 +64,19 @@ QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b
   QueryStats stats;
   const auto na = static_cast<std::uint32_t>(a.mesh.triangles.size());
   const auto nb = static_cast<std::uint32_t>(b.mesh.triangles.size());
+  // Distance: every pair against the tolerance (no bound from the pairs before it), the closest kept.
+  narrow::Nearest nearest;
   for (std::uint32_t ta = 0; ta < na; ++ta) {
     for (std::uint32_t tb = 0; tb < nb; ++tb) {
       ++stats.leaf_tests;
-      ctx.leaf_test(ta, tb, candidates);
+      if (request.kind != QueryKind::distance) {
+        ctx.leaf_test(ta, tb, candidates);
+      } else if (narrow::Candidate c; ctx.leaf_distance(ta, tb, request.tolerance, c)) {
+        nearest.offer(c);
+      }
     }
   }
+  if (nearest.found) candidates.push_back(nearest.best);
   return narrow::finalize(ctx, candidates, stats);
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <compare>
+#include <utility>
 #include <cstdint>
 #include <vector>
 
@@ -117,6 +118,7 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
+  std::vector<std::pair<double, NodePair>> waiting;  ///< distance traversal: the heap of nodes by gap
 };
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
@@ -144,6 +146,98 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   }
   stats.node_tests += counted.node_tests;
   stats.leaf_tests += counted.leaf_tests;
+}
+
+/// The closest triangle pair a distance traversal has found so far.
+struct Nearest {
+  bool found = false;
+  Candidate best{};
+
+  /// Keeps c if it is closer than the best, or as close with lower triangle ids: the order every
+  /// method agrees on, so the answer does not depend on which pairs a traversal met first.
+  void offer(const Candidate& c) {
+    if (!found || c.distance < best.distance ||
+        (c.distance == best.distance && (c.tri_a < best.tri_a || (c.tri_a == best.tri_a && c.tri_b < best.tri_b)))) {
+      best = c;
+      found = true;
+    }
+  }
+  /// The distance beyond which nothing can win: the best so far, or the query's tolerance.
+  [[nodiscard]] double bound(const PairContext& ctx) const { return found ? best.distance : ctx.request().tolerance; }
+};
+
+/// The distance traversal (branch and bound, best first) of the CD subtree rooted at `root`: the
+/// nodes that pass their test wait in a heap by their gap (PairContext::gap, a lower bound on the
+/// distance below them); the nearest is visited next, each child tested within the best distance
+/// found so far, and the traversal ends when the nearest waiting node is farther than that distance
+/// by more than the safety margin. A node or pair exactly as close as the best is still examined,
+/// so ties go to the lowest ids. Counts node and leaf tests like traverse_depth_first; honours a
+/// taboo list the same way.
+inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
+                             QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
+  using Waiting = std::pair<double, NodePair>;
+  std::vector<Waiting>& heap = scratch.waiting;
+  heap.clear();
+  // Nearest first; ties by node, so that the order (and the node-test count) is reproducible.
+  const auto later = [](const Waiting& x, const Waiting& y) { return x.first != y.first ? x.first > y.first : x.second > y.second; };
+  {
+    const PairContext::SideA sa = ctx.prepare_a(root.a);
+    const PairContext::SideB sb = ctx.prepare_b(root.b);
+    if (root_tested || (++stats.node_tests, ctx.node_within(sa, sb, ctx.reach_for(nearest.bound(ctx))))) {
+      heap.emplace_back(PairContext::gap(sa, sb), root);
+    }
+  }
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const auto [gap, n] = heap.back();
+    heap.pop_back();
+    const double reach = ctx.reach_for(nearest.bound(ctx));
+    if (gap > reach) break;  // every node still waiting is at least as far
+    const BvhNode& a = ctx.a().nodes[n.a];
+    const BvhNode& b = ctx.b().nodes[n.b];
+    if (a.is_leaf() && b.is_leaf()) {
+      ++stats.leaf_tests;
+      if (Candidate c; ctx.leaf_distance(a.index, b.index, nearest.bound(ctx), c)) nearest.offer(c);
+      continue;
+    }
+    bool split_a, split_b;
+    cd_split(a, b, split_a, split_b);
+    PairContext::SideA sa[2];
+    PairContext::SideB sb[2];
+    const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
+    for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
+    for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
+    for (int i = 0; i < na; ++i) {
+      for (int j = 0; j < nb; ++j) {
+        const NodePair child{sa[i].index, sb[j].index};
+        if (taboo.taboo != nullptr) {
+          const int t = taboo.taboo->find(child);
+          if (t >= 0) {
+            taboo.reached[t] = 1;
+            continue;
+          }
+        }
+        ++stats.node_tests;
+        if (ctx.node_within(sa[i], sb[j], reach)) {
+          heap.emplace_back(PairContext::gap(sa[i], sb[j]), child);
+          std::push_heap(heap.begin(), heap.end(), later);
+        }
+      }
+    }
+  }
+}
+
+/// The traversal every schedule runs on its pieces: for a distance query, traverse_nearest (the
+/// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first.
+inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
+                     QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
+  if (ctx.request().kind == QueryKind::distance) {
+    Nearest nearest;
+    traverse_nearest(ctx, root, scratch, nearest, stats, root_tested, taboo);
+    if (nearest.found) out.push_back(nearest.best);
+    return;
+  }
+  traverse_depth_first(ctx, root, scratch, out, stats, root_tested, taboo);
 }
 
 }  // namespace caliber::narrow

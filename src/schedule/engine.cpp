@@ -71,6 +71,11 @@ void validate_frame(const Frame& frame) {
     }
   }
   validate_request(frame.request);
+  if (frame.request.kind == QueryKind::distance && frame.request.tolerance == kUnbounded) {
+    throw Error(ErrorCode::bad_value, "frame",
+                "a distance query on the engine needs a finite tolerance (the largest distance of interest); "
+                "caliber::query takes an unbounded one");
+  }
 }
 
 struct Engine::Impl {

@@ -71,6 +71,31 @@ check bad-angle 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind contac
 check no-args 2 "$cli"
 check unknown-flag 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --frobnicate
 
+# The distance query: the closest pair, a bound that answers "not closer than d", the same answer
+# from every engine method on a scene, and no engine run without a finite tolerance.
+check distance 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --json
+python3 - "$out" <<'PY' || { echo "FAIL distance-json"; failures=$((failures + 1)); }
+import json, math, sys
+r = json.loads(sys.argv[1])
+assert r["kind"] == "distance" and len(r["pairs"]) == 1 and len(r["contacts"]) == 1
+c = r["contacts"][0]
+assert 0.9 < c["distance"] < 2.0 and abs(math.dist(c["point_a"], c["point_b"]) - c["distance"]) < 1e-12
+PY
+check distance-bounded 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --tolerance 0.5
+contains distance-bounded "none within the tolerance 0.5"
+check distance-engine-unbounded 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind distance --method hybrid
+contains distance-engine-unbounded "finite tolerance"
+check distance-negative 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind distance --tolerance -1
+dtmp=$(mktemp -d)
+for m in sequential exploitation stealing aposteriori apriori hybrid; do
+  check "distance-run-$m" 0 "$cli" run "$data/scenes/distance_tetras.json" --method "$m" --threads 2 --contacts "$dtmp/$m.jsonl"
+done
+for m in exploitation stealing aposteriori apriori hybrid; do
+  cmp -s "$dtmp/sequential.jsonl" "$dtmp/$m.jsonl" && passes=$((passes + 1)) || { echo "FAIL distance-run: $m differs"; failures=$((failures + 1)); }
+done
+grep -q '"distance"' "$dtmp/sequential.jsonl" && passes=$((passes + 1)) || { echo "FAIL distance-run: no contacts"; failures=$((failures + 1)); }
+rm -rf "$dtmp"
+
 # caliber run
 tmp=$(mktemp -d)
 check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"

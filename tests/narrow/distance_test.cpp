@@ -1,0 +1,173 @@
+// The distance query: the closest triangle pair, against the brute-force minimum (same pair, same
+// bits) at gaps from 1e-6 to 1 of the meshes' size, in contact, within and beyond a tolerance, and
+// on the engine: every method and thread count gives the query's answer bit for bit.
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/engine.h"
+#include "caliber/error.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "support/random_poses.h"
+
+namespace caliber {
+namespace {
+
+QueryRequest distance_request(double tolerance = kUnbounded) {
+  QueryRequest r;
+  r.kind = QueryKind::distance;
+  r.tolerance = tolerance;
+  return r;
+}
+
+struct Shapes {
+  std::shared_ptr<const Model> sphere = build_model(make_sphere(1.0, 10, 14));
+  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.35, 14, 10));
+  std::shared_ptr<const Model> box = build_model(make_box(0.8, 0.5, 0.3, 3));
+};
+
+const Shapes& shapes() {
+  static const Shapes s;
+  return s;
+}
+
+/// B placed along a random direction so that its bounding sphere's gap to A's is `gap`, randomly
+/// turned: the true gap between the meshes is then at least `gap` and usually a little more.
+Pose separated(std::mt19937_64& rng, const Model& a, const Model& b, double gap) {
+  const Pose turned = test::random_pose(rng, 0.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::Vector3d dir(g(rng), g(rng), g(rng));
+  dir.normalize();
+  const double ra = a.nodes[0].radius, rb = b.nodes[0].radius;
+  const Eigen::Vector3d ca(a.nodes[0].center[0], a.nodes[0].center[1], a.nodes[0].center[2]);
+  const Eigen::Vector3d cb(b.nodes[0].center[0], b.nodes[0].center[1], b.nodes[0].center[2]);
+  const Eigen::Vector3d where = ca + dir * (ra + rb + gap) - turned.rotation * cb;
+  return Pose{turned.rotation, where};
+}
+
+TEST(Distance, EqualsTheBruteForceMinimumAtEveryScaleOfGap) {
+  std::mt19937_64 rng(7);
+  const Model* models[] = {shapes().sphere.get(), shapes().torus.get(), shapes().box.get()};
+  int cases = 0;
+  for (const double gap : {1e-6, 1e-4, 1e-2, 0.1, 0.5, 1.0, 2.0}) {
+    for (int k = 0; k < 6; ++k) {
+      const Model& a = *models[k % 3];
+      const Model& b = *models[(k + 1) % 3];
+      const Pose pa = test::random_pose(rng, 0.0);
+      const Pose pb_local = separated(rng, a, b, gap);
+      const Pose pb{pa.rotation * pb_local.rotation, pa.apply(pb_local.translation)};
+      const std::string what = "gap " + std::to_string(gap) + " case " + std::to_string(k);
+      const QueryResult fast = query(a, pa, b, pb, distance_request());
+      const QueryResult slow = query_brute_force(a, pa, b, pb, distance_request());
+      test::expect_identical(fast, slow, what);
+      ASSERT_EQ(fast.pairs.size(), 1u) << what;
+      const Contact& c = fast.contacts.front();
+      EXPECT_GE(c.distance, gap * (1 - 1e-9)) << what << ": the spheres' gap is a lower bound";
+      EXPECT_NEAR((c.point_b - c.point_a).norm(), c.distance, 1e-12 * (1 + c.distance)) << what;
+      EXPECT_LT(fast.stats.leaf_tests, slow.stats.leaf_tests / 20) << what << ": the bound prunes";
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 42);
+}
+
+TEST(Distance, RandomPosesAgreeWithTheOracleIncludingOverlaps) {
+  std::mt19937_64 rng(11);
+  const auto torus = build_model(make_torus(1.0, 0.35, 10, 6));
+  const auto sphere = build_model(make_sphere(1.0, 6, 8));
+  int overlapping = 0, apart = 0;
+  for (int i = 0; i < 80; ++i) {
+    const Model& a = *torus;
+    const Model& b = i % 2 ? *sphere : *torus;
+    const Pose pa = test::random_pose(rng, 1.2);
+    const Pose pb = test::random_pose(rng, 1.2);
+    const QueryResult fast = query(a, pa, b, pb, distance_request());
+    test::expect_identical(fast, query_brute_force(a, pa, b, pb, distance_request()), "pose " + std::to_string(i));
+    ASSERT_EQ(fast.pairs.size(), 1u);
+    (fast.contacts.front().distance == 0.0 ? overlapping : apart)++;
+  }
+  EXPECT_GT(overlapping, 10) << "overlapping poses must be tested: their ties at 0 go to the lowest ids";
+  EXPECT_GT(apart, 10);
+}
+
+TEST(Distance, TheToleranceBoundsTheAnswer) {
+  std::mt19937_64 rng(3);
+  const Model& a = *shapes().sphere;
+  const Model& b = *shapes().box;
+  const Pose pb = separated(rng, a, b, 0.25);
+  const QueryResult any = query(a, Pose{}, b, pb, distance_request());
+  ASSERT_EQ(any.contacts.size(), 1u);
+  const double d = any.contacts.front().distance;
+  const QueryResult within = query(a, Pose{}, b, pb, distance_request(d));
+  test::expect_identical(within, any, "tolerance exactly the distance");
+  const QueryResult beyond = query(a, Pose{}, b, pb, distance_request(std::nextafter(d, 0.0)));
+  EXPECT_TRUE(beyond.pairs.empty() && beyond.contacts.empty()) << "nothing within a tolerance below the distance";
+  test::expect_identical(beyond, query_brute_force(a, Pose{}, b, pb, distance_request(std::nextafter(d, 0.0))), "oracle");
+  EXPECT_LT(beyond.stats.node_tests, any.stats.node_tests) << "a tolerance answers early";
+}
+
+TEST(Distance, OnlyDistanceTakesAnUnboundedTolerance) {
+  QueryRequest r = distance_request();
+  EXPECT_NO_THROW(validate_request(r));
+  r.kind = QueryKind::proximity;
+  EXPECT_THROW(validate_request(r), Error);
+  r = distance_request(-1.0);
+  EXPECT_THROW(validate_request(r), Error);
+  r = distance_request(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_THROW(validate_request(r), Error);
+  EXPECT_EQ(parse_query_kind("distance"), QueryKind::distance);
+  EXPECT_EQ(to_string(QueryKind::distance), "distance");
+}
+
+TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
+  std::mt19937_64 rng(5);
+  Frame frame;
+  frame.models = {shapes().torus, shapes().sphere, shapes().box, shapes().torus};
+  for (int i = 0; i < 4; ++i) frame.poses.push_back(test::random_pose(rng, 1.5));
+  for (std::uint32_t a = 0; a < 4; ++a) {
+    for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(Task{a, b});
+  }
+  frame.request = distance_request(1.5);
+  std::vector<SceneContact> want;
+  for (const Task& t : frame.pairs) {
+    const QueryResult r = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+    for (const Contact& c : r.contacts) want.push_back(SceneContact{t.a, t.b, c});
+  }
+  ASSERT_GE(want.size(), 3u) << "most pairs must be within the tolerance for this to test anything";
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
+                              Method::apriori, Method::hybrid}) {
+    for (const int threads : {1, 2, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      options.beta = 16;  // many tasks, so that pairs are split
+      options.stealing_depth = 3;
+      Engine engine(options);
+      for (int step = 0; step < 2; ++step) {  // the second step uses what the temporal methods learnt
+        const StepResult got = engine.step(frame);
+        const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
+        ASSERT_EQ(got.contacts.size(), want.size()) << what;
+        for (std::size_t i = 0; i < want.size(); ++i) {
+          EXPECT_EQ(got.contacts[i].object_a, want[i].object_a) << what;
+          EXPECT_EQ(got.contacts[i].object_b, want[i].object_b) << what;
+          test::expect_identical(QueryResult{QueryKind::distance, {{got.contacts[i].contact.tri_a, got.contacts[i].contact.tri_b}},
+                                             {got.contacts[i].contact}, {}},
+                                 QueryResult{QueryKind::distance, {{want[i].contact.tri_a, want[i].contact.tri_b}},
+                                             {want[i].contact}, {}},
+                                 what);
+        }
+      }
+    }
+  }
+  frame.request.tolerance = kUnbounded;
+  Engine engine;
+  EXPECT_THROW((void)engine.step(frame), Error) << "the engine needs a finite tolerance";
+}
+
+}  // namespace
+}  // namespace caliber
