@@ -72,8 +72,10 @@ py::array_t<std::int64_t> faces_of(const caliber::Mesh& mesh) {
 }
 
 /// `tolerance` None: 0, or for a distance query, any distance (caliber::kUnbounded).
-caliber::QueryRequest make_request(const std::string& kind, std::optional<double> tolerance, double angle) {
+caliber::QueryRequest make_request(const std::string& kind, std::optional<double> tolerance, double angle,
+                                   std::size_t max_pairs = 0) {
   caliber::QueryRequest request;
+  request.max_pairs = max_pairs;
   request.kind = caliber::parse_query_kind(kind);
   request.tolerance = tolerance ? *tolerance : request.kind == caliber::QueryKind::distance ? caliber::kUnbounded : 0.0;
   request.angle_deg = angle;
@@ -88,6 +90,7 @@ struct PyResult {
   py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
   py::array_t<double> distances;       ///< k
   std::uint64_t node_tests = 0, leaf_tests = 0;
+  bool limit_reached = false;          ///< more than max_pairs were found: a partial answer
 };
 
 PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const caliber::QueryStats& stats) {
@@ -127,7 +130,9 @@ PyResult query_result(const caliber::QueryResult& q) {
   std::vector<caliber::SceneContact> contacts;
   contacts.reserve(q.pairs.size());
   for (std::size_t i = 0; i < q.pairs.size(); ++i) contacts.push_back(caliber::SceneContact{0, 1, caliber::contact_at(q, i)});
-  return to_result(contacts, q.stats);
+  PyResult r = to_result(contacts, q.stats);
+  r.limit_reached = q.limit_reached;
+  return r;
 }
 
 caliber::Pose pose_from_matrix(const py::array_t<double, py::array::c_style | py::array::forcecast>& m) {
@@ -231,14 +236,15 @@ PYBIND11_MODULE(caliber, m) {
       .def_readonly("normals", &PyResult::normals)
       .def_readonly("distances", &PyResult::distances)
       .def_readonly("node_tests", &PyResult::node_tests)
+      .def_readonly("limit_reached", &PyResult::limit_reached)
       .def_readonly("leaf_tests", &PyResult::leaf_tests)
       .def("__len__", [](const PyResult& r) { return static_cast<std::size_t>(r.distances.shape(0)); });
 
   m.def(
       "query",
       [](const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b, const std::string& kind,
-         std::optional<double> tolerance, double angle) {
-        const caliber::QueryRequest request = make_request(kind, tolerance, angle);
+         std::optional<double> tolerance, double angle, std::size_t max_pairs) {
+        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs);
         caliber::QueryResult q;
         {
           py::gil_scoped_release release;
@@ -247,9 +253,10 @@ PYBIND11_MODULE(caliber, m) {
         return query_result(q);
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
-      py::arg("angle") = 30.0,
+      py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
       "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
-      "beyond the tolerance; no tolerance: any distance).");
+      "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
+      "limit_reached (1: any pair).");
 
   py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on a fixed number of threads; keeps temporal state.")
       .def(py::init([](const std::string& method, int threads) {

@@ -19,6 +19,7 @@ nlohmann::json to_json(const QueryResult& result) {
                         {"normal", vec(c.normal)},
                         {"distance", c.distance}});
   }
+  out["limit_reached"] = result.limit_reached;
   out["stats"] = {{"node_tests", result.stats.node_tests}, {"leaf_tests", result.stats.leaf_tests}};
   return out;
 }

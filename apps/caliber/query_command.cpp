@@ -36,6 +36,8 @@ struct QueryOptions {
   std::string method = "sequential";
   int threads = 0;
   int repeat = 1;
+  std::size_t max_pairs = 0;
+  bool first = false;
 };
 
 bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
@@ -58,6 +60,7 @@ caliber::QueryResult query_with_engine(caliber::Engine& engine, const caliber::F
   caliber::QueryResult result;
   result.kind = frame.request.kind;
   result.stats = step.stats;
+  result.limit_reached = step.limit_reached;
   for (const caliber::SceneContact& c : step.contacts) {
     result.pairs.push_back({c.contact.tri_a, c.contact.tri_b});
     if (frame.request.kind != caliber::QueryKind::interference) result.contacts.push_back(c.contact);
@@ -71,6 +74,7 @@ int run_query(const QueryOptions& opt) {
   request.tolerance = opt.tolerance;
   if (request.kind == caliber::QueryKind::distance && !opt.tolerance_given) request.tolerance = caliber::kUnbounded;
   request.angle_deg = opt.angle;
+  request.max_pairs = opt.first ? 1 : opt.max_pairs;
   caliber::validate_request(request);
   const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
   const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
@@ -175,6 +179,10 @@ int run_query(const QueryOptions& opt) {
     }
   }
   if (shown < result.pairs.size()) std::printf("  ... %zu more (use --json for all)\n", result.pairs.size() - shown);
+  if (result.limit_reached) {
+    std::printf("  limit reached: more than %zu pairs; the query stopped early and reports %zu of them\n", request.max_pairs,
+                result.pairs.size());
+  }
   check_stdout();
   return 0;
 }
@@ -203,6 +211,10 @@ Runner add_query_command(CLI::App& app) {
                   "apriori, hybrid (same pairs; build time then counted in query_ms)")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Engine threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--max-pairs", opt->max_pairs,
+                  "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
+      ->capture_default_str();
+  cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1");
   cmd->add_option("--repeat", opt->repeat,
                   "Run the query R times: stats.query_ms is the first (cold) run, stats.query_ms_warm the median of "
                   "the others (every run must give the same result)")

@@ -40,6 +40,7 @@ struct RunOptions {
   std::string json;
   std::string contacts;
   ExportOptions exports;
+  std::size_t max_pairs = 0;
 };
 
 nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
@@ -48,7 +49,7 @@ nlohmann::json step_record(const StepResult& s) {
   nlohmann::json tasks = nlohmann::json::array();
   for (const TaskRecord& t : s.tasks) {
     tasks.push_back({{"a", t.task.a}, {"b", t.task.b}, {"node_tests", t.stats.node_tests},
-                     {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}});
+                     {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}, {"limit_reached", t.limit_reached}});
   }
   const ScheduleRecord& c = s.schedule;
   nlohmann::json schedule = {{"omega", c.omega},
@@ -78,6 +79,7 @@ nlohmann::json step_record(const StepResult& s) {
           {"node_tests", s.stats.node_tests},
           {"leaf_tests", s.stats.leaf_tests},
           {"contacts", s.contacts.size()},
+          {"limit_reached", s.limit_reached},
           {"tasks", tasks}};
 }
 
@@ -95,7 +97,7 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
     }
     list.push_back(std::move(j));
   }
-  return {{"schema_version", kSchemaVersion}, {"step", s.step}, {"contacts", list}};
+  return {{"schema_version", kSchemaVersion}, {"step", s.step}, {"limit_reached", s.limit_reached}, {"contacts", list}};
 }
 
 std::string pair_name(const World& world, const Task& t) {
@@ -121,6 +123,7 @@ int run_scene(const RunOptions& opt) {
   Scene scene = load_scene(opt.scene);
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
   if (opt.steps > 0) scene.steps = opt.steps;
+  if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
   for (const int p : opt.simulate) {
     if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
   }
@@ -162,6 +165,7 @@ int run_scene(const RunOptions& opt) {
   for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
   const Progress progress(static_cast<std::size_t>(sc.steps));
   const InterruptGuard interrupt;
+  std::size_t limited_steps = 0;
   for (int k = 0; k < sc.steps && !gInterrupted.load(); ++k) {
     StepResult s;
     try {
@@ -170,6 +174,7 @@ int run_scene(const RunOptions& opt) {
       throw Error(ErrorCode::out_of_memory, sc.file.string(), "out of memory while running step " + std::to_string(k));
     }
     stats.add(s);
+    limited_steps += s.limit_reached ? 1 : 0;
     for (SimulatedRun& sim : sims) sim.add(s);
     if (json_out) steps.push_back(step_record(s));
     if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
@@ -183,6 +188,10 @@ int run_scene(const RunOptions& opt) {
   if (interrupted) std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
   if (contacts_out) contacts_out->commit();
 
+  if (limited_steps > 0) {
+    std::printf("\n%zu of %zu steps reached --max-pairs %zu on some pair: their contacts are partial\n", limited_steps,
+                stats.steps(), opt.max_pairs);
+  }
   const auto [heavy, heavy_share] = stats.heaviest_pair();
   const auto [second, second_share] = stats.second_heaviest_pair();
   std::printf("\nsummary over %zu steps\n", stats.steps());
@@ -267,6 +276,10 @@ Runner add_run_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");
   cmd->add_option("--contacts", opt->contacts, "Write each step's contacts, one JSON line per step, to this file");
+  cmd->add_option("--max-pairs", opt->max_pairs,
+                  "Per object pair and step, report at most N triangle pairs: past N it stops early and the step says "
+                  "so (0: the scene's query.max_pairs, or no limit)")
+      ->capture_default_str();
   cmd->add_option("--export", opt->exports.dir, "Write PLY files of chosen steps into this folder (docs/exports.md)");
   cmd->add_option("--export-steps", opt->exports.steps, "The steps --export writes")->delimiter(',')->capture_default_str();
   cmd->add_option("--bvh-depth", opt->exports.bvh_depth, "--export also writes every BVH's boxes down to this depth (-1: none)")

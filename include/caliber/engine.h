@@ -37,6 +37,7 @@ struct TaskRecord {
   Task task;              ///< the object pair
   QueryStats stats;       ///< node and leaf tests
   std::size_t pairs = 0;  ///< triangle pairs reported
+  bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `pairs` is partial
 };
 
 /// One piece of a step's work on one thread (EngineOptions::timeline): what a Gantt chart draws.
@@ -109,6 +110,7 @@ struct StepResult {
   std::vector<SceneContact> contacts;   ///< sorted by (object a, object b, tri a, tri b)
   QueryStats stats;                     ///< totals over the tasks
   ScheduleRecord schedule;              ///< how the work was cut and scheduled
+  bool limit_reached = false;           ///< some pair reached QueryRequest::max_pairs (its contacts are partial)
 };
 
 /// One moment of a set of rigid objects, as the engine takes it: whatever produced it (a scene's

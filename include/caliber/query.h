@@ -4,6 +4,7 @@
 
 #include "caliber/export.h"
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <string_view>
@@ -52,6 +53,12 @@ struct QueryRequest {
   double angle_deg = 30.0;
   /// Group compatibility; null means every group may touch every group. Not owned.
   const GroupCompatibility* groups = nullptr;
+  /// The most triangle pairs to report per object pair; 0: no limit. A query that finds more stops
+  /// early and sets QueryResult::limit_reached: it returns max_pairs of the pairs it found (the
+  /// lowest ids among them; which pairs it found first depends on the traversal and the method),
+  /// and memory stays bounded. 1 asks "do they touch at all?" (any pair, or none). For contact
+  /// queries the limit applies before the local-minimum reduction. Ignored by distance queries.
+  std::size_t max_pairs = 0;
 };
 
 /// A distance query's tolerance when any distance will do.
@@ -100,6 +107,9 @@ struct QueryResult {
   std::vector<TrianglePair> pairs;           ///< sorted by (tri_a, tri_b)
   std::vector<Contact> contacts;             ///< sorted like pairs
   QueryStats stats;                          ///< work done
+  /// More than QueryRequest::max_pairs pairs were found: the query stopped early and `pairs` is a
+  /// part of the answer (max_pairs of the pairs found), not all of it.
+  bool limit_reached = false;
 };
 
 /// Reported pair k of a result as a Contact: the result's contact for proximity and contact

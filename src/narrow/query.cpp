@@ -53,7 +53,10 @@ QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose
   narrow::TraversalScratch scratch;
   std::vector<narrow::Candidate> candidates;
   QueryStats stats;
-  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats);
+  narrow::PairLimit limit;
+  limit.max = request.max_pairs;
+  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats, false, {},
+                   request.max_pairs != 0 ? &limit : nullptr);
   return narrow::finalize(ctx, candidates, stats);
 }
 

@@ -4,6 +4,7 @@
 /// cuts this tree into tasks differently; all of them run this routine on their pieces.
 
 #include <algorithm>
+#include <atomic>
 #include <compare>
 #include <utility>
 #include <cstdint>
@@ -115,6 +116,19 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
   return count;
 }
 
+/// How many triangle pairs the traversals of one object pair have kept, against
+/// QueryRequest::max_pairs; shared by the pair's traversals (any threads), which stop once it is
+/// exceeded. Which pairs were kept by then depends on the schedule; finalize keeps max_pairs of them.
+struct PairLimit {
+  std::atomic<std::size_t> kept{0};
+  std::size_t max = 0;  ///< 0: no limit
+
+  /// Counts one more kept pair; true when the limit is now exceeded.
+  bool add() { return kept.fetch_add(1, std::memory_order_relaxed) + 1 > max; }
+  /// Whether some traversal has exceeded the limit.
+  [[nodiscard]] bool exceeded() const { return kept.load(std::memory_order_relaxed) > max; }
+};
+
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
@@ -127,7 +141,7 @@ struct TraversalScratch {
 /// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
                                  std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false,
-                                 TabooView taboo = {}) {
+                                 TabooView taboo = {}, PairLimit* limit = nullptr) {
   // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
   // more than 3 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
@@ -138,8 +152,14 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   QueryStats counted;
   if (root_tested || test_root(ctx, root, counted)) *top++ = root;
   NodePair passed[4];
+  std::size_t seen = out.size();
   while (top != base) {
     const int count = visit(ctx, *--top, out, counted, passed, taboo);
+    // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
+    if (limit != nullptr && count < 0) {
+      if (out.size() != seen && (seen = out.size(), limit->add())) break;
+      if (limit->exceeded()) break;
+    }
     // Pushed in reverse so that the first child is popped first (the order of cd_children).
     for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
@@ -228,16 +248,17 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
 }
 
 /// The traversal every schedule runs on its pieces: for a distance query, traverse_nearest (the
-/// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first.
+/// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first (stopping
+/// early at the pair's limit, if one is given).
 inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
-                     QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
+                     QueryStats& stats, bool root_tested = false, TabooView taboo = {}, PairLimit* limit = nullptr) {
   if (ctx.request().kind == QueryKind::distance) {
     Nearest nearest;
     traverse_nearest(ctx, root, scratch, nearest, stats, root_tested, taboo);
     if (nearest.found) out.push_back(nearest.best);
     return;
   }
-  traverse_depth_first(ctx, root, scratch, out, stats, root_tested, taboo);
+  traverse_depth_first(ctx, root, scratch, out, stats, root_tested, taboo, limit);
 }
 
 }  // namespace caliber::narrow

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <numeric>
 #include <tuple>
 #include <string>
@@ -142,6 +143,12 @@ StepResult Engine::step(const Frame& frame) {
   mImpl->workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
   mImpl->timeline.begin(mOptions.timeline);
   schedule::StepState state{contexts, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1};
+  std::unique_ptr<narrow::PairLimit[]> limits;
+  if (frame.request.max_pairs != 0 && frame.request.kind != QueryKind::distance) {
+    limits = std::make_unique<narrow::PairLimit[]>(n);
+    for (std::size_t i = 0; i < n; ++i) limits[i].max = frame.request.max_pairs;
+    state.limits = limits.get();
+  }
   ScheduleRecord& record = out.schedule;
   tasks::Plan plan;
   std::vector<std::vector<std::uint64_t>> stage_root_tests;

@@ -83,8 +83,8 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
         const std::uint64_t before = stats.node_tests;
         const narrow::TabooView taboo = root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()}
                                                         : narrow::TabooView{};
-        narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats,
-                                     root.tested, taboo);
+        narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats, root.tested,
+                         taboo, state.limit(root.pair));
         tests += stats.node_tests - before;
         if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
         if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;
@@ -113,13 +113,15 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
 void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>& results, StepResult& out) {
   out.tasks.clear();
   out.contacts.clear();
+  out.limit_reached = false;
   out.stats = QueryStats{};
   std::size_t total = 0;
   for (const QueryResult& r : results) total += r.pairs.size();
   out.contacts.reserve(total);
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const QueryResult& r = results[i];
-    out.tasks.push_back(TaskRecord{pairs[i], r.stats, r.pairs.size()});
+    out.tasks.push_back(TaskRecord{pairs[i], r.stats, r.pairs.size(), r.limit_reached});
+    out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
     for (std::size_t k = 0; k < r.pairs.size(); ++k) out.contacts.push_back(SceneContact{pairs[i].a, pairs[i].b, contact_at(r, k)});

@@ -89,6 +89,10 @@ struct StepState {
   Timeline& timeline;
   std::vector<QueryResult>& results;
   bool parallel_finalize = true;  ///< let one heavy pair's finalization use several threads
+  /// Per pair: its kept pairs against QueryRequest::max_pairs; null when there is no limit.
+  narrow::PairLimit* limits = nullptr;
+  /// The pair's limit for a traversal, or null.
+  [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
 };
 
 /// Per pair, in parallel, most candidates first: `start` seeds the pair's candidates and counts

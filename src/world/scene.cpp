@@ -162,7 +162,7 @@ SceneObject read_object(const Reader& r, const Json& j, const std::string& where
 }
 
 QueryRequest read_query(const Reader& r, const Json& q) {
-  r.only_keys(q, "query", {"kind", "tolerance", "angle"});
+  r.only_keys(q, "query", {"kind", "tolerance", "angle", "max_pairs"});
   QueryRequest query;
   if (q.contains("kind")) {
     try {
@@ -179,6 +179,7 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   }
   query.angle_deg = r.number(q, "query", "angle", query.angle_deg);
   if (query.angle_deg < 0.0 || query.angle_deg > 180.0) r.fail("query.angle", "must be in [0, 180] degrees");
+  if (q.contains("max_pairs")) query.max_pairs = static_cast<std::size_t>(r.integer(q.at("max_pairs"), "query.max_pairs", 0, 0x7fffffff));
   return query;
 }
 

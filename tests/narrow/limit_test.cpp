@@ -1,0 +1,143 @@
+// QueryRequest::max_pairs: a query that finds more pairs stops early, says so, and reports only
+// pairs of the full answer (with the full answer's bits); one that finds no more is unchanged. On
+// the engine, every method and thread count keeps to the limit (which pairs may differ).
+
+#include <algorithm>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/engine.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "support/random_poses.h"
+
+namespace caliber {
+namespace {
+
+struct Shapes {
+  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.35, 24, 16));
+  std::shared_ptr<const Model> sphere = build_model(make_sphere(0.9, 16, 24));
+};
+
+const Shapes& shapes() {
+  static const Shapes s;
+  return s;
+}
+
+/// Every reported pair of `part` is in `full`, with the same contact to the last bit.
+void expect_part_of(const QueryResult& part, const QueryResult& full, const std::string& what) {
+  for (std::size_t k = 0; k < part.pairs.size(); ++k) {
+    const auto it = std::lower_bound(full.pairs.begin(), full.pairs.end(), part.pairs[k]);
+    ASSERT_TRUE(it != full.pairs.end() && *it == part.pairs[k]) << what << ": a pair the full answer lacks";
+    if (!full.contacts.empty()) {
+      const Contact& a = part.contacts[k];
+      const Contact& b = full.contacts[static_cast<std::size_t>(it - full.pairs.begin())];
+      EXPECT_EQ(a.distance, b.distance) << what;
+      EXPECT_EQ(a.point_a, b.point_a) << what;
+      EXPECT_EQ(a.point_b, b.point_b) << what;
+    }
+  }
+}
+
+TEST(MaxPairs, StopsEarlyFlagsAndReportsOnlyTrueAnswers) {
+  const Pose pb = Pose::from_values(0.9, 0.1, 0.05, 1, 0.2, 0.1, 0);
+  for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity}) {
+    QueryRequest request;
+    request.kind = kind;
+    request.tolerance = 0.02;
+    const QueryResult full = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
+    ASSERT_GT(full.pairs.size(), 20u) << "the test pose must give many pairs";
+    EXPECT_FALSE(full.limit_reached);
+    for (const std::size_t limit : {std::size_t{1}, std::size_t{7}, full.pairs.size() - 1}) {
+      request.max_pairs = limit;
+      const std::string what = std::string(to_string(kind)) + " limit " + std::to_string(limit);
+      const QueryResult part = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
+      EXPECT_TRUE(part.limit_reached) << what;
+      EXPECT_EQ(part.pairs.size(), limit) << what;
+      expect_part_of(part, full, what);
+      if (limit < 10) EXPECT_LT(part.stats.leaf_tests, full.stats.leaf_tests) << what << ": it stopped early";
+    }
+    for (const std::size_t limit : {full.pairs.size(), full.pairs.size() + 1}) {
+      request.max_pairs = limit;
+      const QueryResult same = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
+      EXPECT_FALSE(same.limit_reached) << "a limit the answer does not exceed changes nothing";
+      test::expect_identical(same, full, "limit " + std::to_string(limit));
+      EXPECT_EQ(same.stats.node_tests, full.stats.node_tests);
+    }
+  }
+}
+
+TEST(MaxPairs, FirstAnswersWhetherTheyTouch) {
+  std::mt19937_64 rng(9);
+  QueryRequest any;
+  any.max_pairs = 1;
+  int touching = 0;
+  for (int i = 0; i < 60; ++i) {
+    const Pose pa = test::random_pose(rng, 1.0);
+    const Pose pb = test::random_pose(rng, 1.0);
+    const QueryResult full = query(*shapes().torus, pa, *shapes().sphere, pb, QueryRequest{});
+    const QueryResult first = query(*shapes().torus, pa, *shapes().sphere, pb, any);
+    ASSERT_EQ(first.pairs.empty(), full.pairs.empty()) << "pose " << i;
+    EXPECT_EQ(first.limit_reached, full.pairs.size() > 1) << "pose " << i;
+    expect_part_of(first, full, "pose " + std::to_string(i));
+    touching += full.pairs.empty() ? 0 : 1;
+  }
+  EXPECT_GT(touching, 10);
+  EXPECT_LT(touching, 55);
+}
+
+TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
+  Frame frame;
+  frame.models = {shapes().torus, shapes().sphere, shapes().torus};
+  frame.poses = {Pose{}, Pose::from_values(0.9, 0.1, 0.05, 1, 0.2, 0.1, 0), Pose::from_values(0.2, 0.3, 0.1, 1, 0, 0.3, 0.1)};
+  frame.pairs = {Task{0, 1}, Task{0, 2}, Task{1, 2}};
+  frame.request.kind = QueryKind::proximity;
+  frame.request.tolerance = 0.02;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, QueryResult> full;
+  for (const Task& t : frame.pairs) {
+    const QueryResult& f = full[{t.a, t.b}] =
+        query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+    ASSERT_GT(f.pairs.size(), 30u) << t.a << "-" << t.b;
+  }
+  frame.request.max_pairs = 25;
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
+                              Method::apriori, Method::hybrid}) {
+    for (const int threads : {1, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      Engine engine(options);
+      const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
+      const StepResult step = engine.step(frame);
+      EXPECT_TRUE(step.limit_reached) << what;
+      for (const TaskRecord& t : step.tasks) {
+        EXPECT_TRUE(t.limit_reached) << what;
+        EXPECT_EQ(t.pairs, 25u) << what;
+      }
+      for (const SceneContact& c : step.contacts) {
+        const QueryResult& f = full[{c.object_a, c.object_b}];
+        const auto it = std::lower_bound(f.pairs.begin(), f.pairs.end(), TrianglePair{c.contact.tri_a, c.contact.tri_b});
+        ASSERT_TRUE(it != f.pairs.end() && *it == (TrianglePair{c.contact.tri_a, c.contact.tri_b})) << what;
+        EXPECT_EQ(c.contact.point_a, f.contacts[static_cast<std::size_t>(it - f.pairs.begin())].point_a) << what;
+      }
+    }
+  }
+}
+
+TEST(MaxPairs, DistanceIgnoresIt) {
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  request.tolerance = kUnbounded;
+  const Pose pb = Pose::from_values(3, 0, 0, 1, 0, 0, 0);
+  const QueryResult plain = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
+  request.max_pairs = 1;
+  const QueryResult limited = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
+  test::expect_identical(limited, plain, "distance");
+  EXPECT_FALSE(limited.limit_reached);
+}
+
+}  // namespace
+}  // namespace caliber
