@@ -89,6 +89,7 @@ struct PyResult {
   py::array_t<std::uint32_t> pairs;    ///< k x 2 triangle ids
   py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
   py::array_t<double> distances;       ///< k
+  py::array_t<double> depths;          ///< k: Contact::depth (intersecting pairs' penetration estimate)
   std::uint64_t node_tests = 0, leaf_tests = 0;
   bool limit_reached = false;          ///< more than max_pairs were found: a partial answer
 };
@@ -102,12 +103,14 @@ PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const cal
   r.points_b = py::array_t<double>({k, py::ssize_t{3}});
   r.normals = py::array_t<double>({k, py::ssize_t{3}});
   r.distances = py::array_t<double>(k);
+  r.depths = py::array_t<double>(k);
   auto obj = r.objects.mutable_unchecked<2>();
   auto tri = r.pairs.mutable_unchecked<2>();
   auto pa = r.points_a.mutable_unchecked<2>();
   auto pb = r.points_b.mutable_unchecked<2>();
   auto nn = r.normals.mutable_unchecked<2>();
   auto dd = r.distances.mutable_unchecked<1>();
+  auto dp = r.depths.mutable_unchecked<1>();
   for (py::ssize_t i = 0; i < k; ++i) {
     const caliber::SceneContact& c = contacts[static_cast<std::size_t>(i)];
     obj(i, 0) = c.object_a;
@@ -120,6 +123,7 @@ PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const cal
       nn(i, d) = c.contact.normal[d];
     }
     dd(i) = c.contact.distance;
+    dp(i) = c.contact.depth;
   }
   r.node_tests = stats.node_tests;
   r.leaf_tests = stats.leaf_tests;
@@ -235,6 +239,7 @@ PYBIND11_MODULE(caliber, m) {
       .def_readonly("points_b", &PyResult::points_b)
       .def_readonly("normals", &PyResult::normals)
       .def_readonly("distances", &PyResult::distances)
+      .def_readonly("depths", &PyResult::depths)
       .def_readonly("node_tests", &PyResult::node_tests)
       .def_readonly("limit_reached", &PyResult::limit_reached)
       .def_readonly("leaf_tests", &PyResult::leaf_tests)

@@ -17,7 +17,8 @@ nlohmann::json to_json(const QueryResult& result) {
                         {"point_a", vec(c.point_a)},
                         {"point_b", vec(c.point_b)},
                         {"normal", vec(c.normal)},
-                        {"distance", c.distance}});
+                        {"distance", c.distance},
+                        {"depth", c.depth}});
   }
   out["limit_reached"] = result.limit_reached;
   out["stats"] = {{"node_tests", result.stats.node_tests}, {"leaf_tests", result.stats.leaf_tests}};

@@ -48,7 +48,10 @@ bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
   for (std::size_t i = 0; i < x.contacts.size(); ++i) {
     const auto& a = x.contacts[i];
     const auto& b = y.contacts[i];
-    if (a.distance != b.distance || a.point_a != b.point_a || a.point_b != b.point_b || a.normal != b.normal) return false;
+    if (a.distance != b.distance || a.point_a != b.point_a || a.point_b != b.point_b || a.normal != b.normal ||
+        a.depth != b.depth) {
+      return false;
+    }
   }
   return true;
 }

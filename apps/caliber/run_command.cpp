@@ -94,6 +94,7 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
       j["point_b"] = vec(c.contact.point_b);
       j["normal"] = vec(c.contact.normal);
       j["distance"] = c.contact.distance;
+      j["depth"] = c.contact.depth;
     }
     list.push_back(std::move(j));
   }

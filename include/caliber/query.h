@@ -90,6 +90,11 @@ struct Contact {
   Eigen::Vector3d point_b;             ///< closest point on triangle B
   Eigen::Vector3d normal;              ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
   double distance = 0.0;               ///< triangle distance; exactly 0 when the triangles intersect
+  /// Intersecting pairs (distance 0) with a normal: a penetration estimate, local to the pair: how
+  /// far B's deepest vertex lies behind the plane through A's closest point, along the normal (the
+  /// translation of B along the normal that takes that triangle's vertices out of A's half-space).
+  /// Not the meshes' global penetration depth. 0 otherwise.
+  double depth = 0.0;
 };
 
 /// Work counters: the parallel engine weighs tasks by them.

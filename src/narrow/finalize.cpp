@@ -110,6 +110,15 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   return kept;
 }
 
+/// Contact::depth of an intersecting pair (A's frame): the largest depth of B's vertices behind
+/// the plane through A's closest point with the contact normal.
+double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::Vector3d& normal) {
+  const double plane = normal.dot(c.point_a);
+  double depth = 0.0;
+  for (int k = 0; k < 3; ++k) depth = std::max(depth, plane - normal.dot(ctx.b_vertex(c.tri_b, k)));
+  return depth;
+}
+
 }  // namespace
 
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
@@ -174,6 +183,7 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
       normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
     }
     contact.normal = ra * normal;
+    if (c.distance == 0.0 && normal.squaredNorm() > 0.0) contact.depth = depth_estimate(ctx, c, normal);
     result.contacts[i] = contact;
   }
   });

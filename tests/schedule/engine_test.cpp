@@ -40,6 +40,7 @@ void expect_same_step(const StepResult& got, const StepResult& want, const std::
     ASSERT_EQ(g.contact.point_a, w.contact.point_a) << what;
     ASSERT_EQ(g.contact.point_b, w.contact.point_b) << what;
     ASSERT_EQ(g.contact.normal, w.contact.normal) << what;
+    ASSERT_EQ(g.contact.depth, w.contact.depth) << what;
   }
 }
 

@@ -33,6 +33,7 @@ inline void expect_identical(const QueryResult& got, const QueryResult& want, co
     ASSERT_EQ(g.point_a, w.point_a) << what << " contact " << i;
     ASSERT_EQ(g.point_b, w.point_b) << what << " contact " << i;
     ASSERT_EQ(g.normal, w.normal) << what << " contact " << i;
+    ASSERT_EQ(g.depth, w.depth) << what << " contact " << i;
   }
 }
 
