@@ -216,6 +216,7 @@ Runner add_query_command(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "Engine threads (0: one per hardware thread)")->capture_default_str();
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1");
   cmd->add_option("--repeat", opt->repeat,

@@ -280,6 +280,7 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Per object pair and step, report at most N triangle pairs: past N it stops early and the step says "
                   "so (0: the scene's query.max_pairs, or no limit)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--export", opt->exports.dir, "Write PLY files of chosen steps into this folder (docs/exports.md)");
   cmd->add_option("--export-steps", opt->exports.steps, "The steps --export writes")->delimiter(',')->capture_default_str();

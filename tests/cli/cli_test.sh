@@ -96,6 +96,38 @@ done
 grep -q '"distance"' "$dtmp/sequential.jsonl" && passes=$((passes + 1)) || { echo "FAIL distance-run: no contacts"; failures=$((failures + 1)); }
 rm -rf "$dtmp"
 
+# --first and --max-pairs: a partial answer, flagged; a limit the answer does not reach changes nothing.
+check first 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --first --json
+python3 - "$out" <<'PY' || { echo "FAIL first-json"; failures=$((failures + 1)); }
+import json, sys
+r = json.loads(sys.argv[1])
+assert len(r["pairs"]) == 1 and r["limit_reached"] is True, r
+PY
+check max-pairs 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --max-pairs 3
+contains max-pairs "limit reached: more than 3 pairs"
+check max-pairs-roomy 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --max-pairs 1000 --json
+contains max-pairs-roomy '"limit_reached":false'
+check max-pairs-negative 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --max-pairs -1
+mtmp=$(mktemp -d)
+check run-max-pairs 0 "$cli" run "$data/scenes/view_tetras.json" --max-pairs 1 --contacts "$mtmp/c.jsonl" --json "$mtmp/r.json"
+contains run-max-pairs "reached --max-pairs 1 on some pair"
+python3 - "$mtmp/c.jsonl" "$mtmp/r.json" <<'PY' || { echo "FAIL run-max-pairs-files"; failures=$((failures + 1)); }
+import json, sys
+lines = [json.loads(l) for l in open(sys.argv[1])]
+assert any(l["limit_reached"] for l in lines)
+for l in lines:
+    per_pair = {}
+    for c in l["contacts"]:
+        per_pair[(c["object_a"], c["object_b"])] = per_pair.get((c["object_a"], c["object_b"]), 0) + 1
+    assert all(n <= 1 for n in per_pair.values()), per_pair
+r = json.load(open(sys.argv[2]))
+assert [s["limit_reached"] for s in r["steps"]] == [l["limit_reached"] for l in lines]
+PY
+sed 's/"tolerance": 0.02}/"tolerance": 0.02, "max_pairs": -3}/; s#"\.\./tetra.off"#"'"$data"'/tetra.off"#g' "$data/scenes/view_tetras.json" > "$mtmp/bad.json"
+check scene-bad-max-pairs 2 "$cli" run "$mtmp/bad.json"
+contains scene-bad-max-pairs "query.max_pairs"
+rm -rf "$mtmp"
+
 # caliber run
 tmp=$(mktemp -d)
 check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
