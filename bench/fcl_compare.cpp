@@ -1,6 +1,7 @@
 // Peer comparison: caliber's sequential interference query against FCL 0.7's BVHModel<OBBRSS>
 // collide with every contact, on CGAL meshes (rotated, overlapping copies). Reports the BVH build
-// and query times (medians), their ratios, and whether the triangle-pair sets are identical.
+// and query times (medians), their ratios, and whether the triangle-pair sets are identical; then
+// the first pair only (ours with max_pairs = 1, FCL with num_max_contacts = 1).
 //
 //   bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md] [--scenes A.json,B.json] [--steps 0,50,100]
 //                     [--no-mesh-pairs]
@@ -74,6 +75,9 @@ struct Row {
   double only_fcl_max_distance;
   std::uint64_t node_tests, leaf_tests;
   long fcl_bv_tests, fcl_leaf_tests;
+  /// Any intersecting pair: ours with max_pairs = 1 (--first), FCL's with num_max_contacts = 1.
+  double first_ours, first_fcl;
+  bool first_agrees = true;  ///< both found a pair exactly when the full queries did
 };
 
 /// Adds one pair's query (ours and FCL's, timed, plus FCL's work counters) to `row`.
@@ -91,6 +95,19 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
     fcl_result.clear();
     fcl::collide(&obj_a, &obj_b, request, fcl_result);
   });
+
+  caliber::QueryRequest first;
+  first.max_pairs = 1;
+  caliber::QueryResult one;
+  row.first_ours += median_ms(repeat, [&] { one = caliber::query(ours_a, pose_a, ours_b, pose_b, first); });
+  const fcl::CollisionRequestd one_request(1, false);
+  fcl::CollisionResultd one_result;
+  row.first_fcl += median_ms(repeat, [&] {
+    one_result.clear();
+    fcl::collide(&obj_a, &obj_b, one_request, one_result);
+  });
+  row.first_agrees = row.first_agrees && one.pairs.empty() == ours.pairs.empty() &&
+                     one_result.isCollision() == fcl_result.isCollision();
 
   std::vector<caliber::TrianglePair> theirs;
   for (std::size_t i = 0; i < fcl_result.numContacts(); ++i) {
@@ -196,7 +213,9 @@ std::string format_row(const Row& r, bool scene) {
   const std::string sizes = scene ? std::to_string(r.tris_a) + " (" + std::to_string(r.tris_b) + " pairs)"
                                   : std::to_string(r.tris_a) + " / " + std::to_string(r.tris_b);
   std::snprintf(line, sizeof line,
-                "| %s | %s | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu / %ld | %llu / %ld |\n", r.name.c_str(),
+                "| %s | %s | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu / %ld | %llu / %ld | %.4f | %.4f | "
+                "%.4f | %s |\n",
+                r.name.c_str(),
                 sizes.c_str(), r.build_ours, r.build_fcl, r.build_ours / r.build_fcl, r.query_ours, r.query_fcl,
                 r.query_fcl > 0 ? r.query_ours / r.query_fcl : 0.0, r.pairs_ours, r.pairs_fcl,
                 (r.only_ours == 0 && r.only_fcl == 0)
@@ -207,7 +226,8 @@ std::string format_row(const Row& r, bool scene) {
                                        : std::string()))
                           .c_str(),
                 static_cast<unsigned long long>(r.node_tests), r.fcl_bv_tests, static_cast<unsigned long long>(r.leaf_tests),
-                r.fcl_leaf_tests);
+                r.fcl_leaf_tests, r.first_ours, r.first_fcl, r.query_ours > 0 ? r.first_ours / r.query_ours : 0.0,
+                r.first_agrees ? "yes" : "NO");
   return line;
 }
 
@@ -257,8 +277,9 @@ int main(int argc, char** argv) {
   };
   std::string table;
   table += "| case | triangles A / B | build ours (ms) | build FCL (ms) | build ratio | query ours (ms) | query FCL (ms) | "
-           "query ratio | pairs ours / FCL | identical | node tests ours / FCL | leaf tests ours / FCL |\n";
-  table += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "query ratio | pairs ours / FCL | identical | node tests ours / FCL | leaf tests ours / FCL | "
+           "first pair ours (ms) | first pair FCL (ms) | first / full query, ours | first agrees |\n";
+  table += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
   for (const Case& c : meshes ? cases : std::vector<Case>{}) {
     if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {

@@ -144,18 +144,19 @@ class PairContext {
   }
 
   /// A lower bound on the distance between any triangles below the two nodes, before the safety
-  /// margin: the gap between their spheres, or the widest gap between their boxes along one of
-  /// the six face axes, whichever is larger (the quantities node_within compares with its reach).
+  /// margin: the largest of the gap between their spheres and the distances between one node's
+  /// box and the box around the other's along the first one's axes (in A's frame, then in B's).
   [[nodiscard]] static double gap(const SideA& a, const SideB& b) {
-    double dist2 = 0.0;
+    double dist2 = 0.0, in_a = 0.0, in_b = 0.0;
     for (int i = 0; i < 3; ++i) {
       const double d = a.center[i] - b.center[i];
       dist2 += d * d;
+      const double ga = std::max(0.0, std::abs(b.box_in_a[i] - a.box[i]) - a.half[i] - b.reach_on_a[i]);
+      const double gb = std::max(0.0, std::abs(b.box[i] - a.box_in_b[i]) - b.half[i] - a.reach_on_b[i]);
+      in_a += ga * ga;
+      in_b += gb * gb;
     }
-    double g = std::sqrt(dist2) - a.radius - b.radius;
-    for (int i = 0; i < 3; ++i) g = std::max(g, std::abs(b.box_in_a[i] - a.box[i]) - a.half[i] - b.reach_on_a[i]);
-    for (int j = 0; j < 3; ++j) g = std::max(g, std::abs(b.box[j] - a.box_in_b[j]) - b.half[j] - a.reach_on_b[j]);
-    return std::max(g, 0.0);
+    return std::max({std::sqrt(dist2) - a.radius - b.radius, std::sqrt(in_a), std::sqrt(in_b), 0.0});
   }
 
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.

@@ -238,10 +238,11 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
           }
         }
         ++stats.node_tests;
-        if (ctx.node_within(sa[i], sb[j], reach)) {
-          heap.emplace_back(PairContext::gap(sa[i], sb[j]), child);
-          std::push_heap(heap.begin(), heap.end(), later);
-        }
+        if (!ctx.node_within(sa[i], sb[j], reach)) continue;
+        const double child_gap = PairContext::gap(sa[i], sb[j]);
+        if (child_gap > reach) continue;  // the boxes' distance prunes what their axes alone let pass
+        heap.emplace_back(child_gap, child);
+        std::push_heap(heap.begin(), heap.end(), later);
       }
     }
   }
