@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <tuple>
 
 #include "caliber/error.h"
 #include "caliber/query.h"
@@ -67,19 +69,21 @@ QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b
   QueryStats stats;
   const auto na = static_cast<std::uint32_t>(a.mesh.triangles.size());
   const auto nb = static_cast<std::uint32_t>(b.mesh.triangles.size());
-  // Distance: every pair against the tolerance (no bound from the pairs before it), the closest kept.
-  narrow::Nearest nearest;
+  // Distance: every pair against the tolerance (no bound from the pairs before it); the closest
+  // kept, ties to the lowest ids, by a comparison of its own (the oracle shares no rule with the
+  // traversal's Nearest).
+  std::optional<narrow::Candidate> best;
   for (std::uint32_t ta = 0; ta < na; ++ta) {
     for (std::uint32_t tb = 0; tb < nb; ++tb) {
       ++stats.leaf_tests;
       if (request.kind != QueryKind::distance) {
         ctx.leaf_test(ta, tb, candidates);
       } else if (narrow::Candidate c; ctx.leaf_distance(ta, tb, request.tolerance, c)) {
-        nearest.offer(c);
+        if (!best || std::tie(c.distance, c.tri_a, c.tri_b) < std::tie(best->distance, best->tri_a, best->tri_b)) best = c;
       }
     }
   }
-  if (nearest.found) candidates.push_back(nearest.best);
+  if (best) candidates.push_back(*best);
   return narrow::finalize(ctx, candidates, stats);
 }
 
