@@ -75,6 +75,36 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
   return ctx.node_test(n.a, n.b);
 }
 
+/// The children of CD-tree node n (not a pair of leaves), each child node of A and of B prepared
+/// once for the (up to) four pairs it takes part in: calls test(side_a, side_b, child) for each in
+/// cd_children order, except those on the taboo list (skipped and marked reached), each counted in
+/// stats.node_tests. The one enumeration of children, for the node visit and the distance traversal.
+template <class Test>
+[[gnu::always_inline]] inline void for_each_child(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
+                                                  QueryStats& stats, TabooView taboo, Test&& test) {
+  bool split_a, split_b;
+  cd_split(a, b, split_a, split_b);
+  PairContext::SideA sa[2];
+  PairContext::SideB sb[2];
+  const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
+  for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
+  for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
+  for (int i = 0; i < na; ++i) {
+    for (int j = 0; j < nb; ++j) {
+      const NodePair child{sa[i].index, sb[j].index};
+      if (taboo.taboo != nullptr) {
+        const int t = taboo.taboo->find(child);
+        if (t >= 0) {
+          taboo.reached[t] = 1;
+          continue;
+        }
+      }
+      ++stats.node_tests;
+      test(sa[i], sb[j], child);
+    }
+  }
+}
+
 /// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
 /// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
 /// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
@@ -91,28 +121,11 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
     ctx.leaf_test(a.index, b.index, out);
     return -1;
   }
-  bool split_a, split_b;
-  cd_split(a, b, split_a, split_b);
-  PairContext::SideA sa[2];
-  PairContext::SideB sb[2];
-  const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-  for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
-  for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
   int count = 0;
-  for (int i = 0; i < na; ++i) {
-    for (int j = 0; j < nb; ++j) {
-      const NodePair child{sa[i].index, sb[j].index};
-      if (taboo.taboo != nullptr) {
-        const int t = taboo.taboo->find(child);
-        if (t >= 0) {
-          taboo.reached[t] = 1;
-          continue;
-        }
-      }
-      ++stats.node_tests;
-      if (ctx.node_test(sa[i], sb[j])) passed[count++] = child;
-    }
-  }
+  for_each_child(ctx, n, a, b, stats, taboo,
+                 [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
+                   if (ctx.node_test(sa, sb)) passed[count++] = child;
+                 });
   return count;
 }
 
@@ -157,8 +170,12 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     const int count = visit(ctx, *--top, out, counted, passed, taboo);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (limit != nullptr && count < 0) {
-      if (out.size() != seen && (seen = out.size(), limit->add())) break;
-      if (limit->exceeded()) break;
+      if (out.size() != seen) {
+        seen = out.size();
+        if (limit->add()) break;
+      } else if (limit->exceeded()) {
+        break;
+      }
     }
     // Pushed in reverse so that the first child is popped first (the order of cd_children).
     for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
@@ -220,31 +237,13 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       if (Candidate c; ctx.leaf_distance(a.index, b.index, nearest.bound(ctx), c)) nearest.offer(c);
       continue;
     }
-    bool split_a, split_b;
-    cd_split(a, b, split_a, split_b);
-    PairContext::SideA sa[2];
-    PairContext::SideB sb[2];
-    const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-    for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
-    for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
-    for (int i = 0; i < na; ++i) {
-      for (int j = 0; j < nb; ++j) {
-        const NodePair child{sa[i].index, sb[j].index};
-        if (taboo.taboo != nullptr) {
-          const int t = taboo.taboo->find(child);
-          if (t >= 0) {
-            taboo.reached[t] = 1;
-            continue;
-          }
-        }
-        ++stats.node_tests;
-        if (!ctx.node_within(sa[i], sb[j], reach)) continue;
-        const double child_gap = PairContext::gap(sa[i], sb[j]);
-        if (child_gap > reach) continue;  // the boxes' distance prunes what their axes alone let pass
-        heap.emplace_back(child_gap, child);
-        std::push_heap(heap.begin(), heap.end(), later);
-      }
-    }
+    for_each_child(ctx, n, a, b, stats, taboo, [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
+      if (!ctx.node_within(sa, sb, reach)) return;
+      const double child_gap = PairContext::gap(sa, sb);
+      if (child_gap > reach) return;  // the boxes' distance prunes what their axes alone let pass
+      heap.emplace_back(child_gap, child);
+      std::push_heap(heap.begin(), heap.end(), later);
+    });
   }
 }
 
