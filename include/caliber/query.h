@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The narrow-phase query between two posed models: interference, proximity and contact.
+/// The narrow-phase query between two posed models: interference, proximity, contact and distance.
 
 #include "caliber/export.h"
 #include <array>

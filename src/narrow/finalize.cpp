@@ -17,13 +17,6 @@ namespace {
 /// world transform run in parallel (one heavy pair's finalization would otherwise be serial work).
 constexpr std::size_t kParallelGrain = 512;
 
-/// Strict total order used by the local-minimum reduction: closer first, then lower ids.
-bool closer(const Candidate& x, const Candidate& y) {
-  if (x.distance != y.distance) return x.distance < y.distance;
-  if (x.tri_a != y.tri_a) return x.tri_a < y.tri_a;
-  return x.tri_b < y.tri_b;
-}
-
 bool by_ids(const Candidate& x, const Candidate& y) {
   return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
 }

@@ -2,6 +2,7 @@
 
 #include <numbers>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -79,60 +80,53 @@ bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {
   return false;
 }
 
-bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const {
-  if (mGroups != nullptr) {
-    const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
-    const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
-    if (!mGroups->allows(ga, gb)) return false;
-  }
-  if (mKind == QueryKind::contact) {
-    const Eigen::Vector3d& na = mA.normals[ta];
-    const Eigen::Vector3d& nb = mB.normals[tb];
-    if (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0) return false;  // degenerate: no normal
-    if (na.dot(mRot * nb) > -mCosTheta) return false;
-  }
-  const auto& tri_a = mA.mesh.triangles[ta];
-  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
-  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
-  if (mKind != QueryKind::interference) {
-    // Most pairs that reach here are farther apart than d: a plane of one triangle with the other
-    // triangle beyond it by more than d (plus the margin, with the rounding certified) proves the
-    // true distance exceeds d, so the full computation below would reject the pair too.
-    if (beyond_plane(a, b, mReach) || beyond_plane(b, a, mReach)) return false;
-  }
-  const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
-  if (mKind == QueryKind::interference) {
-    if (intersecting) out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
-    return intersecting;
-  }
-  const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
-  const double distance = intersecting ? 0.0 : closest.distance;
-  if (!(distance <= mRequest.tolerance)) return false;
-  out.push_back(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
-  return true;
+bool PairContext::groups_allow(std::uint32_t ta, std::uint32_t tb) const {
+  if (mGroups == nullptr) return true;
+  const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
+  const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
+  return mGroups->allows(ga, gb);
 }
 
-}  // namespace caliber::narrow
-
-namespace caliber::narrow {
-
-bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {
-  if (mGroups != nullptr) {
-    const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
-    const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
-    if (!mGroups->allows(ga, gb)) return false;
-  }
+template <class Keep>
+bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const {
+  if (!groups_allow(ta, tb)) return false;
   const auto& tri_a = mA.mesh.triangles[ta];
   const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
   const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
-  const double reach = reach_for(bound);
+  // Most pairs that reach here are farther apart than the bound: a plane of one triangle with the
+  // other triangle beyond it by more than the bound (plus the margin, with the rounding certified)
+  // proves the true distance exceeds it, so the full computation below would reject the pair too.
   if (beyond_plane(a, b, reach) || beyond_plane(b, a, reach)) return false;
   const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
   const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
   const double distance = intersecting ? 0.0 : closest.distance;
   if (!(distance <= bound)) return false;
-  out = Candidate{ta, tb, distance, closest.on_a, closest.on_b};
+  keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
   return true;
+}
+
+bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const {
+  if (mKind != QueryKind::interference) {
+    if (mKind == QueryKind::contact) {
+      const Eigen::Vector3d& na = mA.normals[ta];
+      const Eigen::Vector3d& nb = mB.normals[tb];
+      if (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0) return false;  // degenerate: no normal
+      if (na.dot(mRot * nb) > -mCosTheta) return false;
+    }
+    // Proximity, contact and distance keep the pairs within the tolerance (mReach is its reach).
+    return leaf_within(ta, tb, mRequest.tolerance, mReach, [&](Candidate&& c) { out.push_back(std::move(c)); });
+  }
+  if (!groups_allow(ta, tb)) return false;
+  const auto& tri_a = mA.mesh.triangles[ta];
+  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
+  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  if (!geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) return false;
+  out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  return true;
+}
+
+bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {
+  return leaf_within(ta, tb, bound, reach_for(bound), [&](Candidate&& c) { out = std::move(c); });
 }
 
 }  // namespace caliber::narrow

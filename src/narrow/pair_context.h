@@ -26,6 +26,14 @@ struct Candidate {
   Eigen::Vector3d point_b;  ///< closest point on B (A's frame); unset for interference
 };
 
+/// The order of closeness every traversal and the finalization agree on: closer first, then lower
+/// triangle ids (a strict total order on a pair's candidates).
+[[nodiscard]] inline bool closer(const Candidate& x, const Candidate& y) {
+  if (x.distance != y.distance) return x.distance < y.distance;
+  if (x.tri_a != y.tri_a) return x.tri_a < y.tri_a;
+  return x.tri_b < y.tri_b;
+}
+
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
 /// disjoint parts of one pair's CD tree with the same context.
 class PairContext {
@@ -210,6 +218,13 @@ class PairContext {
     return true;
   }
   bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;
+  /// Whether the groups of triangles ta (of A) and tb (of B) may touch (always without groups).
+  [[nodiscard]] bool groups_allow(std::uint32_t ta, std::uint32_t tb) const;
+  /// The leaf test within `bound` (its reach given: leaf_test passes mReach, computed once): calls
+  /// keep(candidate) and returns true when the triangles are within it. Defined in the .cpp, the
+  /// only place that calls it.
+  template <class Keep>
+  bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   /// Whether a box lies beyond the slab lo <= axis . x <= hi by more than the reach: `center` is the
   /// box's center in the slab's frame, `half` its half-extents along its own axes, and `on[k]` is

@@ -190,11 +190,10 @@ struct Nearest {
   bool found = false;
   Candidate best{};
 
-  /// Keeps c if it is closer than the best, or as close with lower triangle ids: the order every
-  /// method agrees on, so the answer does not depend on which pairs a traversal met first.
+  /// Keeps c if it is closer than the best by narrow::closer (ties: lower triangle ids), the order
+  /// every method agrees on, so the answer does not depend on which pairs a traversal met first.
   void offer(const Candidate& c) {
-    if (!found || c.distance < best.distance ||
-        (c.distance == best.distance && (c.tri_a < best.tri_a || (c.tri_a == best.tri_a && c.tri_b < best.tri_b)))) {
+    if (!found || closer(c, best)) {
       best = c;
       found = true;
     }

@@ -144,7 +144,7 @@ StepResult Engine::step(const Frame& frame) {
   mImpl->timeline.begin(mOptions.timeline);
   schedule::StepState state{contexts, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1};
   std::unique_ptr<narrow::PairLimit[]> limits;
-  if (frame.request.max_pairs != 0 && frame.request.kind != QueryKind::distance) {
+  if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);
     for (std::size_t i = 0; i < n; ++i) limits[i].max = frame.request.max_pairs;
     state.limits = limits.get();
