@@ -4,7 +4,9 @@
 // Reports both distances, their relative difference, whether the closest triangle pair is the same,
 // and warm median times of interleaved runs.
 //
-//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md]
+//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME]
+//
+// --only runs the cases whose name contains NAME.
 
 #include <algorithm>
 #include <cmath>
@@ -17,6 +19,8 @@
 #include <vector>
 
 #include <fcl/narrowphase/distance.h>
+#include <fcl/narrowphase/detail/traversal/collision_node.h>
+#include <fcl/narrowphase/detail/traversal/distance/mesh_distance_traversal_node.h>
 
 #include "caliber/model.h"
 #include "caliber/query.h"
@@ -58,7 +62,20 @@ struct Row {
   bool same_pair;
   double ours_ms, fcl_ms;
   std::uint64_t node_tests, leaf_tests;
+  std::uint64_t fcl_node_tests = 0, fcl_leaf_tests = 0;
 };
+
+/// FCL's own bounding-volume and leaf test counts for the same query: the traversal fcl::distance
+/// runs for two OBBRSS meshes, with its statistics on.
+void fcl_counts(const FclModel& fa, const FclModel& fb, const Pose& pose_b, const fcl::DistanceRequestd& request, Row& row) {
+  fcl::detail::MeshDistanceTraversalNodeOBBRSS<double> node;
+  fcl::DistanceResultd result;
+  fcl::detail::initialize(node, fa, bench::to_fcl(Pose{}), fb, bench::to_fcl(pose_b), request, result);
+  node.enable_statistics = true;
+  fcl::detail::distance<double>(&node);  // what fcl::distance runs for two meshes (depth first, qsize 2)
+  row.fcl_node_tests = static_cast<std::uint64_t>(node.num_bv_tests);
+  row.fcl_leaf_tests = static_cast<std::uint64_t>(node.num_leaf_tests);
+}
 
 Row run(const Case& c, double gap, const Model& a, const Model& b, const std::shared_ptr<FclModel>& fa,
         const std::shared_ptr<FclModel>& fb, int repeat) {
@@ -94,6 +111,7 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
   const Eigen::Vector3d vb[3] = {rb * b.mesh.vertices[tb[0]] + pose_b.translation, rb * b.mesh.vertices[tb[1]] + pose_b.translation,
                                  rb * b.mesh.vertices[tb[2]] + pose_b.translation};
   row.same_pair = geometry::closest_points_triangles(va, vb).distance == row.ours;
+  fcl_counts(*fa, *fb, pose_b, freq, row);
   return row;
 }
 
@@ -102,13 +120,14 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
 int main(int argc, char** argv) {
   std::filesystem::path dir = "data/meshes";
   int repeat = 7;
-  std::string out;
+  std::string out, only;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else {
-      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md]\n");
+      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME]\n");
       return 2;
     }
   }
@@ -120,10 +139,12 @@ int main(int argc, char** argv) {
       {"fandisk x rotor", "fandisk_large.off", "rotor_small.off", 15, {1, 0, 0}},
   };
   std::string table = "| case | gap (× diagonal) | caliber distance | FCL distance | relative difference | FCL's pair at our distance | "
-                      "caliber ms | FCL ms | caliber / FCL | node tests | leaf tests |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+                      "caliber ms | FCL ms | caliber / FCL | node tests | leaf tests | FCL node tests | FCL leaf tests |\n"
+                      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   BuildOptions bvh_only;
   bvh_only.adjacency = false;
   for (const Case& c : cases) {
+    if (c.name.find(only) == std::string::npos) continue;
     const auto a = build_model(load_mesh(dir / c.mesh_a), bvh_only);
     const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(dir / c.mesh_b), bvh_only);
     const auto fa = bench::build_fcl(a->mesh);
@@ -132,10 +153,11 @@ int main(int argc, char** argv) {
       const Row r = run(c, gap, *a, *b, fa, fb, repeat);
       const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);
       char line[512];
-      std::snprintf(line, sizeof line, "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu |\n",
+      std::snprintf(line, sizeof line, "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n",
                     r.name.c_str(), r.gap, r.ours, r.fcl, rel, r.same_pair ? "yes" : "no", r.ours_ms, r.fcl_ms,
                     r.ours_ms / r.fcl_ms, static_cast<unsigned long long>(r.node_tests),
-                    static_cast<unsigned long long>(r.leaf_tests));
+                    static_cast<unsigned long long>(r.leaf_tests), static_cast<unsigned long long>(r.fcl_node_tests),
+                    static_cast<unsigned long long>(r.fcl_leaf_tests));
       table += line;
       std::fputs(line, stdout);
       std::fflush(stdout);

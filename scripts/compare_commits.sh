@@ -53,6 +53,8 @@ if [ ! -x "$old_bin" ]; then
   git -C "$root" worktree prune
   git -C "$root" worktree add --detach "$old_dir/src" "$sha" >/dev/null
   cmake -S "$old_dir/src" -B "$old_dir/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  # Revisions before the embed step made its own folder fail without viewer/node_modules.
+  mkdir -p "$old_dir/build/viewer"
   cmake --build "$old_dir/build" -j "${JOBS:-2}" --target caliber_cli >/dev/null
   git -C "$root" worktree remove --force "$old_dir/src"
 fi

@@ -5,6 +5,7 @@
 /// to share between threads and between objects that use the same mesh.
 
 #include "caliber/export.h"
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -63,6 +64,40 @@ struct BvhNodeFilter {
   std::uint64_t groups;
 };
 
+/// What only the distance query reads of a node: the ranges along the two lateral axes of its cone
+/// axis (lateral_axes), every vertex v below having lateral_lo[k] <= axis_k . v <= lateral_hi[k],
+/// rounded outward. With the slab, a box around the triangles below in the frame of the cone axis,
+/// tight where they are nearly coplanar. All 0 when the cone axis is 0.
+struct BvhNodeLateral {
+  float lateral_lo[2], lateral_hi[2];
+};
+
+/// The two axes that complete a unit axis (nx, ny, nz) to an orthonormal frame (Duff et al. 2017's
+/// branchless basis), up to double rounding.
+inline void lateral_axes_of_unit(double nx, double ny, double nz, double u[3], double v[3]) {
+  const double sign = std::copysign(1.0, nz);
+  const double a = -1.0 / (sign + nz);
+  const double b = nx * ny * a;
+  u[0] = 1.0 + sign * nx * nx * a;
+  u[1] = sign * b;
+  u[2] = -sign * nx;
+  v[0] = b;
+  v[1] = sign + ny * ny * a;
+  v[2] = -ny;
+}
+
+/// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
+/// axis, by the same formula at build and at query time. Both 0 when the axis is 0.
+inline void lateral_axes(const float axis[3], double u[3], double v[3]) {
+  const double x = axis[0], y = axis[1], z = axis[2];
+  const double len = std::sqrt(x * x + y * y + z * z);
+  if (!(len > 0.0)) {
+    for (int k = 0; k < 3; ++k) u[k] = v[k] = 0.0;
+    return;
+  }
+  lateral_axes_of_unit(x / len, y / len, z / len, u, v);
+}
+
 /// Options of the BVH build.
 struct BuildOptions {
   /// Compute the vertex-adjacency of triangles (needed by contact queries). On by default.
@@ -77,6 +112,8 @@ struct Model {
   std::vector<BvhNode> nodes;
   /// filters[i]: normal cone, slab and group mask of nodes[i].
   std::vector<BvhNodeFilter> filters;
+  /// laterals[i]: the lateral ranges of nodes[i] (distance queries).
+  std::vector<BvhNodeLateral> laterals;
   /// The triangles below node i are those whose leaf_position lies in
   /// [first_leaf[i], first_leaf[i] + nodes[i].count): every subtree is a run of the leaf order.
   std::vector<std::uint32_t> first_leaf;

@@ -47,6 +47,12 @@ Vec3 to_float_axis(const Vec3& axis) {
   return rounded;
 }
 
+/// lateral_axes of a cone axis already rounded to float (so exactly the stored one).
+void lateral_axes(const Vec3& axis, Vec3& u, Vec3& v) {
+  const float stored[3] = {static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z())};
+  caliber::lateral_axes(stored, u.data(), v.data());
+}
+
 /// A node while it is built, in double precision; converted to BvhNode / BvhNodeFilter at the end.
 struct WorkNode {
   Vec3 center = Vec3::Zero();
@@ -56,6 +62,7 @@ struct WorkNode {
   Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
   double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
+  double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along lateral_axes(axis)
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -88,11 +95,12 @@ class Builder {
     model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()));
     model.nodes.resize(mWork.size());
     model.filters.resize(mWork.size());
+    model.laterals.resize(mWork.size());
     model.first_leaf.resize(mWork.size());
     model.leaf_position.resize(mOrder.size());
     parallel::parallel_for(0, mWork.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
-        convert(mWork[i], model.nodes[i], model.filters[i]);
+        convert(mWork[i], model.nodes[i], model.filters[i], model.laterals[i]);
         model.first_leaf[i] = mWork[i].first;
       }
     });
@@ -149,21 +157,34 @@ class Builder {
 
   /// One pass over the vertices of the triangles in mOrder[begin, end): the largest distances from
   /// c1 and from c2, rounded up a little so that they cover every vertex despite rounding in the
-  /// norms, and the range [lo, hi] of axis . v.
-  void exact_bounds(const Vec3& c1, const Vec3& c2, const Vec3& axis, std::uint32_t begin, std::uint32_t end, double& r1,
-                    double& r2, double& lo, double& hi) const {
+  /// norms, and the ranges of axis . v (the slab) and of the lateral axes' products (node.lateral_*).
+  void exact_bounds(const Vec3& c1, const Vec3& c2, WorkNode& node, std::uint32_t begin, std::uint32_t end, double& r1,
+                    double& r2) const {
     double d1 = 0.0, d2 = 0.0;
-    lo = std::numeric_limits<double>::infinity();
-    hi = -lo;
+    Vec3 u, v;
+    lateral_axes(node.axis, u, v);
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::numeric_limits<double>::infinity();
+      hi[k] = -lo[k];
+    }
     for (std::uint32_t i = begin; i < end; ++i) {
-      for (const std::uint32_t v : mMesh.triangles[mOrder[i]]) {
-        const Vec3& p = mMesh.vertices[v];
+      for (const std::uint32_t w : mMesh.triangles[mOrder[i]]) {
+        const Vec3& p = mMesh.vertices[w];
         d1 = std::max(d1, (p - c1).squaredNorm());
         d2 = std::max(d2, (p - c2).squaredNorm());
-        const double s = axis.dot(p);
-        lo = std::min(lo, s);
-        hi = std::max(hi, s);
+        const double s[3] = {node.axis.dot(p), u.dot(p), v.dot(p)};
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], s[k]);
+          hi[k] = std::max(hi[k], s[k]);
+        }
       }
+    }
+    node.slab_lo = lo[0];
+    node.slab_hi = hi[0];
+    for (int k = 0; k < 2; ++k) {
+      node.lateral_lo[k] = lo[k + 1];
+      node.lateral_hi[k] = hi[k + 1];
     }
     r1 = std::sqrt(d1) * (1.0 + 1e-14);
     r2 = std::sqrt(d2) * (1.0 + 1e-14);
@@ -205,6 +226,13 @@ class Builder {
       const double along[3] = {node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)};
       node.slab_lo = std::min({along[0], along[1], along[2]});
       node.slab_hi = std::max({along[0], along[1], along[2]});
+      Vec3 lateral[2];
+      lateral_axes(node.axis, lateral[0], lateral[1]);
+      for (int k = 0; k < 2; ++k) {
+        const double at[3] = {lateral[k].dot(a), lateral[k].dot(b), lateral[k].dot(c)};
+        node.lateral_lo[k] = std::min({at[0], at[1], at[2]});
+        node.lateral_hi[k] = std::max({at[0], at[1], at[2]});
+      }
     }
   }
 
@@ -246,7 +274,7 @@ class Builder {
     double r_merged, r_box;
     if (node.count <= kExactRadiusCount) {
       // The slab's range comes from the same pass (unused, and the axis 0, when there is no cone).
-      exact_bounds(merged, box, node.axis, begin, end, r_merged, r_box, node.slab_lo, node.slab_hi);
+      exact_bounds(merged, box, node, begin, end, r_merged, r_box);
     } else {
       // Near the root, the children's spheres bound the radius: O(1) instead of a pass over every
       // vertex below, which keeps the build O(n log n) with a small constant. These few large
@@ -256,14 +284,22 @@ class Builder {
       };
       r_merged = bound(merged);
       r_box = bound(box);
-      // The slab likewise: the children's boxes projected on the axis (a bound, not the range).
-      node.slab_lo = std::numeric_limits<double>::infinity();
-      node.slab_hi = -node.slab_lo;
-      for (const WorkNode* kid : {&l, &r}) {
-        const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
-        const double mid = node.axis.dot(center), reach = node.axis.cwiseAbs().dot(half);
-        node.slab_lo = std::min(node.slab_lo, mid - reach);
-        node.slab_hi = std::max(node.slab_hi, mid + reach);
+      // The slab and lateral ranges likewise: the children's boxes projected on the axes (a bound,
+      // not the range).
+      Vec3 u, v;
+      lateral_axes(node.axis, u, v);
+      const Vec3* axes[3] = {&node.axis, &u, &v};
+      double* lo[3] = {&node.slab_lo, &node.lateral_lo[0], &node.lateral_lo[1]};
+      double* hi[3] = {&node.slab_hi, &node.lateral_hi[0], &node.lateral_hi[1]};
+      for (int k = 0; k < 3; ++k) {
+        *lo[k] = std::numeric_limits<double>::infinity();
+        *hi[k] = -*lo[k];
+        for (const WorkNode* kid : {&l, &r}) {
+          const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
+          const double mid = axes[k]->dot(center), reach = axes[k]->cwiseAbs().dot(half);
+          *lo[k] = std::min(*lo[k], mid - reach);
+          *hi[k] = std::max(*hi[k], mid + reach);
+        }
       }
     }
     node.center = r_box < r_merged ? box : merged;
@@ -273,7 +309,7 @@ class Builder {
 
   /// Rounds the volumes outward to floats: the stored radius and half-extents also cover the
   /// distance the center moved when it was rounded.
-  static void convert(const WorkNode& w, BvhNode& node, BvhNodeFilter& filter) {
+  static void convert(const WorkNode& w, BvhNode& node, BvhNodeFilter& filter, BvhNodeLateral& lateral) {
     const Vec3 box_center = 0.5 * (w.lo + w.hi);
     const Vec3 box_half = 0.5 * (w.hi - w.lo);
     const double pad = 1e-14 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
@@ -296,6 +332,10 @@ class Builder {
     const double slab_pad = 1e-13 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
     filter.slab_lo = w.cone >= 0.0 ? round_down(w.slab_lo - slab_pad) : 0.0f;
     filter.slab_hi = w.cone >= 0.0 ? round_up(w.slab_hi + slab_pad) : 0.0f;
+    for (int k = 0; k < 2; ++k) {
+      lateral.lateral_lo[k] = w.cone >= 0.0 ? round_down(w.lateral_lo[k] - slab_pad) : 0.0f;
+      lateral.lateral_hi[k] = w.cone >= 0.0 ? round_up(w.lateral_hi[k] + slab_pad) : 0.0f;
+    }
   }
 
   const Mesh& mMesh;

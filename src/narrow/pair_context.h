@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -145,26 +146,126 @@ class PairContext {
   /// safety margin (rounding in the transformed centers and vertices, certified far below it).
   [[nodiscard]] double reach_for(double d) const { return d + kRelativeMargin * (mScale + d); }
 
-  /// The geometric part of the node test (no cones), within `reach` (reach_for of a distance):
-  /// false only when no triangle pair below the two nodes can be within it, or none may touch.
-  [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach) const {
-    return node_within(a, b, reach, reach * (1.0 + 1e-6));
+  /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
+  /// rounding), center and half-extents along them. The box in the frame of the node's slab (the
+  /// slab and the lateral ranges) where the node has one, else its own box.
+  struct Frame {
+    double axis[3][3];
+    double center[3];
+    double half[3];
+  };
+  /// A node prepared for the distance bound: its sphere and Frame in A's frame, and its own box
+  /// as the node test has it (SideA / SideB's box fields).
+  struct Near {
+    std::uint32_t index;  ///< node index in its model
+    double center[3];     ///< sphere center
+    double radius;        ///< sphere radius
+    Frame frame;
+    double box[3];        ///< box center in its own model's frame
+    double half[3];       ///< box half-extents (its model's axes)
+    double box_across[3];    ///< box center in the other model's frame
+    double reach_across[3];  ///< half-extent of the box along each of the other model's axes
+  };
+
+  /// Prepares node ia of A for the distance bound.
+  [[nodiscard]] Near near_a(std::uint32_t ia) const {
+    const BvhNode& n = mA.nodes[ia];
+    Near s;
+    s.index = ia;
+    s.radius = n.radius;
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = n.center[i];
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    own_frame(n, mA.filters[ia], mA.laterals[ia], s.frame);
+    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
+    for (int j = 0; j < 3; ++j) {
+      s.box_across[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
+      s.reach_across[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
+    }
+    return s;
   }
 
-  /// A lower bound on the distance between any triangles below the two nodes, before the safety
-  /// margin: the largest of the gap between their spheres and the distances between one node's
-  /// box and the box around the other's along the first one's axes (in A's frame, then in B's).
-  [[nodiscard]] static double gap(const SideA& a, const SideB& b) {
-    double dist2 = 0.0, in_a = 0.0, in_b = 0.0;
+  /// Prepares node ib of B for the distance bound: sphere and frame brought into A's frame.
+  [[nodiscard]] Near near_b(std::uint32_t ib) const {
+    const BvhNode& n = mB.nodes[ib];
+    Near s;
+    s.index = ib;
+    s.radius = n.radius;
+    Frame own;
+    own_frame(n, mB.filters[ib], mB.laterals[ib], own);
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = mRot(i, 0) * n.center[0] + mRot(i, 1) * n.center[1] + mRot(i, 2) * n.center[2] + mTrans[i];
+      s.frame.center[i] = mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mTrans[i];
+    }
+    for (int k = 0; k < 3; ++k) {
+      s.frame.half[k] = own.half[k];
+      for (int i = 0; i < 3; ++i) {
+        s.frame.axis[k][i] = mRot(i, 0) * own.axis[k][0] + mRot(i, 1) * own.axis[k][1] + mRot(i, 2) * own.axis[k][2];
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      s.box_across[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
+      s.reach_across[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
+    }
+    return s;
+  }
+
+  /// A lower bound on the distance between any triangles below two nodes, before the safety
+  /// margin, when it is at most `reach` (reach_for of a distance); otherwise some number above
+  /// `reach` (the sphere bound is tried first and ends the test when beyond), and +infinity when
+  /// groups forbid every pair below. The bound is the largest of the gap between the spheres, the
+  /// distances between one node's box and the box around the other's along the first one's axes
+  /// (in A's frame, then in B's), and the distance between the nodes' Frames along the axes of
+  /// one, then of the other: along orthonormal axes the squared gaps add up to a squared distance.
+  [[nodiscard]] double gap(const Near& a, const Near& b, double reach) const {
+    double dist2 = 0.0;
     for (int i = 0; i < 3; ++i) {
       const double d = a.center[i] - b.center[i];
       dist2 += d * d;
-      const double ga = std::max(0.0, std::abs(b.box_in_a[i] - a.box[i]) - a.half[i] - b.reach_on_a[i]);
-      const double gb = std::max(0.0, std::abs(b.box[i] - a.box_in_b[i]) - b.half[i] - a.reach_on_b[i]);
-      in_a += ga * ga;
-      in_b += gb * gb;
     }
-    return std::max({std::sqrt(dist2) - a.radius - b.radius, std::sqrt(in_a), std::sqrt(in_b), 0.0});
+    const double spheres = std::sqrt(dist2) - a.radius - b.radius;
+    if (spheres > reach) return spheres;
+    double boxes_a = 0.0, boxes_b = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      boxes_a += square(std::max(0.0, std::abs(b.box_across[i] - a.box[i]) - a.half[i] - b.reach_across[i]));
+      boxes_b += square(std::max(0.0, std::abs(b.box[i] - a.box_across[i]) - b.half[i] - a.reach_across[i]));
+    }
+    const double boxes2 = std::max(boxes_a, boxes_b);
+    if (boxes2 > reach * reach) return std::sqrt(boxes2);
+    double d[3], dots[3][3], in_a = 0.0, in_b = 0.0;
+    for (int i = 0; i < 3; ++i) d[i] = b.frame.center[i] - a.frame.center[i];
+    // |a's axis i . b's axis k|, grown by a hair for rounding in the rotated axes.
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        dots[i][k] = std::abs(a.frame.axis[i][0] * b.frame.axis[k][0] + a.frame.axis[i][1] * b.frame.axis[k][1] +
+                              a.frame.axis[i][2] * b.frame.axis[k][2]) + kRotationHair;
+      }
+    }
+    // The frames' axes are orthonormal to about 1e-15: a factor of 1 + 1e-9 covers it.
+    constexpr double kFrameScale2 = (1.0 + 1e-9) * (1.0 + 1e-9);
+    for (int i = 0; i < 3; ++i) {
+      const double along_a = a.frame.axis[i][0] * d[0] + a.frame.axis[i][1] * d[1] + a.frame.axis[i][2] * d[2];
+      const double reach_b = dots[i][0] * b.frame.half[0] + dots[i][1] * b.frame.half[1] + dots[i][2] * b.frame.half[2];
+      in_a += square(std::max(0.0, std::abs(along_a) - a.frame.half[i] - reach_b));
+    }
+    in_a /= kFrameScale2;
+    if (in_a > reach * reach) return std::sqrt(in_a);
+    for (int i = 0; i < 3; ++i) {
+      const double along_b = b.frame.axis[i][0] * d[0] + b.frame.axis[i][1] * d[1] + b.frame.axis[i][2] * d[2];
+      const double reach_a = dots[0][i] * a.frame.half[0] + dots[1][i] * a.frame.half[1] + dots[2][i] * a.frame.half[2];
+      in_b += square(std::max(0.0, std::abs(along_b) - b.frame.half[i] - reach_a));
+    }
+    in_b /= kFrameScale2;
+    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return std::max({spheres, std::sqrt(std::max({boxes2, in_a, in_b})), 0.0});
   }
 
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
@@ -226,6 +327,39 @@ class PairContext {
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
+  static double square(double x) { return x * x; }
+  /// A node's Frame in its own model's frame: the box in its slab's frame (the slab along the
+  /// normalized cone axis, the lateral ranges along lateral_axes) where it has a slab, else its own
+  /// box along the model's axes.
+  static void own_frame(const BvhNode& n, const BvhNodeFilter& f, const BvhNodeLateral& l, Frame& out) {
+    const double x = f.cone_axis[0], y = f.cone_axis[1], z = f.cone_axis[2];
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (len > 0.0) {
+      const double axis[3] = {x / len, y / len, z / len};  // as lateral_axes computes it
+      double u[3], v[3];
+      lateral_axes_of_unit(axis[0], axis[1], axis[2], u, v);
+      const double lo[3] = {f.slab_lo / len, l.lateral_lo[0], l.lateral_lo[1]};
+      const double hi[3] = {f.slab_hi / len, l.lateral_hi[0], l.lateral_hi[1]};
+      double mid[3], half[3];
+      for (int k = 0; k < 3; ++k) {
+        mid[k] = 0.5 * (lo[k] + hi[k]);
+        half[k] = 0.5 * (hi[k] - lo[k]) * (1.0 + 1e-12);  // the division by len rounds
+      }
+      for (int i = 0; i < 3; ++i) {
+        out.axis[0][i] = axis[i];
+        out.axis[1][i] = u[i];
+        out.axis[2][i] = v[i];
+        out.center[i] = mid[0] * axis[i] + mid[1] * u[i] + mid[2] * v[i];
+      }
+      for (int k = 0; k < 3; ++k) out.half[k] = half[k];
+      return;
+    }
+    for (int k = 0; k < 3; ++k) {
+      for (int i = 0; i < 3; ++i) out.axis[k][i] = k == i ? 1.0 : 0.0;
+      out.center[k] = n.box_center[k];
+      out.half[k] = n.box_half[k];
+    }
+  }
   /// Whether a box lies beyond the slab lo <= axis . x <= hi by more than the reach: `center` is the
   /// box's center in the slab's frame, `half` its half-extents along its own axes, and `on[k]` is
   /// |axis . box axis k|. A gap g along an axis up to 1 + 1e-6 long is a distance >= g / |axis|.

@@ -76,19 +76,20 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
 }
 
 /// The children of CD-tree node n (not a pair of leaves), each child node of A and of B prepared
-/// once for the (up to) four pairs it takes part in: calls test(side_a, side_b, child) for each in
-/// cd_children order, except those on the taboo list (skipped and marked reached), each counted in
-/// stats.node_tests. The one enumeration of children, for the node visit and the distance traversal.
-template <class Test>
-[[gnu::always_inline]] inline void for_each_child(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
-                                                  QueryStats& stats, TabooView taboo, Test&& test) {
+/// once (by prepare_a / prepare_b: the node test's sides, or the distance bound's) for the (up to)
+/// four pairs it takes part in: calls test(side_a, side_b, child) for each in cd_children order,
+/// except those on the taboo list (skipped and marked reached), each counted in stats.node_tests.
+/// The one enumeration of children, for the node visit and the distance traversal.
+template <class PrepareA, class PrepareB, class Test>
+[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, QueryStats& stats, TabooView taboo,
+                                                  PrepareA&& prepare_a, PrepareB&& prepare_b, Test&& test) {
   bool split_a, split_b;
   cd_split(a, b, split_a, split_b);
-  PairContext::SideA sa[2];
-  PairContext::SideB sb[2];
+  decltype(prepare_a(std::uint32_t{})) sa[2];
+  decltype(prepare_b(std::uint32_t{})) sb[2];
   const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-  for (int i = 0; i < na; ++i) sa[i] = ctx.prepare_a(split_a ? a.index + i : n.a);
-  for (int j = 0; j < nb; ++j) sb[j] = ctx.prepare_b(split_b ? b.index + j : n.b);
+  for (int i = 0; i < na; ++i) sa[i] = prepare_a(split_a ? a.index + i : n.a);
+  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(split_b ? b.index + j : n.b);
   for (int i = 0; i < na; ++i) {
     for (int j = 0; j < nb; ++j) {
       const NodePair child{sa[i].index, sb[j].index};
@@ -122,10 +123,11 @@ template <class Test>
     return -1;
   }
   int count = 0;
-  for_each_child(ctx, n, a, b, stats, taboo,
-                 [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
-                   if (ctx.node_test(sa, sb)) passed[count++] = child;
-                 });
+  for_each_child(
+      n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); }, [&](std::uint32_t j) { return ctx.prepare_b(j); },
+      [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
+        if (ctx.node_test(sa, sb)) passed[count++] = child;
+      });
   return count;
 }
 
@@ -214,14 +216,13 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   using Waiting = std::pair<double, NodePair>;
   std::vector<Waiting>& heap = scratch.waiting;
   heap.clear();
-  // Nearest first; ties by node, so that the order (and the node-test count) is reproducible.
-  const auto later = [](const Waiting& x, const Waiting& y) { return x.first != y.first ? x.first > y.first : x.second > y.second; };
+  // Nearest first (equal gaps in an order that depends only on the order they came in: the same
+  // on every run).
+  const auto later = [](const Waiting& x, const Waiting& y) { return x.first > y.first; };
   {
-    const PairContext::SideA sa = ctx.prepare_a(root.a);
-    const PairContext::SideB sb = ctx.prepare_b(root.b);
-    if (root_tested || (++stats.node_tests, ctx.node_within(sa, sb, ctx.reach_for(nearest.bound(ctx))))) {
-      heap.emplace_back(PairContext::gap(sa, sb), root);
-    }
+    const double reach = ctx.reach_for(nearest.bound(ctx));
+    const double root_gap = ctx.gap(ctx.near_a(root.a), ctx.near_b(root.b), reach);
+    if (root_tested || (++stats.node_tests, root_gap <= reach)) heap.emplace_back(root_gap, root);
   }
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), later);
@@ -236,13 +237,14 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       if (Candidate c; ctx.leaf_distance(a.index, b.index, nearest.bound(ctx), c)) nearest.offer(c);
       continue;
     }
-    for_each_child(ctx, n, a, b, stats, taboo, [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
-      if (!ctx.node_within(sa, sb, reach)) return;
-      const double child_gap = PairContext::gap(sa, sb);
-      if (child_gap > reach) return;  // the boxes' distance prunes what their axes alone let pass
-      heap.emplace_back(child_gap, child);
-      std::push_heap(heap.begin(), heap.end(), later);
-    });
+    for_each_child(
+        n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.near_a(i); }, [&](std::uint32_t j) { return ctx.near_b(j); },
+        [&](const PairContext::Near& sa, const PairContext::Near& sb, NodePair child) {
+          const double child_gap = ctx.gap(sa, sb, reach);
+          if (child_gap > reach) return;
+          heap.emplace_back(child_gap, child);
+          std::push_heap(heap.begin(), heap.end(), later);
+        });
   }
 }
 

@@ -18,6 +18,7 @@ namespace {
 std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const BvhNode& node = m.nodes[index];
   const BvhNodeFilter& filter = m.filters[index];
+  const BvhNodeLateral& lateral_range = m.laterals[index];
   std::vector<std::uint32_t> below;
   if (node.is_leaf()) {
     below.push_back(node.index);
@@ -36,6 +37,8 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const Eigen::Vector3d bh(node.box_half[0], node.box_half[1], node.box_half[2]);
   const Eigen::Vector3d stored_axis(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]);
   const Eigen::Vector3d axis = stored_axis.normalized();
+  double lateral[2][3];
+  lateral_axes(filter.cone_axis, lateral[0], lateral[1]);
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh.triangles[t]) {
@@ -44,6 +47,10 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
       EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
       const double along = stored_axis.dot(p);
       EXPECT_TRUE(filter.slab_lo <= along && along <= filter.slab_hi) << "node " << index << " slab must cover its vertices: " << filter.slab_lo << " <= " << along << " <= " << filter.slab_hi << " (triangle " << t << ")";
+      for (int k = 0; k < 2; ++k) {
+        const double at = lateral[k][0] * p.x() + lateral[k][1] * p.y() + lateral[k][2] * p.z();
+        EXPECT_TRUE(lateral_range.lateral_lo[k] <= at && at <= lateral_range.lateral_hi[k]) << "node " << index << " lateral range " << k << " must cover its vertices: " << lateral_range.lateral_lo[k] << " <= " << at << " <= " << lateral_range.lateral_hi[k] << " (triangle " << t << ")";
+      }
     }
     if (m.normals[t].squaredNorm() > 0.0) {
       any_normal = true;
@@ -52,7 +59,18 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
     }
   }
   EXPECT_EQ(any_normal, filter.cone_angle >= 0.0f) << "node " << index;
-  if (!any_normal) EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
+  if (!any_normal) {
+    EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
+    for (int k = 0; k < 2; ++k) EXPECT_TRUE(lateral_range.lateral_lo[k] == 0.0f && lateral_range.lateral_hi[k] == 0.0f) << "node " << index << ": no axis, no lateral range";
+  } else {
+    // The frame is orthonormal: the lateral axes unit, orthogonal to each other and to the axis.
+    const Eigen::Vector3d u(lateral[0][0], lateral[0][1], lateral[0][2]), w(lateral[1][0], lateral[1][1], lateral[1][2]);
+    EXPECT_NEAR(u.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(w.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(u.dot(w), 0.0, 1e-12);
+    EXPECT_NEAR(u.dot(axis), 0.0, 1e-12);
+    EXPECT_NEAR(w.dot(axis), 0.0, 1e-12);
+  }
   return below;
 }
 
@@ -151,6 +169,7 @@ TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
     executor.execute([&] { many = build_model(mesh); });
     EXPECT_EQ(bytes(many->nodes), bytes(one->nodes)) << threads << " threads";
     EXPECT_EQ(bytes(many->filters), bytes(one->filters)) << threads << " threads";
+    EXPECT_EQ(bytes(many->laterals), bytes(one->laterals)) << threads << " threads";
     EXPECT_EQ(many->first_leaf, one->first_leaf);
     EXPECT_EQ(many->leaf_position, one->leaf_position);
     EXPECT_EQ(bytes(many->normals), bytes(one->normals));
