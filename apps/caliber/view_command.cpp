@@ -196,7 +196,8 @@ Runner add_view_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("view", "Run a scene and write an HTML page that shows its steps (three.js, offline)");
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--out", opt->out, "The HTML file to write")->required();
-  cmd->add_option("--steps", opt->steps, "Run and show this many steps instead of the scene's");
+  cmd->add_option("--steps", opt->steps, "Run and show this many steps instead of the scene's")
+      ->check(kAtLeastOne);  // -1, the default, stands for the scene's steps: not a value to give
   cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();

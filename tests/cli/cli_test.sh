@@ -149,6 +149,11 @@ PY
 check run-steps 0 "$cli" run "$data/scenes/tetras.json" --steps 3
 contains run-steps "summary over 3 steps"
 check run-zero-steps 2 "$cli" run "$data/scenes/tetras.json" --steps 0
+# -1 is how the program marks "the scene's steps"; given, it is a bad value like any negative.
+check query-negative-show 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --show -2
+contains query-negative-show "must be a whole number >= 0"
+check run-negative-steps 2 "$cli" run "$data/scenes/tetras.json" --steps -1
+contains run-negative-steps "steps"
 check run-missing 2 "$cli" run "$data/scenes/nope.json"
 contains run-missing "no such scene file"
 check run-bad-key 2 "$cli" run "$data/scenes/bad_key.json"

@@ -91,6 +91,7 @@ PY
 check view-no-out 2 "$cli" view "$scene"
 check view-missing-scene 2 "$cli" view "$tmp/nope.json" --out "$tmp/v.html"
 check view-zero-steps 2 "$cli" view "$scene" --out "$tmp/v.html" --steps 0
+check view-negative-steps 2 "$cli" view "$scene" --out "$tmp/v.html" --steps -1
 check view-over-scene 2 "$cli" view "$scene" --out "$scene"
 check view-bad-method 2 "$cli" view "$scene" --out "$tmp/v.html" --method fastest
 check view-no-folder 2 "$cli" view "$scene" --out "$tmp/no/such/v.html"
