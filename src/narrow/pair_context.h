@@ -76,21 +76,8 @@ class PairContext {
 
   /// Prepares node ia of A for node tests.
   [[nodiscard]] SideA prepare_a(std::uint32_t ia) const {
-    const BvhNode& n = mA.nodes[ia];
     SideA s;
-    s.index = ia;
-    s.radius = n.radius;
-    for (int i = 0; i < 3; ++i) {
-      s.center[i] = n.center[i];
-      s.box[i] = n.box_center[i];
-      s.half[i] = n.box_half[i];
-    }
-    // B's frame: x_b = R^T (x_a - T).
-    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
-    for (int j = 0; j < 3; ++j) {
-      s.box_in_b[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
-      s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
-    }
+    fill_a(ia, s);
     const BvhNodeFilter& f = mA.filters[ia];
     for (int i = 0; i < 3; ++i) s.slab_axis[i] = f.cone_axis[i];
     for (int j = 0; j < 3; ++j) {
@@ -104,20 +91,8 @@ class PairContext {
 
   /// Prepares node ib of B for node tests.
   [[nodiscard]] SideB prepare_b(std::uint32_t ib) const {
-    const BvhNode& n = mB.nodes[ib];
     SideB s;
-    s.index = ib;
-    s.radius = n.radius;
-    const double c[3] = {n.center[0], n.center[1], n.center[2]};
-    for (int i = 0; i < 3; ++i) {
-      s.box[i] = n.box_center[i];
-      s.half[i] = n.box_half[i];
-    }
-    for (int i = 0; i < 3; ++i) {
-      s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
-      s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
-      s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
-    }
+    fill_b(ib, s);
     const BvhNodeFilter& f = mB.filters[ib];
     for (int i = 0; i < 3; ++i) s.slab_axis[i] = f.cone_axis[i];
     for (int i = 0; i < 3; ++i) {
@@ -154,49 +129,35 @@ class PairContext {
     double center[3];
     double half[3];
   };
-  /// A node prepared for the distance bound: its sphere and Frame in A's frame, and its own box
-  /// as the node test has it (SideA / SideB's box fields).
-  struct Near {
-    std::uint32_t index;  ///< node index in its model
-    double center[3];     ///< sphere center
-    double radius;        ///< sphere radius
+  /// A node of A prepared for the distance bound: its sphere and box as SideA has them, and its
+  /// Frame.
+  struct NearA {
+    std::uint32_t index;
+    double center[3], radius, box[3], half[3], box_in_b[3], reach_on_b[3];  ///< as in SideA
     Frame frame;
-    double box[3];        ///< box center in its own model's frame
-    double half[3];       ///< box half-extents (its model's axes)
-    double box_across[3];    ///< box center in the other model's frame
-    double reach_across[3];  ///< half-extent of the box along each of the other model's axes
+  };
+  /// A node of B prepared for the distance bound: as SideB, and its Frame brought into A's frame.
+  struct NearB {
+    std::uint32_t index;
+    double center[3], radius, box[3], half[3], box_in_a[3], reach_on_a[3];  ///< as in SideB
+    Frame frame;
   };
 
   /// Prepares node ia of A for the distance bound.
-  [[nodiscard]] Near near_a(std::uint32_t ia) const {
-    const BvhNode& n = mA.nodes[ia];
-    Near s;
-    s.index = ia;
-    s.radius = n.radius;
-    for (int i = 0; i < 3; ++i) {
-      s.center[i] = n.center[i];
-      s.box[i] = n.box_center[i];
-      s.half[i] = n.box_half[i];
-    }
-    own_frame(n, mA.filters[ia], mA.laterals[ia], s.frame);
-    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
-    for (int j = 0; j < 3; ++j) {
-      s.box_across[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
-      s.reach_across[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
-    }
+  [[nodiscard]] NearA near_a(std::uint32_t ia) const {
+    NearA s;
+    fill_a(ia, s);
+    own_frame(mA.nodes[ia], mA.filters[ia], mA.laterals[ia], s.frame);
     return s;
   }
 
-  /// Prepares node ib of B for the distance bound: sphere and frame brought into A's frame.
-  [[nodiscard]] Near near_b(std::uint32_t ib) const {
-    const BvhNode& n = mB.nodes[ib];
-    Near s;
-    s.index = ib;
-    s.radius = n.radius;
+  /// Prepares node ib of B for the distance bound.
+  [[nodiscard]] NearB near_b(std::uint32_t ib) const {
+    NearB s;
+    fill_b(ib, s);
     Frame own;
-    own_frame(n, mB.filters[ib], mB.laterals[ib], own);
+    own_frame(mB.nodes[ib], mB.filters[ib], mB.laterals[ib], own);
     for (int i = 0; i < 3; ++i) {
-      s.center[i] = mRot(i, 0) * n.center[0] + mRot(i, 1) * n.center[1] + mRot(i, 2) * n.center[2] + mTrans[i];
       s.frame.center[i] = mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mTrans[i];
     }
     for (int k = 0; k < 3; ++k) {
@@ -204,14 +165,6 @@ class PairContext {
       for (int i = 0; i < 3; ++i) {
         s.frame.axis[k][i] = mRot(i, 0) * own.axis[k][0] + mRot(i, 1) * own.axis[k][1] + mRot(i, 2) * own.axis[k][2];
       }
-    }
-    for (int i = 0; i < 3; ++i) {
-      s.box[i] = n.box_center[i];
-      s.half[i] = n.box_half[i];
-    }
-    for (int i = 0; i < 3; ++i) {
-      s.box_across[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
-      s.reach_across[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
     }
     return s;
   }
@@ -223,7 +176,7 @@ class PairContext {
   /// distances between one node's box and the box around the other's along the first one's axes
   /// (in A's frame, then in B's), and the distance between the nodes' Frames along the axes of
   /// one, then of the other: along orthonormal axes the squared gaps add up to a squared distance.
-  [[nodiscard]] double gap(const Near& a, const Near& b, double reach) const {
+  [[nodiscard]] double gap(const NearA& a, const NearB& b, double reach) const {
     double dist2 = 0.0;
     for (int i = 0; i < 3; ++i) {
       const double d = a.center[i] - b.center[i];
@@ -233,8 +186,8 @@ class PairContext {
     if (spheres > reach) return spheres;
     double boxes_a = 0.0, boxes_b = 0.0;
     for (int i = 0; i < 3; ++i) {
-      boxes_a += square(std::max(0.0, std::abs(b.box_across[i] - a.box[i]) - a.half[i] - b.reach_across[i]));
-      boxes_b += square(std::max(0.0, std::abs(b.box[i] - a.box_across[i]) - b.half[i] - a.reach_across[i]));
+      boxes_a += square(std::max(0.0, std::abs(b.box_in_a[i] - a.box[i]) - a.half[i] - b.reach_on_a[i]));
+      boxes_b += square(std::max(0.0, std::abs(b.box[i] - a.box_in_b[i]) - b.half[i] - a.reach_on_b[i]));
     }
     const double boxes2 = std::max(boxes_a, boxes_b);
     if (boxes2 > reach * reach) return std::sqrt(boxes2);
@@ -328,6 +281,42 @@ class PairContext {
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   static double square(double x) { return x * x; }
+  /// The part of a prepared node of A that SideA and NearA share: index, sphere, box, and the box
+  /// seen from B's frame.
+  template <class Side>
+  void fill_a(std::uint32_t ia, Side& s) const {
+    const BvhNode& n = mA.nodes[ia];
+    s.index = ia;
+    s.radius = n.radius;
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = n.center[i];
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    // B's frame: x_b = R^T (x_a - T).
+    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
+    for (int j = 0; j < 3; ++j) {
+      s.box_in_b[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
+      s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
+    }
+  }
+  /// The part of a prepared node of B that SideB and NearB share, brought into A's frame.
+  template <class Side>
+  void fill_b(std::uint32_t ib, Side& s) const {
+    const BvhNode& n = mB.nodes[ib];
+    s.index = ib;
+    s.radius = n.radius;
+    const double c[3] = {n.center[0], n.center[1], n.center[2]};
+    for (int i = 0; i < 3; ++i) {
+      s.box[i] = n.box_center[i];
+      s.half[i] = n.box_half[i];
+    }
+    for (int i = 0; i < 3; ++i) {
+      s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
+      s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
+      s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
+    }
+  }
   /// A node's Frame in its own model's frame: the box in its slab's frame (the slab along the
   /// normalized cone axis, the lateral ranges along lateral_axes) where it has a slab, else its own
   /// box along the model's axes.

@@ -239,7 +239,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     }
     for_each_child(
         n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.near_a(i); }, [&](std::uint32_t j) { return ctx.near_b(j); },
-        [&](const PairContext::Near& sa, const PairContext::Near& sb, NodePair child) {
+        [&](const PairContext::NearA& sa, const PairContext::NearB& sb, NodePair child) {
           const double child_gap = ctx.gap(sa, sb, reach);
           if (child_gap > reach) return;
           heap.emplace_back(child_gap, child);
