@@ -8,6 +8,7 @@
 #include <compare>
 #include <utility>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "caliber/query.h"
@@ -88,11 +89,12 @@ template <class PrepareA, class PrepareB, class Test>
   decltype(prepare_a(std::uint32_t{})) sa[2];
   decltype(prepare_b(std::uint32_t{})) sb[2];
   const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-  for (int i = 0; i < na; ++i) sa[i] = prepare_a(split_a ? a.index + i : n.a);
-  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(split_b ? b.index + j : n.b);
+  const std::uint32_t ia[2] = {split_a ? a.index : n.a, a.index + 1}, ib[2] = {split_b ? b.index : n.b, b.index + 1};
+  for (int i = 0; i < na; ++i) sa[i] = prepare_a(ia[i]);
+  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(ib[j]);
   for (int i = 0; i < na; ++i) {
     for (int j = 0; j < nb; ++j) {
-      const NodePair child{sa[i].index, sb[j].index};
+      const NodePair child{ia[i], ib[j]};
       if (taboo.taboo != nullptr) {
         const int t = taboo.taboo->find(child);
         if (t >= 0) {
@@ -144,10 +146,66 @@ struct PairLimit {
   [[nodiscard]] bool exceeded() const { return kept.load(std::memory_order_relaxed) > max; }
 };
 
+/// The nodes one traversal has prepared, by node index, so that each is prepared once however many
+/// partners it meets (the distance traversal meets a node 7-10 times on the bunny): an open-
+/// addressing table of indices over a store whose entries never move (so a reference to one
+/// stays valid while others are added). Cleared per traversal: a prepared node depends on the
+/// pair's relative pose.
+template <class Prepared>
+class PreparedNodes {
+ public:
+  /// Forgets every entry (keeps the memory).
+  void clear() {
+    std::fill(mKeys.begin(), mKeys.end(), kEmpty);
+    mCount = 0;
+  }
+  /// The entry of node `index`, made by prepare(index) the first time it is asked for.
+  template <class Prepare>
+  const Prepared& get(std::uint32_t index, Prepare&& prepare) {
+    if (2 * (mCount + 1) > mKeys.size()) grow();
+    const std::size_t mask = mKeys.size() - 1;
+    for (std::size_t h = (index * std::size_t{0x9E3779B1u}) & mask;; h = (h + 1) & mask) {
+      if (mKeys[h] == index) return at(mSlots[h]);
+      if (mKeys[h] == kEmpty) {
+        mKeys[h] = index;
+        mSlots[h] = mCount;
+        if (mCount / kChunk == mChunks.size()) mChunks.push_back(std::make_unique_for_overwrite<Prepared[]>(kChunk));
+        Prepared& entry = at(mCount++);
+        entry = prepare(index);
+        return entry;
+      }
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+  static constexpr std::size_t kChunk = 64;
+  Prepared& at(std::size_t slot) { return mChunks[slot / kChunk][slot % kChunk]; }
+  void grow() {
+    const std::size_t size = std::max<std::size_t>(64, 2 * mKeys.size());
+    std::vector<std::uint32_t> keys(size, kEmpty), slots(size);
+    for (std::size_t h = 0; h < mKeys.size(); ++h) {
+      if (mKeys[h] == kEmpty) continue;
+      std::size_t g = (mKeys[h] * std::size_t{0x9E3779B1u}) & (size - 1);
+      while (keys[g] != kEmpty) g = (g + 1) & (size - 1);
+      keys[g] = mKeys[h];
+      slots[g] = mSlots[h];
+    }
+    mKeys = std::move(keys);
+    mSlots = std::move(slots);
+  }
+  std::vector<std::uint32_t> mKeys;   ///< node index per table slot, kEmpty when free
+  std::vector<std::uint32_t> mSlots;  ///< its entry in the store
+  std::vector<std::unique_ptr<Prepared[]>> mChunks;
+  std::size_t mCount = 0;
+};
+
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
   std::vector<std::pair<double, NodePair>> waiting;  ///< distance traversal: the heap of nodes by gap
+  PreparedNodes<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
+  PreparedNodes<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
 };
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
@@ -216,12 +274,16 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   using Waiting = std::pair<double, NodePair>;
   std::vector<Waiting>& heap = scratch.waiting;
   heap.clear();
+  scratch.near_a.clear();
+  scratch.near_b.clear();
+  const auto near_a = [&](std::uint32_t i) { return &scratch.near_a.get(i, [&](std::uint32_t k) { return ctx.near_a(k); }); };
+  const auto near_b = [&](std::uint32_t j) { return &scratch.near_b.get(j, [&](std::uint32_t k) { return ctx.near_b(k); }); };
   // Nearest first (equal gaps in an order that depends only on the order they came in: the same
   // on every run).
   const auto later = [](const Waiting& x, const Waiting& y) { return x.first > y.first; };
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
-    const double root_gap = ctx.gap(ctx.near_a(root.a), ctx.near_b(root.b), reach);
+    const double root_gap = ctx.gap(*near_a(root.a), *near_b(root.b), reach);
     if (root_tested || (++stats.node_tests, root_gap <= reach)) heap.emplace_back(root_gap, root);
   }
   while (!heap.empty()) {
@@ -238,9 +300,8 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       continue;
     }
     for_each_child(
-        n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.near_a(i); }, [&](std::uint32_t j) { return ctx.near_b(j); },
-        [&](const PairContext::NearA& sa, const PairContext::NearB& sb, NodePair child) {
-          const double child_gap = ctx.gap(sa, sb, reach);
+        n, a, b, stats, taboo, near_a, near_b, [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
+          const double child_gap = ctx.gap(*sa, *sb, reach);
           if (child_gap > reach) return;
           heap.emplace_back(child_gap, child);
           std::push_heap(heap.begin(), heap.end(), later);
