@@ -76,6 +76,16 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
   return ctx.node_test(n.a, n.b);
 }
 
+/// The node index of a prepared node, held or pointed to.
+template <class Side>
+std::uint32_t index_of(const Side& side) {
+  return side.index;
+}
+template <class Side>
+std::uint32_t index_of(const Side* side) {
+  return side->index;
+}
+
 /// The children of CD-tree node n (not a pair of leaves), each child node of A and of B prepared
 /// once (by prepare_a / prepare_b: the node test's sides, or the distance bound's) for the (up to)
 /// four pairs it takes part in: calls test(side_a, side_b, child) for each in cd_children order,
@@ -89,12 +99,11 @@ template <class PrepareA, class PrepareB, class Test>
   decltype(prepare_a(std::uint32_t{})) sa[2];
   decltype(prepare_b(std::uint32_t{})) sb[2];
   const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-  const std::uint32_t ia[2] = {split_a ? a.index : n.a, a.index + 1}, ib[2] = {split_b ? b.index : n.b, b.index + 1};
-  for (int i = 0; i < na; ++i) sa[i] = prepare_a(ia[i]);
-  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(ib[j]);
+  for (int i = 0; i < na; ++i) sa[i] = prepare_a(split_a ? a.index + i : n.a);
+  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(split_b ? b.index + j : n.b);
   for (int i = 0; i < na; ++i) {
     for (int j = 0; j < nb; ++j) {
-      const NodePair child{ia[i], ib[j]};
+      const NodePair child{index_of(sa[i]), index_of(sb[j])};
       if (taboo.taboo != nullptr) {
         const int t = taboo.taboo->find(child);
         if (t >= 0) {
