@@ -8,20 +8,18 @@
 
 namespace caliber::cli {
 
-/// Option checks with plain messages (CLI11's own number checks print their range's limits as
-/// 300-digit numbers): a whole number >= 1, and a whole number >= 0.
-inline const CLI::Validator kAtLeastOne(
-    [](std::string& text) -> std::string {
-      long long value = 0;
-      return CLI::detail::lexical_cast(text, value) && value >= 1 ? std::string() : "must be a whole number >= 1, not " + text;
-    },
-    "N >= 1");
-inline const CLI::Validator kAtLeastZero(
-    [](std::string& text) -> std::string {
-      long long value = 0;
-      return CLI::detail::lexical_cast(text, value) && value >= 0 ? std::string() : "must be a whole number >= 0, not " + text;
-    },
-    "N >= 0");
+/// An option check with a plain message (CLI11's own number checks print their range's limits as
+/// 300-digit numbers): a whole number >= `least`.
+inline CLI::Validator at_least(long long least) {
+  return CLI::Validator(
+      [least](std::string& text) -> std::string {
+        long long value = 0;
+        return CLI::detail::lexical_cast(text, value) && value >= least
+                   ? std::string()
+                   : "must be a whole number >= " + std::to_string(least) + ", not " + text;
+      },
+      "N >= " + std::to_string(least));
+}
 
 /// A subcommand: registered on the app, then run if it was the one parsed.
 using Runner = std::function<int()>;

@@ -208,7 +208,7 @@ Runner add_query_command(CLI::App& app) {
       ->each([opt](const std::string&) { opt->tolerance_given = true; });
   cmd->add_option("--angle", opt->angle, "Contact angle theta in degrees, [0, 180]")->capture_default_str();
   cmd->add_flag("--json", opt->json, "Print one JSON object with every pair and contact");
-  cmd->add_option("--show", opt->show, "How many pairs the summary lists")->capture_default_str()->check(kAtLeastZero);
+  cmd->add_option("--show", opt->show, "How many pairs the summary lists")->capture_default_str()->check(at_least(0));
   cmd->add_option("--method", opt->method,
                   "sequential (default: caliber::query) or an engine method: exploitation, stealing, aposteriori, "
                   "apriori, hybrid (same pairs; build time then counted in query_ms)")
@@ -216,7 +216,7 @@ Runner add_query_command(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "Engine threads (0: one per hardware thread)")->capture_default_str();
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
-      ->check(kAtLeastZero)
+      ->check(at_least(0))
       ->capture_default_str();
   cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1");
   cmd->add_option("--repeat", opt->repeat,

@@ -263,7 +263,7 @@ Runner add_run_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene over its time steps");
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--steps", opt->steps, "Run this many steps instead of the scene's")
-      ->check(kAtLeastOne);  // -1, the default, stands for the scene's steps: not a value to give
+      ->check(at_least(1));  // -1, the default, stands for the scene's steps: not a value to give
   cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")->capture_default_str();
   cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
       ->capture_default_str();
@@ -281,7 +281,7 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Per object pair and step, report at most N triangle pairs: past N it stops early and the step says "
                   "so (0: the scene's query.max_pairs, or no limit)")
-      ->check(kAtLeastZero)
+      ->check(at_least(0))
       ->capture_default_str();
   cmd->add_option("--export", opt->exports.dir, "Write PLY files of chosen steps into this folder (docs/exports.md)");
   cmd->add_option("--export-steps", opt->exports.steps, "The steps --export writes")->delimiter(',')->capture_default_str();

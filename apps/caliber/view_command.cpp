@@ -197,7 +197,7 @@ Runner add_view_command(CLI::App& app) {
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--out", opt->out, "The HTML file to write")->required();
   cmd->add_option("--steps", opt->steps, "Run and show this many steps instead of the scene's")
-      ->check(kAtLeastOne);  // -1, the default, stands for the scene's steps: not a value to give
+      ->check(at_least(1));  // -1, the default, stands for the scene's steps: not a value to give
   cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();

@@ -190,6 +190,18 @@ class Builder {
     r2 = std::sqrt(d2) * (1.0 + 1e-14);
   }
 
+  /// The range along `axis` of the children's boxes (a bound on the vertices' range, not the range).
+  static void children_range(const Vec3& axis, const WorkNode& l, const WorkNode& r, double& lo, double& hi) {
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
+    for (const WorkNode* kid : {&l, &r}) {
+      const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
+      const double mid = axis.dot(center), reach = axis.cwiseAbs().dot(half);
+      lo = std::min(lo, mid - reach);
+      hi = std::max(hi, mid + reach);
+    }
+  }
+
   void make_leaf(std::uint32_t slot, std::uint32_t tri) {
     const auto& t = mMesh.triangles[tri];
     const Vec3& a = mMesh.vertices[t[0]];
@@ -288,19 +300,9 @@ class Builder {
       // not the range).
       Vec3 u, v;
       lateral_axes(node.axis, u, v);
-      const Vec3* axes[3] = {&node.axis, &u, &v};
-      double* lo[3] = {&node.slab_lo, &node.lateral_lo[0], &node.lateral_lo[1]};
-      double* hi[3] = {&node.slab_hi, &node.lateral_hi[0], &node.lateral_hi[1]};
-      for (int k = 0; k < 3; ++k) {
-        *lo[k] = std::numeric_limits<double>::infinity();
-        *hi[k] = -*lo[k];
-        for (const WorkNode* kid : {&l, &r}) {
-          const Vec3 center = 0.5 * (kid->lo + kid->hi), half = 0.5 * (kid->hi - kid->lo);
-          const double mid = axes[k]->dot(center), reach = axes[k]->cwiseAbs().dot(half);
-          *lo[k] = std::min(*lo[k], mid - reach);
-          *hi[k] = std::max(*hi[k], mid + reach);
-        }
-      }
+      children_range(node.axis, l, r, node.slab_lo, node.slab_hi);
+      children_range(u, l, r, node.lateral_lo[0], node.lateral_hi[0]);
+      children_range(v, l, r, node.lateral_lo[1], node.lateral_hi[1]);
     }
     node.center = r_box < r_merged ? box : merged;
     node.radius = std::min(r_box, r_merged);

@@ -45,10 +45,9 @@ class PairContext {
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
 
-  /// A node of A with what the node-node test needs of it precomputed: its box center seen from
-  /// B's frame and its box's extent along each of B's axes. Prepared once per node and reused
-  /// against every node of B it meets (the traversal tests two children of A against two of B).
-  struct SideA {
+  /// What every prepared node of A holds: its sphere, its box, and that box seen from B's frame
+  /// (center, and extent along each of B's axes).
+  struct NodeA {
     std::uint32_t index;   ///< node index in A
     double center[3];      ///< sphere center (A's frame)
     double radius;         ///< sphere radius
@@ -56,12 +55,9 @@ class PairContext {
     double half[3];        ///< box half-extents (A's axes)
     double box_in_b[3];    ///< box center in B's frame
     double reach_on_b[3];  ///< half-extent of A's box along each of B's axes
-    double slab_axis[3];   ///< slab axis (A's frame), 0 when the node has none
-    double slab_on_b[3];   ///< |slab axis . B's axis k|: how much of B's half-extent k it sees
-    double slab_lo, slab_hi;
   };
-  /// A node of B, prepared the same way: centers brought into A's frame.
-  struct SideB {
+  /// What every prepared node of B holds, the same brought into A's frame.
+  struct NodeB {
     std::uint32_t index;   ///< node index in B
     double center[3];      ///< sphere center in A's frame
     double radius;         ///< sphere radius
@@ -69,11 +65,21 @@ class PairContext {
     double half[3];        ///< box half-extents (B's axes)
     double box_in_a[3];    ///< box center in A's frame
     double reach_on_a[3];  ///< half-extent of B's box along each of A's axes
+  };
+  /// A node of A with what the node-node test needs of it precomputed. Prepared once per node and
+  /// reused against every node of B it meets (the traversal tests two children of A against two
+  /// of B).
+  struct SideA : NodeA {
+    double slab_axis[3];   ///< slab axis (A's frame), 0 when the node has none
+    double slab_on_b[3];   ///< |slab axis . B's axis k|: how much of B's half-extent k it sees
+    double slab_lo, slab_hi;
+  };
+  /// A node of B, prepared the same way: centers brought into A's frame.
+  struct SideB : NodeB {
     double slab_axis[3];   ///< slab axis (B's own frame), 0 when the node has none
     double slab_on_a[3];   ///< |slab axis . A's axis k|
     double slab_lo, slab_hi;
   };
-
   /// Prepares node ia of A for node tests.
   [[nodiscard]] SideA prepare_a(std::uint32_t ia) const {
     SideA s;
@@ -129,17 +135,12 @@ class PairContext {
     double center[3];
     double half[3];
   };
-  /// A node of A prepared for the distance bound: its sphere and box as SideA has them, and its
-  /// Frame.
-  struct NearA {
-    std::uint32_t index;
-    double center[3], radius, box[3], half[3], box_in_b[3], reach_on_b[3];  ///< as in SideA
+  /// A node of A prepared for the distance bound: NodeA and its Frame.
+  struct NearA : NodeA {
     Frame frame;
   };
-  /// A node of B prepared for the distance bound: as SideB, and its Frame brought into A's frame.
-  struct NearB {
-    std::uint32_t index;
-    double center[3], radius, box[3], half[3], box_in_a[3], reach_on_a[3];  ///< as in SideB
+  /// A node of B prepared for the distance bound: NodeB and its Frame brought into A's frame.
+  struct NearB : NodeB {
     Frame frame;
   };
 
@@ -281,10 +282,8 @@ class PairContext {
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   static double square(double x) { return x * x; }
-  /// The part of a prepared node of A that SideA and NearA share: index, sphere, box, and the box
-  /// seen from B's frame.
-  template <class Side>
-  void fill_a(std::uint32_t ia, Side& s) const {
+  /// The NodeA part of a prepared node of A (SideA or NearA).
+  void fill_a(std::uint32_t ia, NodeA& s) const {
     const BvhNode& n = mA.nodes[ia];
     s.index = ia;
     s.radius = n.radius;
@@ -300,9 +299,8 @@ class PairContext {
       s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
     }
   }
-  /// The part of a prepared node of B that SideB and NearB share, brought into A's frame.
-  template <class Side>
-  void fill_b(std::uint32_t ib, Side& s) const {
+  /// The NodeB part of a prepared node of B (SideB or NearB), brought into A's frame.
+  void fill_b(std::uint32_t ib, NodeB& s) const {
     const BvhNode& n = mB.nodes[ib];
     s.index = ib;
     s.radius = n.radius;
