@@ -336,17 +336,36 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
 }
 
 /// The load-balance simulation of every method but sequential at each simulated core count: tasks
-/// cut for P threads (the engine runs P threads, so calibration targets P), their node tests
-/// list-scheduled on P virtual cores; and the estimate's correlation at P = 8 (or the first P).
+/// cut for P threads (EngineOptions::plan_threads) and run on one thread, their node tests and
+/// their measured times list-scheduled on P virtual cores (speed-up by node tests, and the step
+/// time predicted by predicted_step_ms, against a sequential run of the same steps); and the
+/// estimate's correlation at P = 8 (or the first P).
 void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
   const Scene& sc = world.scene();
   const int steps = simulated_steps(b.opt, sc);
+  // The sequential time of the very steps replayed (the measured runs may cover more steps, and
+  // steps differ in cost): what a predicted step time is a speed-up against.
+  if (!b.fits(sequential_s * steps / sc.steps, sc.name + " sequential, the simulation's steps")) return;
+  double sequential_ms = 0.0;
+  {
+    Engine engine(engine_options(Variant{"sequential", Method::sequential, false}, 1));
+    for (int k = 0; k < steps; ++k) {
+      const StepResult s = step(world, engine, k);
+      sequential_ms += (s.broad_ms + s.narrow_ms + s.reduce_ms) / steps;
+    }
+  }
   for (const Variant& v : b.variants) {
     if (v.method == Method::sequential) continue;
     bool correlated = false;
     for (const int p : b.opt.simulate) {
       if (!b.fits(sequential_s * steps / sc.steps, sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores")) return;
-      Engine engine(engine_options(v, p));
+      // The cut made for P threads, run on one thread with its timeline: each piece timed
+      // undisturbed (this machine may have fewer cores than P), replayed on P virtual cores both
+      // by node tests and by measured time.
+      EngineOptions options = engine_options(v, 1);
+      options.plan_threads = p;
+      options.timeline = true;
+      Engine engine(options);
       SimulatedRun simulated(v.method, p);
       std::vector<double> estimated, effective;
       for (int k = 0; k < steps; ++k) {
@@ -366,7 +385,8 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
           b.progress.update(b.done, line);
         }
       }
-      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", simulated.speedup()}};
+      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", simulated.speedup()},
+                     {"predicted_step_ms", simulated.predicted_ms()}, {"sequential_step_ms", sequential_ms}};
       if (!estimated.empty() && (p == 8 || !correlated)) {
         // Keep at most 4000 points for the figure (evenly spaced); r uses all of them.
         Json points = Json::array();

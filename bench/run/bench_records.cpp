@@ -153,7 +153,7 @@ struct SceneRecords {
   Json info;  ///< name, file, steps (from the header)
   Json table1;
   std::map<std::pair<std::string, int>, std::vector<Json>> runs;  ///< (method, threads) -> run records
-  std::map<std::string, Json> simulated, correlation;              ///< method -> {cores: speedup}, correlation
+  std::map<std::string, Json> simulated, predicted, correlation;   ///< method -> {cores: speedup}, {cores: {ms, speedup}}, correlation
   std::map<int, std::vector<double>> ceiling;                      ///< copies -> each copy's ms/step
 };
 
@@ -182,6 +182,7 @@ Json scene_results(const SceneRecords& s, const std::vector<std::string>& method
     if (method["threads"].empty()) continue;
     if (m == "sequential") sequential = method["threads"]["1"]["step_ms"].get<double>();
     if (s.simulated.count(m)) method["simulated_speedup"] = s.simulated.at(m);
+    if (s.predicted.count(m)) method["predicted"] = s.predicted.at(m);
     if (s.correlation.count(m)) method["correlation"] = s.correlation.at(m);
     scene["methods"][m] = method;
   }
@@ -236,6 +237,13 @@ Json results_from_records(const std::vector<Json>& records) {
       SceneRecords& s = scene_of(r);
       const std::string m = r["method"].get<std::string>();
       s.simulated[m][std::to_string(r["cores"].get<int>())] = r["speedup"];
+      if (r.contains("predicted_step_ms") && r["predicted_step_ms"].is_number() && r["predicted_step_ms"].get<double>() > 0 &&
+          r.contains("sequential_step_ms") && r["sequential_step_ms"].is_number()) {
+        const double predicted = r["predicted_step_ms"].get<double>();
+        s.predicted[m][std::to_string(r["cores"].get<int>())] = {
+            {"step_ms", predicted}, {"sequential_step_ms", r["sequential_step_ms"]},
+            {"speedup", r["sequential_step_ms"].get<double>() / predicted}};
+      }
       if (r.contains("correlation")) s.correlation[m] = r["correlation"];
     } else if (kind == "mismatch") {
       identical = false;

@@ -10,7 +10,9 @@
 //               traverse_ms, finalize_ms (per step), balance_speedup}
 //   table1      scene, and the paper's Table 1 fields (objects, triangles, node_tests_per_step, ...)
 //   ceiling     scene, copies P, copy_step_ms [one per copy]: P independent sequential copies at once
-//   simulation  scene, method, cores, speedup, and (optional) correlation {cores, pearson, tasks, points}
+//   simulation  scene, method, cores, speedup (by node tests), and (optional) predicted_step_ms (by
+//               measured time per piece) with sequential_step_ms (a sequential run of the same steps),
+//               and (optional) correlation {cores, pearson, tasks, points}
 //   mismatch    scene, method, threads, step: contacts that differ from sequential's
 //   gantt       the per-thread timeline of one step (see bench_command.cpp)
 //   fcl         report: the FCL comparison's Markdown

@@ -191,6 +191,35 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
     }
   }
 
+  out << "\n## Predicted from measured time per piece (simulation, not measured)\n\n(The cut for P threads run on one thread, "
+         "each piece of work timed, replayed on P virtual cores: predicted_step_ms. Speed-up over a sequential run of the same "
+         "steps; where P threads were measured too, the measured speed-up and measured / predicted.)\n\n| scene | method |";
+  for (const int p : simulate) out << " P=" << p << " |";
+  out << "\n|---|---|";
+  for (std::size_t i = 0; i < simulate.size(); ++i) out << "---|";
+  out << "\n";
+  for (const Json& s : r["scenes"]) {
+    const double seq = s["sequential_step_ms"].get<double>();
+    for (const std::string& m : method_names(s)) {
+      if (!s["methods"][m].contains("predicted")) continue;
+      out << "| " << s["name"].get<std::string>() << " | " << m << " |";
+      const Json& predicted = s["methods"][m]["predicted"];
+      for (const int p : simulate) {
+        const std::string key = std::to_string(p);
+        if (!predicted.contains(key)) {
+          out << " |";
+          continue;
+        }
+        const double want = predicted[key]["speedup"].get<double>();
+        out << " " << num(want) << "x";
+        const double got = seq / step_ms(s, m, p);
+        if (!std::isnan(got)) out << "; measured " << num(got) << "x (" << num(got / want) << ")";
+        out << " |";
+      }
+      out << "\n";
+    }
+  }
+
   out << "\n## Estimated vs effective node tests per run-time task\n\n(Pearson r between the weight the calibration gave "
          "each run-time task and the node tests it took; tasks cut for P = 8 threads when simulated.)\n\n| scene | method | r | tasks |\n|---|---|---|---|\n";
   for (const Json& s : r["scenes"]) {

@@ -38,6 +38,9 @@ struct TaskRecord {
   QueryStats stats;       ///< node and leaf tests
   std::size_t pairs = 0;  ///< triangle pairs reported
   bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `pairs` is partial
+  /// Triangle pairs the traversals kept, before the contact reduction and max_pairs: what the
+  /// pair's finalization worked on.
+  std::size_t candidates = 0;
 };
 
 /// One piece of a step's work on one thread (EngineOptions::timeline): what a Gantt chart draws.
@@ -74,6 +77,11 @@ struct ScheduleRecord {
   std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
   std::size_t queue_peak = 0;                  ///< widest level of the weight-driven stage (nodes waiting at once)
   std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
+  /// The weight-driven stage level by level: for each level of each split task (the split tasks in
+  /// the order of stage_task_node_tests, each one's levels from the root down), the node tests of
+  /// each chunk of the level's nodes that one thread ran. A level waits for the one above it.
+  std::vector<std::vector<std::uint64_t>> stage_levels;
+  std::vector<std::uint32_t> stage_level_task;  ///< the split task (index in stage_task_node_tests) of each stage level
   /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
   /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
   /// cut-off and the single node tests above it (stealing). The load-balance simulation replays them.
@@ -152,6 +160,10 @@ struct EngineOptions {
   Method method = Method::sequential;
   /// Worker threads (1..1024); 0 means the machine's hardware threads. `sequential` always uses one.
   int threads = 0;
+  /// Calibrated methods: the thread count the cut is made for (Omega = total weight / (beta *
+  /// plan_threads)); 0 means `threads`. The cut for P threads run on one thread measures each of
+  /// its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
+  int plan_threads = 0;
   /// Stealing: CD-tree depth from which a subtree is traversed serially by one task.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
@@ -177,20 +189,37 @@ struct EngineOptions {
 
 /// The load-balance simulation: the speed-up on `cores` virtual cores that the step's recorded
 /// work units predict for `method` (total node tests / simulated makespan). Calibrated methods: the
-/// weight-driven stage, then a barrier, then the run-time tasks in handout order. Exploitation: the
+/// weight-driven stage (each split task's levels in turn, a level's chunks list-scheduled, the split
+/// tasks side by side), then a barrier, then the run-time tasks in handout order. Exploitation: the
 /// pairs in order. Stealing: its depth-first pieces, largest first, plus the splitting work spread
 /// evenly (an optimistic model of stealing). Sequential: 1.
 [[nodiscard]] CALIBER_EXPORT double simulated_speedup(const StepResult& step, Method method, int cores);
+
+/// The load-balance simulation in time: the step's measured pieces of work replayed on `cores`
+/// virtual cores, in ms: what the step (its broad phase, serial, its narrow phase and its
+/// reduction) would take there. Needs the
+/// step's timeline (EngineOptions::timeline) and is meant for a step run on one thread (pieces
+/// timed undisturbed; EngineOptions::plan_threads = cores gives the cut made for that many).
+/// Replayed: each weight-driven stage's levels (a stage's time shared among its levels' chunks by
+/// node tests, chunks list-scheduled, a barrier after each level; the split tasks side by side),
+/// then the traversal units list-scheduled in handout order (stealing: largest first, plus its
+/// splitting spread evenly), then each pair's finalization list-scheduled (a pair with many
+/// candidates as the chunks its finalization runs in parallel, its time shared evenly among them);
+/// everything outside those pieces (setting up the pairs, weights, the cart, the reduction) stays
+/// serial. Throws caliber::Error when the step has no timeline.
+[[nodiscard]] CALIBER_EXPORT double predicted_step_ms(const StepResult& step, Method method, int cores);
 
 /// The load-balance simulation over a run: the run's predicted speed-up on `cores` virtual cores is
 /// its total node tests over the sum of its steps' simulated makespans.
 class CALIBER_EXPORT SimulatedRun {
  public:
   SimulatedRun(Method method, int cores) : mMethod(method), mCores(cores) {}
-  /// Adds one step.
+  /// Adds one step (and its predicted_step_ms when it has a timeline).
   void add(const StepResult& step);
   /// The predicted speed-up of the steps added (1 when they did no work).
   [[nodiscard]] double speedup() const { return mSpan > 0.0 ? mWork / mSpan : 1.0; }
+  /// The mean predicted_step_ms of the steps added with a timeline (0 when none had one).
+  [[nodiscard]] double predicted_ms() const { return mTimed > 0 ? mPredictedMs / mTimed : 0.0; }
   /// The core count simulated.
   [[nodiscard]] int cores() const { return mCores; }
 
@@ -199,6 +228,8 @@ class CALIBER_EXPORT SimulatedRun {
   int mCores;
   double mWork = 0.0;
   double mSpan = 0.0;
+  double mPredictedMs = 0.0;
+  int mTimed = 0;
 };
 
 /// Runs frames with a method on a fixed number of threads (a oneTBB task arena of exactly that

@@ -13,10 +13,6 @@ namespace caliber {
 namespace narrow {
 namespace {
 
-/// Below this many candidates a pair is finalized serially; above, its sort, local-minimum test and
-/// world transform run in parallel (one heavy pair's finalization would otherwise be serial work).
-constexpr std::size_t kParallelGrain = 512;
-
 bool by_ids(const Candidate& x, const Candidate& y) {
   return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
 }
@@ -116,7 +112,7 @@ double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::V
 
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
   // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
-  const std::size_t grain = parallel ? kParallelGrain : std::max<std::size_t>(candidates.size(), 1);
+  const std::size_t grain = parallel ? kFinalizeGrain : std::max<std::size_t>(candidates.size(), 1);
   QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
@@ -141,7 +137,7 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     candidates = {*std::min_element(candidates.begin(), candidates.end(), closer)};
   }
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
-  if (parallel && candidates.size() >= kParallelGrain) {
+  if (parallel && candidates.size() >= kFinalizeGrain) {
     parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
   } else {
     std::sort(candidates.begin(), candidates.end(), by_ids);

@@ -3,12 +3,18 @@
 /// The one finalization of an object pair's candidates, shared by caliber::query and every method
 /// of the engine, so that the contacts do not depend on how the traversal was cut.
 
+#include <cstddef>
 #include <vector>
 
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 
 namespace caliber::narrow {
+
+/// Below this many candidates a pair is finalized serially; above, its hash index, local-minimum
+/// test, sort and world transform run in chunks of this many on several threads (one heavy pair's
+/// finalization would otherwise be serial work).
+inline constexpr std::size_t kFinalizeGrain = 128;
 
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
 /// object pair canonically (by triangle ids) and converts them to world coordinates. With

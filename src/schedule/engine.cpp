@@ -93,6 +93,9 @@ Engine::Engine(const EngineOptions& options) : mOptions(options) {
   if (mOptions.threads < 0 || mOptions.threads > 1024) {
     throw Error(ErrorCode::bad_value, "threads", "must be between 1 and 1024 (0: one per hardware thread)");
   }
+  if (mOptions.plan_threads < 0 || mOptions.plan_threads > 1024) {
+    throw Error(ErrorCode::bad_value, "plan threads", "must be between 1 and 1024 (0: the engine's threads)");
+  }
   if (mOptions.stealing_depth < 0) throw Error(ErrorCode::bad_value, "stealing depth", "must be >= 0");
   if (!(mOptions.beta > 0.0) || !std::isfinite(mOptions.beta)) throw Error(ErrorCode::bad_value, "beta", "must be a finite number > 0");
   if (!(mOptions.epsilon >= 0.0) || !std::isfinite(mOptions.epsilon)) {
@@ -181,6 +184,7 @@ StepResult Engine::step(const Frame& frame) {
 
   const auto reduce = util::Clock::now();
   schedule::gather_step(frame.pairs, results, out);
+  for (std::size_t i = 0; i < n && i < state.candidates.size(); ++i) out.tasks[i].candidates = state.candidates[i];
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
                                 [](const SceneContact& x, const SceneContact& y) {
                                   return std::tie(x.object_a, x.object_b, x.contact.tri_a, x.contact.tri_b) <

@@ -23,6 +23,7 @@ void finalize_pairs(StepState& state,
   }
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
+  state.candidates.assign(n, 0);
   parallel::for_each_in_order(n, [&](std::size_t k) {
     const std::size_t i = order[k];
     state.timeline.record(TaskSpan::Phase::finalize, i, [&] {
@@ -36,6 +37,7 @@ void finalize_pairs(StepState& state,
         stats.node_tests += w->stats[i].node_tests;
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
+      state.candidates[i] = all.size();
       state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.parallel_finalize);
     });
   });
@@ -65,6 +67,10 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
     stage_root_tests[s].assign(plan.splits[s].stage.size(), 0);
     record.stage_node_tests += plan.splits[s].stats.node_tests;
     record.stage_task_node_tests.push_back(plan.splits[s].stats.node_tests);
+    for (const std::vector<std::uint64_t>& level : plan.splits[s].levels) {
+      record.stage_levels.push_back(level);
+      record.stage_level_task.push_back(static_cast<std::uint32_t>(s));
+    }
     record.queue_peak = std::max(record.queue_peak, plan.splits[s].queue_peak);
   }
   std::vector<std::vector<std::uint64_t>> sub_tests(plan.taboos.size());

@@ -1,5 +1,6 @@
-// The load-balance simulation: what a step's recorded work units predict on P virtual cores.
-// It predicts; it does not measure (a node test is taken to cost the same everywhere).
+// The load-balance simulation: what a step's recorded work units predict on P virtual cores, in
+// node tests (a node test taken to cost the same everywhere) or in measured time per piece. It
+// predicts; it does not measure.
 
 #include <algorithm>
 #include <functional>
@@ -7,15 +8,19 @@
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "narrow/finalize.h"
 
 namespace caliber {
 
-double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores) {
-  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+namespace {
+
+/// Greedy list scheduling of `costs` in order on `cores` cores: the makespan.
+template <class Cost>
+double list_schedule(const std::vector<Cost>& costs, int cores) {
   std::priority_queue<double, std::vector<double>, std::greater<>> loads;
   for (int c = 0; c < cores; ++c) loads.push(0.0);
   double makespan = 0.0;
-  for (const std::uint64_t cost : costs) {
+  for (const Cost cost : costs) {
     const double load = loads.top() + static_cast<double>(cost);
     loads.pop();
     loads.push(load);
@@ -23,6 +28,37 @@ double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores
   }
   return makespan;
 }
+
+}  // namespace
+
+double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores) {
+  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+  return list_schedule(costs, cores);
+}
+
+namespace {
+
+/// The weight-driven stage's makespan, each node test of split task s costing `unit[s]`: each
+/// split task's levels one after another (a level's chunks list-scheduled on the cores, a barrier
+/// after it), the split tasks side by side; at least the stage's cost spread evenly (the cores are
+/// shared by the split tasks).
+double stage_makespan(const ScheduleRecord& r, const std::vector<double>& unit, int cores) {
+  const std::size_t splits = r.stage_task_node_tests.size();
+  double total = 0.0;
+  std::vector<double> span(splits);
+  for (std::size_t s = 0; s < splits; ++s) {
+    total += unit[s] * static_cast<double>(r.stage_task_node_tests[s]);
+    span[s] = unit[s];  // the root's test
+  }
+  if (total <= 0.0) return 0.0;
+  for (std::size_t l = 0; l < r.stage_levels.size() && l < r.stage_level_task.size(); ++l) {
+    const std::uint32_t s = r.stage_level_task[l];
+    if (s < splits) span[s] += unit[s] * list_schedule(r.stage_levels[l], cores);
+  }
+  return std::max(total / cores, *std::max_element(span.begin(), span.end()));
+}
+
+}  // namespace
 
 double simulated_speedup(const StepResult& step, Method method, int cores) {
   const ScheduleRecord& r = step.schedule;
@@ -38,13 +74,72 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
     case Method::aposteriori:
     case Method::apriori:
     case Method::hybrid:
-      makespan = list_schedule_makespan(r.stage_task_node_tests, cores) + list_schedule_makespan(r.task_node_tests, cores);
+      makespan = stage_makespan(r, std::vector<double>(r.stage_task_node_tests.size(), 1.0), cores) +
+                 list_schedule_makespan(r.task_node_tests, cores);
       break;
   }
   return makespan > 0.0 ? total / makespan : 1.0;
 }
 
+double predicted_step_ms(const StepResult& step, Method method, int cores) {
+  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+  const ScheduleRecord& r = step.schedule;
+  if (r.timeline.empty()) {
+    throw Error(ErrorCode::bad_argument, "predicted_step_ms", "the step has no timeline (EngineOptions::timeline)");
+  }
+  std::vector<const TaskSpan*> stage, traverse, finalize;
+  double spans = 0.0;
+  for (const TaskSpan& t : r.timeline) {
+    spans += t.end_ms - t.start_ms;
+    (t.phase == TaskSpan::Phase::stage ? stage : t.phase == TaskSpan::Phase::traverse ? traverse : finalize).push_back(&t);
+  }
+  const auto by_unit = [](const TaskSpan* x, const TaskSpan* y) { return x->unit != y->unit ? x->unit < y->unit : x->start_ms < y->start_ms; };
+  const auto length = [](const TaskSpan* t) { return t->end_ms - t->start_ms; };
+  // The stage: split tasks in pair order, as the stage spans' units (pairs) sort.
+  std::sort(stage.begin(), stage.end(), by_unit);
+  double stage_ms = 0.0;
+  if (!stage.empty()) {
+    std::vector<double> unit(r.stage_task_node_tests.size(), 0.0);
+    if (stage.size() == unit.size()) {
+      for (std::size_t s = 0; s < unit.size(); ++s) {
+        unit[s] = r.stage_task_node_tests[s] > 0 ? length(stage[s]) / static_cast<double>(r.stage_task_node_tests[s]) : 0.0;
+      }
+      stage_ms = stage_makespan(r, unit, cores);
+    } else {  // not the stage's records (a step not from the engine): its spans one after another
+      for (const TaskSpan* t : stage) stage_ms += length(t);
+    }
+  }
+  // The traversal units: the run-time tasks in handout order; stealing's pieces largest first,
+  // with the splitting above the cut-off (the traversal's time outside the pieces) spread evenly.
+  std::vector<double> units;
+  double split_ms = 0.0;
+  if (method == Method::stealing) {
+    for (const TaskSpan* t : traverse) units.push_back(length(t));
+    std::sort(units.begin(), units.end(), std::greater<>());
+    double pieces = 0.0;
+    for (const double u : units) pieces += u;
+    split_ms = std::max(0.0, r.traverse_ms - pieces);
+  } else {
+    std::sort(traverse.begin(), traverse.end(), by_unit);
+    for (const TaskSpan* t : traverse) units.push_back(length(t));
+  }
+  // Finalization: the pairs in the order they ran, a large one as its chunks.
+  std::sort(finalize.begin(), finalize.end(), [](const TaskSpan* x, const TaskSpan* y) { return x->start_ms < y->start_ms; });
+  std::vector<double> finals;
+  for (const TaskSpan* t : finalize) {
+    const std::size_t candidates = t->unit < step.tasks.size() ? step.tasks[t->unit].candidates : 0;
+    const std::size_t chunks = candidates >= narrow::kFinalizeGrain ? (candidates + narrow::kFinalizeGrain - 1) / narrow::kFinalizeGrain : 1;
+    for (std::size_t c = 0; c < chunks; ++c) finals.push_back(length(t) / static_cast<double>(chunks));
+  }
+  const double serial = step.broad_ms + std::max(0.0, step.narrow_ms + step.reduce_ms - spans - split_ms);
+  return serial + stage_ms + split_ms / cores + list_schedule(units, cores) + list_schedule(finals, cores);
+}
+
 void SimulatedRun::add(const StepResult& step) {
+  if (!step.schedule.timeline.empty()) {
+    mPredictedMs += predicted_step_ms(step, mMethod, mCores);
+    ++mTimed;
+  }
   if (step.stats.node_tests == 0) return;
   const double work = static_cast<double>(step.stats.node_tests);
   mWork += work;

@@ -91,6 +91,8 @@ struct StepState {
   bool parallel_finalize = true;  ///< let one heavy pair's finalization use several threads
   /// Per pair: its kept pairs against QueryRequest::max_pairs; null when there is no limit.
   narrow::PairLimit* limits = nullptr;
+  /// Per pair: the candidates its finalization took in (filled by finalize_pairs).
+  std::vector<std::size_t> candidates;
   /// The pair's limit for a traversal, or null.
   [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
 };

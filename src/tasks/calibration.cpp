@@ -48,8 +48,11 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
 
 namespace {
 
-/// Nodes of one level of the stage handed to a thread at a time (a node test is ~0.1-0.3 us).
-constexpr std::size_t kStageGrain = 32;
+/// Nodes of one level of the stage handed to a thread at a time: a visit is up to four node tests
+/// of ~0.1-0.3 us, so a chunk is a few microseconds, and a level of a hundred nodes spreads over
+/// a dozen threads. Fixed chunks (not the partitioner's), so that the load-balance simulation
+/// replays the very pieces that ran.
+constexpr std::size_t kStageGrain = 8;
 
 /// A node waiting in the stage, with its weight.
 struct StageItem {
@@ -77,9 +80,10 @@ struct StageOutcome {
 void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& level, double omega, double eps,
                  const std::function<double(narrow::NodePair)>& weight_of, std::vector<StageOutcome>& outcome) {
   outcome.assign(level.size(), StageOutcome{});
-  parallel::parallel_for(0, level.size(), kStageGrain, [&](std::size_t lo, std::size_t hi) {
+  const std::size_t chunks = (level.size() + kStageGrain - 1) / kStageGrain;
+  parallel::parallel_for(0, chunks, 1, [&](std::size_t first, std::size_t last) {
     std::vector<narrow::Candidate> found;
-    for (std::size_t i = lo; i != hi; ++i) {
+    for (std::size_t i = first * kStageGrain; i != std::min(last * kStageGrain, level.size()); ++i) {
       const StageItem& e = level[i];
       StageOutcome& o = outcome[i];
       const bool leaves = ctx.a().nodes[e.node.a].is_leaf() && ctx.b().nodes[e.node.b].is_leaf();
@@ -112,9 +116,11 @@ void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& l
 std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const std::vector<StageOutcome>& outcome,
                                     std::uint32_t pair, SplitResult& out) {
   std::vector<StageItem> next;
+  std::vector<std::uint64_t>& chunks = out.levels.emplace_back((level.size() + kStageGrain - 1) / kStageGrain, 0);
   for (std::size_t i = 0; i < level.size(); ++i) {
     const StageItem& e = level[i];
     const StageOutcome& o = outcome[i];
+    chunks[i / kStageGrain] += o.stats.node_tests;
     out.stats.node_tests += o.stats.node_tests;
     out.stats.leaf_tests += o.stats.leaf_tests;
     StageRecord record{};

@@ -69,6 +69,9 @@ struct SplitResult {
   QueryStats stats;                           ///< node and leaf tests made in the stage
   std::size_t queue_peak = 0;                 ///< widest level of the stage (nodes waiting at once)
   std::vector<StageRecord> stage;             ///< every node that passed, level by level (parents first)
+  /// Each level's node tests, per chunk of nodes handed to a thread at once (the root's own test
+  /// is not in them).
+  std::vector<std::vector<std::uint64_t>> levels;
 };
 
 /// The weight-driven partial traversal of one pair's CD tree (the paper's alternate traversal):

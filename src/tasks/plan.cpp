@@ -127,7 +127,7 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pair
   const InitialWeights w = initial_weights(options.method, pairs, contexts, history);
   Plan plan;
   plan.weighted = true;
-  plan.omega = caliber_threshold(w.total, options.beta, options.threads);
+  plan.omega = caliber_threshold(w.total, options.beta, options.plan_threads > 0 ? options.plan_threads : options.threads);
   const double eps = options.epsilon * plan.omega;
   std::vector<Root> cart;
   std::vector<std::size_t> to_split;

@@ -202,13 +202,17 @@ for m, v in s["methods"].items():
                 assert abs(b - 1.0) < 1e-9, (m, b)
     if m != "sequential":
         assert set(v["simulated_speedup"]) == {"4"}, m
+        # The cut for 4 threads run on one, its pieces timed and replayed on 4 cores.
+        p = v["predicted"]["4"]
+        assert set(v["predicted"]) == {"4"} and p["step_ms"] > 0 and p["sequential_step_ms"] > 0, m
+        assert abs(p["speedup"] - p["sequential_step_ms"] / p["step_ms"]) < 1e-9 * p["speedup"], m
 assert s["table1"]["objects"] == 2
 assert set(r["gantt"]["methods"]) == {"exploitation", "hybrid"}
 assert set(s["ceiling"]) == {"2"} and len(s["ceiling"]["2"]["copy_step_ms"]) == 2 and s["ceiling"]["2"]["ceiling_speedup"] > 0
 assert r["runs_done"] == r["runs_planned"] == 2 * (1 + 5 * 2) and "stopped" not in r
 report = open(d + "/report.md").read()
 for heading in ("## Table 1", "## Table 2", "## The machine's ceiling", "## One-thread overhead", "## Simulated speed-up",
-                "## Targets", "**all identical**", "Runs done: 22 of 22"):
+                "## Predicted from measured time per piece", "## Targets", "**all identical**", "Runs done: 22 of 22"):
     assert heading in report, heading
 # The log: one record per line, as measured; every run is there.
 records = [json.loads(line) for line in open(d + "/runs.jsonl")]

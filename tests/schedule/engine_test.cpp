@@ -77,7 +77,15 @@ void expect_all_methods_identical(const World& world, int steps) {
         // Conservation: every node sequential tests is tested once; a posteriori may add the work of
         // sub-tasks whose root the original task never reached, and says how much.
         EXPECT_EQ(got.stats.node_tests - got.schedule.taboo_unreached_node_tests, reference[k].stats.node_tests) << what;
+        for (const TaskRecord& t : got.tasks) EXPECT_GE(t.candidates, t.pairs) << what << ": reported pairs are candidates";
         if (method == Method::apriori || method == Method::hybrid) {
+          // The stage's levels hold its node tests (all but each split task's root test).
+          std::uint64_t levels = got.schedule.stage_task_node_tests.size();
+          for (const std::vector<std::uint64_t>& level : got.schedule.stage_levels) {
+            for (const std::uint64_t chunk : level) levels += chunk;
+          }
+          EXPECT_EQ(levels, got.schedule.stage_node_tests) << what;
+          EXPECT_EQ(got.schedule.stage_levels.size(), got.schedule.stage_level_task.size()) << what;
           // Conservation: the weight-driven stage and the run-time tasks test every node once.
           std::uint64_t cut = got.schedule.stage_node_tests;
           for (const std::uint64_t t : got.schedule.task_node_tests) cut += t;
@@ -175,8 +183,18 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_NEAR(simulated_speedup(step, Method::exploitation, 8), 100.0 / 60.0, 1e-12) << "bound by the heaviest pair";
   EXPECT_EQ(simulated_speedup(step, Method::sequential, 8), 1.0);
   step.schedule.task_node_tests = {20, 20, 20, 20};
+  // One split task: its root's test, then levels of 4 and 15 node tests (chunks 8 and 7: one core
+  // each at most), 20 in all: a span of 1 + 4 + 8 = 13 on 4 cores, above 20 / 4.
   step.schedule.stage_task_node_tests = {20};
-  EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / 40.0, 1e-12) << "stage, barrier, then the tasks";
+  step.schedule.stage_levels = {{4}, {8, 7}};
+  step.schedule.stage_level_task = {0, 0};
+  EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / (13.0 + 20.0), 1e-12) << "stage, barrier, then the tasks";
+  // Wide levels: the stage's tests spread evenly bound it (two split tasks sharing the cores).
+  step.schedule.stage_task_node_tests = {35, 35};
+  step.schedule.stage_levels = {{2}, {4, 4, 4, 4, 4, 4, 4, 4}, {2}, {4, 4, 4, 4, 4, 4, 4, 4}};
+  step.schedule.stage_level_task = {0, 0, 1, 1};
+  step.stats.node_tests = 150;
+  EXPECT_NEAR(simulated_speedup(step, Method::apriori, 4), 150.0 / (70.0 / 4 + 20.0), 1e-12) << "each span 1 + 2 + 8";
 }
 
 TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
@@ -273,6 +291,104 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
   const StepResult plain = step(world, quiet, 0);
   EXPECT_TRUE(plain.schedule.timeline.empty()) << "off by default";
   EXPECT_TRUE(plain.schedule.task_roots.empty()) << "off by default";
+}
+
+TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
+  const World world(parse_scene(R"({"steps": 3, "dt": 0.1, "query": {"kind": "contact", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off", "motion": {"type": "velocity", "angular": [0, 0.5, 0]}},
+      {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity", "linear": [-0.1, 0, 0]}},
+      {"name": "c", "mesh": "cube.off", "position": [-0.6, 0.5, 0]}]})",
+                                dir, "plan_threads.json"));
+  for (const Method method : {Method::apriori, Method::hybrid}) {
+    EngineOptions wide;
+    wide.method = method;
+    wide.threads = 4;
+    EngineOptions narrow = wide;
+    narrow.threads = 1;
+    narrow.plan_threads = 4;
+    Engine four(wide), one(narrow);
+    EXPECT_EQ(one.threads(), 1);
+    bool split = false;
+    for (int k = 0; k < 3; ++k) {
+      const StepResult a = step(world, four, k), b = step(world, one, k);
+      const std::string what = std::string(to_string(method)) + " step " + std::to_string(k);
+      expect_same_step(b, a, what);
+      EXPECT_EQ(b.schedule.omega, a.schedule.omega) << what;
+      EXPECT_EQ(b.schedule.task_node_tests, a.schedule.task_node_tests) << what << ": the same tasks, in the same order";
+      EXPECT_EQ(b.schedule.stage_task_node_tests, a.schedule.stage_task_node_tests) << what;
+      EXPECT_EQ(b.schedule.stage_levels, a.schedule.stage_levels) << what;
+      split = split || a.schedule.split > 0;
+    }
+    EXPECT_TRUE(split) << to_string(method) << ": a cut with a weight-driven stage, or the test shows little";
+  }
+  EngineOptions bad;
+  bad.plan_threads = -1;
+  EXPECT_THROW(Engine{bad}, Error);
+  bad.plan_threads = 2000;
+  EXPECT_THROW(Engine{bad}, Error);
+}
+
+TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
+  const World world(parse_scene(R"({"query": {"kind": "contact", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}},
+      {"name": "c", "mesh": "cube.off", "position": [-0.6, 0.5, 0], "motion": {"type": "velocity"}}]})",
+                                dir, "predicted.json"));
+  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori,
+                              Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 1;
+    options.plan_threads = 8;
+    options.stealing_depth = 2;
+    options.timeline = true;
+    Engine engine(options);
+    const StepResult s = step(world, engine, 0);
+    const std::string what(to_string(method));
+    // On one core the replay gives back the step as measured: every piece once, the rest serial.
+    const double measured = s.broad_ms + s.narrow_ms + s.reduce_ms;
+    EXPECT_NEAR(predicted_step_ms(s, method, 1), measured, 1e-9 * measured) << what;
+    // More cores never take longer; the serial rest and the longest piece bound it from below.
+    double longest = 0.0;
+    for (const TaskSpan& t : s.schedule.timeline) {
+      if (t.phase == TaskSpan::Phase::traverse) longest = std::max(longest, t.end_ms - t.start_ms);
+    }
+    const double four = predicted_step_ms(s, method, 4);
+    EXPECT_LE(four, measured * (1 + 1e-12)) << what;
+    EXPECT_LE(predicted_step_ms(s, method, 8), four * (1 + 1e-12)) << what;
+    EXPECT_GE(four, longest) << what;
+  }
+  // Without a timeline there is nothing to replay.
+  EngineOptions quiet;
+  quiet.method = Method::hybrid;
+  quiet.threads = 1;
+  Engine engine(quiet);
+  EXPECT_THROW((void)predicted_step_ms(step(world, engine, 0), Method::hybrid, 4), Error);
+}
+
+TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
+  // A hand-made step: a split pair whose stage took 2 ms for 20 node tests (its root test, then
+  // levels of 4 and 15 tests), four run-time tasks of 1 ms, the pair's finalization 0.4 ms over
+  // 256 candidates (two chunks), and 0.45 ms outside every piece (broad phase 0.1, the rest 0.35).
+  StepResult step;
+  step.tasks.resize(2);
+  step.tasks[0].candidates = 256;
+  step.stats.node_tests = 100;
+  ScheduleRecord& r = step.schedule;
+  r.stage_task_node_tests = {20};
+  r.stage_levels = {{4}, {8, 7}};
+  r.stage_level_task = {0, 0};
+  r.task_node_tests = {20, 20, 20, 20};
+  r.timeline.push_back(TaskSpan{0, 0.0, 2.0, TaskSpan::Phase::stage, 0});
+  for (std::uint32_t t = 0; t < 4; ++t) r.timeline.push_back(TaskSpan{0, 2.0 + t, 3.0 + t, TaskSpan::Phase::traverse, t});
+  r.timeline.push_back(TaskSpan{0, 6.0, 6.4, TaskSpan::Phase::finalize, 0});
+  step.broad_ms = 0.1;
+  step.narrow_ms = 6.7;
+  step.reduce_ms = 0.05;
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 1), 6.85, 1e-12) << "one core: the step as measured";
+  // Four cores: the stage's levels in turn (0.1 ms a test: 1 + 4 + 8 tests deep), the four tasks at
+  // once, the two finalization chunks at once.
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.2, 1e-12);
+  EXPECT_THROW((void)predicted_step_ms(step, Method::hybrid, 0), Error);
 }
 
 TEST(EngineOptionsValidation, RejectsBadValues) {
