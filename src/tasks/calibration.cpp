@@ -217,34 +217,31 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 
 namespace {
 
-/// Fills summary[slot] for CD node n with the reported pairs `items` below it, then its children.
-void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::NodePair n, std::vector<TrianglePair> items,
-                  std::vector<SummaryNode>& summary) {
+/// Fills summary[slot] for CD node n with the reported pairs in [first, last) below it, then its
+/// children. The pairs are partitioned in place (each goes to the first child that holds both
+/// triangles, as a traversal would meet it), so the tree costs no allocation per node.
+void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::NodePair n, TrianglePair* first,
+                  TrianglePair* last, std::vector<SummaryNode>& summary) {
   summary[slot].node = n;
-  summary[slot].contacts = static_cast<std::uint32_t>(items.size());
+  summary[slot].contacts = static_cast<std::uint32_t>(last - first);
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return;
   narrow::NodePair kids[4];
   const int count = narrow::cd_children(a, b, n, kids);
-  std::vector<TrianglePair> parts[4];
-  for (const TrianglePair& p : items) {
-    for (int k = 0; k < count; ++k) {
-      if (a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b)) {
-        parts[k].push_back(p);
-        break;
-      }
-    }
+  TrianglePair* bounds[5] = {first};
+  for (int k = 0; k < count; ++k) {
+    bounds[k + 1] = std::partition(bounds[k], last, [&](const TrianglePair& p) {
+      return a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b);
+    });
   }
-  items.clear();
-  items.shrink_to_fit();
-  const auto first = static_cast<std::uint32_t>(summary.size());
+  const auto at = static_cast<std::uint32_t>(summary.size());
   std::uint32_t children = 0;
-  for (int k = 0; k < count; ++k) children += parts[k].empty() ? 0 : 1;
-  summary[slot].first = first;
+  for (int k = 0; k < count; ++k) children += bounds[k + 1] != bounds[k] ? 1 : 0;
+  summary[slot].first = at;
   summary[slot].children = children;
   summary.resize(summary.size() + children);
-  std::uint32_t next = first;
+  std::uint32_t next = at;
   for (int k = 0; k < count; ++k) {
-    if (!parts[k].empty()) fill_summary(a, b, next++, kids[k], std::move(parts[k]), summary);
+    if (bounds[k + 1] != bounds[k]) fill_summary(a, b, next++, kids[k], bounds[k], bounds[k + 1], summary);
   }
 }
 
@@ -253,8 +250,10 @@ void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::No
 std::vector<SummaryNode> build_summary(const Model& a, const Model& b, const std::vector<TrianglePair>& reported) {
   std::vector<SummaryNode> summary;
   if (reported.empty()) return summary;
+  std::vector<TrianglePair> items = reported;
+  summary.reserve(2 * items.size() + 1);
   summary.resize(1);
-  fill_summary(a, b, 0, narrow::NodePair{0, 0}, reported, summary);
+  fill_summary(a, b, 0, narrow::NodePair{0, 0}, items.data(), items.data() + items.size(), summary);
   return summary;
 }
 
