@@ -29,7 +29,7 @@ namespace {
 
 struct RunOptions {
   std::string scene;
-  std::string method = "sequential";
+  std::string method{to_string(kRecommendedMethod)};
   int threads = 0;
   int stealing_depth = EngineOptions{}.stealing_depth;
   double beta = EngineOptions{}.beta;

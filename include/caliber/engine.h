@@ -154,6 +154,13 @@ enum class Method : std::uint8_t {
 /// Parses a method name; throws caliber::Error on an unknown one.
 [[nodiscard]] CALIBER_EXPORT Method parse_method(std::string_view name);
 
+/// The method `caliber run` uses unless told otherwise, on the machine's hardware threads: work
+/// stealing, the fastest measured at 16 threads on three of the four scenes (Intel Xeon, 16 cores,
+/// medians of 5 interleaved rounds at 2a20389, issue 14: stealing 7.9 / 6.9 / 9.5 / 10.2x, hybrid
+/// 8.7 / 2.3 / 9.1 / 7.3x on two_large / two_small / funnel / front_car; single runs in
+/// bench/results/intel-xeon-16c/). EngineOptions keeps `sequential`, the reference, as its default.
+inline constexpr Method kRecommendedMethod = Method::stealing;
+
 /// Options of the engine.
 struct EngineOptions {
   /// The method.

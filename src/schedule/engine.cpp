@@ -145,7 +145,7 @@ StepResult Engine::step(const Frame& frame) {
   std::vector<QueryResult> results(n);
   mImpl->workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
   mImpl->timeline.begin(mOptions.timeline);
-  schedule::StepState state{contexts, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1};
+  schedule::StepState state{contexts, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1, nullptr, {}};
   std::unique_ptr<narrow::PairLimit[]> limits;
   if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);

@@ -133,6 +133,7 @@ tmp=$(mktemp -d)
 check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
 contains run "summary over 12 steps"
 contains run "heaviest pair"
+contains run "method stealing on"  # the default: caliber::kRecommendedMethod on the hardware threads
 python3 - "$tmp/report.json" "$tmp/contacts.jsonl" <<'PY' || { echo "FAIL run-files"; failures=$((failures + 1)); }
 import json, sys
 r = json.load(open(sys.argv[1]))
