@@ -4,19 +4,33 @@
 /// its subtree will take.
 ///
 /// Derivation. Two nodes hold P_a and P_b triangles of surfaces that their spheres (radii r_a, r_b)
-/// bound. Only the parts of the two surfaces near the lens where the spheres (grown by d) overlap can
-/// lead the traversal deep; elsewhere it stops near the top. Let o be the depth of that overlap:
-/// the smaller of the spheres' r_a + r_b + d - |c_a - c_b| and the boxes' least penetration over
-/// the six face axes (0 when apart). Spheres alone overrate thin parts, whose spheres are large and
-/// loose: on front_car that made the a priori method split the wrong pairs (1.08x at 2 threads,
-/// against 1.6x once the boxes are used). A surface patch spread over a sphere of
-/// radius r has about the fraction o / (2 r) of its area inside a cap of height o (the area of a
-/// spherical cap is proportional to its height), so about n_a = P_a min(1, o / 2 r_a) triangles of A
-/// and n_b = P_b min(1, o / 2 r_b) of B are in play. A depth-first traversal of two surfaces in
-/// contact costs a few node tests per triangle in play (each one is reached by a path whose upper
-/// part it shares with its neighbours), so the estimate is w = 1 + 2 (n_a + n_b): 1 for the test of
-/// the node itself. Only ratios of weights matter to calibration (Omega is a fraction of their
-/// sum, and the hybrid metric rescales them by measured counts), so the factor 2 is cosmetic.
+/// and boxes bound. Only the parts of the two surfaces inside the region where the two volumes
+/// (grown by d) overlap can lead the traversal deep; elsewhere it stops near the top. A depth-first
+/// traversal of two surfaces in contact costs a few node tests per triangle in play (each one is
+/// reached by a path whose upper part it shares with its neighbours), so the estimate is
+/// w = 1 + 2 (s_a P_a + s_b P_b), where s is the share of a node's triangles in play (1 for the
+/// test of the node itself). Only ratios of weights matter to calibration (Omega is a fraction of
+/// their sum, and the hybrid metric rescales them by measured counts), so the factor 2 is cosmetic.
+///
+/// The share is estimated twice, the two estimates failing in opposite directions, and s is their
+/// geometric mean (their average in the log domain, where a factor too high and a factor too low
+/// weigh alike):
+///  - depth: with o the least penetration (of the spheres, r_a + r_b + d - |c_a - c_b|, and of the
+///    boxes on the six face axes), a patch spread over a sphere of radius r has about o / 2r of its
+///    area inside a cap of height o (a cap's area is proportional to its height). Spheres alone
+///    overrate thin parts, whose spheres are large and loose (on front_car that made the a priori
+///    method split the wrong pairs: 1.08x at 2 threads, against 1.6x once the boxes were used); but
+///    dividing a long part's least penetration (its thickness) by its diameter underrates it: two
+///    crossing rods, or the heavy pairs of front_car, weighed no more than light pairs (at 16
+///    threads the pairs that took 36,749 and 22,258 node tests were weighed 1,772 and 1,828, light
+///    ones up to 2,417; neither heavy pair was split, 1.9x simulated at 16).
+///  - axes: along each of the six box axes, the part of the node's extent inside the other's grown
+///    box, the least of them (and of the sphere cap o / 2r): exact for a box-shaped spread of
+///    triangles cut by one axis, but it overrates flat patches whose boxes overlap though their
+///    surfaces do not come near (two_large: 1.77x simulated at P = 2 with this share alone).
+/// Measured (bench/results/amd-epyc-2c/issue14/weights.md): the log correlation with the node
+/// tests each CD node's subtree takes rises on every scene (nodes with >= 1,000 tests: two_large
+/// 0.81 -> 0.83, two_small 0.82 -> 0.86, funnel 0.88 -> 0.92, front_car 0.59 -> 0.69).
 /// The paper's printed formula is garbled; this one keeps its ingredients (P, r, the centers'
 /// distance) and its behaviour (heavier when larger and deeper in contact).
 
