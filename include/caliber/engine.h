@@ -209,8 +209,9 @@ struct EngineOptions {
 /// timed undisturbed; EngineOptions::plan_threads = cores gives the cut made for that many).
 /// Replayed: each weight-driven stage's levels (a stage's time shared among its levels' chunks by
 /// node tests, chunks list-scheduled, a barrier after each level; the split tasks side by side),
-/// then the traversal units list-scheduled in handout order (stealing: largest first, plus its
-/// splitting spread evenly), then each pair's finalization list-scheduled (a pair with many
+/// then the traversal units list-scheduled in handout order (stealing: largest first), the
+/// traversal's time outside them (handing units out; stealing's splitting above the cut-off)
+/// spread evenly over the cores, then each pair's finalization list-scheduled (a pair with many
 /// candidates as the chunks its finalization runs in parallel, its time shared evenly among them);
 /// everything outside those pieces (setting up the pairs, weights, the cart, the reduction) stays
 /// serial. Throws caliber::Error when the step has no timeline.

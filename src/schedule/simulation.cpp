@@ -109,20 +109,20 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
       for (const TaskSpan* t : stage) stage_ms += length(t);
     }
   }
-  // The traversal units: the run-time tasks in handout order; stealing's pieces largest first,
-  // with the splitting above the cut-off (the traversal's time outside the pieces) spread evenly.
+  // The traversal units: the run-time tasks in handout order; stealing's pieces largest first.
+  // The traversal's time outside the units (handing each one out, and stealing's splitting above
+  // the cut-off) is done by every thread for the units it takes: spread evenly.
   std::vector<double> units;
-  double split_ms = 0.0;
   if (method == Method::stealing) {
     for (const TaskSpan* t : traverse) units.push_back(length(t));
     std::sort(units.begin(), units.end(), std::greater<>());
-    double pieces = 0.0;
-    for (const double u : units) pieces += u;
-    split_ms = std::max(0.0, r.traverse_ms - pieces);
   } else {
     std::sort(traverse.begin(), traverse.end(), by_unit);
     for (const TaskSpan* t : traverse) units.push_back(length(t));
   }
+  double in_units = 0.0;
+  for (const double u : units) in_units += u;
+  const double split_ms = traverse.empty() ? 0.0 : std::max(0.0, r.traverse_ms - in_units);
   // Finalization: the pairs in the order they ran, a large one as its chunks.
   std::sort(finalize.begin(), finalize.end(), [](const TaskSpan* x, const TaskSpan* y) { return x->start_ms < y->start_ms; });
   std::vector<double> finals;

@@ -388,6 +388,12 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   // Four cores: the stage's levels in turn (0.1 ms a test: 1 + 4 + 8 tests deep), the four tasks at
   // once, the two finalization chunks at once.
   EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.2, 1e-12);
+  // The traversal took 0.4 ms more than its four tasks (handing them out): each thread hands out
+  // the tasks it takes, so that time is spread over the cores, not serial.
+  r.traverse_ms = 4.4;
+  step.narrow_ms += 0.4;
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 1), 7.25, 1e-12);
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.1 + 0.2, 1e-12);
   EXPECT_THROW((void)predicted_step_ms(step, Method::hybrid, 0), Error);
 }
 
