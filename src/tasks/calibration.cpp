@@ -32,6 +32,7 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
     return x.node.b < y.node.b;
   });
   std::vector<RunTask> tasks;
+  tasks.reserve(cart.size());
   std::size_t light = 0, heavy = cart.size();
   while (light < heavy) {
     RunTask task;

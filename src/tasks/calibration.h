@@ -6,7 +6,9 @@
 ///   a heavier one is split by the weight-driven stage, a lighter one goes to the cart; the cart is
 ///   sorted and its heaviest item is merged with the lightest ones until the merge reaches Omega.
 
+#include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "caliber/query.h"
@@ -28,10 +30,41 @@ struct Root {
   std::int32_t stage = -1;     ///< weight-driven stage: index of its record in SplitResult::stage
 };
 
+/// A run-time task's roots: up to three held in place (nearly every task: a step cuts hundreds of
+/// tasks, and a task on the heap each cost the serial part of calibration its allocations), more
+/// on the heap.
+class RootList {
+ public:
+  RootList() = default;
+  RootList(std::initializer_list<Root> roots) {
+    for (const Root& r : roots) push_back(r);
+  }
+  void push_back(const Root& r) {
+    if (mSize < kInPlace) {
+      mInPlace[mSize] = r;
+    } else {
+      if (mSize == kInPlace) mSpill.assign(mInPlace.begin(), mInPlace.end());
+      mSpill.push_back(r);
+    }
+    ++mSize;
+  }
+  [[nodiscard]] const Root* begin() const { return mSize > kInPlace ? mSpill.data() : mInPlace.data(); }
+  [[nodiscard]] const Root* end() const { return begin() + mSize; }
+  [[nodiscard]] std::size_t size() const { return mSize; }
+  [[nodiscard]] bool empty() const { return mSize == 0; }
+  [[nodiscard]] const Root& operator[](std::size_t i) const { return begin()[i]; }
+
+ private:
+  static constexpr std::size_t kInPlace = 3;
+  std::array<Root, kInPlace> mInPlace{};
+  std::vector<Root> mSpill;  ///< all of them once there are more than kInPlace
+  std::size_t mSize = 0;
+};
+
 /// A run-time task: one or more roots, traversed depth first by one thread.
 struct RunTask {
-  std::vector<Root> roots;  ///< never empty
-  double weight = 0.0;      ///< sum of the roots' weights
+  RootList roots;       ///< never empty
+  double weight = 0.0;  ///< sum of the roots' weights
 };
 
 /// What calibration does with an initial task or a node of the weight-driven stage.

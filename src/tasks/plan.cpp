@@ -148,7 +148,14 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pair
   plan.carted = cart.size();
   for (RunTask& t : merge_cart(std::move(cart), plan.omega)) plan.run.push_back(std::move(t));
   // Heaviest first, so that the ordered hand-out does not end on a heavy straggler.
-  std::stable_sort(plan.run.begin(), plan.run.end(), [](const RunTask& x, const RunTask& y) { return x.weight > y.weight; });
+  // (An order of indices, then each task moved once: tasks are too large to be moved around a sort.)
+  std::vector<std::uint32_t> order(plan.run.size());
+  for (std::size_t t = 0; t < order.size(); ++t) order[t] = static_cast<std::uint32_t>(t);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return plan.run[x].weight > plan.run[y].weight; });
+  std::vector<RunTask> sorted;
+  sorted.reserve(order.size());
+  for (const std::uint32_t t : order) sorted.push_back(std::move(plan.run[t]));
+  plan.run = std::move(sorted);
   return plan;
 }
 
