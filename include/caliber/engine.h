@@ -82,6 +82,9 @@ struct ScheduleRecord {
   /// each chunk of the level's nodes that one thread ran. A level waits for the one above it.
   std::vector<std::vector<std::uint64_t>> stage_levels;
   std::vector<std::uint32_t> stage_level_task;  ///< the split task (index in stage_task_node_tests) of each stage level
+  /// Per split task, the stage's wall time outside its levels' parallel visits (taking each
+  /// level's outcomes in order, the final sorts): serial within that task's stage.
+  std::vector<double> stage_serial_ms;
   /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
   /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
   /// cut-off and the single node tests above it (stealing). The load-balance simulation replays them.
@@ -207,8 +210,9 @@ struct EngineOptions {
 /// reduction) would take there. Needs the
 /// step's timeline (EngineOptions::timeline) and is meant for a step run on one thread (pieces
 /// timed undisturbed; EngineOptions::plan_threads = cores gives the cut made for that many).
-/// Replayed: each weight-driven stage's levels (a stage's time shared among its levels' chunks by
-/// node tests, chunks list-scheduled, a barrier after each level; the split tasks side by side),
+/// Replayed: each weight-driven stage's levels (a stage's time, less its serial part, shared among
+/// its levels' chunks by node tests, chunks list-scheduled, a barrier after each level, the serial
+/// part on its path; the split tasks side by side),
 /// then the traversal units list-scheduled in handout order (stealing: largest first), the
 /// traversal's time outside them (handing units out; stealing's splitting above the cut-off)
 /// spread evenly over the cores, then each pair's finalization list-scheduled (a pair with many

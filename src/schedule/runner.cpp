@@ -67,6 +67,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
     stage_root_tests[s].assign(plan.splits[s].stage.size(), 0);
     record.stage_node_tests += plan.splits[s].stats.node_tests;
     record.stage_task_node_tests.push_back(plan.splits[s].stats.node_tests);
+    record.stage_serial_ms.push_back(plan.splits[s].serial_ms);
     for (const std::vector<std::uint64_t>& level : plan.splits[s].levels) {
       record.stage_levels.push_back(level);
       record.stage_level_task.push_back(static_cast<std::uint32_t>(s));

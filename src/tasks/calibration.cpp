@@ -8,6 +8,7 @@
 #include "caliber/model.h"
 #include "parallel/executor.h"
 #include "util/assert.h"
+#include "util/timing.h"
 
 #include "tasks/weights.h"
 
@@ -170,25 +171,30 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
   // depends on the node alone, never on when it is popped, so the stage is the same cut when run
   // level by level: every node of a level visited in parallel (narrow::visit, which tests its
   // children), the children that pass the next level.
+  const auto started = util::Clock::now();
+  double visiting_ms = 0.0;
   SplitResult out;
   std::vector<StageItem> level;
   if (narrow::test_root(ctx, narrow::NodePair{0, 0}, out.stats)) level.push_back(StageItem{root_weight, narrow::NodePair{0, 0}});
   std::vector<StageOutcome> outcome;
   while (!level.empty()) {
     out.queue_peak = std::max(out.queue_peak, level.size());
+    const auto visiting = util::Clock::now();
     visit_level(ctx, level, omega, eps, weight_of, outcome);
+    visiting_ms += util::ms_since(visiting);
     level = gather_level(level, outcome, pair, out);
   }
-  // The priority queue popped every root and cart item after the last split node (from then on
-  // nothing heavier is pushed), so in order of weight, heaviest first, ties by node: the same
-  // order here, so that the run-time task list is the one the queue made, ties included.
+  // The priority queue popped every root after the last split node (from then on nothing heavier
+  // is pushed), so in order of weight, heaviest first, ties by node: the same order here, so that
+  // the run-time task list is the one the queue made, ties included.
   const auto popped_before = [](const Root& x, const Root& y) {
     if (x.weight != y.weight) return x.weight > y.weight;
     if (x.node.a != y.node.a) return x.node.a < y.node.a;
     return x.node.b < y.node.b;
   };
   std::sort(out.roots.begin(), out.roots.end(), popped_before);
-  std::sort(out.cart.begin(), out.cart.end(), popped_before);
+  // (The cart is left in level order: merge_cart sorts every cart item by a total order.)
+  out.serial_ms = std::max(0.0, util::ms_since(started) - visiting_ms);
   return out;
 }
 

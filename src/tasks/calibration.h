@@ -105,6 +105,9 @@ struct SplitResult {
   /// Each level's node tests, per chunk of nodes handed to a thread at once (the root's own test
   /// is not in them).
   std::vector<std::vector<std::uint64_t>> levels;
+  /// Wall time of the stage outside its levels' parallel visits (taking each level's outcomes in
+  /// order, the final sorts): serial within the split task.
+  double serial_ms = 0.0;
 };
 
 /// The weight-driven partial traversal of one pair's CD tree (the paper's alternate traversal):

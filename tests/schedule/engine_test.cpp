@@ -394,6 +394,11 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   step.narrow_ms += 0.4;
   EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 1), 7.25, 1e-12);
   EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.1 + 0.2, 1e-12);
+  // 0.5 ms of the stage was serial (taking its levels' outcomes in order): on the stage's path
+  // whole, the other 1.5 ms shared by its 20 tests (0.075 ms each, 1 + 4 + 8 deep).
+  r.stage_serial_ms = {0.5};
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 1), 7.25, 1e-12);
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + (0.075 * 13 + 0.5) + 1.0 + 0.1 + 0.2, 1e-12);
   EXPECT_THROW((void)predicted_step_ms(step, Method::hybrid, 0), Error);
 }
 
