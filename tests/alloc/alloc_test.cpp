@@ -17,16 +17,13 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <new>
 #include <memory>
 #include <string>
-#include <unistd.h>
 
 #include "caliber/engine.h"
-#include "caliber/mesh.h"
-#include "caliber/procedural.h"
 #include "caliber/world.h"
+#include "support/touching_world.h"
 
 namespace {
 std::atomic<long> gAllocations{0};
@@ -66,22 +63,6 @@ struct Counts {
   std::uint64_t leaf_tests = 0;
 };
 
-std::unique_ptr<caliber::World> make_world(int fineness) {
-  const auto dir = std::filesystem::temp_directory_path() / ("caliber-alloc-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  caliber::save_off(caliber::make_box(0.5, 0.5, 0.5, 6 * fineness), dir / "box.off");
-  caliber::save_off(caliber::make_sphere(0.6, 16 * fineness, 24 * fineness), dir / "sphere.off");
-  caliber::save_off(caliber::make_torus(0.8, 0.25, 32 * fineness, 16 * fineness), dir / "torus.off");
-  auto world = std::make_unique<caliber::World>(caliber::parse_scene(R"({"name": "alloc", "dt": 0.01,
-    "query": {"kind": "contact", "tolerance": 0.02, "angle": 30}, "objects": [
-      {"name": "box", "mesh": "box.off", "motion": {"type": "velocity", "angular": [0, 0, 2.1]}},
-      {"name": "ball", "mesh": "sphere.off", "position": [1.05, 0, 0], "motion": {"type": "velocity", "angular": [0.7, 0.3, 0]}},
-      {"name": "ring", "mesh": "torus.off", "position": [1.05, 0.1, 0], "motion": {"type": "velocity", "angular": [0.31, 1.3, 0.2]}}]})",
-                                                                     dir, "alloc.json"));
-  std::filesystem::remove_all(dir);
-  return world;
-}
-
 /// Steps an engine through warm-up, a first window, a gap and a last window, counting the
 /// allocations of each Engine::step (the frame is made outside the count).
 Counts count(const caliber::World& world, caliber::Method method, int threads, bool moving) {
@@ -117,8 +98,8 @@ int main() {
   std::puts("caliber_alloc_test: skipped in a sanitizer build");
   return 77;
 #else
-  const auto coarse = make_world(1);
-  const auto fine = make_world(4);
+  const auto coarse = caliber::test::touching_world(1, "alloc");
+  const auto fine = caliber::test::touching_world(4, "alloc_fine");
   int failures = 0;
   const auto check = [&](bool ok, const char* what) {
     if (!ok) {

@@ -8,16 +8,13 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
-#include "caliber/mesh.h"
-#include "caliber/procedural.h"
 #include "caliber/world.h"
+#include "support/touching_world.h"
 
 namespace {
 
@@ -81,20 +78,8 @@ int main(int argc, char** argv) {
   }
   options.threads = threads;
 
-  const auto dir = std::filesystem::temp_directory_path() / ("caliber-soak-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  caliber::save_off(caliber::make_box(0.5, 0.5, 0.5, 6), dir / "box.off");
-  caliber::save_off(caliber::make_sphere(0.6, 16, 24), dir / "sphere.off");
-  caliber::save_off(caliber::make_torus(0.8, 0.25, 32, 16), dir / "torus.off");
-  // Rotations only, so contacts come and go forever without anything drifting away. The box spins
-  // against the sphere; the torus tumbles around the sphere, touching it and the box by turns.
-  const caliber::World world(caliber::parse_scene(R"({"name": "soak", "dt": 0.01,
-    "query": {"kind": "contact", "tolerance": 0.02, "angle": 30}, "objects": [
-      {"name": "box", "mesh": "box.off", "motion": {"type": "velocity", "angular": [0, 0, 2.1]}},
-      {"name": "ball", "mesh": "sphere.off", "position": [1.05, 0, 0], "motion": {"type": "velocity", "angular": [0.7, 0.3, 0]}},
-      {"name": "ring", "mesh": "torus.off", "position": [1.05, 0.1, 0], "motion": {"type": "velocity", "angular": [0.31, 1.3, 0.2]}}]})",
-                                                  dir, "soak.json"));
-  std::filesystem::remove_all(dir);
+  const auto owned = caliber::test::touching_world(1, "soak");
+  const caliber::World& world = *owned;
 
   caliber::Engine engine(options);
   const auto start = std::chrono::steady_clock::now();
