@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "caliber/error.h"
 #include "caliber/world.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"

@@ -30,9 +30,9 @@ struct Root {
   std::int32_t stage = -1;     ///< weight-driven stage: index of its record in SplitResult::stage
 };
 
-/// A run-time task's roots: up to three held in place (nearly every task: a step cuts hundreds of
-/// tasks, and a task on the heap each cost the serial part of calibration its allocations), more
-/// on the heap.
+/// A run-time task's roots: up to three held in place (nearly every task has one to three, and a
+/// step cuts hundreds of tasks, whose allocations were serial work of the calibration), more on
+/// the heap.
 class RootList {
  public:
   RootList() = default;

@@ -4,6 +4,7 @@
 #include "tasks/plan.h"
 
 #include <algorithm>
+#include <numeric>
 
 #include "parallel/executor.h"
 #include "tasks/weights.h"
@@ -150,7 +151,7 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pair
   // Heaviest first, so that the ordered hand-out does not end on a heavy straggler.
   // (An order of indices, then each task moved once: tasks are too large to be moved around a sort.)
   std::vector<std::uint32_t> order(plan.run.size());
-  for (std::size_t t = 0; t < order.size(); ++t) order[t] = static_cast<std::uint32_t>(t);
+  std::iota(order.begin(), order.end(), 0u);
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return plan.run[x].weight > plan.run[y].weight; });
   std::vector<RunTask> sorted;
   sorted.reserve(order.size());

@@ -10,8 +10,6 @@
 //  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does.
 // Prints the counts. Exit 0: all hold; 1: a check failed; 77: skipped (sanitizer build, whose
 // allocator hooks would count their own allocations).
-// Exit 0: bounded and flat; 1: a check failed; 77: skipped (sanitizer build, whose allocator hooks
-// would count their own allocations).
 
 #include <algorithm>
 #include <atomic>
@@ -59,8 +57,7 @@ struct Counts {
   long first = 0;       // allocations over the first window after warm-up
   long last = 0;        // over the last window
   long most = 0;        // the most in one step
-  std::uint64_t node_tests = 0;
-  std::uint64_t leaf_tests = 0;
+  std::uint64_t node_tests = 0;  // the most in one step
 };
 
 /// Steps an engine through warm-up, a first window, a gap and a last window, counting the
@@ -86,7 +83,6 @@ Counts count(const caliber::World& world, caliber::Method method, int threads, b
     if (at >= kWindow + kGap) c.last += n;
     c.most = std::max(c.most, n);
     c.node_tests = std::max(c.node_tests, result.stats.node_tests);
-    c.leaf_tests = std::max(c.leaf_tests, result.stats.leaf_tests);
   }
   return c;
 }
