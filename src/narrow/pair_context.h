@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -373,5 +374,8 @@ class PairContext {
   double mCosTheta;    ///< cos(theta)
   double mSinTheta;    ///< sin(theta)
 };
+
+/// A step's pair contexts, one per pair of the frame, in the frame's pair order.
+using PairContexts = std::span<const PairContext>;
 
 }  // namespace caliber::narrow

@@ -84,7 +84,7 @@ struct Timeline {
 /// What a runner works on in one step: the pairs' contexts, the workers' slots, the timeline, and
 /// where each pair's finalized result goes.
 struct StepState {
-  const std::vector<narrow::PairContext>& contexts;
+  narrow::PairContexts contexts;
   Workers& workers;
   Timeline& timeline;
   std::vector<QueryResult>& results;

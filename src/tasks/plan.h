@@ -52,7 +52,7 @@ struct InitialWeights {
   double total = 0.0;
 };
 [[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<Task>& pairs,
-                                             const std::vector<narrow::PairContext>& contexts, const History& history);
+                                             narrow::PairContexts contexts, const History& history);
 
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
 /// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
@@ -61,7 +61,7 @@ struct InitialWeights {
 /// (the engine times it).
 using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;
 [[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs,
-                                   const std::vector<narrow::PairContext>& contexts, const History& history,
+                                   narrow::PairContexts contexts, const History& history,
                                    const StageWrapper& around_stage = {});
 
 }  // namespace caliber::tasks

@@ -2,6 +2,7 @@
 // the bit, and (for these methods, which cut the same tree) the same node tests per pair.
 
 #include <filesystem>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -528,6 +529,12 @@ TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {
   f = memory_frame(0.0);
   f.models[2] = nullptr;
   EXPECT_NE(message(f).find("object 2 has no model"), std::string::npos) << message(f);
+  f = memory_frame(0.0);
+  f.poses[1].translation.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(f).find("pose of object 1: pose has a non-finite value"), std::string::npos) << message(f);
+  f = memory_frame(0.0);
+  f.poses[2].rotation.coeffs() *= 2.0;
+  EXPECT_NE(message(f).find("pose of object 2: quaternion is not unit length"), std::string::npos) << message(f);
   f = memory_frame(0.0);
   f.pairs = {Task{0, 3}};
   EXPECT_NE(message(f).find("a < b < 3"), std::string::npos) << message(f);
