@@ -76,81 +76,123 @@ struct StageOutcome {
   narrow::Candidate candidate;  ///< leaf, reported: the pair
 };
 
-/// Visits every node of one level (in parallel; each node's outcome in its slot). A pair of leaves
-/// gets its leaf test, a heavy node is split (its children tested, those that pass weighed), any
-/// other becomes a root or a cart item by its weight.
+/// What one chunk of a level produced: its tests, and how many of each output it adds (so that
+/// every chunk knows where its outputs go once the chunks before it are counted).
+struct ChunkTally {
+  QueryStats stats;
+  std::size_t children = 0, candidates = 0, roots = 0, cart = 0;
+};
+
+/// Visits every node of one level, a chunk of kStageGrain nodes per thread at a time: a pair of
+/// leaves gets its leaf test, a heavy node is split (its children tested, those that pass
+/// weighed), any other becomes a root or a cart item by its weight. Each node's outcome goes to its
+/// slot, its record to out.stage[base + i] (out.stage already sized), each chunk's counts to its
+/// tally.
 void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& level, double omega, double eps,
-                 const std::function<double(narrow::NodePair)>& weight_of, std::vector<StageOutcome>& outcome) {
+                 const std::function<double(narrow::NodePair)>& weight_of, std::size_t base, std::vector<StageOutcome>& outcome,
+                 std::vector<ChunkTally>& tally, SplitResult& out) {
   outcome.assign(level.size(), StageOutcome{});
   const std::size_t chunks = (level.size() + kStageGrain - 1) / kStageGrain;
+  tally.assign(chunks, ChunkTally{});
   parallel::parallel_for(0, chunks, 1, [&](std::size_t first, std::size_t last) {
     std::vector<narrow::Candidate> found;
     for (std::size_t i = first * kStageGrain; i != std::min(last * kStageGrain, level.size()); ++i) {
       const StageItem& e = level[i];
       StageOutcome& o = outcome[i];
+      StageRecord& record = out.stage[base + i];
+      ChunkTally& t = tally[i / kStageGrain];
+      record = StageRecord{};
+      record.node = e.node;
       const bool leaves = ctx.a().nodes[e.node.a].is_leaf() && ctx.b().nodes[e.node.b].is_leaf();
       const Verdict verdict = classify(e.weight, omega, eps);
       if (!leaves && verdict != Verdict::split) {
         o.kind = StageOutcome::Kind::root;
         o.keep = verdict == Verdict::keep;
+        record.root = true;
+        ++(o.keep ? t.roots : t.cart);
         continue;
       }
       found.clear();
       narrow::NodePair passed[4];
       const int count = narrow::visit(ctx, e.node, found, o.stats, passed);
+      t.stats.node_tests += o.stats.node_tests;
+      t.stats.leaf_tests += o.stats.leaf_tests;
       if (count < 0) {
         o.kind = StageOutcome::Kind::leaf;
         o.reported = !found.empty();
         if (o.reported) o.candidate = found.front();
+        t.candidates += o.reported ? 1 : 0;
         continue;
       }
       o.kind = StageOutcome::Kind::split;
       o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, o.all));
       CALIBER_ASSERT(o.stats.node_tests == o.tested, "a visit tests each child once");
       o.children = static_cast<std::uint8_t>(count);
+      t.children += static_cast<std::size_t>(count);
       for (int k = 0; k < count; ++k) o.child[k] = StageItem{weight_of(passed[k]), passed[k]};
+      record.children = o.tested;
+      for (int k = 0, p = 0; k < o.tested; ++k) {
+        record.child[k] = o.all[k];
+        if (p < o.children && o.child[p].node == o.all[k]) {
+          record.passed |= static_cast<std::uint8_t>(1u << k);
+          ++p;
+        }
+      }
     }
   });
 }
 
 /// Takes one level's outcomes in the level's order (so the cut does not depend on the thread
-/// count): the counts, candidates, roots, cart items and records; returns the next level.
+/// count): the counts, candidates, roots and cart items, and the next level. Only the chunks'
+/// tallies are added up in order here; each chunk then writes its outputs at its offsets in
+/// parallel (timed into `parallel_ms`), so the serial part is per chunk, not per node.
 std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const std::vector<StageOutcome>& outcome,
-                                    std::uint32_t pair, SplitResult& out) {
-  std::vector<StageItem> next;
-  std::vector<std::uint64_t>& chunks = out.levels.emplace_back((level.size() + kStageGrain - 1) / kStageGrain, 0);
-  for (std::size_t i = 0; i < level.size(); ++i) {
-    const StageItem& e = level[i];
-    const StageOutcome& o = outcome[i];
-    chunks[i / kStageGrain] += o.stats.node_tests;
-    out.stats.node_tests += o.stats.node_tests;
-    out.stats.leaf_tests += o.stats.leaf_tests;
-    StageRecord record{};
-    record.node = e.node;
-    switch (o.kind) {
-      case StageOutcome::Kind::leaf:
-        if (o.reported) out.candidates.push_back(o.candidate);
-        break;
-      case StageOutcome::Kind::split:
-        record.children = o.tested;
-        for (int k = 0, p = 0; k < o.tested; ++k) {
-          record.child[k] = o.all[k];
-          if (p < o.children && o.child[p].node == o.all[k]) {
-            record.passed |= static_cast<std::uint8_t>(1u << k);
-            next.push_back(o.child[p++]);
+                                    const std::vector<ChunkTally>& tally, std::uint32_t pair, std::size_t base,
+                                    SplitResult& out, double& parallel_ms) {
+  const std::size_t chunks = tally.size();
+  std::vector<std::uint64_t>& tests = out.levels.emplace_back(chunks, 0);
+  std::vector<ChunkTally> at(chunks);  // where each chunk's outputs start
+  ChunkTally total{{}, 0, out.candidates.size(), out.roots.size(), out.cart.size()};
+  for (std::size_t c = 0; c < chunks; ++c) {
+    at[c] = total;
+    tests[c] = tally[c].stats.node_tests;
+    total.stats.node_tests += tally[c].stats.node_tests;
+    total.stats.leaf_tests += tally[c].stats.leaf_tests;
+    total.children += tally[c].children;
+    total.candidates += tally[c].candidates;
+    total.roots += tally[c].roots;
+    total.cart += tally[c].cart;
+  }
+  out.stats.node_tests += total.stats.node_tests;
+  out.stats.leaf_tests += total.stats.leaf_tests;
+  std::vector<StageItem> next(total.children);
+  out.candidates.resize(total.candidates);
+  out.roots.resize(total.roots);
+  out.cart.resize(total.cart);
+  const auto writing = util::Clock::now();
+  parallel::parallel_for(0, chunks, 1, [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c != last; ++c) {
+      ChunkTally w = at[c];
+      for (std::size_t i = c * kStageGrain; i != std::min((c + 1) * kStageGrain, level.size()); ++i) {
+        const StageOutcome& o = outcome[i];
+        switch (o.kind) {
+          case StageOutcome::Kind::leaf:
+            if (o.reported) out.candidates[w.candidates++] = o.candidate;
+            break;
+          case StageOutcome::Kind::split:
+            for (int k = 0; k < o.children; ++k) next[w.children++] = o.child[k];
+            break;
+          case StageOutcome::Kind::root: {
+            Root r{pair, level[i].node, true, level[i].weight};
+            r.stage = static_cast<std::int32_t>(base + i);
+            (o.keep ? out.roots[w.roots++] : out.cart[w.cart++]) = r;
+            break;
           }
         }
-        break;
-      case StageOutcome::Kind::root: {
-        record.root = true;
-        Root r{pair, e.node, true, e.weight};
-        r.stage = static_cast<std::int32_t>(out.stage.size());
-        (o.keep ? out.roots : out.cart).push_back(r);
-        break;
       }
     }
-    out.stage.push_back(record);
-  }
+  });
+  parallel_ms += util::ms_since(writing);
   return next;
 }
 
@@ -172,17 +214,20 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
   // level by level: every node of a level visited in parallel (narrow::visit, which tests its
   // children), the children that pass the next level.
   const auto started = util::Clock::now();
-  double visiting_ms = 0.0;
+  double parallel_ms = 0.0;  // the levels' parallel parts: the visits, the outputs' writing
   SplitResult out;
   std::vector<StageItem> level;
   if (narrow::test_root(ctx, narrow::NodePair{0, 0}, out.stats)) level.push_back(StageItem{root_weight, narrow::NodePair{0, 0}});
   std::vector<StageOutcome> outcome;
+  std::vector<ChunkTally> tally;
   while (!level.empty()) {
     out.queue_peak = std::max(out.queue_peak, level.size());
+    const std::size_t base = out.stage.size();
+    out.stage.resize(base + level.size());
     const auto visiting = util::Clock::now();
-    visit_level(ctx, level, omega, eps, weight_of, outcome);
-    visiting_ms += util::ms_since(visiting);
-    level = gather_level(level, outcome, pair, out);
+    visit_level(ctx, level, omega, eps, weight_of, base, outcome, tally, out);
+    parallel_ms += util::ms_since(visiting);
+    level = gather_level(level, outcome, tally, pair, base, out, parallel_ms);
   }
   // The priority queue popped every root after the last split node (from then on nothing heavier
   // is pushed), so in order of weight, heaviest first, ties by node: the same order here, so that
@@ -194,7 +239,7 @@ SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, doubl
   };
   std::sort(out.roots.begin(), out.roots.end(), popped_before);
   // (The cart is left in level order: merge_cart sorts every cart item by a total order.)
-  out.serial_ms = std::max(0.0, util::ms_since(started) - visiting_ms);
+  out.serial_ms = std::max(0.0, util::ms_since(started) - parallel_ms);
   return out;
 }
 

@@ -105,8 +105,8 @@ struct SplitResult {
   /// Each level's node tests, per chunk of nodes handed to a thread at once (the root's own test
   /// is not in them).
   std::vector<std::vector<std::uint64_t>> levels;
-  /// Wall time of the stage outside its levels' parallel visits (taking each level's outcomes in
-  /// order, the final sorts): serial within the split task.
+  /// Wall time of the stage outside its levels' parallel parts (adding up each level's chunk
+  /// tallies in order, sizing the outputs, the final sort): serial within the split task.
   double serial_ms = 0.0;
 };
 
