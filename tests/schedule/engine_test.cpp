@@ -1,6 +1,8 @@
 // Every method, every thread count, every step: the same contacts as the sequential reference, to
 // the bit, and (for these methods, which cut the same tree) the same node tests per pair.
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 
@@ -493,6 +495,46 @@ TEST(EngineFrames, EveryMethodRecordsItsTraversalAndFinalization) {
       if (method != Method::stealing) {
         EXPECT_GT(r.calibrate_ms, 0.0) << to_string(method) << ": planning is timed too";
         EXPECT_EQ(r.generated, r.task_node_tests.size()) << to_string(method);
+      }
+    }
+  }
+}
+
+TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
+  // 17 objects, every one of the 136 pairs asked for: more pairs than one chunk of the step's
+  // context building, so the contexts are made on several threads; each pair's result must still
+  // be the pairwise query of its own two objects.
+  Frame frame;
+  const std::shared_ptr<const Model> sphere = build_model(make_sphere(0.5, 10, 14));
+  const std::shared_ptr<const Model> box = build_model(make_box(0.4, 0.3, 0.35, 2));
+  for (int i = 0; i < 17; ++i) {
+    frame.models.push_back(i % 3 == 0 ? box : sphere);
+    const double angle = 0.37 * i;
+    frame.poses.push_back(Pose::from_values(0.45 * (i % 4), 0.5 * (i / 4), 0.05 * i, std::cos(angle), 0, std::sin(angle), 0));
+  }
+  for (std::uint32_t a = 0; a < 17; ++a) {
+    for (std::uint32_t b = a + 1; b < 17; ++b) frame.pairs.push_back(Task{a, b});
+  }
+  frame.request.kind = QueryKind::proximity;
+  frame.request.tolerance = 0.02;
+  std::vector<std::size_t> want;
+  std::size_t total = 0;
+  for (const Task& t : frame.pairs) {
+    want.push_back(query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request).pairs.size());
+    total += want.back();
+  }
+  ASSERT_GT(total, 0u) << "some pairs are within the tolerance";
+  ASSERT_GT(std::count(want.begin(), want.end(), std::size_t{0}), 0) << "and some are not";
+  for (const Method method : {Method::exploitation, Method::stealing, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 3;
+    Engine engine(options);
+    for (int repeat = 0; repeat < 2; ++repeat) {  // the second step reuses the contexts' storage
+      const StepResult got = engine.step(frame);
+      ASSERT_EQ(got.tasks.size(), frame.pairs.size());
+      for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
+        EXPECT_EQ(got.tasks[i].pairs, want[i]) << to_string(method) << " pair " << i;
       }
     }
   }
