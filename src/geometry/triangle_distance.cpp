@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <Eigen/Geometry>
 
 namespace caliber::geometry {
@@ -10,9 +14,16 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
+/// t > 0 ? (t < 1 ? t : 1) : 0: NaN (from 0/0 on a degenerate input) falls to 0 as well. With SSE2
+/// as a max then a min, each instruction defined to return exactly what the expression beside it
+/// does (NaN and signed zeros included): the same values, and no branch to mispredict.
 double clamp01(double t) {
-  // NaN (from 0/0 on a degenerate input) falls to 0 as well.
+#if defined(__SSE2__)
+  const __m128d m = _mm_max_sd(_mm_set_sd(t), _mm_setzero_pd());  // t > 0 ? t : 0
+  return _mm_cvtsd_f64(_mm_min_sd(m, _mm_set_sd(1.0)));           // m < 1 ? m : 1
+#else
   return t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;
+#endif
 }
 
 /// Where segment pq crosses the plane through a with normal n (floating point), if it does.
