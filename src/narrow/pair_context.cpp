@@ -21,16 +21,17 @@ bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double
   const double len = n.norm();
   if (!(len > 0.0)) return false;
   const double uv = u.norm() * v.norm();
-  int side = 0;
+  // All three vertices beyond the plane on one side, decided once (& and |, not && and ||): which
+  // vertex fails first is data, and a branch on it mispredicts.
+  bool above = true, below = true;
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d w = q[i] - p[0];
     const double s = n.dot(w);
     const double need = reach * len * (1.0 + 1e-12) + 1e-13 * uv * w.norm();
-    const int sign = s > need ? 1 : (s < -need ? -1 : 0);
-    if (sign == 0 || (side != 0 && sign != side)) return false;
-    side = sign;
+    above &= s > need;
+    below &= s < -need;
   }
-  return true;
+  return above | below;
 }
 
 }  // namespace
