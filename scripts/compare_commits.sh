@@ -154,7 +154,7 @@ done
 # When the two files differ as bytes: whether they differ only by fields one version writes and the
 # other does not (a contact's `depth` or the objects' names, added after 2a20389). Every contact (or
 # pair) must be there in both, in the same order, and every field both have must be equal (JSON
-# numbers parsed back to the same double). Prints "identical (shared fields; new adds ...)" and
+# numbers parsed back to the same double). Prints "identical (shared fields; differ in ...)" and
 # succeeds, or fails.
 shared_fields_equal() {
   python3 - "$1" "$2" <<'PY'

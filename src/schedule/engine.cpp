@@ -182,12 +182,11 @@ StepResult Engine::step(const Frame& frame) {
   StepResult out;
   const auto start = util::Clock::now();
   const std::size_t n = frame.pairs.size();
-  // The contexts are made on the executor's threads, inside the step's first parallel region.
-  narrow::PairContexts contexts;
   std::vector<QueryResult> results(n);
   mImpl->workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
   mImpl->timeline.begin(mOptions.timeline);
-  schedule::StepState state{contexts, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1, nullptr, {}};
+  // Its contexts are made on the executor's threads, inside the step's first parallel region.
+  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1, nullptr, {}};
   std::unique_ptr<narrow::PairLimit[]> limits;
   if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);
@@ -198,8 +197,7 @@ StepResult Engine::step(const Frame& frame) {
   tasks::Plan plan;
   std::vector<std::vector<std::uint64_t>> stage_root_tests;
   mImpl->executor.execute([&] {
-    contexts = mImpl->contexts.build(frame);
-    state.contexts = contexts;
+    state.contexts = mImpl->contexts.build(frame);
     if (mOptions.method == Method::stealing) {
       schedule::run_stealing(mOptions.stealing_depth, state, record);
       return;
@@ -208,7 +206,7 @@ StepResult Engine::step(const Frame& frame) {
     if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
       plan = tasks::plan_pairs(n);
     } else {
-      plan = tasks::plan_calibrated(mOptions, frame.pairs, contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
+      plan = tasks::plan_calibrated(mOptions, frame.pairs, state.contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
         mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
       });
     }
