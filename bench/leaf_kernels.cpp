@@ -5,7 +5,9 @@
 // as caliber's leaf test sees it (up to kMaxPairs per scene, taken evenly). Each benchmark runs one
 // kernel over all of a scene's pairs; items/s is triangle pairs per second.
 //
-//   closest_points/SCENE   caliber::geometry::closest_points_triangles (the contact kernel)
+//   closest_points/SCENE   caliber::geometry::closest_points_triangles (the contact kernel; AVX2
+//                          where the CPU has it)
+//   closest_points_portable/SCENE  the same kernel's portable form (the same bits, no AVX2)
 //   fcl_tri_distance/SCENE fcl::detail::TriangleDistance<double>::triDistance (FCL's, PQP's)
 //   intersect/SCENE        caliber::geometry::triangles_intersect (exact; the interference kernel)
 //   fcl_intersect/SCENE    fcl::detail::Intersect<double>::intersect_Triangle (FCL's collide kernel)
@@ -131,10 +133,11 @@ const Sample& sample(const std::string& scene) {
   return g_samples.emplace(scene, std::move(s)).first->second;
 }
 
+template <caliber::geometry::ClosestPoints (*kernel)(const Vec3*, const Vec3*)>
 void closest_points(benchmark::State& state, const std::string& scene) {
   const Sample& s = sample(scene);
   for (auto _ : state) {
-    for (const TrianglePair& p : s.pairs) benchmark::DoNotOptimize(caliber::geometry::closest_points_triangles(p.a, p.b));
+    for (const TrianglePair& p : s.pairs) benchmark::DoNotOptimize(kernel(p.a, p.b));
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * s.pairs.size()));
 }
@@ -202,7 +205,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   for (const std::string scene : {"two_small", "funnel", "front_car", "two_large"}) {
-    benchmark::RegisterBenchmark(("closest_points/" + scene).c_str(), closest_points, scene)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("closest_points/" + scene).c_str(), closest_points<caliber::geometry::closest_points_triangles>,
+                                 scene)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("closest_points_portable/" + scene).c_str(),
+                                 closest_points<caliber::geometry::detail::closest_points_triangles_portable>, scene)
+        ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("fcl_tri_distance/" + scene).c_str(), fcl_tri_distance, scene)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("intersect/" + scene).c_str(), intersect, scene)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("fcl_intersect/" + scene).c_str(), fcl_intersect, scene)->Unit(benchmark::kMillisecond);

@@ -1,4 +1,5 @@
 #include "geometry/triangle_distance.h"
+#include "geometry/triangle_kernel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -45,23 +46,8 @@ Vec3 closest_point_on_segment(const Vec3& x, const Vec3& p, const Vec3& q) {
   return p + clamp01((x - p).dot(d) / len2) * d;
 }
 
-namespace {
+namespace kernel {
 
-/// A triangle with what the closest-point query on it needs of its own: computed once per triangle
-/// and reused for every point (the same expressions as a single query, so the same values).
-struct TriangleFrame {
-  const Vec3* v;   ///< the three corners
-  Vec3 ab, ac;     ///< v[1] - v[0], v[2] - v[0]
-  bool solid;      ///< far enough from degenerate for the region test (else: nearest edge point)
-
-  explicit TriangleFrame(const Vec3 corners[3]) : v(corners), ab(corners[1] - corners[0]), ac(corners[2] - corners[0]) {
-    const double area2 = ab.cross(ac).squaredNorm();
-    const double scale2 = std::max(ab.squaredNorm(), ac.squaredNorm());
-    solid = area2 > 1e-24 * scale2 * scale2;
-  }
-};
-
-/// Closest point to x on the triangle of `t`.
 Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t) {
   // Ericson, Real-Time Collision Detection, 5.1.5, with guards: a degenerate triangle, or any
   // division that cannot be trusted, falls back to the nearest point on the three edges.
@@ -107,30 +93,6 @@ Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t) {
   return best;
 }
 
-/// The nearest pair found so far. A new pair replaces it when its distance (the square root of its
-/// squared length, as Eigen's norm() computes it) is strictly smaller; the square root is taken
-/// only when the squared length is smaller, since sqrt is monotone and correctly rounded
-/// (d2 >= best_d2 implies sqrt(d2) >= best.distance), so the winner is the same as comparing
-/// every distance.
-struct Nearest {
-  ClosestPoints best;
-  double best_d2;
-
-  Nearest(const Vec3& p, const Vec3& q) : best{p, q, 0.0}, best_d2((q - p).squaredNorm()) { best.distance = std::sqrt(best_d2); }
-
-  void consider(const Vec3& p, const Vec3& q) {
-    const double d2 = (q - p).squaredNorm();
-    if (!(d2 < best_d2)) return;
-    const double d = std::sqrt(d2);
-    if (d < best.distance) {
-      best = ClosestPoints{p, q, d};
-      best_d2 = d2;
-    }
-  }
-};
-
-/// Closest points c1 on p1 + s d1 and c2 on p2 + t d2 (s, t in [0, 1]), given a = |d1|^2 and
-/// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
 void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1,
                           Vec3& c2) {
   // Ericson 5.1.9, with the parameters always clamped to [0, 1].
@@ -164,35 +126,39 @@ void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& 
   c2 = p2 + t * d2;
 }
 
-}  // namespace
+void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
+                        Nearest& nearest) {
+  const Vec3 na = fa.ab.cross(fa.ac);
+  const Vec3 nb = fb.ab.cross(fb.ac);
+  Vec3 x;
+  for (int i = 0; i < 3; ++i) {
+    if (crossing_point(a[i], a[(i + 1) % 3], b[0], nb, x)) nearest.consider(x, closest_point_on_frame(x, fb));
+    if (crossing_point(b[i], b[(i + 1) % 3], a[0], na, x)) nearest.consider(closest_point_on_frame(x, fa), x);
+  }
+}
+
+}  // namespace kernel
 
 Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 corners[3] = {a, b, c};
-  return closest_point_on_frame(x, TriangleFrame(corners));
+  return kernel::closest_point_on_frame(x, kernel::TriangleFrame(corners));
 }
 
 void closest_points_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1, Vec3& c2) {
   const Vec3 d1 = q1 - p1, d2 = q2 - p2;
-  closest_points_edges(p1, d1, d1.squaredNorm(), p2, d2, d2.squaredNorm(), c1, c2);
+  kernel::closest_points_edges(p1, d1, d1.squaredNorm(), p2, d2, d2.squaredNorm(), c1, c2);
 }
 
-ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
-  // Each edge vector, its squared length and each triangle's frame are computed once here and
-  // shared by the 9 edge pairs and 6 vertex-face queries (the same expressions, so the same values
-  // as computing them per query).
-  Vec3 ea[3], eb[3];
-  double la[3], lb[3];
-  for (int i = 0; i < 3; ++i) {
-    ea[i] = a[(i + 1) % 3] - a[i];
-    eb[i] = b[(i + 1) % 3] - b[i];
-    la[i] = ea[i].squaredNorm();
-    lb[i] = eb[i].squaredNorm();
-  }
+namespace detail {
+
+ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]) {
+  using namespace kernel;
+  const EdgeVectors e(a, b);
   Nearest nearest(a[0], b[0]);
   Vec3 c1, c2;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      closest_points_edges(a[i], ea[i], la[i], b[j], eb[j], lb[j], c1, c2);
+      closest_points_edges(a[i], e.a[i], e.la[i], b[j], e.b[j], e.lb[j], c1, c2);
       nearest.consider(c1, c2);
     }
   }
@@ -201,15 +167,19 @@ ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
     nearest.consider(a[i], closest_point_on_frame(a[i], fb));
     nearest.consider(closest_point_on_frame(b[i], fa), b[i]);
   }
-  // Intersecting triangles: an edge of one pierces the other; its crossing point is a candidate.
-  const Vec3 na = fa.ab.cross(fa.ac);
-  const Vec3 nb = fb.ab.cross(fb.ac);
-  Vec3 x;
-  for (int i = 0; i < 3; ++i) {
-    if (crossing_point(a[i], a[(i + 1) % 3], b[0], nb, x)) nearest.consider(x, closest_point_on_frame(x, fb));
-    if (crossing_point(b[i], b[(i + 1) % 3], a[0], na, x)) nearest.consider(closest_point_on_frame(x, fa), x);
-  }
+  consider_crossings(a, b, fa, fb, nearest);
   return nearest.best;
+}
+
+}  // namespace detail
+
+/// The AVX2 kernel where the CPU has it, the portable one elsewhere: chosen at the first call.
+ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
+  static const detail::TriangleKernel chosen = [] {
+    const detail::TriangleKernel avx2 = detail::closest_points_triangles_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : &detail::closest_points_triangles_portable;
+  }();
+  return chosen(a, b);
 }
 
 }  // namespace caliber::geometry

@@ -29,6 +29,15 @@ struct ClosestPoints {
 
 /// Closest points between triangles A and B: the nearest of the edge-edge, vertex-face and
 /// edge-through-face candidates (the last ones find the crossing point of intersecting triangles).
+/// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
+
+namespace detail {
+/// The two forms of closest_points_triangles, for tests and benchmarks.
+using TriangleKernel = ClosestPoints (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
+ClosestPoints closest_points_triangles_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
+/// The AVX2 form, or nullptr where this build or this CPU has none.
+TriangleKernel closest_points_triangles_avx2_if_supported();
+}  // namespace detail
 
 }  // namespace caliber::geometry

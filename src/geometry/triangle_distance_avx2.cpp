@@ -1,0 +1,284 @@
+#include "geometry/triangle_distance.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+#include <cstdint>
+
+#include "geometry/triangle_kernel.h"
+
+namespace caliber::geometry {
+
+using kernel::Nearest;
+using kernel::TriangleFrame;
+using kernel::Vec3;
+
+// The same kernel, four candidates at a time in AVX2 registers (x86-64, chosen at run time where
+// the CPU has AVX2). Each lane computes exactly what the portable code computes for its candidate:
+// the same IEEE operations in the same order (no FMA: this file is built with -ffp-contract=off and
+// only "avx2" is enabled here, not "fma"), every region and case of the branches evaluated and the
+// one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on
+// NaN, as in C++), and clamp01 is max then min with the operands in the order of the scalar
+// maxsd/minsd of clamp01 (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The candidates are then
+// taken by the same Nearest in the portable order, so the same pair wins. Eigen computes a
+// 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does dot() here
+// (tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
+namespace {
+
+#define CALIBER_AVX2 __attribute__((target("avx2")))
+
+struct Pack3 {
+  __m256d x, y, z;
+};
+
+CALIBER_AVX2 inline __m256d lanes(double l0, double l1, double l2, double l3) { return _mm256_setr_pd(l0, l1, l2, l3); }
+CALIBER_AVX2 inline Pack3 lanes(const Vec3& l0, const Vec3& l1, const Vec3& l2, const Vec3& l3) {
+  return {lanes(l0.x(), l1.x(), l2.x(), l3.x()), lanes(l0.y(), l1.y(), l2.y(), l3.y()), lanes(l0.z(), l1.z(), l2.z(), l3.z())};
+}
+CALIBER_AVX2 inline Pack3 operator+(const Pack3& u, const Pack3& v) {
+  return {_mm256_add_pd(u.x, v.x), _mm256_add_pd(u.y, v.y), _mm256_add_pd(u.z, v.z)};
+}
+CALIBER_AVX2 inline Pack3 operator-(const Pack3& u, const Pack3& v) {
+  return {_mm256_sub_pd(u.x, v.x), _mm256_sub_pd(u.y, v.y), _mm256_sub_pd(u.z, v.z)};
+}
+/// s * v, as Eigen's scalar times vector: s * v[k] for each coordinate.
+CALIBER_AVX2 inline Pack3 operator*(__m256d s, const Pack3& v) {
+  return {_mm256_mul_pd(s, v.x), _mm256_mul_pd(s, v.y), _mm256_mul_pd(s, v.z)};
+}
+CALIBER_AVX2 inline __m256d dot(const Pack3& u, const Pack3& v) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(u.x, v.x), _mm256_mul_pd(u.y, v.y)), _mm256_mul_pd(u.z, v.z));
+}
+/// mask ? u : v, lane by lane.
+CALIBER_AVX2 inline __m256d pick(__m256d mask, __m256d u, __m256d v) { return _mm256_blendv_pd(v, u, mask); }
+CALIBER_AVX2 inline Pack3 pick(__m256d mask, const Pack3& u, const Pack3& v) {
+  return {pick(mask, u.x, v.x), pick(mask, u.y, v.y), pick(mask, u.z, v.z)};
+}
+CALIBER_AVX2 inline __m256d clamp01x4(__m256d t) {
+  // _mm256_max_pd(t, 0) returns its second operand where either is NaN, as maxsd does in clamp01
+  // (triangle_distance.cpp).
+  return _mm256_min_pd(_mm256_max_pd(t, _mm256_setzero_pd()), _mm256_set1_pd(1.0));
+}
+CALIBER_AVX2 inline __m256d gt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GT_OQ); }
+CALIBER_AVX2 inline __m256d ge(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GE_OQ); }
+CALIBER_AVX2 inline __m256d lt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LT_OQ); }
+CALIBER_AVX2 inline __m256d le(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LE_OQ); }
+/// Every mask's lanes anded, or ored.
+template <class... Masks>
+CALIBER_AVX2 inline __m256d all(__m256d m, Masks... rest) {
+  ((m = _mm256_and_pd(m, rest)), ...);
+  return m;
+}
+template <class... Masks>
+CALIBER_AVX2 inline __m256d any(__m256d m, Masks... rest) {
+  ((m = _mm256_or_pd(m, rest)), ...);
+  return m;
+}
+CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_set1_pd(-0.0)); }
+
+/// Four candidates' points and squared distances, lane by lane, for Nearest.
+struct Candidates4 {
+  alignas(32) double px[4], py[4], pz[4], qx[4], qy[4], qz[4], d2[4];
+
+  CALIBER_AVX2 void store(const Pack3& p, const Pack3& q) {
+    _mm256_store_pd(px, p.x);
+    _mm256_store_pd(py, p.y);
+    _mm256_store_pd(pz, p.z);
+    _mm256_store_pd(qx, q.x);
+    _mm256_store_pd(qy, q.y);
+    _mm256_store_pd(qz, q.z);
+    const Pack3 pq = q - p;
+    _mm256_store_pd(d2, dot(pq, pq));
+  }
+  Vec3 p(int l) const { return {px[l], py[l], pz[l]}; }
+  Vec3 q(int l) const { return {qx[l], qy[l], qz[l]}; }
+};
+
+/// closest_points_edges in four lanes: every case computed, the branches' choice selected.
+CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m256d a, const Pack3& p2, const Pack3& d2,
+                                          __m256d e, Candidates4& out) {
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+  const Pack3 r = p1 - p2;
+  const __m256d f = dot(d2, r);
+  const __m256d c = dot(d1, r);
+  const __m256d b = dot(d1, d2);
+  const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero);
+  // a > 0 and e > 0: the general case.
+  const __m256d denom = _mm256_sub_pd(_mm256_mul_pd(a, e), _mm256_mul_pd(b, b));
+  const __m256d s_general = _mm256_and_pd(
+      gt(denom, zero), clamp01x4(_mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(b, f), _mm256_mul_pd(c, e)), denom)));
+  const __m256d t_general = _mm256_div_pd(_mm256_add_pd(_mm256_mul_pd(b, s_general), f), e);
+  const __m256d s_at_0 = clamp01x4(_mm256_div_pd(negate(c), a));            // clamp01(-c / a)
+  const __m256d s_at_1 = clamp01x4(_mm256_div_pd(_mm256_sub_pd(b, c), a));  // clamp01((b - c) / a)
+  const __m256d t_below = lt(t_general, zero), t_above = gt(t_general, one);
+  __m256d s = pick(t_below, s_at_0, pick(t_above, s_at_1, s_general));
+  __m256d t = clamp01x4(pick(t_below, zero, pick(t_above, one, t_general)));
+  // a > 0, e not: t = 0, s = clamp01(-c / a). a not, e > 0: s = 0, t = clamp01(f / e). Neither: 0, 0.
+  s = pick(e_pos, s, s_at_0);
+  t = _mm256_and_pd(e_pos, t);
+  s = _mm256_and_pd(a_pos, s);
+  t = pick(a_pos, t, _mm256_and_pd(e_pos, clamp01x4(_mm256_div_pd(f, e))));
+  out.store(p1 + s * d1, p2 + t * d2);
+}
+
+/// A triangle in four lanes (one triangle or several), with what closest_point_on_frame reads.
+struct Frame4 {
+  Pack3 a, b, c, ab, ac;
+  __m256d solid;  ///< all ones where the lane's triangle is solid
+};
+
+/// closest_point_on_segment in four lanes, and the squared distance to x.
+CALIBER_AVX2 Pack3 closest_point_on_segment_x4(const Pack3& x, const Pack3& p, const Pack3& q, __m256d& dist2) {
+  const Pack3 d = q - p;
+  const __m256d len2 = dot(d, d);
+  const Pack3 y = pick(gt(len2, _mm256_setzero_pd()), p + clamp01x4(_mm256_div_pd(dot(x - p, d), len2)) * d, p);
+  dist2 = dot(y - x, y - x);
+  return y;
+}
+
+/// closest_point_on_frame in four lanes: its regions in its order, the first that holds wins; the
+/// nearest edge point where none does or the triangle is not solid.
+CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+  const Pack3 ax = x - t.a, bx = x - t.b, cx = x - t.c;
+  const __m256d d1 = dot(t.ab, ax), d2 = dot(t.ac, ax);
+  const __m256d d3 = dot(t.ab, bx), d4 = dot(t.ac, bx);
+  const __m256d d5 = dot(t.ab, cx), d6 = dot(t.ac, cx);
+  const __m256d vc = _mm256_sub_pd(_mm256_mul_pd(d1, d4), _mm256_mul_pd(d3, d2));
+  const __m256d vb = _mm256_sub_pd(_mm256_mul_pd(d5, d2), _mm256_mul_pd(d1, d6));
+  const __m256d va = _mm256_sub_pd(_mm256_mul_pd(d3, d6), _mm256_mul_pd(d5, d4));
+  const __m256d d1_d3 = _mm256_sub_pd(d1, d3), d2_d6 = _mm256_sub_pd(d2, d6);
+  const __m256d d4_d3 = _mm256_sub_pd(d4, d3), d5_d6 = _mm256_sub_pd(d5, d6);
+  const __m256d bc_sum = _mm256_add_pd(d4_d3, d5_d6);
+  const __m256d vsum = _mm256_add_pd(_mm256_add_pd(va, vb), vc);
+  const __m256d denom = _mm256_div_pd(one, vsum);
+  const __m256d v = _mm256_mul_pd(vb, denom), w = _mm256_mul_pd(vc, denom);
+
+  const __m256d in_a = all(le(d1, zero), le(d2, zero));
+  const __m256d in_b = all(ge(d3, zero), le(d4, d3));
+  const __m256d in_ab = all(le(vc, zero), ge(d1, zero), le(d3, zero), gt(d1_d3, zero));
+  const __m256d in_c = all(ge(d6, zero), le(d5, d6));
+  const __m256d in_ac = all(le(vb, zero), ge(d2, zero), le(d6, zero), gt(d2_d6, zero));
+  const __m256d in_bc = all(le(va, zero), ge(d4_d3, zero), ge(d5_d6, zero), gt(bc_sum, zero));
+  const __m256d in_face = all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero),
+                              le(_mm256_add_pd(v, w), one));
+  const __m256d settled = all(t.solid, any(in_a, in_b, in_ab, in_c, in_ac, in_bc, in_face));
+
+  Pack3 y = x;  // every lane is overwritten below
+  if (_mm256_movemask_pd(settled) != 0xF) {
+    __m256d best_d, d;
+    y = closest_point_on_segment_x4(x, t.a, t.b, best_d);
+    Pack3 e = closest_point_on_segment_x4(x, t.b, t.c, d);
+    const __m256d closer_bc = lt(d, best_d);
+    y = pick(closer_bc, e, y);
+    best_d = pick(closer_bc, d, best_d);
+    e = closest_point_on_segment_x4(x, t.c, t.a, d);
+    y = pick(lt(d, best_d), e, y);
+  }
+  y = pick(all(t.solid, in_face), t.a + v * t.ab + w * t.ac, y);
+  y = pick(all(t.solid, in_bc), t.b + _mm256_div_pd(d4_d3, bc_sum) * (t.c - t.b), y);
+  y = pick(all(t.solid, in_ac), t.a + _mm256_div_pd(d2, d2_d6) * t.ac, y);
+  y = pick(all(t.solid, in_c), t.c, y);
+  y = pick(all(t.solid, in_ab), t.a + _mm256_div_pd(d1, d1_d3) * t.ab, y);
+  y = pick(all(t.solid, in_b), t.b, y);
+  return pick(all(t.solid, in_a), t.a, y);
+}
+
+CALIBER_AVX2 __m256d solid_mask(bool l0, bool l1, bool l2, bool l3) {
+  return _mm256_castsi256_pd(_mm256_setr_epi64x(-int64_t{l0}, -int64_t{l1}, -int64_t{l2}, -int64_t{l3}));
+}
+
+/// f0, f1, f0, f1 in the four lanes.
+CALIBER_AVX2 Frame4 alternating(const TriangleFrame& f0, const TriangleFrame& f1) {
+  return Frame4{lanes(f0.v[0], f1.v[0], f0.v[0], f1.v[0]), lanes(f0.v[1], f1.v[1], f0.v[1], f1.v[1]),
+                lanes(f0.v[2], f1.v[2], f0.v[2], f1.v[2]), lanes(f0.ab, f1.ab, f0.ab, f1.ab),
+                lanes(f0.ac, f1.ac, f0.ac, f1.ac), solid_mask(f0.solid, f1.solid, f0.solid, f1.solid)};
+}
+
+/// consider_crossings in four lanes: edges (first of A, first of B, second of A, second of B),
+/// each against the other triangle's plane (normal n through o); the crossing ones are candidates,
+/// taken in the portable order.
+CALIBER_AVX2 void consider_crossings_x4(const Pack3& p, const Pack3& q, const Pack3& n, const Pack3& o,
+                                        const Frame4& onto, int count, Nearest& nearest) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d sp = dot(n, p - o), sq = dot(n, q - o);
+  const __m256d apart = any(all(gt(sp, zero), gt(sq, zero)), all(lt(sp, zero), lt(sq, zero)), _mm256_cmp_pd(sp, sq, _CMP_EQ_OQ));
+  const int crossing = ~_mm256_movemask_pd(apart) & ((1 << count) - 1);
+  if (crossing == 0) return;
+  const Pack3 x = p + clamp01x4(_mm256_div_pd(sp, _mm256_sub_pd(sp, sq))) * (q - p);
+  const Pack3 y = closest_point_on_frame_x4(x, onto);
+  // A's edge point with its point on B; B's edge point's point on A with it.
+  const __m256d a_first = solid_mask(true, false, true, false);
+  Candidates4 c;
+  c.store(pick(a_first, x, y), pick(a_first, y, x));
+  for (int l = 0; l < count; ++l) {
+    if ((crossing >> l) & 1) nearest.consider(c.p(l), c.q(l), c.d2[l]);
+  }
+}
+
+#undef CALIBER_AVX2
+
+}  // namespace
+
+namespace detail {
+
+__attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
+  const kernel::EdgeVectors e(a, b);
+  Nearest nearest(a[0], b[0]);
+  // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
+  // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone.
+  Candidates4 edges;
+  for (int first = 0; first < 8; first += 4) {
+    const int i0 = first / 3, i1 = (first + 1) / 3, i2 = (first + 2) / 3, i3 = (first + 3) / 3;
+    const int j0 = first % 3, j1 = (first + 1) % 3, j2 = (first + 2) % 3, j3 = (first + 3) % 3;
+    closest_points_edges_x4(lanes(a[i0], a[i1], a[i2], a[i3]), lanes(e.a[i0], e.a[i1], e.a[i2], e.a[i3]),
+                            lanes(e.la[i0], e.la[i1], e.la[i2], e.la[i3]), lanes(b[j0], b[j1], b[j2], b[j3]),
+                            lanes(e.b[j0], e.b[j1], e.b[j2], e.b[j3]), lanes(e.lb[j0], e.lb[j1], e.lb[j2], e.lb[j3]), edges);
+    for (int l = 0; l < 4; ++l) nearest.consider(edges.p(l), edges.q(l), edges.d2[l]);
+  }
+  Vec3 c1, c2;
+  kernel::closest_points_edges(a[2], e.a[2], e.la[2], b[2], e.b[2], e.lb[2], c1, c2);
+  nearest.consider(c1, c2);
+
+  // Vertex-face candidates in the portable order: a[0] on B, b[0] on A, a[1] on B, b[1] on A in
+  // the first four lanes, a[2] on B and b[2] on A in the next (its last two lanes repeat them).
+  const TriangleFrame fa(a), fb(b);
+  const Frame4 onto = alternating(fb, fa);
+  Candidates4 faces;
+  for (int first = 0; first < 3; first += 2) {
+    const int second = std::min(first + 1, 2);
+    const Pack3 x = lanes(a[first], b[first], a[second], b[second]);
+    const Pack3 y = closest_point_on_frame_x4(x, onto);
+    // a[i] with its point on B; b[i]'s point on A with b[i].
+    const __m256d a_first = solid_mask(true, false, true, false);
+    faces.store(pick(a_first, x, y), pick(a_first, y, x));
+    for (int l = 0; l < (first == 0 ? 4 : 2); ++l) nearest.consider(faces.p(l), faces.q(l), faces.d2[l]);
+  }
+  // Edge-plane crossings, in the same lanes: edge i of A and of B (p to q) against the other's
+  // plane (normal n through its first corner).
+  const Vec3 na = fa.ab.cross(fa.ac);
+  const Vec3 nb = fb.ab.cross(fb.ac);
+  const Pack3 n = lanes(nb, na, nb, na), o = lanes(b[0], a[0], b[0], a[0]);
+  consider_crossings_x4(lanes(a[0], b[0], a[1], b[1]), lanes(a[1], b[1], a[2], b[2]), n, o, onto, 4, nearest);
+  consider_crossings_x4(lanes(a[2], b[2], a[2], b[2]), lanes(a[0], b[0], a[0], b[0]), n, o, onto, 2, nearest);
+  return nearest.best;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+TriangleKernel closest_points_triangles_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &closest_points_triangles_avx2 : nullptr;
+}
+
+}  // namespace detail
+}  // namespace caliber::geometry
+
+#else
+
+namespace caliber::geometry::detail {
+TriangleKernel closest_points_triangles_avx2_if_supported() { return nullptr; }
+}  // namespace caliber::geometry::detail
+
+#endif

@@ -1,0 +1,86 @@
+#pragma once
+/// \file
+/// What the two forms of the triangle kernel (closest_points_triangles: portable in
+/// triangle_distance.cpp, AVX2 in triangle_distance_avx2.cpp) share, so that both compute each
+/// candidate with the same operations and take the candidates in the same order: the same bits
+/// either way.
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "geometry/triangle_distance.h"
+
+namespace caliber::geometry::kernel {
+
+using Vec3 = Eigen::Vector3d;
+
+/// Each edge vector (corner i to corner i + 1) of both triangles and its squared length: computed
+/// once and shared by the 9 edge pairs (the same expressions as computing them per pair).
+struct EdgeVectors {
+  Vec3 a[3], b[3];
+  double la[3], lb[3];
+
+  EdgeVectors(const Vec3 ta[3], const Vec3 tb[3]) {
+    for (int i = 0; i < 3; ++i) {
+      a[i] = ta[(i + 1) % 3] - ta[i];
+      b[i] = tb[(i + 1) % 3] - tb[i];
+      la[i] = a[i].squaredNorm();
+      lb[i] = b[i].squaredNorm();
+    }
+  }
+};
+
+/// A triangle with what the closest-point query on it needs of its own: computed once per triangle
+/// and reused for every point (the same expressions as a single query, so the same values).
+struct TriangleFrame {
+  const Vec3* v;   ///< the three corners
+  Vec3 ab, ac;     ///< v[1] - v[0], v[2] - v[0]
+  bool solid;      ///< far enough from degenerate for the region test (else: nearest edge point)
+
+  explicit TriangleFrame(const Vec3 corners[3]) : v(corners), ab(corners[1] - corners[0]), ac(corners[2] - corners[0]) {
+    const double area2 = ab.cross(ac).squaredNorm();
+    const double scale2 = std::max(ab.squaredNorm(), ac.squaredNorm());
+    solid = area2 > 1e-24 * scale2 * scale2;
+  }
+};
+
+/// The nearest pair found so far. A new pair replaces it when its distance (the square root of its
+/// squared length, as Eigen's norm() computes it) is strictly smaller; the square root is taken
+/// only when the squared length is smaller, since sqrt is monotone and correctly rounded
+/// (d2 >= best_d2 implies sqrt(d2) >= best.distance), so the winner is the same as comparing
+/// every distance.
+struct Nearest {
+  ClosestPoints best;
+  double best_d2;
+
+  Nearest(const Vec3& p, const Vec3& q) : best{p, q, 0.0}, best_d2((q - p).squaredNorm()) { best.distance = std::sqrt(best_d2); }
+
+  void consider(const Vec3& p, const Vec3& q) { consider(p, q, (q - p).squaredNorm()); }
+
+  /// The same, given d2 = (q - p).squaredNorm() computed elsewhere with the same operations.
+  void consider(const Vec3& p, const Vec3& q, double d2) {
+    if (!(d2 < best_d2)) return;
+    const double d = std::sqrt(d2);
+    if (d < best.distance) {
+      best = ClosestPoints{p, q, d};
+      best_d2 = d2;
+    }
+  }
+};
+
+/// Closest point to x on the triangle of `t`.
+Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t);
+
+/// Closest points c1 on p1 + s d1 and c2 on p2 + t d2 (s, t in [0, 1]), given a = |d1|^2 and
+/// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
+void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1,
+                          Vec3& c2);
+
+/// The last candidates of the triangle kernel, in its order: an edge of one triangle that pierces
+/// the other gives its crossing point and that point's nearest point on the other.
+void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
+                        Nearest& nearest);
+
+}  // namespace caliber::geometry::kernel
