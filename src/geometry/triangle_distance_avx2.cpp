@@ -93,6 +93,18 @@ struct Candidates4 {
   Vec3 q(int l) const { return {qx[l], qy[l], qz[l]}; }
 };
 
+/// Offers the lanes of `c` in `offered` (bit l for lane l) to `nearest`, in lane order. Lanes whose
+/// squared distance is not below the best one at the start are left out: they would be refused,
+/// since the best squared distance only ever decreases.
+CALIBER_AVX2 void take(const Candidates4& c, int offered, Nearest& nearest) {
+  int left = offered & _mm256_movemask_pd(lt(_mm256_load_pd(c.d2), _mm256_set1_pd(nearest.best_d2)));
+  while (left != 0) {
+    const int l = __builtin_ctz(static_cast<unsigned>(left));
+    left &= left - 1;
+    nearest.consider(c.p(l), c.q(l), c.d2[l]);
+  }
+}
+
 /// closest_points_edges in four lanes: every case computed, the branches' choice selected.
 CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m256d a, const Pack3& p2, const Pack3& d2,
                                           __m256d e, Candidates4& out) {
@@ -183,35 +195,74 @@ CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
   return pick(all(t.solid, in_a), t.a, y);
 }
 
-CALIBER_AVX2 __m256d solid_mask(bool l0, bool l1, bool l2, bool l3) {
-  return _mm256_castsi256_pd(_mm256_setr_epi64x(-int64_t{l0}, -int64_t{l1}, -int64_t{l2}, -int64_t{l3}));
+CALIBER_AVX2 inline Pack3 broadcast(const Vec3& v) {
+  return {_mm256_set1_pd(v.x()), _mm256_set1_pd(v.y()), _mm256_set1_pd(v.z())};
 }
 
-/// f0, f1, f0, f1 in the four lanes.
-CALIBER_AVX2 Frame4 alternating(const TriangleFrame& f0, const TriangleFrame& f1) {
-  return Frame4{lanes(f0.v[0], f1.v[0], f0.v[0], f1.v[0]), lanes(f0.v[1], f1.v[1], f0.v[1], f1.v[1]),
-                lanes(f0.v[2], f1.v[2], f0.v[2], f1.v[2]), lanes(f0.ab, f1.ab, f0.ab, f1.ab),
-                lanes(f0.ac, f1.ac, f0.ac, f1.ac), solid_mask(f0.solid, f1.solid, f0.solid, f1.solid)};
+/// One triangle's frame in all four lanes.
+CALIBER_AVX2 Frame4 broadcast(const TriangleFrame& f) {
+  return {broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2]), broadcast(f.ab), broadcast(f.ac),
+          _mm256_castsi256_pd(_mm256_set1_epi64x(f.solid ? -1 : 0))};
 }
 
-/// consider_crossings in four lanes: edges (first of A, first of B, second of A, second of B),
-/// each against the other triangle's plane (normal n through o); the crossing ones are candidates,
-/// taken in the portable order.
-CALIBER_AVX2 void consider_crossings_x4(const Pack3& p, const Pack3& q, const Pack3& n, const Pack3& o,
-                                        const Frame4& onto, int count, Nearest& nearest) {
+CALIBER_AVX2 Frame4 pick(__m256d mask, const Frame4& u, const Frame4& v) {
+  return {pick(mask, u.a, v.a), pick(mask, u.b, v.b), pick(mask, u.c, v.c), pick(mask, u.ab, v.ab), pick(mask, u.ac, v.ac),
+          pick(mask, u.solid, v.solid)};
+}
+
+/// The points the kernel projects onto the other triangle, in the portable order: a[0], b[0],
+/// a[1], b[1], a[2], b[2], then the crossing points of the edges that cross the other's plane
+/// (edge 0 of A, of B, edge 1 of A, ...). A point of A goes onto B, a point of B onto A; the
+/// candidate is (point, its projection) for A's, (projection, point) for B's.
+struct Projections {
+  static constexpr int kMost = 12;  ///< 6 corners, 6 crossings
+  alignas(32) double x[kMost], y[kMost], z[kMost];
+  alignas(32) std::int64_t of_a[kMost];  ///< all ones for a point of A
+  int count = 0;
+
+  void add(double px, double py, double pz, bool from_a) {
+    x[count] = px;
+    y[count] = py;
+    z[count] = pz;
+    of_a[count] = from_a ? -1 : 0;
+    ++count;
+  }
+  /// Repeats the first point up to a whole number of lanes, so that every loaded lane is defined.
+  void pad() {
+    for (int i = count; i % 4 != 0; ++i) x[i] = x[0], y[i] = y[0], z[i] = z[0], of_a[i] = of_a[0];
+  }
+};
+
+/// Each projection of `points`, four at a time, offered to `nearest` in their order.
+CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
+  const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
+  Candidates4 c;
+  for (int first = 0; first < points.count; first += 4) {
+    const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
+    const __m256d of_a = _mm256_castsi256_pd(_mm256_load_si256(reinterpret_cast<const __m256i*>(points.of_a + first)));
+    const Pack3 y = closest_point_on_frame_x4(x, pick(of_a, onto_b, onto_a));
+    c.store(pick(of_a, x, y), pick(of_a, y, x));
+    take(c, points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
+  }
+}
+
+/// crossing_point in four lanes: edges p to q against the plane through o with normal n. Appends
+/// the crossing points of the first `count` lanes, in lane order, to `points` (lane l from A where
+/// l is even).
+CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& q, const Pack3& n, const Pack3& o, int count,
+                                Projections& points) {
   const __m256d zero = _mm256_setzero_pd();
   const __m256d sp = dot(n, p - o), sq = dot(n, q - o);
   const __m256d apart = any(all(gt(sp, zero), gt(sq, zero)), all(lt(sp, zero), lt(sq, zero)), _mm256_cmp_pd(sp, sq, _CMP_EQ_OQ));
   const int crossing = ~_mm256_movemask_pd(apart) & ((1 << count) - 1);
   if (crossing == 0) return;
   const Pack3 x = p + clamp01x4(_mm256_div_pd(sp, _mm256_sub_pd(sp, sq))) * (q - p);
-  const Pack3 y = closest_point_on_frame_x4(x, onto);
-  // A's edge point with its point on B; B's edge point's point on A with it.
-  const __m256d a_first = solid_mask(true, false, true, false);
-  Candidates4 c;
-  c.store(pick(a_first, x, y), pick(a_first, y, x));
+  alignas(32) double xs[4], ys[4], zs[4];
+  _mm256_store_pd(xs, x.x);
+  _mm256_store_pd(ys, x.y);
+  _mm256_store_pd(zs, x.z);
   for (int l = 0; l < count; ++l) {
-    if ((crossing >> l) & 1) nearest.consider(c.p(l), c.q(l), c.d2[l]);
+    if ((crossing >> l) & 1) points.add(xs[l], ys[l], zs[l], l % 2 == 0);
   }
 }
 
@@ -233,33 +284,27 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
     closest_points_edges_x4(lanes(a[i0], a[i1], a[i2], a[i3]), lanes(e.a[i0], e.a[i1], e.a[i2], e.a[i3]),
                             lanes(e.la[i0], e.la[i1], e.la[i2], e.la[i3]), lanes(b[j0], b[j1], b[j2], b[j3]),
                             lanes(e.b[j0], e.b[j1], e.b[j2], e.b[j3]), lanes(e.lb[j0], e.lb[j1], e.lb[j2], e.lb[j3]), edges);
-    for (int l = 0; l < 4; ++l) nearest.consider(edges.p(l), edges.q(l), edges.d2[l]);
+    take(edges, 0xF, nearest);
   }
   Vec3 c1, c2;
   kernel::closest_points_edges(a[2], e.a[2], e.la[2], b[2], e.b[2], e.lb[2], c1, c2);
   nearest.consider(c1, c2);
 
-  // Vertex-face candidates in the portable order: a[0] on B, b[0] on A, a[1] on B, b[1] on A in
-  // the first four lanes, a[2] on B and b[2] on A in the next (its last two lanes repeat them).
+  // Vertex-face candidates, then edge-plane crossings (edge i of A and of B, p to q, against the
+  // other's plane: normal n through its first corner), as Projections lists them.
   const TriangleFrame fa(a), fb(b);
-  const Frame4 onto = alternating(fb, fa);
-  Candidates4 faces;
-  for (int first = 0; first < 3; first += 2) {
-    const int second = std::min(first + 1, 2);
-    const Pack3 x = lanes(a[first], b[first], a[second], b[second]);
-    const Pack3 y = closest_point_on_frame_x4(x, onto);
-    // a[i] with its point on B; b[i]'s point on A with b[i].
-    const __m256d a_first = solid_mask(true, false, true, false);
-    faces.store(pick(a_first, x, y), pick(a_first, y, x));
-    for (int l = 0; l < (first == 0 ? 4 : 2); ++l) nearest.consider(faces.p(l), faces.q(l), faces.d2[l]);
+  Projections points;
+  for (int i = 0; i < 3; ++i) {
+    points.add(a[i].x(), a[i].y(), a[i].z(), true);
+    points.add(b[i].x(), b[i].y(), b[i].z(), false);
   }
-  // Edge-plane crossings, in the same lanes: edge i of A and of B (p to q) against the other's
-  // plane (normal n through its first corner).
   const Vec3 na = fa.ab.cross(fa.ac);
   const Vec3 nb = fb.ab.cross(fb.ac);
   const Pack3 n = lanes(nb, na, nb, na), o = lanes(b[0], a[0], b[0], a[0]);
-  consider_crossings_x4(lanes(a[0], b[0], a[1], b[1]), lanes(a[1], b[1], a[2], b[2]), n, o, onto, 4, nearest);
-  consider_crossings_x4(lanes(a[2], b[2], a[2], b[2]), lanes(a[0], b[0], a[0], b[0]), n, o, onto, 2, nearest);
+  add_crossings(lanes(a[0], b[0], a[1], b[1]), lanes(a[1], b[1], a[2], b[2]), n, o, 4, points);
+  add_crossings(lanes(a[2], b[2], a[2], b[2]), lanes(a[0], b[0], a[0], b[0]), n, o, 2, points);
+  points.pad();
+  project(points, fa, fb, nearest);
   return nearest.best;
 }
 
