@@ -77,7 +77,7 @@ CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_s
 
 /// Four candidates' points and squared distances, lane by lane, for Nearest.
 struct Candidates4 {
-  alignas(32) double px[4], py[4], pz[4], qx[4], qy[4], qz[4], d2[4];
+  alignas(32) double px[4], py[4], pz[4], qx[4], qy[4], qz[4], d2[4], d[4];
 
   CALIBER_AVX2 void store(const Pack3& p, const Pack3& q) {
     _mm256_store_pd(px, p.x);
@@ -87,7 +87,9 @@ struct Candidates4 {
     _mm256_store_pd(qy, q.y);
     _mm256_store_pd(qz, q.z);
     const Pack3 pq = q - p;
-    _mm256_store_pd(d2, dot(pq, pq));
+    const __m256d squared = dot(pq, pq);
+    _mm256_store_pd(d2, squared);
+    _mm256_store_pd(d, _mm256_sqrt_pd(squared));  // IEEE square roots, as std::sqrt's
   }
   Vec3 p(int l) const { return {px[l], py[l], pz[l]}; }
   Vec3 q(int l) const { return {qx[l], qy[l], qz[l]}; }
@@ -96,12 +98,12 @@ struct Candidates4 {
 /// Offers the lanes of `c` in `offered` (bit l for lane l) to `nearest`, in lane order. Lanes whose
 /// squared distance is not below the best one at the start are left out: they would be refused,
 /// since the best squared distance only ever decreases.
-CALIBER_AVX2 void take(const Candidates4& c, int offered, Nearest& nearest) {
+CALIBER_AVX2 __attribute__((always_inline)) inline void take(const Candidates4& c, int offered, Nearest& nearest) {
   int left = offered & _mm256_movemask_pd(lt(_mm256_load_pd(c.d2), _mm256_set1_pd(nearest.best_d2)));
   while (left != 0) {
     const int l = __builtin_ctz(static_cast<unsigned>(left));
     left &= left - 1;
-    nearest.consider(c.p(l), c.q(l), c.d2[l]);
+    if (c.d2[l] < nearest.best_d2) nearest.consider(c.p(l), c.q(l), c.d2[l], c.d[l]);
   }
 }
 
@@ -246,17 +248,56 @@ CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, co
   }
 }
 
-/// crossing_point in four lanes: edges p to q against the plane through o with normal n. Appends
-/// the crossing points of the first `count` lanes, in lane order, to `points` (lane l from A where
-/// l is even).
-CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& q, const Pack3& n, const Pack3& o, int count,
-                                Projections& points) {
+/// A triangle's corners in lanes 0-2 (lane 3 repeats corner 0), each edge vector (corner i to
+/// corner i + 1, the same subtraction as the portable form's) and its squared length.
+struct Triangle4 {
+  Pack3 v, e;
+  __m256d len2;
+};
+
+template <int kImm>
+CALIBER_AVX2 inline Pack3 permute(const Pack3& u) {
+  return {_mm256_permute4x64_pd(u.x, kImm), _mm256_permute4x64_pd(u.y, kImm), _mm256_permute4x64_pd(u.z, kImm)};
+}
+
+/// Lanes i0, i1, i2, i3 of u (each 0-3).
+template <int i0, int i1, int i2, int i3>
+CALIBER_AVX2 inline Pack3 gather(const Pack3& u) {
+  return permute<i0 | (i1 << 2) | (i2 << 4) | (i3 << 6)>(u);
+}
+template <int i0, int i1, int i2, int i3>
+CALIBER_AVX2 inline __m256d gather(__m256d u) {
+  return _mm256_permute4x64_pd(u, i0 | (i1 << 2) | (i2 << 4) | (i3 << 6));
+}
+
+/// (u_i, w_i, u_j, w_j): a lane of A and of B, twice.
+template <int i, int j>
+CALIBER_AVX2 inline Pack3 interleave(const Pack3& u, const Pack3& w) {
+  const Pack3 pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
+  return {_mm256_blend_pd(pu.x, pw.x, 0b1010), _mm256_blend_pd(pu.y, pw.y, 0b1010), _mm256_blend_pd(pu.z, pw.z, 0b1010)};
+}
+template <int i, int j>
+CALIBER_AVX2 inline __m256d interleave(__m256d u, __m256d w) {
+  return _mm256_blend_pd(gather<i, i, j, j>(u), gather<i, i, j, j>(w), 0b1010);
+}
+
+CALIBER_AVX2 Triangle4 load(const Vec3 t[3]) {
+  Triangle4 r;
+  r.v = lanes(t[0], t[1], t[2], t[0]);
+  r.e = gather<1, 2, 0, 1>(r.v) - r.v;
+  r.len2 = dot(r.e, r.e);
+  return r;
+}
+
+/// crossing_point in four lanes: edges p to p + e (e = q - p) whose ends lie sp and sq along the
+/// other's normal. Appends the crossing points of the first `count` lanes, in lane order, to
+/// `points` (lane l from A where l is even).
+CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& e, __m256d sp, __m256d sq, int count, Projections& points) {
   const __m256d zero = _mm256_setzero_pd();
-  const __m256d sp = dot(n, p - o), sq = dot(n, q - o);
   const __m256d apart = any(all(gt(sp, zero), gt(sq, zero)), all(lt(sp, zero), lt(sq, zero)), _mm256_cmp_pd(sp, sq, _CMP_EQ_OQ));
   const int crossing = ~_mm256_movemask_pd(apart) & ((1 << count) - 1);
   if (crossing == 0) return;
-  const Pack3 x = p + clamp01x4(_mm256_div_pd(sp, _mm256_sub_pd(sp, sq))) * (q - p);
+  const Pack3 x = p + clamp01x4(_mm256_div_pd(sp, _mm256_sub_pd(sp, sq))) * e;
   alignas(32) double xs[4], ys[4], zs[4];
   _mm256_store_pd(xs, x.x);
   _mm256_store_pd(ys, x.y);
@@ -273,36 +314,40 @@ CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& q, const Pack3& n, 
 namespace detail {
 
 __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
-  const kernel::EdgeVectors e(a, b);
+  const Triangle4 ta = load(a), tb = load(b);
   Nearest nearest(a[0], b[0]);
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone.
   Candidates4 edges;
-  for (int first = 0; first < 8; first += 4) {
-    const int i0 = first / 3, i1 = (first + 1) / 3, i2 = (first + 2) / 3, i3 = (first + 3) / 3;
-    const int j0 = first % 3, j1 = (first + 1) % 3, j2 = (first + 2) % 3, j3 = (first + 3) % 3;
-    closest_points_edges_x4(lanes(a[i0], a[i1], a[i2], a[i3]), lanes(e.a[i0], e.a[i1], e.a[i2], e.a[i3]),
-                            lanes(e.la[i0], e.la[i1], e.la[i2], e.la[i3]), lanes(b[j0], b[j1], b[j2], b[j3]),
-                            lanes(e.b[j0], e.b[j1], e.b[j2], e.b[j3]), lanes(e.lb[j0], e.lb[j1], e.lb[j2], e.lb[j3]), edges);
-    take(edges, 0xF, nearest);
-  }
+  closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
+                          gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges);
+  take(edges, 0xF, nearest);
+  closest_points_edges_x4(gather<1, 1, 2, 2>(ta.v), gather<1, 1, 2, 2>(ta.e), gather<1, 1, 2, 2>(ta.len2),
+                          gather<1, 2, 0, 1>(tb.v), gather<1, 2, 0, 1>(tb.e), gather<1, 2, 0, 1>(tb.len2), edges);
+  take(edges, 0xF, nearest);
+  const Vec3 ea2 = a[0] - a[2], eb2 = b[0] - b[2];
   Vec3 c1, c2;
-  kernel::closest_points_edges(a[2], e.a[2], e.la[2], b[2], e.b[2], e.lb[2], c1, c2);
+  kernel::closest_points_edges(a[2], ea2, ea2.squaredNorm(), b[2], eb2, eb2.squaredNorm(), c1, c2);
   nearest.consider(c1, c2);
 
-  // Vertex-face candidates, then edge-plane crossings (edge i of A and of B, p to q, against the
-  // other's plane: normal n through its first corner), as Projections lists them.
+  // Vertex-face candidates, then edge-plane crossings (edge i of A and of B against the other's
+  // plane: normal n through its first corner), as Projections lists them.
   const TriangleFrame fa(a), fb(b);
   Projections points;
-  for (int i = 0; i < 3; ++i) {
-    points.add(a[i].x(), a[i].y(), a[i].z(), true);
-    points.add(b[i].x(), b[i].y(), b[i].z(), false);
-  }
-  const Vec3 na = fa.ab.cross(fa.ac);
-  const Vec3 nb = fb.ab.cross(fb.ac);
-  const Pack3 n = lanes(nb, na, nb, na), o = lanes(b[0], a[0], b[0], a[0]);
-  add_crossings(lanes(a[0], b[0], a[1], b[1]), lanes(a[1], b[1], a[2], b[2]), n, o, 4, points);
-  add_crossings(lanes(a[2], b[2], a[2], b[2]), lanes(a[0], b[0], a[0], b[0]), n, o, 2, points);
+  const Pack3 corners01 = interleave<0, 1>(ta.v, tb.v), corners2 = interleave<2, 2>(ta.v, tb.v);
+  _mm256_store_pd(points.x, corners01.x);
+  _mm256_store_pd(points.y, corners01.y);
+  _mm256_store_pd(points.z, corners01.z);
+  _mm256_store_pd(points.x + 4, corners2.x);
+  _mm256_store_pd(points.y + 4, corners2.y);
+  _mm256_store_pd(points.z + 4, corners2.z);
+  for (int i = 0; i < 6; ++i) points.of_a[i] = i % 2 == 0 ? -1 : 0;
+  points.count = 6;
+  // Each corner's signed distance along the other's normal, as crossing_point computes it.
+  const __m256d sa = dot(broadcast(fb.ab.cross(fb.ac)), ta.v - broadcast(b[0]));
+  const __m256d sb = dot(broadcast(fa.ab.cross(fa.ac)), tb.v - broadcast(a[0]));
+  add_crossings(corners01, interleave<0, 1>(ta.e, tb.e), interleave<0, 1>(sa, sb), interleave<1, 2>(sa, sb), 4, points);
+  add_crossings(corners2, interleave<2, 2>(ta.e, tb.e), interleave<2, 2>(sa, sb), interleave<0, 0>(sa, sb), 2, points);
   points.pad();
   project(points, fa, fb, nearest);
   return nearest.best;

@@ -61,8 +61,11 @@ struct Nearest {
 
   /// The same, given d2 = (q - p).squaredNorm() computed elsewhere with the same operations.
   void consider(const Vec3& p, const Vec3& q, double d2) {
-    if (!(d2 < best_d2)) return;
-    const double d = std::sqrt(d2);
+    if (d2 < best_d2) consider(p, q, d2, std::sqrt(d2));
+  }
+
+  /// The same, given also d = sqrt(d2) (correctly rounded, as std::sqrt is), with d2 < best_d2.
+  void consider(const Vec3& p, const Vec3& q, double d2, double d) {
     if (d < best.distance) {
       best = ClosestPoints{p, q, d};
       best_d2 = d2;
