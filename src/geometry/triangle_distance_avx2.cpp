@@ -236,15 +236,14 @@ struct Projections {
 };
 
 /// Each projection of `points`, four at a time, offered to `nearest` in their order.
-CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
+CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb,
+                          Candidates4 out[Projections::kMost / 4]) {
   const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
-  Candidates4 c;
   for (int first = 0; first < points.count; first += 4) {
     const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
     const __m256d of_a = _mm256_castsi256_pd(_mm256_load_si256(reinterpret_cast<const __m256i*>(points.of_a + first)));
     const Pack3 y = closest_point_on_frame_x4(x, pick(of_a, onto_b, onto_a));
-    c.store(pick(of_a, x, y), pick(of_a, y, x));
-    take(c, points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
+    out[first / 4].store(pick(of_a, x, y), pick(of_a, y, x));
   }
 }
 
@@ -278,7 +277,8 @@ CALIBER_AVX2 inline Pack3 interleave(const Pack3& u, const Pack3& w) {
 }
 template <int i, int j>
 CALIBER_AVX2 inline __m256d interleave(__m256d u, __m256d w) {
-  return _mm256_blend_pd(gather<i, i, j, j>(u), gather<i, i, j, j>(w), 0b1010);
+  const __m256d pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
+  return _mm256_blend_pd(pu, pw, 0b1010);
 }
 
 CALIBER_AVX2 Triangle4 load(const Vec3 t[3]) {
@@ -318,17 +318,16 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   Nearest nearest(a[0], b[0]);
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone.
-  Candidates4 edges;
+  // Every candidate is computed first and offered in order at the end, so that the batches do not
+  // wait on one another.
+  Candidates4 edges[2];
   closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
-                          gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges);
-  take(edges, 0xF, nearest);
+                          gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges[0]);
   closest_points_edges_x4(gather<1, 1, 2, 2>(ta.v), gather<1, 1, 2, 2>(ta.e), gather<1, 1, 2, 2>(ta.len2),
-                          gather<1, 2, 0, 1>(tb.v), gather<1, 2, 0, 1>(tb.e), gather<1, 2, 0, 1>(tb.len2), edges);
-  take(edges, 0xF, nearest);
+                          gather<1, 2, 0, 1>(tb.v), gather<1, 2, 0, 1>(tb.e), gather<1, 2, 0, 1>(tb.len2), edges[1]);
   const Vec3 ea2 = a[0] - a[2], eb2 = b[0] - b[2];
   Vec3 c1, c2;
   kernel::closest_points_edges(a[2], ea2, ea2.squaredNorm(), b[2], eb2, eb2.squaredNorm(), c1, c2);
-  nearest.consider(c1, c2);
 
   // Vertex-face candidates, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
@@ -349,7 +348,15 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   add_crossings(corners01, interleave<0, 1>(ta.e, tb.e), interleave<0, 1>(sa, sb), interleave<1, 2>(sa, sb), 4, points);
   add_crossings(corners2, interleave<2, 2>(ta.e, tb.e), interleave<2, 2>(sa, sb), interleave<0, 0>(sa, sb), 2, points);
   points.pad();
-  project(points, fa, fb, nearest);
+  Candidates4 projected[Projections::kMost / 4];
+  project(points, fa, fb, projected);
+
+  take(edges[0], 0xF, nearest);
+  take(edges[1], 0xF, nearest);
+  nearest.consider(c1, c2);
+  for (int first = 0; first < points.count; first += 4) {
+    take(projected[first / 4], points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
+  }
   return nearest.best;
 }
 
