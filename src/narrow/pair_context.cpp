@@ -20,14 +20,17 @@ bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double
   const Eigen::Vector3d n = u.cross(v);
   const double len = n.norm();
   if (!(len > 0.0)) return false;
-  const double uv = u.norm() * v.norm();
+  // The rounding bound below is 1e-13 |u| |v| |w|, some hundred times the error of n.dot(w); two
+  // square roots fewer than the norms would take: |u| |v| as one root of the product (a few ulps
+  // off, within the slack), and |w| bounded above by its 1-norm (a larger bound only rejects less).
+  const double uv = std::sqrt(u.squaredNorm() * v.squaredNorm());
   // All three vertices beyond the plane on one side, decided once (& and |, not && and ||): which
   // vertex fails first is data, and a branch on it mispredicts.
   bool above = true, below = true;
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d w = q[i] - p[0];
     const double s = n.dot(w);
-    const double need = reach * len * (1.0 + 1e-12) + 1e-13 * uv * w.norm();
+    const double need = reach * len * (1.0 + 1e-12) + 1e-13 * uv * w.lpNorm<1>();
     above &= s > need;
     below &= s < -need;
   }
