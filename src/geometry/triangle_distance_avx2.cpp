@@ -78,21 +78,25 @@ CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_s
 /// Four candidates' points and squared distances, lane by lane, for Nearest.
 struct Candidates4 {
   alignas(32) double px[4], py[4], pz[4], qx[4], qy[4], qz[4], d2[4], d[4];
+  int swapped = 0;  ///< bit l: lane l holds (q, p), not (p, q)
 
-  CALIBER_AVX2 void store(const Pack3& p, const Pack3& q) {
+  /// Stores the pairs (p, q), or (q, p) in the lanes of `swap` (bits): the squared distance is the
+  /// same either way round, since p - q is exactly -(q - p).
+  CALIBER_AVX2 void store(const Pack3& p, const Pack3& q, int swap = 0) {
     _mm256_store_pd(px, p.x);
     _mm256_store_pd(py, p.y);
     _mm256_store_pd(pz, p.z);
     _mm256_store_pd(qx, q.x);
     _mm256_store_pd(qy, q.y);
     _mm256_store_pd(qz, q.z);
+    swapped = swap;
     const Pack3 pq = q - p;
     const __m256d squared = dot(pq, pq);
     _mm256_store_pd(d2, squared);
     _mm256_store_pd(d, _mm256_sqrt_pd(squared));  // IEEE square roots, as std::sqrt's
   }
-  Vec3 p(int l) const { return {px[l], py[l], pz[l]}; }
-  Vec3 q(int l) const { return {qx[l], qy[l], qz[l]}; }
+  Vec3 p(int l) const { return (swapped >> l) & 1 ? Vec3{qx[l], qy[l], qz[l]} : Vec3{px[l], py[l], pz[l]}; }
+  Vec3 q(int l) const { return (swapped >> l) & 1 ? Vec3{px[l], py[l], pz[l]} : Vec3{qx[l], qy[l], qz[l]}; }
 };
 
 /// Offers the lanes of `c` in `offered` (bit l for lane l) to `nearest`, in lane order. Lanes whose
@@ -243,7 +247,8 @@ CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, co
     const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
     const __m256d of_a = _mm256_castsi256_pd(_mm256_load_si256(reinterpret_cast<const __m256i*>(points.of_a + first)));
     const Pack3 y = closest_point_on_frame_x4(x, pick(of_a, onto_b, onto_a));
-    out[first / 4].store(pick(of_a, x, y), pick(of_a, y, x));
+    // A's point with its projection on B; B's point's projection on A with the point.
+    out[first / 4].store(x, y, ~_mm256_movemask_pd(of_a) & 0xF);
   }
 }
 
