@@ -53,6 +53,15 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mScale = a.extent + b.extent + mTrans.norm();
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
+  mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {},
+                kRotationHair, mReach, mSlabReach};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      mNodeFrame.rot[i][j] = mRot(i, j);
+      mNodeFrame.abs_rot[i][j] = mAbsRot(i, j);
+    }
+    mNodeFrame.trans[i] = mTrans[i];
+  }
   mTheta = request.angle_deg * std::numbers::pi / 180.0;
   mCosTheta = std::cos(mTheta);
   mSinTheta = std::sin(mTheta);
@@ -73,6 +82,28 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   const double cos_ab = ca * cb - sa * sb, sin_ab = sa * cb + ca * sb;
   const double cos_total = cos_ab * mCosTheta - sin_ab * mSinTheta;
   return facing >= cos_total - kConeCosMargin;
+}
+
+int PairContext::node_tests_2x2(std::uint32_t first_a, std::uint32_t first_b) const {
+  static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
+  int pass = 0;
+  if (within == nullptr) {
+    const SideA sa[2] = {prepare_a(first_a), prepare_a(first_a + 1)};
+    const SideB sb[2] = {prepare_b(first_b), prepare_b(first_b + 1)};
+    for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
+    return pass;
+  }
+  pass = within(mNodeFrame, first_a, first_b);
+  // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
+  for (int left = pass; left != 0; left &= left - 1) {
+    const int k = __builtin_ctz(static_cast<unsigned>(left));
+    const std::uint32_t ia = first_a + k / 2, ib = first_b + k % 2;
+    if ((mGroups != nullptr && !groups_can_touch(mA.filters[ia].groups, mB.filters[ib].groups)) ||
+        (mKind == QueryKind::contact && !cones_can_face(mA.filters[ia], mB.filters[ib]))) {
+      pass &= ~(1 << k);
+    }
+  }
+  return pass;
 }
 
 bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {

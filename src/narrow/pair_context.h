@@ -16,6 +16,7 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
+#include "narrow/node_test_avx2.h"
 
 namespace caliber::narrow {
 
@@ -120,6 +121,12 @@ class PairContext {
     if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
     return true;
   }
+
+  /// node_test on each child pair of a visit that splits both sides: bit 2i + j is set where node
+  /// first_a + i of A and node first_b + j of B pass. The same decisions as four calls of
+  /// node_test on prepared nodes; the preparation and the geometric part four at a time in AVX2
+  /// where the CPU has it (node_test_avx2.cpp).
+  [[nodiscard]] int node_tests_2x2(std::uint32_t first_a, std::uint32_t first_b) const;
 
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
@@ -373,6 +380,7 @@ class PairContext {
   double mTheta;       ///< contact angle, radians
   double mCosTheta;    ///< cos(theta)
   double mSinTheta;    ///< sin(theta)
+  detail::NodeTestFrame mNodeFrame;  ///< what node_tests_2x2's AVX2 form reads of the above
 };
 
 /// A step's pair contexts, one per pair of the frame, in the frame's pair order.

@@ -134,6 +134,17 @@ template <class PrepareA, class PrepareB, class Test>
     return -1;
   }
   int count = 0;
+  bool split_a, split_b;
+  cd_split(a, b, split_a, split_b);
+  if (split_a && split_b && taboo.taboo == nullptr) {
+    // Both sides split and nothing to skip: the four child pairs tested at once, in cd_children order.
+    stats.node_tests += 4;
+    const int pass = ctx.node_tests_2x2(a.index, b.index);
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      if ((pass >> k) & 1) passed[count++] = NodePair{a.index + k / 2, b.index + k % 2};
+    }
+    return count;
+  }
   for_each_child(
       n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); }, [&](std::uint32_t j) { return ctx.prepare_b(j); },
       [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {

@@ -1,0 +1,130 @@
+// The node test of a visit's four child pairs at once (AVX2, chosen at run time where the CPU has it):
+// the same decisions as PairContext::node_within on each pair, bit for bit.
+
+#include "narrow/node_test_avx2.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+namespace caliber::narrow::detail {
+namespace {
+
+#define CALIBER_AVX2 __attribute__((target("avx2")))
+
+/// Lanes of the four child pairs (a0 b0, a0 b1, a1 b0, a1 b1): A's children a0 a0 a1 a1, B's b0 b1 b0 b1.
+/// A float field of two adjacent records (nodes or filters), converted to double (exactly).
+template <class Record>
+CALIBER_AVX2 inline __m256d lanes_a(const Record* first, const float Record::*field) {
+  return _mm256_cvtps_pd(_mm_setr_ps(first[0].*field, first[0].*field, first[1].*field, first[1].*field));
+}
+template <class Record>
+CALIBER_AVX2 inline __m256d lanes_b(const Record* first, const float Record::*field) {
+  return _mm256_cvtps_pd(_mm_setr_ps(first[0].*field, first[1].*field, first[0].*field, first[1].*field));
+}
+template <class Record>
+CALIBER_AVX2 inline __m256d lanes_a(const Record* first, const float (Record::*field)[3], int k) {
+  return _mm256_cvtps_pd(_mm_setr_ps((first[0].*field)[k], (first[0].*field)[k], (first[1].*field)[k], (first[1].*field)[k]));
+}
+template <class Record>
+CALIBER_AVX2 inline __m256d lanes_b(const Record* first, const float (Record::*field)[3], int k) {
+  return _mm256_cvtps_pd(_mm_setr_ps((first[0].*field)[k], (first[1].*field)[k], (first[0].*field)[k], (first[1].*field)[k]));
+}
+
+CALIBER_AVX2 inline __m256d add(__m256d u, __m256d v) { return _mm256_add_pd(u, v); }
+CALIBER_AVX2 inline __m256d sub(__m256d u, __m256d v) { return _mm256_sub_pd(u, v); }
+CALIBER_AVX2 inline __m256d mul(__m256d u, __m256d v) { return _mm256_mul_pd(u, v); }
+CALIBER_AVX2 inline __m256d gt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GT_OQ); }
+CALIBER_AVX2 inline __m256d lt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LT_OQ); }
+CALIBER_AVX2 inline __m256d either(__m256d u, __m256d v) { return _mm256_or_pd(u, v); }
+CALIBER_AVX2 inline __m256d magnitude(__m256d u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
+/// (u0 v0 + u1 v1) + u2 v2, as the scalar dot products of the node test sum them.
+CALIBER_AVX2 inline __m256d dot3(const __m256d u[3], const __m256d v[3]) {
+  return add(add(mul(u[0], v[0]), mul(u[1], v[1])), mul(u[2], v[2]));
+}
+/// Row i of m (m[i][0], m[i][1], m[i][2]) dotted with v, m's entries the same in every lane.
+CALIBER_AVX2 inline __m256d row_dot(const double m[3][3], int i, const __m256d v[3]) {
+  return add(add(mul(_mm256_set1_pd(m[i][0]), v[0]), mul(_mm256_set1_pd(m[i][1]), v[1])), mul(_mm256_set1_pd(m[i][2]), v[2]));
+}
+/// Column j of m dotted with v.
+CALIBER_AVX2 inline __m256d column_dot(const double m[3][3], int j, const __m256d v[3]) {
+  return add(add(mul(_mm256_set1_pd(m[0][j]), v[0]), mul(_mm256_set1_pd(m[1][j]), v[1])), mul(_mm256_set1_pd(m[2][j]), v[2]));
+}
+
+/// PairContext::box_beyond_slab in four lanes.
+CALIBER_AVX2 inline __m256d beyond_slab(const __m256d axis[3], const __m256d on[3], __m256d lo, __m256d hi,
+                                        const __m256d center[3], const __m256d half[3], __m256d slab_reach) {
+  const __m256d at = dot3(axis, center);
+  const __m256d reach = dot3(on, half);
+  return either(gt(sub(at, reach), add(hi, slab_reach)), lt(add(at, reach), sub(lo, slab_reach)));
+}
+
+/// PairContext::prepare_a / prepare_b and node_within on the four child pairs, lane by lane the
+/// scalar code's operations in its order (fill_a, fill_b, box_beyond_slab).
+CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t first_a, std::uint32_t first_b) {
+  const BvhNode* na = f.nodes_a + first_a;
+  const BvhNode* nb = f.nodes_b + first_b;
+  const BvhNodeFilter* fa = f.filters_a + first_a;
+  const BvhNodeFilter* fb = f.filters_b + first_b;
+  const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach);
+  const __m256d hair = _mm256_set1_pd(f.hair);
+  __m256d a_center[3], a_box[3], a_half[3], a_rel[3], a_axis[3], a_box_in_b[3], a_reach_on_b[3], a_slab_on_b[3];
+  __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3];
+  for (int k = 0; k < 3; ++k) {
+    a_center[k] = lanes_a(na, &BvhNode::center, k);
+    a_box[k] = lanes_a(na, &BvhNode::box_center, k);
+    a_half[k] = lanes_a(na, &BvhNode::box_half, k);
+    a_rel[k] = sub(a_box[k], _mm256_set1_pd(f.trans[k]));
+    a_axis[k] = lanes_a(fa, &BvhNodeFilter::cone_axis, k);
+    b_c[k] = lanes_b(nb, &BvhNode::center, k);
+    b_box[k] = lanes_b(nb, &BvhNode::box_center, k);
+    b_half[k] = lanes_b(nb, &BvhNode::box_half, k);
+    b_axis[k] = lanes_b(fb, &BvhNodeFilter::cone_axis, k);
+  }
+  for (int k = 0; k < 3; ++k) {
+    // A's box seen from B: x_b = R^T (x_a - T); B's node brought into A's frame: R x_b + T.
+    a_box_in_b[k] = column_dot(f.rot, k, a_rel);
+    a_reach_on_b[k] = column_dot(f.abs_rot, k, a_half);
+    a_slab_on_b[k] = add(magnitude(column_dot(f.rot, k, a_axis)), hair);
+    const __m256d t = _mm256_set1_pd(f.trans[k]);
+    b_center[k] = add(row_dot(f.rot, k, b_c), t);
+    b_box_in_a[k] = add(row_dot(f.rot, k, b_box), t);
+    b_reach_on_a[k] = row_dot(f.abs_rot, k, b_half);
+    b_slab_on_a[k] = add(magnitude(row_dot(f.rot, k, b_axis)), hair);
+  }
+  // Spheres: dist2 accumulates from 0 (0 + x is x), the radii summed before the reach is added.
+  __m256d d[3];
+  for (int k = 0; k < 3; ++k) d[k] = sub(a_center[k], b_center[k]);
+  const __m256d dist2 = add(add(mul(d[0], d[0]), mul(d[1], d[1])), mul(d[2], d[2]));
+  const __m256d spheres = add(add(lanes_a(na, &BvhNode::radius), lanes_b(nb, &BvhNode::radius)), reach);
+  __m256d apart = gt(dist2, mul(spheres, spheres));
+  for (int k = 0; k < 3; ++k) {  // A's axes, then B's
+    apart = either(apart, gt(magnitude(sub(b_box_in_a[k], a_box[k])), add(add(a_half[k], b_reach_on_a[k]), reach)));
+  }
+  for (int k = 0; k < 3; ++k) {
+    apart = either(apart, gt(magnitude(sub(b_box[k], a_box_in_b[k])), add(add(b_half[k], a_reach_on_b[k]), reach)));
+  }
+  apart = either(apart, beyond_slab(a_axis, a_slab_on_b, lanes_a(fa, &BvhNodeFilter::slab_lo), lanes_a(fa, &BvhNodeFilter::slab_hi),
+                                    b_box_in_a, b_half, slab_reach));
+  apart = either(apart, beyond_slab(b_axis, b_slab_on_a, lanes_b(fb, &BvhNodeFilter::slab_lo), lanes_b(fb, &BvhNodeFilter::slab_hi),
+                                    a_box_in_b, a_half, slab_reach));
+  return ~_mm256_movemask_pd(apart) & 0xF;
+}
+
+#undef CALIBER_AVX2
+
+}  // namespace
+
+NodeWithin2x2 node_within_2x2_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &node_within_2x2_avx2 : nullptr;
+}
+
+}  // namespace caliber::narrow::detail
+
+#else
+
+namespace caliber::narrow::detail {
+NodeWithin2x2 node_within_2x2_avx2_if_supported() { return nullptr; }
+}  // namespace caliber::narrow::detail
+
+#endif

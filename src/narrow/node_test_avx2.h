@@ -1,0 +1,31 @@
+#pragma once
+/// \file
+/// The geometric part of the node test (PairContext::node_within: spheres, boxes, slabs) on the
+/// four child pairs of a visit at once, in AVX2: the same decisions as the scalar test, bit for
+/// bit (each lane does the scalar test's operations in its order).
+
+#include <cstdint>
+
+#include "caliber/model.h"
+
+namespace caliber::narrow::detail {
+
+/// What the test reads of a pair context: the two models' nodes, B's pose in A's frame (as
+/// PairContext keeps it: rot[i][j] is mRot(i, j)) and the reaches.
+struct NodeTestFrame {
+  const BvhNode* nodes_a;
+  const BvhNodeFilter* filters_a;
+  const BvhNode* nodes_b;
+  const BvhNodeFilter* filters_b;
+  double rot[3][3], abs_rot[3][3], trans[3];
+  double hair, reach, slab_reach;
+};
+
+/// Bit 2i + j set where child i of A (node first_a + i) and child j of B (node first_b + j) pass
+/// spheres, boxes and slabs: PairContext::node_within on prepare_a and prepare_b of each.
+using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t first_a, std::uint32_t first_b);
+
+/// The AVX2 form, or nullptr where this build or this CPU has none.
+NodeWithin2x2 node_within_2x2_avx2_if_supported();
+
+}  // namespace caliber::narrow::detail

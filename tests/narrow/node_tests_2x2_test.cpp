@@ -1,0 +1,59 @@
+// PairContext::node_tests_2x2 (the four child pairs of a visit prepared and tested at once, AVX2
+// where the CPU has it) against prepare_a, prepare_b and node_test on each pair: the same decision for every pair, on overlapping and nearby
+// objects, for every depth-first kind.
+
+#include <random>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "narrow/pair_context.h"
+#include "support/random_poses.h"
+
+namespace caliber::narrow {
+namespace {
+
+TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
+  const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
+  const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
+  std::mt19937_64 rng(20261125);
+  long passed = 0, failed = 0, differing = 0;
+  for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
+    QueryRequest request;
+    request.kind = kind;
+    request.tolerance = kind == QueryKind::interference ? 0.0 : 0.05;
+    for (int p = 0; p < 24; ++p) {
+      const PairContext ctx(*a, test::random_pose(rng, 0.3), *b, test::random_pose(rng, 1.2), request);
+      // Visit the CD tree as far as both sides have children: below the roots, every pair whose
+      // four children are tested, descending into those that pass (where the decisions are close).
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
+      for (std::size_t w = 0; w < work.size() && w < 20000; ++w) {
+        const BvhNode& na = a->nodes[work[w].first];
+        const BvhNode& nb = b->nodes[work[w].second];
+        if (na.is_leaf() || nb.is_leaf()) continue;
+        const PairContext::SideA sa[2] = {ctx.prepare_a(na.index), ctx.prepare_a(na.index + 1)};
+        const PairContext::SideB sb[2] = {ctx.prepare_b(nb.index), ctx.prepare_b(nb.index + 1)};
+        const int mask = ctx.node_tests_2x2(na.index, nb.index);
+        for (std::uint32_t k = 0; k < 4; ++k) {
+          const bool want = ctx.node_test(sa[k / 2], sb[k % 2]);
+          (want ? passed : failed) += 1;
+          if (want) work.emplace_back(na.index + k / 2, nb.index + k % 2);
+          if (want != (((mask >> k) & 1) != 0) && ++differing <= 5) {
+            ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " pair " << k << ": scalar " << want;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0);
+  // Both outcomes occur often, so the comparison says something.
+  EXPECT_GT(passed, 10000);
+  EXPECT_GT(failed, 10000);
+}
+
+}  // namespace
+}  // namespace caliber::narrow
