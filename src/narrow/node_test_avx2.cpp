@@ -1,4 +1,4 @@
-// The node test of a visit's four child pairs at once (AVX2, chosen at run time where the CPU has it):
+// The node test of a visit's child pairs, four at a time (AVX2, chosen at run time where the CPU has it):
 // the same decisions as PairContext::node_within on each pair, bit for bit.
 
 #include "narrow/node_test_avx2.h"
@@ -11,23 +11,23 @@ namespace {
 
 #define CALIBER_AVX2 __attribute__((target("avx2")))
 
-/// Lanes of the four child pairs (a0 b0, a0 b1, a1 b0, a1 b1): A's children a0 a0 a1 a1, B's b0 b1 b0 b1.
-/// A float field of two adjacent records (nodes or filters), converted to double (exactly).
+/// Lanes of the four node pairs (a0 b0, a0 b1, a1 b0, a1 b1): A's nodes a0 a0 a1 a1, B's b0 b1 b0 b1.
+/// A float field of two records (nodes or filters), converted to double (exactly).
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_a(const Record* first, const float Record::*field) {
-  return _mm256_cvtps_pd(_mm_setr_ps(first[0].*field, first[0].*field, first[1].*field, first[1].*field));
+CALIBER_AVX2 inline __m256d lanes_a(const Record& r0, const Record& r1, const float Record::*field) {
+  return _mm256_cvtps_pd(_mm_setr_ps(r0.*field, r0.*field, r1.*field, r1.*field));
 }
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_b(const Record* first, const float Record::*field) {
-  return _mm256_cvtps_pd(_mm_setr_ps(first[0].*field, first[1].*field, first[0].*field, first[1].*field));
+CALIBER_AVX2 inline __m256d lanes_b(const Record& r0, const Record& r1, const float Record::*field) {
+  return _mm256_cvtps_pd(_mm_setr_ps(r0.*field, r1.*field, r0.*field, r1.*field));
 }
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_a(const Record* first, const float (Record::*field)[3], int k) {
-  return _mm256_cvtps_pd(_mm_setr_ps((first[0].*field)[k], (first[0].*field)[k], (first[1].*field)[k], (first[1].*field)[k]));
+CALIBER_AVX2 inline __m256d lanes_a(const Record& r0, const Record& r1, const float (Record::*field)[3], int k) {
+  return _mm256_cvtps_pd(_mm_setr_ps((r0.*field)[k], (r0.*field)[k], (r1.*field)[k], (r1.*field)[k]));
 }
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_b(const Record* first, const float (Record::*field)[3], int k) {
-  return _mm256_cvtps_pd(_mm_setr_ps((first[0].*field)[k], (first[1].*field)[k], (first[0].*field)[k], (first[1].*field)[k]));
+CALIBER_AVX2 inline __m256d lanes_b(const Record& r0, const Record& r1, const float (Record::*field)[3], int k) {
+  return _mm256_cvtps_pd(_mm_setr_ps((r0.*field)[k], (r1.*field)[k], (r0.*field)[k], (r1.*field)[k]));
 }
 
 CALIBER_AVX2 inline __m256d add(__m256d u, __m256d v) { return _mm256_add_pd(u, v); }
@@ -58,27 +58,26 @@ CALIBER_AVX2 inline __m256d beyond_slab(const __m256d axis[3], const __m256d on[
   return either(gt(sub(at, reach), add(hi, slab_reach)), lt(add(at, reach), sub(lo, slab_reach)));
 }
 
-/// PairContext::prepare_a / prepare_b and node_within on the four child pairs, lane by lane the
+/// PairContext::prepare_a / prepare_b and node_within on the four node pairs, lane by lane the
 /// scalar code's operations in its order (fill_a, fill_b, box_beyond_slab).
-CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t first_a, std::uint32_t first_b) {
-  const BvhNode* na = f.nodes_a + first_a;
-  const BvhNode* nb = f.nodes_b + first_b;
-  const BvhNodeFilter* fa = f.filters_a + first_a;
-  const BvhNodeFilter* fb = f.filters_b + first_b;
+CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                                     std::uint32_t b1) {
+  const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
+  const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
   const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach);
   const __m256d hair = _mm256_set1_pd(f.hair);
   __m256d a_center[3], a_box[3], a_half[3], a_rel[3], a_axis[3], a_box_in_b[3], a_reach_on_b[3], a_slab_on_b[3];
   __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3];
   for (int k = 0; k < 3; ++k) {
-    a_center[k] = lanes_a(na, &BvhNode::center, k);
-    a_box[k] = lanes_a(na, &BvhNode::box_center, k);
-    a_half[k] = lanes_a(na, &BvhNode::box_half, k);
+    a_center[k] = lanes_a(na0, na1, &BvhNode::center, k);
+    a_box[k] = lanes_a(na0, na1, &BvhNode::box_center, k);
+    a_half[k] = lanes_a(na0, na1, &BvhNode::box_half, k);
     a_rel[k] = sub(a_box[k], _mm256_set1_pd(f.trans[k]));
-    a_axis[k] = lanes_a(fa, &BvhNodeFilter::cone_axis, k);
-    b_c[k] = lanes_b(nb, &BvhNode::center, k);
-    b_box[k] = lanes_b(nb, &BvhNode::box_center, k);
-    b_half[k] = lanes_b(nb, &BvhNode::box_half, k);
-    b_axis[k] = lanes_b(fb, &BvhNodeFilter::cone_axis, k);
+    a_axis[k] = lanes_a(fa0, fa1, &BvhNodeFilter::cone_axis, k);
+    b_c[k] = lanes_b(nb0, nb1, &BvhNode::center, k);
+    b_box[k] = lanes_b(nb0, nb1, &BvhNode::box_center, k);
+    b_half[k] = lanes_b(nb0, nb1, &BvhNode::box_half, k);
+    b_axis[k] = lanes_b(fb0, fb1, &BvhNodeFilter::cone_axis, k);
   }
   for (int k = 0; k < 3; ++k) {
     // A's box seen from B: x_b = R^T (x_a - T); B's node brought into A's frame: R x_b + T.
@@ -95,7 +94,7 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t firs
   __m256d d[3];
   for (int k = 0; k < 3; ++k) d[k] = sub(a_center[k], b_center[k]);
   const __m256d dist2 = add(add(mul(d[0], d[0]), mul(d[1], d[1])), mul(d[2], d[2]));
-  const __m256d spheres = add(add(lanes_a(na, &BvhNode::radius), lanes_b(nb, &BvhNode::radius)), reach);
+  const __m256d spheres = add(add(lanes_a(na0, na1, &BvhNode::radius), lanes_b(nb0, nb1, &BvhNode::radius)), reach);
   __m256d apart = gt(dist2, mul(spheres, spheres));
   for (int k = 0; k < 3; ++k) {  // A's axes, then B's
     apart = either(apart, gt(magnitude(sub(b_box_in_a[k], a_box[k])), add(add(a_half[k], b_reach_on_a[k]), reach)));
@@ -103,9 +102,9 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t firs
   for (int k = 0; k < 3; ++k) {
     apart = either(apart, gt(magnitude(sub(b_box[k], a_box_in_b[k])), add(add(b_half[k], a_reach_on_b[k]), reach)));
   }
-  apart = either(apart, beyond_slab(a_axis, a_slab_on_b, lanes_a(fa, &BvhNodeFilter::slab_lo), lanes_a(fa, &BvhNodeFilter::slab_hi),
+  apart = either(apart, beyond_slab(a_axis, a_slab_on_b, lanes_a(fa0, fa1, &BvhNodeFilter::slab_lo), lanes_a(fa0, fa1, &BvhNodeFilter::slab_hi),
                                     b_box_in_a, b_half, slab_reach));
-  apart = either(apart, beyond_slab(b_axis, b_slab_on_a, lanes_b(fb, &BvhNodeFilter::slab_lo), lanes_b(fb, &BvhNodeFilter::slab_hi),
+  apart = either(apart, beyond_slab(b_axis, b_slab_on_a, lanes_b(fb0, fb1, &BvhNodeFilter::slab_lo), lanes_b(fb0, fb1, &BvhNodeFilter::slab_hi),
                                     a_box_in_b, a_half, slab_reach));
   return ~_mm256_movemask_pd(apart) & 0xF;
 }

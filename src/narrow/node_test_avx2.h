@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The geometric part of the node test (PairContext::node_within: spheres, boxes, slabs) on the
-/// four child pairs of a visit at once, in AVX2: the same decisions as the scalar test, bit for
+/// child pairs of a visit, four at a time, in AVX2: the same decisions as the scalar test, bit for
 /// bit (each lane does the scalar test's operations in its order).
 
 #include <cstdint>
@@ -21,9 +21,10 @@ struct NodeTestFrame {
   double hair, reach, slab_reach;
 };
 
-/// Bit 2i + j set where child i of A (node first_a + i) and child j of B (node first_b + j) pass
-/// spheres, boxes and slabs: PairContext::node_within on prepare_a and prepare_b of each.
-using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t first_a, std::uint32_t first_b);
+/// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes and slabs:
+/// PairContext::node_within on prepare_a(ai) and prepare_b(bj).
+using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                              std::uint32_t b1);
 
 /// The AVX2 form, or nullptr where this build or this CPU has none.
 NodeWithin2x2 node_within_2x2_avx2_if_supported();

@@ -84,22 +84,24 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   return facing >= cos_total - kConeCosMargin;
 }
 
-int PairContext::node_tests_2x2(std::uint32_t first_a, std::uint32_t first_b) const {
+int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
+  const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
   int pass = 0;
   if (within == nullptr) {
-    const SideA sa[2] = {prepare_a(first_a), prepare_a(first_a + 1)};
-    const SideB sb[2] = {prepare_b(first_b), prepare_b(first_b + 1)};
+    const SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
+    const SideB sb[2] = {prepare_b(b0), prepare_b(b1)};
     for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
     return pass;
   }
-  pass = within(mNodeFrame, first_a, first_b);
+  pass = within(mNodeFrame, a0, a1, b0, b1);
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
     const int k = __builtin_ctz(static_cast<unsigned>(left));
-    const std::uint32_t ia = first_a + k / 2, ib = first_b + k % 2;
-    if ((mGroups != nullptr && !groups_can_touch(mA.filters[ia].groups, mB.filters[ib].groups)) ||
-        (mKind == QueryKind::contact && !cones_can_face(mA.filters[ia], mB.filters[ib]))) {
+    const BvhNodeFilter& fa = mA.filters[ia[k / 2]];
+    const BvhNodeFilter& fb = mB.filters[ib[k % 2]];
+    if ((mGroups != nullptr && !groups_can_touch(fa.groups, fb.groups)) ||
+        (mKind == QueryKind::contact && !cones_can_face(fa, fb))) {
       pass &= ~(1 << k);
     }
   }

@@ -122,11 +122,11 @@ class PairContext {
     return true;
   }
 
-  /// node_test on each child pair of a visit that splits both sides: bit 2i + j is set where node
-  /// first_a + i of A and node first_b + j of B pass. The same decisions as four calls of
-  /// node_test on prepared nodes; the preparation and the geometric part four at a time in AVX2
-  /// where the CPU has it (node_test_avx2.cpp).
-  [[nodiscard]] int node_tests_2x2(std::uint32_t first_a, std::uint32_t first_b) const;
+  /// node_test on the four pairs of nodes a0 or a1 of A with b0 or b1 of B (the children of a
+  /// visit; a side that does not split gives its node twice): bit 2i + j is set where ai and bj
+  /// pass. The same decisions as node_test on prepare_a(ai) and prepare_b(bj); the preparation and
+  /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp).
+  [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
 
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }

@@ -35,15 +35,24 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
         const BvhNode& na = a->nodes[work[w].first];
         const BvhNode& nb = b->nodes[work[w].second];
         if (na.is_leaf() || nb.is_leaf()) continue;
-        const PairContext::SideA sa[2] = {ctx.prepare_a(na.index), ctx.prepare_a(na.index + 1)};
-        const PairContext::SideB sb[2] = {ctx.prepare_b(nb.index), ctx.prepare_b(nb.index + 1)};
-        const int mask = ctx.node_tests_2x2(na.index, nb.index);
-        for (std::uint32_t k = 0; k < 4; ++k) {
-          const bool want = ctx.node_test(sa[k / 2], sb[k % 2]);
-          (want ? passed : failed) += 1;
-          if (want) work.emplace_back(na.index + k / 2, nb.index + k % 2);
-          if (want != (((mask >> k) & 1) != 0) && ++differing <= 5) {
-            ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " pair " << k << ": scalar " << want;
+        // Both sides split, then only A's, then only B's (the other side's node given twice).
+        const std::uint32_t wa = work[w].first, wb = work[w].second;
+        const std::uint32_t cases[3][4] = {{na.index, na.index + 1, nb.index, nb.index + 1},
+                                           {na.index, na.index + 1, wb, wb},
+                                           {wa, wa, nb.index, nb.index + 1}};
+        for (int c = 0; c < 3; ++c) {
+          const auto& [a0, a1, b0, b1] = cases[c];
+          const PairContext::SideA sa[2] = {ctx.prepare_a(a0), ctx.prepare_a(a1)};
+          const PairContext::SideB sb[2] = {ctx.prepare_b(b0), ctx.prepare_b(b1)};
+          const int mask = ctx.node_tests_2x2(a0, a1, b0, b1);
+          for (std::uint32_t k = 0; k < 4; ++k) {
+            const bool want = ctx.node_test(sa[k / 2], sb[k % 2]);
+            (want ? passed : failed) += 1;
+            if (want && c == 0) work.emplace_back(na.index + k / 2, nb.index + k % 2);
+            if (want != (((mask >> k) & 1) != 0) && ++differing <= 5) {
+              ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << " pair " << k
+                            << ": scalar " << want;
+            }
           }
         }
       }
