@@ -71,7 +71,7 @@ struct WorkNode {
 
 /// Subtrees over more triangles than this build their two halves in parallel (on the executor the
 /// caller runs in); smaller ones, and every leaf-level pass, in a loop of their own.
-constexpr std::uint32_t kParallelBuildCount = 8192;
+constexpr std::uint32_t kParallelBuildCount = 2048;
 /// Items per chunk for the build's per-triangle and per-node loops.
 constexpr std::size_t kBuildGrain = 4096;
 

@@ -157,7 +157,7 @@ std::vector<unsigned char> bytes(const std::vector<T>& v) {
 }
 
 TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
-  // Over 8192 triangles, so the two halves of the top subtrees are built at once.
+  // Over 2048 triangles (kParallelBuildCount), so the two halves of the top subtrees are built at once.
   const Mesh mesh = make_sphere(1.0, 120, 160);
   ASSERT_GT(mesh.triangles.size(), 30000u);
   std::shared_ptr<const Model> one;
