@@ -86,15 +86,9 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
 
 int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
+  if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
   const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
-  int pass = 0;
-  if (within == nullptr) {
-    const SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
-    const SideB sb[2] = {prepare_b(b0), prepare_b(b1)};
-    for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
-    return pass;
-  }
-  pass = within(mNodeFrame, a0, a1, b0, b1);
+  int pass = within(mNodeFrame, a0, a1, b0, b1);
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
     const int k = __builtin_ctz(static_cast<unsigned>(left));
@@ -105,6 +99,14 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
       pass &= ~(1 << k);
     }
   }
+  return pass;
+}
+
+int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
+  const SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
+  const SideB sb[2] = {prepare_b(b0), prepare_b(b1)};
+  int pass = 0;
+  for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
   return pass;
 }
 

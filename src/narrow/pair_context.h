@@ -127,6 +127,8 @@ class PairContext {
   /// pass. The same decisions as node_test on prepare_a(ai) and prepare_b(bj); the preparation and
   /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp).
   [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
+  /// The same, one pair at a time: what node_tests_2x2 runs where the CPU has no AVX2.
+  [[nodiscard]] int node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
 
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }

@@ -45,6 +45,9 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
           const PairContext::SideA sa[2] = {ctx.prepare_a(a0), ctx.prepare_a(a1)};
           const PairContext::SideB sb[2] = {ctx.prepare_b(b0), ctx.prepare_b(b1)};
           const int mask = ctx.node_tests_2x2(a0, a1, b0, b1);
+          if (ctx.node_tests_2x2_scalar(a0, a1, b0, b1) != mask && ++differing <= 5) {
+            ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": the scalar form differs";
+          }
           for (std::uint32_t k = 0; k < 4; ++k) {
             const bool want = ctx.node_test(sa[k / 2], sb[k % 2]);
             (want ? passed : failed) += 1;
