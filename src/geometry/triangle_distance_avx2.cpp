@@ -19,8 +19,9 @@ using kernel::Vec3;
 // only "avx2" is enabled here, not "fma"), every region and case of the branches evaluated and the
 // one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on
 // NaN, as in C++), and clamp01 is max then min with the operands in the order of the scalar
-// maxsd/minsd of clamp01 (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The candidates are then
-// taken by the same Nearest in the portable order, so the same pair wins. Eigen computes a
+// maxsd/minsd of clamp01 (triangle_distance.cpp), so NaN falls to 0 in every lane as it does
+// there. The candidates are then taken by the same Nearest in the portable order, so the same pair
+// wins. Eigen computes a
 // 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does dot() here
 // (tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
 namespace {
@@ -239,7 +240,8 @@ struct Projections {
   }
 };
 
-/// Each projection of `points`, four at a time, offered to `nearest` in their order.
+/// Each projection of `points`, four at a time: batch k of `out` holds points 4k to 4k + 3 with
+/// their projections (the caller offers them to Nearest in that order).
 CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb,
                           Candidates4 out[Projections::kMost / 4]) {
   const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
