@@ -126,6 +126,26 @@ void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& 
   c2 = p2 + t * d2;
 }
 
+namespace {
+
+/// Each edge vector (corner i to corner i + 1) of both triangles and its squared length: computed
+/// once and shared by the 9 edge pairs (the same expressions as computing them per pair).
+struct EdgeVectors {
+  Vec3 a[3], b[3];
+  double la[3], lb[3];
+
+  EdgeVectors(const Vec3 ta[3], const Vec3 tb[3]) {
+    for (int i = 0; i < 3; ++i) {
+      a[i] = ta[(i + 1) % 3] - ta[i];
+      b[i] = tb[(i + 1) % 3] - tb[i];
+      la[i] = a[i].squaredNorm();
+      lb[i] = b[i].squaredNorm();
+    }
+  }
+};
+
+/// The last candidates of the triangle kernel, in its order. Intersecting triangles: an edge of one
+/// pierces the other; its crossing point is a candidate.
 void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
                         Nearest& nearest) {
   const Vec3 na = fa.ab.cross(fa.ac);
@@ -137,6 +157,7 @@ void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& f
   }
 }
 
+}  // namespace
 }  // namespace kernel
 
 Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {

@@ -16,22 +16,6 @@ namespace caliber::geometry::kernel {
 
 using Vec3 = Eigen::Vector3d;
 
-/// Each edge vector (corner i to corner i + 1) of both triangles and its squared length: computed
-/// once and shared by the 9 edge pairs (the same expressions as computing them per pair).
-struct EdgeVectors {
-  Vec3 a[3], b[3];
-  double la[3], lb[3];
-
-  EdgeVectors(const Vec3 ta[3], const Vec3 tb[3]) {
-    for (int i = 0; i < 3; ++i) {
-      a[i] = ta[(i + 1) % 3] - ta[i];
-      b[i] = tb[(i + 1) % 3] - tb[i];
-      la[i] = a[i].squaredNorm();
-      lb[i] = b[i].squaredNorm();
-    }
-  }
-};
-
 /// A triangle with what the closest-point query on it needs of its own: computed once per triangle
 /// and reused for every point (the same expressions as a single query, so the same values).
 struct TriangleFrame {
@@ -57,10 +41,8 @@ struct Nearest {
 
   Nearest(const Vec3& p, const Vec3& q) : best{p, q, 0.0}, best_d2((q - p).squaredNorm()) { best.distance = std::sqrt(best_d2); }
 
-  void consider(const Vec3& p, const Vec3& q) { consider(p, q, (q - p).squaredNorm()); }
-
-  /// The same, given d2 = (q - p).squaredNorm() computed elsewhere with the same operations.
-  void consider(const Vec3& p, const Vec3& q, double d2) {
+  void consider(const Vec3& p, const Vec3& q) {
+    const double d2 = (q - p).squaredNorm();
     if (d2 < best_d2) consider(p, q, d2, std::sqrt(d2));
   }
 
@@ -80,10 +62,5 @@ Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t);
 /// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
 void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1,
                           Vec3& c2);
-
-/// The last candidates of the triangle kernel, in its order: an edge of one triangle that pierces
-/// the other gives its crossing point and that point's nearest point on the other.
-void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
-                        Nearest& nearest);
 
 }  // namespace caliber::geometry::kernel
