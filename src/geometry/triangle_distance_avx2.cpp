@@ -327,14 +327,13 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone.
   // Every candidate is computed first and offered in order at the end, so that the batches do not
   // wait on one another.
-  Candidates4 edges[2];
+  Candidates4 edges[3];
   closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
                           gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges[0]);
   closest_points_edges_x4(gather<1, 1, 2, 2>(ta.v), gather<1, 1, 2, 2>(ta.e), gather<1, 1, 2, 2>(ta.len2),
                           gather<1, 2, 0, 1>(tb.v), gather<1, 2, 0, 1>(tb.e), gather<1, 2, 0, 1>(tb.len2), edges[1]);
-  const Vec3 ea2 = a[0] - a[2], eb2 = b[0] - b[2];
-  Vec3 c1, c2;
-  kernel::closest_points_edges(a[2], ea2, ea2.squaredNorm(), b[2], eb2, eb2.squaredNorm(), c1, c2);
+  closest_points_edges_x4(gather<2, 2, 2, 2>(ta.v), gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(ta.len2),
+                          gather<2, 2, 2, 2>(tb.v), gather<2, 2, 2, 2>(tb.e), gather<2, 2, 2, 2>(tb.len2), edges[2]);
 
   // Vertex-face candidates, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
@@ -360,7 +359,7 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
 
   take(edges[0], 0xF, nearest);
   take(edges[1], 0xF, nearest);
-  nearest.consider(c1, c2);
+  take(edges[2], 0x1, nearest);
   for (int first = 0; first < points.count; first += 4) {
     take(projected[first / 4], points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
   }
