@@ -81,7 +81,8 @@ bool shares_vertex(const Model& m, std::uint32_t t, std::uint32_t u) {
 
 /// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
-/// the candidates (times the adjacency's degree): each neighbour is one hash lookup. Each verdict
+/// the candidates (times the adjacency's degree): the candidates next to it in the list first, then
+/// each neighbour by one hash lookup. Each verdict
 /// depends only on the set of candidates, not on their order, so they need no sorting first; the
 /// kept ones are returned in the input's order.
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
