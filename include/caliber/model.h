@@ -149,6 +149,16 @@ struct Model {
       }
     }
   }
+  /// Whether u is among the triangles for_each_neighbour(t, ...) gives: distinct from t, sharing
+  /// a vertex position with it.
+  [[nodiscard]] bool are_neighbours(std::uint32_t t, std::uint32_t u) const {
+    if (t == u) return false;
+    const std::uint32_t* vt = &corner_vertex[std::size_t{t} * 3];
+    const std::uint32_t* vu = &corner_vertex[std::size_t{u} * 3];
+    bool shared = false;
+    for (int k = 0; k < 3; ++k) shared |= (vt[k] == vu[0]) | (vt[k] == vu[1]) | (vt[k] == vu[2]);
+    return shared;
+  }
   /// Largest distance of a vertex from the object-space origin (used to bound rounding error).
   double extent = 0.0;
   /// Height of the BVH (a root-only tree has height 1).

@@ -68,17 +68,6 @@ class PairIndex {
 /// How many candidates on each side of a candidate local_minima looks at before its lookups.
 constexpr std::size_t kNearby = 8;
 
-/// Whether triangles t and u of m are neighbours as Model::for_each_neighbour has them: distinct,
-/// with a welded vertex in common.
-bool shares_vertex(const Model& m, std::uint32_t t, std::uint32_t u) {
-  if (t == u) return false;
-  const std::uint32_t* vt = &m.corner_vertex[std::size_t{t} * 3];
-  const std::uint32_t* vu = &m.corner_vertex[std::size_t{u} * 3];
-  bool shared = false;
-  for (int k = 0; k < 3; ++k) shared |= (vt[k] == vu[0]) | (vt[k] == vu[1]) | (vt[k] == vu[2]);
-  return shared;
-}
-
 /// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
 /// the candidates (times the adjacency's degree): the candidates next to it in the list first, then
@@ -100,8 +89,8 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
       const std::size_t first = i >= kNearby ? i - kNearby : 0, last = std::min(candidates.size(), i + kNearby + 1);
       for (std::size_t j = first; j != last && !dominated; ++j) {
         const Candidate& o = candidates[j];
-        dominated = closer(o, c) && ((o.tri_b == c.tri_b && shares_vertex(ma, o.tri_a, c.tri_a)) ||
-                                     (o.tri_a == c.tri_a && shares_vertex(mb, o.tri_b, c.tri_b)));
+        dominated = closer(o, c) && ((o.tri_b == c.tri_b && ma.are_neighbours(o.tri_a, c.tri_a)) ||
+                                     (o.tri_a == c.tri_a && mb.are_neighbours(o.tri_b, c.tri_b)));
       }
       if (dominated) continue;  // keep[i] stays 0
       ma.for_each_neighbour(c.tri_a, [&](std::uint32_t u) {
