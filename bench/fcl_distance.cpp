@@ -4,9 +4,10 @@
 // Reports both distances, their relative difference, whether the closest triangle pair is the same,
 // and warm median times of interleaved runs.
 //
-//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME]
+//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--ours-only]
 //
-// --only runs the cases whose name contains NAME.
+// --only runs the cases whose name contains NAME. --ours-only runs caliber's query alone, R times
+// per case and gap, and prints its median time (no FCL model, no table): for `perf record`.
 
 #include <algorithm>
 #include <cmath>
@@ -121,13 +122,15 @@ int main(int argc, char** argv) {
   std::filesystem::path dir = "data/meshes";
   int repeat = 7;
   std::string out, only;
+  bool ours_only = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--ours-only")) ours_only = true;
     else {
-      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME]\n");
+      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--ours-only]\n");
       return 2;
     }
   }
@@ -147,6 +150,20 @@ int main(int argc, char** argv) {
     if (c.name.find(only) == std::string::npos) continue;
     const auto a = build_model(load_mesh(dir / c.mesh_a), bvh_only);
     const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(dir / c.mesh_b), bvh_only);
+    if (ours_only) {
+      for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
+        const Pose pose_b = place(c, a->mesh, b->mesh, gap);
+        QueryRequest request;
+        request.kind = QueryKind::distance;
+        request.tolerance = kUnbounded;
+        QueryResult ours;
+        const double ms = bench::median_ms(repeat, [&] { ours = query(*a, Pose{}, *b, pose_b, request); });
+        std::printf("%s gap %g: %.12g in %.3f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,
+                    ours.contacts.front().distance, ms, repeat, static_cast<unsigned long long>(ours.stats.node_tests),
+                    static_cast<unsigned long long>(ours.stats.leaf_tests));
+      }
+      continue;
+    }
     const auto fa = bench::build_fcl(a->mesh);
     const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh);
     for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {

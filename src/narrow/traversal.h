@@ -295,7 +295,9 @@ struct Nearest {
 /// nodes that pass their test wait in a heap by their gap (PairContext::gap, a lower bound on the
 /// distance below them); the nearest is visited next, each child tested within the best distance
 /// found so far, and the traversal ends when the nearest waiting node is farther than that distance
-/// by more than the safety margin. A node or pair exactly as close as the best is still examined,
+/// by more than the safety margin. A visited node's nearest child is visited next directly, without
+/// the heap, when no waiting node is nearer: the order popping would give, without its cost (the
+/// heap's sift was a third of the bunny's time). A node or pair exactly as close as the best is still examined,
 /// so ties go to the lowest ids. Counts node and leaf tests like traverse_depth_first; honours a
 /// taboo list the same way.
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
@@ -310,15 +312,25 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   // Nearest first (equal gaps in an order that depends only on the order they came in: the same
   // on every run).
   const auto later = [](const Waiting& x, const Waiting& y) { return x.first > y.first; };
+  Waiting next;  // the node to visit next
+  bool have_next = false;
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
     const double root_gap = ctx.gap(*near_a(root.a), *near_b(root.b), reach);
-    if (root_tested || (++stats.node_tests, root_gap <= reach)) heap.emplace_back(root_gap, root);
+    if (root_tested || (++stats.node_tests, root_gap <= reach)) {
+      next = Waiting{root_gap, root};
+      have_next = true;
+    }
   }
-  while (!heap.empty()) {
-    std::pop_heap(heap.begin(), heap.end(), later);
-    const auto [gap, n] = heap.back();
-    heap.pop_back();
+  for (;;) {
+    if (!have_next) {
+      if (heap.empty()) break;
+      std::pop_heap(heap.begin(), heap.end(), later);
+      next = heap.back();
+      heap.pop_back();
+    }
+    have_next = false;
+    const auto [gap, n] = next;
     const double reach = ctx.reach_for(nearest.bound(ctx));
     if (gap > reach) break;  // every node still waiting is at least as far
     const BvhNode& a = ctx.a().nodes[n.a];
@@ -328,13 +340,26 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       if (Candidate c; ctx.leaf_distance(a.index, b.index, nearest.bound(ctx), c)) nearest.offer(c);
       continue;
     }
+    Waiting kids[4];
+    int count = 0, nearest_kid = -1;
     for_each_child(
         n, a, b, stats, taboo, near_a, near_b, [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
           const double child_gap = ctx.gap(*sa, *sb, reach);
           if (child_gap > reach) return;
-          heap.emplace_back(child_gap, child);
-          std::push_heap(heap.begin(), heap.end(), later);
+          if (nearest_kid < 0 || child_gap < kids[nearest_kid].first) nearest_kid = count;
+          kids[count++] = Waiting{child_gap, child};
         });
+    // The nearest child is visited next without going through the heap when nothing waiting is
+    // nearer (what popping the heap would give); the others wait.
+    if (nearest_kid >= 0 && (heap.empty() || kids[nearest_kid].first <= heap.front().first)) {
+      next = kids[nearest_kid];
+      have_next = true;
+    }
+    for (int k = 0; k < count; ++k) {
+      if (have_next && k == nearest_kid) continue;
+      heap.push_back(kids[k]);
+      std::push_heap(heap.begin(), heap.end(), later);
+    }
   }
 }
 
