@@ -14,6 +14,7 @@
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 #include "util/assert.h"
+#include "util/min_heap4.h"
 
 namespace caliber::narrow {
 
@@ -232,7 +233,7 @@ class PreparedNodes {
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
-  std::vector<std::pair<double, NodePair>> waiting;  ///< distance traversal: the heap of nodes by gap
+  util::MinHeap4<NodePair> waiting;  ///< distance traversal: the heap of nodes by gap
   PreparedNodes<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
   PreparedNodes<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
 };
@@ -302,8 +303,8 @@ struct Nearest {
 /// taboo list the same way.
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
-  using Waiting = std::pair<double, NodePair>;
-  std::vector<Waiting>& heap = scratch.waiting;
+  using Waiting = util::MinHeap4<NodePair>::Entry;
+  util::MinHeap4<NodePair>& heap = scratch.waiting;
   heap.clear();
   scratch.near_a.clear();
   scratch.near_b.clear();
@@ -311,7 +312,6 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   const auto near_b = [&](std::uint32_t j) { return &scratch.near_b.get(j, [&](std::uint32_t k) { return ctx.near_b(k); }); };
   // Nearest first (equal gaps in an order that depends only on the order they came in: the same
   // on every run).
-  const auto later = [](const Waiting& x, const Waiting& y) { return x.first > y.first; };
   Waiting next;  // the node to visit next
   bool have_next = false;
   {
@@ -325,9 +325,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   for (;;) {
     if (!have_next) {
       if (heap.empty()) break;
-      std::pop_heap(heap.begin(), heap.end(), later);
-      next = heap.back();
-      heap.pop_back();
+      next = heap.pop();
     }
     have_next = false;
     const auto [gap, n] = next;
@@ -346,19 +344,18 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
         n, a, b, stats, taboo, near_a, near_b, [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
           const double child_gap = ctx.gap(*sa, *sb, reach);
           if (child_gap > reach) return;
-          if (nearest_kid < 0 || child_gap < kids[nearest_kid].first) nearest_kid = count;
+          if (nearest_kid < 0 || child_gap < kids[nearest_kid].key) nearest_kid = count;
           kids[count++] = Waiting{child_gap, child};
         });
     // The nearest child is visited next without going through the heap when nothing waiting is
     // nearer (what popping the heap would give); the others wait.
-    if (nearest_kid >= 0 && (heap.empty() || kids[nearest_kid].first <= heap.front().first)) {
+    if (nearest_kid >= 0 && (heap.empty() || kids[nearest_kid].key <= heap.top().key)) {
       next = kids[nearest_kid];
       have_next = true;
     }
     for (int k = 0; k < count; ++k) {
       if (have_next && k == nearest_kid) continue;
-      heap.push_back(kids[k]);
-      std::push_heap(heap.begin(), heap.end(), later);
+      heap.push(kids[k].key, kids[k].value);
     }
   }
 }
