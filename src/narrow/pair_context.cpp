@@ -136,8 +136,11 @@ bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, 
   // other triangle beyond it by more than the bound (plus the margin, with the rounding certified)
   // proves the true distance exceeds it, so the full computation below would reject the pair too.
   if (beyond_plane(a, b, reach) || beyond_plane(b, a, reach)) return false;
-  const bool intersecting = geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
   const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
+  // The exact intersection test decides whether the pair is at distance 0; a plane between the
+  // closest points that certifiably separates the triangles says "no" without it.
+  const bool intersecting = !geometry::certainly_separated(closest.on_b - closest.on_a, a, b) &&
+                            geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
   const double distance = intersecting ? 0.0 : closest.distance;
   if (!(distance <= bound)) return false;
   keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});

@@ -1,5 +1,7 @@
 #include "geometry/triangle_intersect.h"
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -154,6 +156,70 @@ TEST(TriangleIntersect, RandomAgreesWithDistanceWherePlain) {
   }
   EXPECT_GT(yes, 1000);
   EXPECT_GT(no, 1000);
+}
+
+
+// certainly_separated may skip triangles_intersect only where it would say false: it must never
+// certify triangles that meet, for the closest points' direction or any other.
+TEST(CertainlySeparated, NeverForTrianglesThatMeet) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int met = 0, certified = 0, apart = 0;
+  for (int iter = 0; iter < 40000; ++iter) {
+    Vec3 a[3], b[3];
+    // Offsets that make meeting, grazing and apart pairs all common; scales from 1e-3 to 1e3.
+    const double scale = std::pow(10.0, (iter % 7) - 3);
+    const Vec3 shift = Vec3(0.5 + 0.6 * u(rng), 0.1 * u(rng), 0.1 * u(rng)) * scale;
+    for (auto& v : a) v = Vec3(u(rng), u(rng), u(rng)) * scale;
+    for (auto& v : b) v = Vec3(u(rng), u(rng), u(rng)) * scale + shift;
+    const ClosestPoints c = closest_points_triangles(a, b);
+    const bool meet = tri_tri(a, b);
+    const bool sep = certainly_separated(c.on_b - c.on_a, a, b);
+    met += meet;
+    apart += !meet;
+    certified += sep;
+    if (meet) {
+      ASSERT_FALSE(sep) << "iteration " << iter;
+      ASSERT_FALSE(certainly_separated(Vec3(u(rng), u(rng), u(rng)), a, b)) << "iteration " << iter;
+    }
+  }
+  EXPECT_GT(met, 5000);
+  // And it does its job: most pairs that are apart get the certificate.
+  EXPECT_GT(certified, apart * 9 / 10);
+}
+
+TEST(CertainlySeparated, NeverForTouchingTriangles) {
+  // Sharing exactly one vertex, one on each side of a plane through it: they touch at that point
+  // only, and n . v is the same number on both sides, so no allowance below zero may pass.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.1, 1.0);
+  for (int iter = 0; iter < 2000; ++iter) {
+    const Vec3 shared(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+    const Vec3 a[3] = {shared, shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5), shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5)};
+    const Vec3 b[3] = {shared, shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5), shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5)};
+    ASSERT_TRUE(tri_tri(a, b));
+    const ClosestPoints c = closest_points_triangles(a, b);
+    EXPECT_FALSE(certainly_separated(c.on_b - c.on_a, a, b)) << "iteration " << iter;
+    EXPECT_FALSE(certainly_separated(Vec3(1, 0, 0), a, b)) << "iteration " << iter;
+  }
+  // A vertex of b on a's face, b above it.
+  const Vec3 a[3] = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+  const Vec3 b[3] = {{1, 1, 0}, {1, 1, 2}, {2, 1, 2}};
+  EXPECT_FALSE(certainly_separated(Vec3(0, 0, 1), a, b));
+  const Vec3 lifted[3] = {{1, 1, 1e-6}, {1, 1, 2}, {2, 1, 2}};
+  EXPECT_TRUE(certainly_separated(Vec3(0, 0, 1), a, lifted));
+}
+
+TEST(CertainlySeparated, NothingFromNaNOrInfinity) {
+  const Vec3 a[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Vec3 b[3] = {{0, 0, 5}, {1, 0, 5}, {0, 1, 5}};
+  EXPECT_TRUE(certainly_separated(Vec3(0, 0, 1), a, b));
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(certainly_separated(Vec3(0, 0, nan), a, b));
+  EXPECT_FALSE(certainly_separated(Vec3(nan, 0, 1), a, b));
+  EXPECT_FALSE(certainly_separated(Vec3(0, 0, inf), a, b));
+  // Products that underflow: no certificate from rounding noise.
+  EXPECT_FALSE(certainly_separated(Vec3(0, 0, 1e-320), a, a));
 }
 
 }  // namespace
