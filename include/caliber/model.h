@@ -67,9 +67,12 @@ struct BvhNodeFilter {
 /// What only the distance query reads of a node: the ranges along the two lateral axes of its cone
 /// axis (lateral_axes), every vertex v below having lateral_lo[k] <= axis_k . v <= lateral_hi[k],
 /// rounded outward. With the slab, a box around the triangles below in the frame of the cone axis,
-/// tight where they are nearly coplanar. All 0 when the cone axis is 0.
+/// tight where they are nearly coplanar. The lateral axes are turned about the cone axis to follow
+/// the spread of the vertices below (their principal direction in the slab's plane), so that an
+/// elongated patch gets a narrow box whatever its direction. All 0 when the cone axis is 0.
 struct BvhNodeLateral {
   float lateral_lo[2], lateral_hi[2];
+  float turn[2];  ///< (cos, sin) of the turn, up to scale (normalized in double where used)
 };
 
 /// The two axes that complete a unit axis (nx, ny, nz) to an orthonormal frame (Duff et al. 2017's
@@ -86,9 +89,26 @@ inline void lateral_axes_of_unit(double nx, double ny, double nz, double u[3], d
   v[2] = -ny;
 }
 
+/// Turns the orthonormal pair (u, v) about their normal by the angle whose (cos, sin) is `turn` up
+/// to scale (normalized here in double, so the pair stays orthonormal up to double rounding; a zero
+/// turn leaves it as it is).
+inline void turn_lateral_axes(const float turn[2], double u[3], double v[3]) {
+  double c = turn[0], s = turn[1];
+  const double r = std::sqrt(c * c + s * s);
+  if (!(r > 0.0)) return;
+  c /= r;
+  s /= r;
+  for (int k = 0; k < 3; ++k) {
+    const double uk = u[k], vk = v[k];
+    u[k] = c * uk + s * vk;
+    v[k] = c * vk - s * uk;
+  }
+}
+
 /// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
-/// axis, by the same formula at build and at query time. Both 0 when the axis is 0.
-inline void lateral_axes(const float axis[3], double u[3], double v[3]) {
+/// axis, turned by the stored turn, by the same formulas at build and at query time. Both 0 when
+/// the axis is 0.
+inline void lateral_axes(const float axis[3], const float turn[2], double u[3], double v[3]) {
   const double x = axis[0], y = axis[1], z = axis[2];
   const double len = std::sqrt(x * x + y * y + z * z);
   if (!(len > 0.0)) {
@@ -96,6 +116,7 @@ inline void lateral_axes(const float axis[3], double u[3], double v[3]) {
     return;
   }
   lateral_axes_of_unit(x / len, y / len, z / len, u, v);
+  turn_lateral_axes(turn, u, v);
 }
 
 /// Options of the BVH build.

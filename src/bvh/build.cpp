@@ -11,12 +11,15 @@
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "bvh/adjacency.h"
+#include "bvh/lateral.h"
 #include "parallel/executor.h"
 
 namespace caliber {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
+using bvh::lateral_axes;
+using bvh::principal_turn;
 
 /// Nodes with at most this many triangles get the exact covering radius (a pass over their vertices);
 /// larger ones bound it from their children's spheres.
@@ -47,11 +50,6 @@ Vec3 to_float_axis(const Vec3& axis) {
   return rounded;
 }
 
-/// lateral_axes of a cone axis already rounded to float (so exactly the stored one).
-void lateral_axes(const Vec3& axis, Vec3& u, Vec3& v) {
-  const float stored[3] = {static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z())};
-  caliber::lateral_axes(stored, u.data(), v.data());
-}
 
 /// A node while it is built, in double precision; converted to BvhNode / BvhNodeFilter at the end.
 struct WorkNode {
@@ -62,7 +60,10 @@ struct WorkNode {
   Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
   double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
-  double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along lateral_axes(axis)
+  double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along lateral_axes(axis, turn)
+  double turn[2] = {1.0, 0.0};                ///< the lateral axes' turn, float values
+  Vec3 moment1 = Vec3::Zero();                ///< sum of the vertices below (once per triangle corner)
+  Eigen::Matrix3d moment2 = Eigen::Matrix3d::Zero();  ///< sum of p p^T over the same
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -162,7 +163,7 @@ class Builder {
                     double& r2) const {
     double d1 = 0.0, d2 = 0.0;
     Vec3 u, v;
-    lateral_axes(node.axis, u, v);
+    lateral_axes(node.axis, node.turn, u, v);
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::numeric_limits<double>::infinity();
@@ -232,14 +233,17 @@ class Builder {
     node.groups = std::uint64_t{1} << (mMesh.groups.empty() ? 0 : mMesh.groups[tri]);
     const Vec3& normal = mNormals[tri];
     node.normal_sum = normal;
+    node.moment1 = a + b + c;
+    node.moment2 = a * a.transpose() + b * b.transpose() + c * c.transpose();
     if (normal.squaredNorm() > 0.0) {
       node.axis = to_float_axis(normal);
+      principal_turn(node.axis, node.moment1, node.moment2, 3.0, node.turn);
       node.cone = angle_between(node.axis.normalized(), normal) + kConeSlack;
       const double along[3] = {node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)};
       node.slab_lo = std::min({along[0], along[1], along[2]});
       node.slab_hi = std::max({along[0], along[1], along[2]});
       Vec3 lateral[2];
-      lateral_axes(node.axis, lateral[0], lateral[1]);
+      lateral_axes(node.axis, node.turn, lateral[0], lateral[1]);
       for (int k = 0; k < 2; ++k) {
         const double at[3] = {lateral[k].dot(a), lateral[k].dot(b), lateral[k].dot(c)};
         node.lateral_lo[k] = std::min({at[0], at[1], at[2]});
@@ -271,6 +275,9 @@ class Builder {
       }
       node.cone = std::min(angle + kConeSlack, 2.0 * std::numbers::pi);
     }
+    node.moment1 = l.moment1 + r.moment1;
+    node.moment2 = l.moment2 + r.moment2;
+    if (node.cone >= 0.0) principal_turn(node.axis, node.moment1, node.moment2, 3.0 * node.count, node.turn);
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.
     Vec3 merged = l.center;
@@ -299,7 +306,7 @@ class Builder {
       // The slab and lateral ranges likewise: the children's boxes projected on the axes (a bound,
       // not the range).
       Vec3 u, v;
-      lateral_axes(node.axis, u, v);
+      lateral_axes(node.axis, node.turn, u, v);
       children_range(node.axis, l, r, node.slab_lo, node.slab_hi);
       children_range(u, l, r, node.lateral_lo[0], node.lateral_hi[0]);
       children_range(v, l, r, node.lateral_lo[1], node.lateral_hi[1]);
@@ -337,6 +344,7 @@ class Builder {
     for (int k = 0; k < 2; ++k) {
       lateral.lateral_lo[k] = w.cone >= 0.0 ? round_down(w.lateral_lo[k] - slab_pad) : 0.0f;
       lateral.lateral_hi[k] = w.cone >= 0.0 ? round_up(w.lateral_hi[k] + slab_pad) : 0.0f;
+      lateral.turn[k] = static_cast<float>(w.turn[k]);  // already float values
     }
   }
 

@@ -334,9 +334,10 @@ class PairContext {
     const double x = f.cone_axis[0], y = f.cone_axis[1], z = f.cone_axis[2];
     const double len = std::sqrt(x * x + y * y + z * z);
     if (len > 0.0) {
-      const double axis[3] = {x / len, y / len, z / len};  // as lateral_axes computes it
+      const double axis[3] = {x / len, y / len, z / len};  // as lateral_axes computes them
       double u[3], v[3];
       lateral_axes_of_unit(axis[0], axis[1], axis[2], u, v);
+      turn_lateral_axes(l.turn, u, v);
       const double lo[3] = {f.slab_lo / len, l.lateral_lo[0], l.lateral_lo[1]};
       const double hi[3] = {f.slab_hi / len, l.lateral_hi[0], l.lateral_hi[1]};
       double mid[3], half[3];

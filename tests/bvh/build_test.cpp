@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <functional>
 #include <random>
 
@@ -38,7 +39,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const Eigen::Vector3d stored_axis(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]);
   const Eigen::Vector3d axis = stored_axis.normalized();
   double lateral[2][3];
-  lateral_axes(filter.cone_axis, lateral[0], lateral[1]);
+  lateral_axes(filter.cone_axis, lateral_range.turn, lateral[0], lateral[1]);
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh.triangles[t]) {
@@ -113,6 +114,30 @@ TEST(BuildModel, FarFromTheOriginVolumesStillCover) {
   Mesh mesh = make_sphere(0.001, 6, 8);
   for (auto& v : mesh.vertices) v += Eigen::Vector3d(1e6, -2e6, 3e5);
   check_model(*build_model(mesh));
+}
+
+TEST(BuildModel, LateralAxesFollowAnElongatedPatch) {
+  // A flat strip 1 long and 0.01 wide along a direction 30 degrees from x, in the plane z = 0 (so
+  // the unturned lateral axes would be x and y, across which the strip is 0.5 and 0.87 wide). The
+  // turned axes follow it: one of the root's lateral ranges is about the strip's width.
+  const int n = 60;
+  const Eigen::Vector3d along(std::cos(std::numbers::pi / 6), std::sin(std::numbers::pi / 6), 0.0);
+  const Eigen::Vector3d across(-along.y(), along.x(), 0.0);
+  Mesh mesh;
+  for (int i = 0; i <= n; ++i) {
+    mesh.vertices.push_back(along * (double(i) / n));
+    mesh.vertices.push_back(along * (double(i) / n) + 0.01 * across);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    mesh.triangles.push_back({2 * i, 2 * i + 2, 2 * i + 1});
+    mesh.triangles.push_back({2 * i + 1, 2 * i + 2, 2 * i + 3});
+  }
+  const auto model = build_model(mesh);
+  check_model(*model);
+  const BvhNodeLateral& root = model->laterals[0];
+  const double width[2] = {double(root.lateral_hi[0]) - root.lateral_lo[0], double(root.lateral_hi[1]) - root.lateral_lo[1]};
+  EXPECT_LT(std::min(width[0], width[1]), 0.011) << width[0] << " " << width[1];
+  EXPECT_GT(std::max(width[0], width[1]), 0.99) << width[0] << " " << width[1];
 }
 
 TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
