@@ -2,6 +2,7 @@
 
 #include <numbers>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -108,6 +109,25 @@ int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::
   int pass = 0;
   for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
   return pass;
+}
+
+void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1, double reach,
+                           double out[4]) const {
+  static const detail::Gaps2x2 avx2 = detail::gaps_2x2_avx2_if_supported();
+  const NearA* as[2] = {&a0, &a1};
+  const NearB* bs[2] = {&b0, &b1};
+  if (avx2 == nullptr) {
+    for (int k = 0; k < 4; ++k) out[k] = gap(*as[k / 2], *bs[k % 2], reach);
+    return;
+  }
+  avx2(detail::BoundConstants{kRotationHair, kFrameShrink2}, a0, a1, b0, b1, out);
+  // What gap adds to the geometry: groups that forbid every pair below.
+  if (mGroups == nullptr) return;
+  for (int k = 0; k < 4; ++k) {
+    if (out[k] <= reach && !groups_can_touch(mA.filters[as[k / 2]->index].groups, mB.filters[bs[k % 2]->index].groups)) {
+      out[k] = std::numeric_limits<double>::infinity();
+    }
+  }
 }
 
 bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {

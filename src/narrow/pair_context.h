@@ -16,7 +16,9 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
+#include "narrow/distance_bound_avx2.h"
 #include "narrow/node_test_avx2.h"
+#include "narrow/prepared.h"
 
 namespace caliber::narrow {
 
@@ -42,32 +44,17 @@ struct Candidate {
 class PairContext {
   /// Added to |rotation . axis| terms: covers rounding in the rotation and in the products.
   static constexpr double kRotationHair = 1e-12;
+  /// The distance bound's Frames have axes orthonormal to about 1e-15: dividing their squared gaps
+  /// by (1 + 1e-9)^2 covers it; multiplying by 1 - 3e-9, below 1 / (1 + 1e-9)^2 by far more than a
+  /// rounding, shrinks them a little more and costs no division.
+  static constexpr double kFrameShrink2 = 1.0 - 3e-9;
 
  public:
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
 
-  /// What every prepared node of A holds: its sphere, its box, and that box seen from B's frame
-  /// (center, and extent along each of B's axes).
-  struct NodeA {
-    std::uint32_t index;   ///< node index in A
-    double center[3];      ///< sphere center (A's frame)
-    double radius;         ///< sphere radius
-    double box[3];         ///< box center (A's frame)
-    double half[3];        ///< box half-extents (A's axes)
-    double box_in_b[3];    ///< box center in B's frame
-    double reach_on_b[3];  ///< half-extent of A's box along each of B's axes
-  };
-  /// What every prepared node of B holds, the same brought into A's frame.
-  struct NodeB {
-    std::uint32_t index;   ///< node index in B
-    double center[3];      ///< sphere center in A's frame
-    double radius;         ///< sphere radius
-    double box[3];         ///< box center (B's own frame)
-    double half[3];        ///< box half-extents (B's axes)
-    double box_in_a[3];    ///< box center in A's frame
-    double reach_on_a[3];  ///< half-extent of B's box along each of A's axes
-  };
+  using NodeA = narrow::NodeA;
+  using NodeB = narrow::NodeB;
   /// A node of A with what the node-node test needs of it precomputed. Prepared once per node and
   /// reused against every node of B it meets (the traversal tests two children of A against two
   /// of B).
@@ -137,22 +124,9 @@ class PairContext {
   /// safety margin (rounding in the transformed centers and vertices, certified far below it).
   [[nodiscard]] double reach_for(double d) const { return d + kRelativeMargin * (mScale + d); }
 
-  /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
-  /// rounding), center and half-extents along them. The box in the frame of the node's slab (the
-  /// slab and the lateral ranges) where the node has one, else its own box.
-  struct Frame {
-    double axis[3][3];
-    double center[3];
-    double half[3];
-  };
-  /// A node of A prepared for the distance bound: NodeA and its Frame.
-  struct NearA : NodeA {
-    Frame frame;
-  };
-  /// A node of B prepared for the distance bound: NodeB and its Frame brought into A's frame.
-  struct NearB : NodeB {
-    Frame frame;
-  };
+  using Frame = narrow::Frame;
+  using NearA = narrow::NearA;
+  using NearB = narrow::NearB;
 
   /// Prepares node ia of A for the distance bound.
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
@@ -211,10 +185,6 @@ class PairContext {
                               a.frame.axis[i][2] * b.frame.axis[k][2]) + kRotationHair;
       }
     }
-    // The frames' axes are orthonormal to about 1e-15: dividing the squared gaps by (1 + 1e-9)^2
-    // covers it; multiplying by 1 - 3e-9, below 1 / (1 + 1e-9)^2 by far more than a rounding,
-    // shrinks them a little more and costs no division.
-    constexpr double kFrameShrink2 = 1.0 - 3e-9;
     for (int i = 0; i < 3; ++i) {
       const double along_a = a.frame.axis[i][0] * d[0] + a.frame.axis[i][1] * d[1] + a.frame.axis[i][2] * d[2];
       const double reach_b = dots[i][0] * b.frame.half[0] + dots[i][1] * b.frame.half[1] + dots[i][2] * b.frame.half[2];
@@ -233,6 +203,12 @@ class PairContext {
     }
     return std::max({spheres, std::sqrt(std::max({boxes2, in_a, in_b})), 0.0});
   }
+
+  /// gap on the four pairs of prepared nodes a0 or a1 of A with b0 or b1 of B (a visit's children
+  /// where both sides split): out[2i + j] for ai and bj. The same value as gap(ai, bj, reach)
+  /// wherever that is within `reach`, and beyond `reach` where that is; four lanes of AVX2 where the
+  /// CPU has it (distance_bound_avx2.cpp).
+  void gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1, double reach, double out[4]) const;
 
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.

@@ -340,13 +340,30 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     }
     Waiting kids[4];
     int count = 0, nearest_kid = -1;
-    for_each_child(
-        n, a, b, stats, taboo, near_a, near_b, [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
-          const double child_gap = ctx.gap(*sa, *sb, reach);
-          if (child_gap > reach) return;
-          if (nearest_kid < 0 || child_gap < kids[nearest_kid].key) nearest_kid = count;
-          kids[count++] = Waiting{child_gap, child};
-        });
+    const auto wait = [&](double child_gap, NodePair child) {
+      if (child_gap > reach) return;
+      if (nearest_kid < 0 || child_gap < kids[nearest_kid].key) nearest_kid = count;
+      kids[count++] = Waiting{child_gap, child};
+    };
+    bool split_a, split_b;
+    cd_split(a, b, split_a, split_b);
+    if (split_a && split_b) {
+      // Both sides split: the four child pairs' bounds at once, then taken in cd_children order
+      // as for_each_child takes them (a child on the taboo list marked reached, not counted).
+      double gaps[4];
+      ctx.gaps_2x2(*near_a(a.index), *near_a(a.index + 1), *near_b(b.index), *near_b(b.index + 1), reach, gaps);
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const NodePair child{a.index + k / 2, b.index + k % 2};
+        if (on_taboo(taboo, child)) continue;
+        ++stats.node_tests;
+        wait(gaps[k], child);
+      }
+    } else {
+      for_each_child(n, a, b, stats, taboo, near_a, near_b,
+                     [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
+                       wait(ctx.gap(*sa, *sb, reach), child);
+                     });
+    }
     // The nearest child is visited next without going through the heap when nothing waiting is
     // nearer (what popping the heap would give); the others wait.
     if (nearest_kid >= 0 && (heap.empty() || kids[nearest_kid].key <= heap.top().key)) {

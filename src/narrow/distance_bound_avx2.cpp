@@ -1,0 +1,103 @@
+// The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
+// PairContext::gap's three bounds (spheres, object-frame boxes, Frames) in every lane, their
+// largest, no early exit, each with the scalar's operations in its order (this file is built with
+// -ffp-contract=off, like the rest, and only "avx2" is enabled here, not "fma").
+
+#include "narrow/distance_bound_avx2.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+namespace caliber::narrow::detail {
+namespace {
+
+#define CALIBER_AVX2 __attribute__((target("avx2")))
+
+/// A's node in lanes 0-1 and 2-3 is a0 and a1; B's alternates b0, b1.
+CALIBER_AVX2 inline __m256d lanes_a(double a0, double a1) { return _mm256_setr_pd(a0, a0, a1, a1); }
+CALIBER_AVX2 inline __m256d lanes_b(double b0, double b1) { return _mm256_setr_pd(b0, b1, b0, b1); }
+
+CALIBER_AVX2 inline __m256d add(__m256d u, __m256d v) { return _mm256_add_pd(u, v); }
+CALIBER_AVX2 inline __m256d sub(__m256d u, __m256d v) { return _mm256_sub_pd(u, v); }
+CALIBER_AVX2 inline __m256d mul(__m256d u, __m256d v) { return _mm256_mul_pd(u, v); }
+CALIBER_AVX2 inline __m256d magnitude(__m256d u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
+/// max(0, u) squared.
+CALIBER_AVX2 inline __m256d square_of_positive(__m256d u) {
+  const __m256d p = _mm256_max_pd(u, _mm256_setzero_pd());
+  return mul(p, p);
+}
+CALIBER_AVX2 inline __m256d dot3(__m256d x0, __m256d x1, __m256d x2, __m256d y0, __m256d y1, __m256d y2) {
+  return add(add(mul(x0, y0), mul(x1, y1)), mul(x2, y2));
+}
+
+CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
+                           double out[4]) {
+  // Spheres: |ca - cb| - ra - rb.
+  __m256d dist2 = _mm256_setzero_pd();
+  for (int i = 0; i < 3; ++i) {
+    const __m256d d = sub(lanes_a(a0.center[i], a1.center[i]), lanes_b(b0.center[i], b1.center[i]));
+    dist2 = add(dist2, mul(d, d));
+  }
+  const __m256d spheres =
+      sub(sub(_mm256_sqrt_pd(dist2), lanes_a(a0.radius, a1.radius)), lanes_b(b0.radius, b1.radius));
+  // Object-frame boxes: each box against the other's box seen along its axes.
+  __m256d boxes_a = _mm256_setzero_pd(), boxes_b = _mm256_setzero_pd();
+  for (int i = 0; i < 3; ++i) {
+    const __m256d along_a = magnitude(sub(lanes_b(b0.box_in_a[i], b1.box_in_a[i]), lanes_a(a0.box[i], a1.box[i])));
+    boxes_a = add(boxes_a, square_of_positive(sub(sub(along_a, lanes_a(a0.half[i], a1.half[i])),
+                                                  lanes_b(b0.reach_on_a[i], b1.reach_on_a[i]))));
+    const __m256d along_b = magnitude(sub(lanes_b(b0.box[i], b1.box[i]), lanes_a(a0.box_in_b[i], a1.box_in_b[i])));
+    boxes_b = add(boxes_b, square_of_positive(sub(sub(along_b, lanes_b(b0.half[i], b1.half[i])),
+                                                  lanes_a(a0.reach_on_b[i], a1.reach_on_b[i]))));
+  }
+  // Frames: along A's frame axes, then B's; |a_i . b_j| grown by the hair.
+  __m256d ax[3][3], bx[3][3], d[3], ah[3], bh[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      ax[i][c] = lanes_a(a0.frame.axis[i][c], a1.frame.axis[i][c]);
+      bx[i][c] = lanes_b(b0.frame.axis[i][c], b1.frame.axis[i][c]);
+    }
+    d[i] = sub(lanes_b(b0.frame.center[i], b1.frame.center[i]), lanes_a(a0.frame.center[i], a1.frame.center[i]));
+    ah[i] = lanes_a(a0.frame.half[i], a1.frame.half[i]);
+    bh[i] = lanes_b(b0.frame.half[i], b1.frame.half[i]);
+  }
+  const __m256d hair = _mm256_set1_pd(k.hair);
+  __m256d dots[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      dots[i][j] = add(magnitude(dot3(ax[i][0], ax[i][1], ax[i][2], bx[j][0], bx[j][1], bx[j][2])), hair);
+    }
+  }
+  __m256d in_a = _mm256_setzero_pd(), in_b = _mm256_setzero_pd();
+  for (int i = 0; i < 3; ++i) {
+    const __m256d along_a = magnitude(dot3(ax[i][0], ax[i][1], ax[i][2], d[0], d[1], d[2]));
+    const __m256d reach_b = dot3(dots[i][0], dots[i][1], dots[i][2], bh[0], bh[1], bh[2]);
+    in_a = add(in_a, square_of_positive(sub(sub(along_a, ah[i]), reach_b)));
+    const __m256d along_b = magnitude(dot3(bx[i][0], bx[i][1], bx[i][2], d[0], d[1], d[2]));
+    const __m256d reach_a = dot3(dots[0][i], dots[1][i], dots[2][i], ah[0], ah[1], ah[2]);
+    in_b = add(in_b, square_of_positive(sub(sub(along_b, bh[i]), reach_a)));
+  }
+  const __m256d frames = mul(_mm256_max_pd(in_a, in_b), _mm256_set1_pd(k.frame_shrink));
+  const __m256d squared = _mm256_max_pd(_mm256_max_pd(boxes_a, boxes_b), frames);
+  const __m256d bound = _mm256_max_pd(_mm256_max_pd(spheres, _mm256_sqrt_pd(squared)), _mm256_setzero_pd());
+  _mm256_storeu_pd(out, bound);
+}
+
+#undef CALIBER_AVX2
+
+}  // namespace
+
+Gaps2x2 gaps_2x2_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &gaps_2x2 : nullptr;
+}
+
+}  // namespace caliber::narrow::detail
+
+#else
+
+namespace caliber::narrow::detail {
+Gaps2x2 gaps_2x2_avx2_if_supported() { return nullptr; }
+}  // namespace caliber::narrow::detail
+
+#endif
