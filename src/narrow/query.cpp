@@ -52,7 +52,9 @@ void validate_request(const QueryRequest& request) {
 
 QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {
   const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
-  narrow::TraversalScratch scratch;
+  // Kept from call to call on each thread: the distance queue's tables cost more to make than a
+  // small query takes.
+  thread_local narrow::TraversalScratch scratch;
   std::vector<narrow::Candidate> candidates;
   QueryStats stats;
   narrow::PairLimit limit;

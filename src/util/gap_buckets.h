@@ -1,0 +1,122 @@
+#pragma once
+/// \file
+/// A priority queue of (key, value) entries with nonnegative double keys, by buckets: what the
+/// distance traversal keeps its waiting nodes in. A key's bucket is the top 20 bits of its IEEE
+/// representation (sign, exponent and 8 bits of mantissa), which orders nonnegative doubles, so a
+/// bucket holds keys within a factor 1 + 1/256 of each other. pop() takes an entry of the lowest
+/// nonempty bucket (the last one pushed there), found through a bitmap of nonempty buckets in
+/// three levels and a few top words: pushing and popping cost a few instructions whatever the
+/// number waiting, where a heap pays a compare per level (a branch either way, and a cache line)
+/// on every pop. Entries come out nearest bucket first, in no particular order within a bucket; a
+/// user that needs the exact order must not rely on it (the distance traversal prunes each popped
+/// node against the best distance found so far, so any order gives the same answer). Buckets of a
+/// sixteenth (16 bits) were measured too coarse: turbine x blade, about 11 apart, took 2.6 times
+/// the node tests.
+
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace caliber::util {
+
+template <class Value>
+class GapBuckets {
+ public:
+  struct Entry {
+    double key;
+    Value value;
+  };
+
+  GapBuckets() = default;
+
+  /// The bucket of a key (>= 0, or +infinity).
+  static std::uint32_t bucket_of(double key) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &key, sizeof bits);
+    return static_cast<std::uint32_t>(bits >> (64 - kBits));
+  }
+  /// The smallest key bucket b can hold.
+  static double floor_of(std::uint32_t b) {
+    const std::uint64_t bits = std::uint64_t{b} << (64 - kBits);
+    double key;
+    std::memcpy(&key, &bits, sizeof key);
+    return key;
+  }
+
+  [[nodiscard]] bool empty() const { return mCount == 0; }
+  /// The lowest nonempty bucket (the queue must not be empty).
+  [[nodiscard]] std::uint32_t min_bucket() const {
+    std::uint32_t i2 = 0;
+    while (mTop[i2] == 0) ++i2;
+    const auto i1 = i2 * 64 + static_cast<std::uint32_t>(std::countr_zero(mTop[i2]));
+    const auto i0 = i1 * 64 + static_cast<std::uint32_t>(std::countr_zero(mMiddle[i1]));
+    return i0 * 64 + static_cast<std::uint32_t>(std::countr_zero(mBottom[i0]));
+  }
+
+  /// Forgets every entry (keeps the memory).
+  void clear() {
+    while (!empty()) unmark(min_bucket());
+    mPool.clear();
+  }
+
+  void push(double key, Value value) {
+    if (!mHeads) allocate();
+    const std::uint32_t b = bucket_of(key);
+    const bool fresh = ((mBottom[b / 64] >> (b % 64)) & 1) == 0;
+    mPool.push_back(Node{Entry{key, value}, fresh ? kNone : mHeads[b]});
+    if (fresh) mark(b);
+    mHeads[b] = static_cast<std::uint32_t>(mPool.size() - 1);
+  }
+
+  /// Removes an entry of the lowest nonempty bucket and returns it (the queue must not be empty).
+  Entry pop() {
+    const std::uint32_t b = min_bucket();
+    const Node& node = mPool[mHeads[b]];
+    mHeads[b] = node.next;
+    if (node.next == kNone) unmark(b);
+    return node.entry;
+  }
+
+ private:
+  static constexpr int kBits = 20;
+  static constexpr std::uint32_t kBuckets = 1u << kBits;
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  struct Node {
+    Entry entry;
+    std::uint32_t next;  ///< the entry pushed before it into its bucket, or kNone
+  };
+
+  /// The buckets' tables, at the first push (a traversal that never queues anything, and the
+  /// scratch of every other kind of query, never pays for them): 4 MiB of heads never touched
+  /// until used, 130 KiB of bitmaps.
+  void allocate() {
+    mHeads = std::make_unique_for_overwrite<std::uint32_t[]>(kBuckets);
+    mBottom.assign(kBuckets / 64, 0);
+    mMiddle.assign(kBuckets / 4096, 0);
+  }
+  void mark(std::uint32_t b) {
+    ++mCount;
+    mBottom[b / 64] |= std::uint64_t{1} << (b % 64);
+    mMiddle[b / 4096] |= std::uint64_t{1} << ((b / 64) % 64);
+    mTop[b / 262144] |= std::uint64_t{1} << ((b / 4096) % 64);
+  }
+  void unmark(std::uint32_t b) {
+    --mCount;
+    if ((mBottom[b / 64] &= ~(std::uint64_t{1} << (b % 64))) != 0) return;
+    if ((mMiddle[b / 4096] &= ~(std::uint64_t{1} << ((b / 64) % 64))) != 0) return;
+    mTop[b / 262144] &= ~(std::uint64_t{1} << ((b / 4096) % 64));
+  }
+
+  std::vector<Node> mPool;            ///< every entry pushed since clear(), popped or not
+  /// Per nonempty bucket: its last entry in mPool (never initialized: read only where the bucket's
+  /// bit says it was written since it was last emptied).
+  std::unique_ptr<std::uint32_t[]> mHeads;
+  std::vector<std::uint64_t> mBottom;  ///< bit b: bucket b is nonempty
+  std::vector<std::uint64_t> mMiddle;  ///< bit w: word w of mBottom is nonzero
+  std::uint64_t mTop[kBuckets / 262144] = {};  ///< bit m: word m of mMiddle is nonzero
+  std::uint32_t mCount = 0;                    ///< nonempty buckets
+};
+
+}  // namespace caliber::util
