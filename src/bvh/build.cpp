@@ -18,8 +18,10 @@ namespace caliber {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using bvh::lateral_axes;
-using bvh::principal_turn;
+using bvh::split_turn;
+using bvh::triangle_turn;
+using bvh::turned_axes;
+using bvh::unturned_axes;
 
 /// Nodes with at most this many triangles get the exact covering radius (a pass over their vertices);
 /// larger ones bound it from their children's spheres.
@@ -60,10 +62,8 @@ struct WorkNode {
   Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
   double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
-  double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along lateral_axes(axis, turn)
+  double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along the turned lateral axes
   double turn[2] = {1.0, 0.0};                ///< the lateral axes' turn, float values
-  Vec3 moment1 = Vec3::Zero();                ///< sum of the vertices below (once per triangle corner)
-  Eigen::Matrix3d moment2 = Eigen::Matrix3d::Zero();  ///< sum of p p^T over the same
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -159,11 +159,11 @@ class Builder {
   /// One pass over the vertices of the triangles in mOrder[begin, end): the largest distances from
   /// c1 and from c2, rounded up a little so that they cover every vertex despite rounding in the
   /// norms, and the ranges of axis . v (the slab) and of the lateral axes' products (node.lateral_*).
-  void exact_bounds(const Vec3& c1, const Vec3& c2, WorkNode& node, std::uint32_t begin, std::uint32_t end, double& r1,
-                    double& r2) const {
+  void exact_bounds(const Vec3& c1, const Vec3& c2, const Vec3& u0, const Vec3& v0, WorkNode& node, std::uint32_t begin,
+                    std::uint32_t end, double& r1, double& r2) const {
     double d1 = 0.0, d2 = 0.0;
     Vec3 u, v;
-    lateral_axes(node.axis, node.turn, u, v);
+    turned_axes(u0, v0, node.turn, u, v);
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::numeric_limits<double>::infinity();
@@ -233,17 +233,17 @@ class Builder {
     node.groups = std::uint64_t{1} << (mMesh.groups.empty() ? 0 : mMesh.groups[tri]);
     const Vec3& normal = mNormals[tri];
     node.normal_sum = normal;
-    node.moment1 = a + b + c;
-    node.moment2 = a * a.transpose() + b * b.transpose() + c * c.transpose();
     if (normal.squaredNorm() > 0.0) {
       node.axis = to_float_axis(normal);
-      principal_turn(node.axis, node.moment1, node.moment2, 3.0, node.turn);
+      Vec3 u0, v0;
+      unturned_axes(node.axis, u0, v0);
+      triangle_turn(u0, v0, a, b, c, node.turn);
       node.cone = angle_between(node.axis.normalized(), normal) + kConeSlack;
       const double along[3] = {node.axis.dot(a), node.axis.dot(b), node.axis.dot(c)};
       node.slab_lo = std::min({along[0], along[1], along[2]});
       node.slab_hi = std::max({along[0], along[1], along[2]});
       Vec3 lateral[2];
-      lateral_axes(node.axis, node.turn, lateral[0], lateral[1]);
+      turned_axes(u0, v0, node.turn, lateral[0], lateral[1]);
       for (int k = 0; k < 2; ++k) {
         const double at[3] = {lateral[k].dot(a), lateral[k].dot(b), lateral[k].dot(c)};
         node.lateral_lo[k] = std::min({at[0], at[1], at[2]});
@@ -275,9 +275,12 @@ class Builder {
       }
       node.cone = std::min(angle + kConeSlack, 2.0 * std::numbers::pi);
     }
-    node.moment1 = l.moment1 + r.moment1;
-    node.moment2 = l.moment2 + r.moment2;
-    if (node.cone >= 0.0) principal_turn(node.axis, node.moment1, node.moment2, 3.0 * node.count, node.turn);
+    // The lateral axes before and after their turn (0 when there is no cone axis).
+    Vec3 u0 = Vec3::Zero(), v0 = Vec3::Zero();
+    if (node.cone >= 0.0) {
+      unturned_axes(node.axis, u0, v0);
+      split_turn(u0, v0, 0.5 * (r.lo + r.hi) - 0.5 * (l.lo + l.hi), node.turn);
+    }
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.
     Vec3 merged = l.center;
@@ -293,7 +296,7 @@ class Builder {
     double r_merged, r_box;
     if (node.count <= kExactRadiusCount) {
       // The slab's range comes from the same pass (unused, and the axis 0, when there is no cone).
-      exact_bounds(merged, box, node, begin, end, r_merged, r_box);
+      exact_bounds(merged, box, u0, v0, node, begin, end, r_merged, r_box);
     } else {
       // Near the root, the children's spheres bound the radius: O(1) instead of a pass over every
       // vertex below, which keeps the build O(n log n) with a small constant. These few large
@@ -306,7 +309,7 @@ class Builder {
       // The slab and lateral ranges likewise: the children's boxes projected on the axes (a bound,
       // not the range).
       Vec3 u, v;
-      lateral_axes(node.axis, node.turn, u, v);
+      turned_axes(u0, v0, node.turn, u, v);
       children_range(node.axis, l, r, node.slab_lo, node.slab_hi);
       children_range(u, l, r, node.lateral_lo[0], node.lateral_hi[0]);
       children_range(v, l, r, node.lateral_lo[1], node.lateral_hi[1]);

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
 /// The lateral axes of a node's frame at build time (the distance bound's box, BvhNodeLateral):
-/// the axes the build measures ranges along, and the turn that fits them to the vertices.
+/// the turn that fits them to the triangles below, and the axes the build measures ranges along.
+/// A turn is a heuristic: any turn gives valid ranges, since they are measured along the turned
+/// axes, which the query computes by the same formulas (caliber::lateral_axes).
 
 #include <cmath>
 
@@ -13,40 +15,65 @@ namespace caliber::bvh {
 
 using Vec3 = Eigen::Vector3d;
 
-/// lateral_axes of a cone axis and a turn already rounded to float (so exactly the stored ones).
-inline void lateral_axes(const Vec3& axis, const double turn[2], Vec3& u, Vec3& v) {
-  const float stored[3] = {static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z())};
-  const float stored_turn[2] = {static_cast<float>(turn[0]), static_cast<float>(turn[1])};
-  caliber::lateral_axes(stored, stored_turn, u.data(), v.data());
-}
-
-/// The turn of the lateral axes that follows the vertices' spread: the principal direction, in the
-/// plane of the unturned lateral axes, of the vertices' second moments (sum of p, of p p^T, and
-/// their count), as (cos, sin) rounded to float. A heuristic: any turn gives valid ranges, since
-/// they are measured along the turned axes.
-inline void principal_turn(const Vec3& axis, const Vec3& sum, const Eigen::Matrix3d& sum2, double count, double turn[2]) {
-  turn[0] = 1.0;
-  turn[1] = 0.0;
-  if (!(count > 0.0)) return;
-  const double none[2] = {1.0, 0.0};
-  Vec3 u, v;
-  lateral_axes(axis, none, u, v);
-  if (u.squaredNorm() == 0.0) return;
-  const Vec3 mean = sum / count;
-  const Eigen::Matrix3d cov = sum2 / count - mean * mean.transpose();
-  const Vec3 cov_u = cov * u;
-  const double x = u.dot(cov_u) - v.dot(cov * v), y = 2.0 * v.dot(cov_u);
-  // The principal angle is half of atan2(y, x); (r + x, y) points along it, with no trigonometry.
-  const double r = std::sqrt(x * x + y * y);
-  const double cx = r + x, sy = y;
-  const double len = std::sqrt(cx * cx + sy * sy);
-  if (!(len > 0.0) || !std::isfinite(len)) {
-    // x <= 0 and y = 0: a quarter turn, or no spread at all (any turn).
-    if (x < 0.0) turn[0] = 0.0, turn[1] = 1.0;
+/// The unturned lateral axes of a cone axis already rounded to float (Duff et al.'s basis of the
+/// stored axis): what a turn is measured from.
+inline void unturned_axes(const Vec3& axis, Vec3& u0, Vec3& v0) {
+  // caliber::lateral_axes before its turn, step by step.
+  const double x = static_cast<float>(axis.x()), y = static_cast<float>(axis.y()), z = static_cast<float>(axis.z());
+  const double len = std::sqrt(x * x + y * y + z * z);
+  if (!(len > 0.0)) {
+    u0.setZero();
+    v0.setZero();
     return;
   }
-  turn[0] = static_cast<float>(cx / len);
-  turn[1] = static_cast<float>(sy / len);
+  caliber::lateral_axes_of_unit(x / len, y / len, z / len, u0.data(), v0.data());
+}
+
+/// The lateral axes the query computes from the stored axis and turn (`turn` holds float values),
+/// from the unturned ones: the same turn_lateral_axes that caliber::lateral_axes ends with.
+inline void turned_axes(const Vec3& u0, const Vec3& v0, const double turn[2], Vec3& u, Vec3& v) {
+  const float stored_turn[2] = {static_cast<float>(turn[0]), static_cast<float>(turn[1])};
+  u = u0;
+  v = v0;
+  caliber::turn_lateral_axes(stored_turn, u.data(), v.data());
+}
+
+/// The turn, as (cos, sin) rounded to float, of the direction (x, y) in the (u0, v0) plane; no
+/// turn where it vanishes.
+inline void turn_towards(double x, double y, double turn[2]) {
+  turn[0] = 1.0;
+  turn[1] = 0.0;
+  const double len = std::sqrt(x * x + y * y);
+  if (!(len > 0.0) || !std::isfinite(len)) return;
+  turn[0] = static_cast<float>(x / len);
+  turn[1] = static_cast<float>(y / len);
+}
+
+/// A triangle's turn: along the principal direction of its corners' spread in the (u0, v0)
+/// plane. The covariance's principal angle is half of atan2(2 c_uv, c_uu - c_vv); (r + x, y)
+/// points along it with no trigonometry (x <= 0 and y = 0: a quarter turn).
+inline void triangle_turn(const Vec3& u0, const Vec3& v0, const Vec3& a, const Vec3& b, const Vec3& c, double turn[2]) {
+  const double pu[3] = {u0.dot(a), u0.dot(b), u0.dot(c)}, pv[3] = {v0.dot(a), v0.dot(b), v0.dot(c)};
+  const double mu = (pu[0] + pu[1] + pu[2]) / 3.0, mv = (pv[0] + pv[1] + pv[2]) / 3.0;
+  double cuu = 0.0, cvv = 0.0, cuv = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    cuu += (pu[i] - mu) * (pu[i] - mu);
+    cvv += (pv[i] - mv) * (pv[i] - mv);
+    cuv += (pu[i] - mu) * (pv[i] - mv);
+  }
+  const double x = cuu - cvv, y = 2.0 * cuv;
+  const double r = std::sqrt(x * x + y * y);
+  if (r + x > 0.0 || y != 0.0) {
+    turn_towards(r + x, y, turn);
+  } else {
+    turn_towards(x < 0.0 ? 0.0 : 1.0, x < 0.0 ? 1.0 : 0.0, turn);
+  }
+}
+
+/// An internal node's turn: along the line between its children's box centers (across which
+/// the build split it), projected on the (u0, v0) plane.
+inline void split_turn(const Vec3& u0, const Vec3& v0, const Vec3& direction, double turn[2]) {
+  turn_towards(direction.dot(u0), direction.dot(v0), turn);
 }
 
 }  // namespace caliber::bvh
