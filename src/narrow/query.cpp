@@ -50,6 +50,9 @@ void validate_request(const QueryRequest& request) {
   }
 }
 
+/// The most traversal scratch query() keeps on a thread between calls.
+constexpr std::size_t kKeptScratchBytes = std::size_t{2} << 20;
+
 QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {
   const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
   // Kept from call to call on each thread: the distance queue's tables cost more to make than a
@@ -61,6 +64,9 @@ QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose
   limit.max = request.max_pairs;
   narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats, false, {},
                    request.max_pairs != 0 ? &limit : nullptr);
+  // A large query's scratch is let go: the thread would hold it, and every later query would
+  // clear its tables. (Such a query takes far longer than making them again.)
+  if (scratch.footprint() > kKeptScratchBytes) scratch = narrow::TraversalScratch{};
   return narrow::finalize(ctx, candidates, stats);
 }
 

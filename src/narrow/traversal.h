@@ -176,66 +176,17 @@ struct PairLimit {
   [[nodiscard]] bool exceeded() const { return kept.load(std::memory_order_relaxed) > max; }
 };
 
-/// The nodes one traversal has prepared, by node index, so that each is prepared once however many
-/// partners it meets (the distance traversal meets a node 7-10 times on the bunny): an open-
-/// addressing table of indices over a store whose entries never move (so a reference to one
-/// stays valid while others are added). Cleared per traversal: a prepared node depends on the
-/// pair's relative pose.
-template <class Prepared>
-class PreparedNodes {
- public:
-  /// Forgets every entry (keeps the memory).
-  void clear() {
-    std::fill(mKeys.begin(), mKeys.end(), kEmpty);
-    mCount = 0;
-  }
-  /// The entry of node `index`, made by prepare(index) the first time it is asked for.
-  template <class Prepare>
-  const Prepared& get(std::uint32_t index, Prepare&& prepare) {
-    if (2 * (mCount + 1) > mKeys.size()) grow();
-    const std::size_t mask = mKeys.size() - 1;
-    for (std::size_t h = (index * std::size_t{0x9E3779B1u}) & mask;; h = (h + 1) & mask) {
-      if (mKeys[h] == index) return at(mSlots[h]);
-      if (mKeys[h] == kEmpty) {
-        mKeys[h] = index;
-        mSlots[h] = mCount;
-        if (mCount / kChunk == mChunks.size()) mChunks.push_back(std::make_unique_for_overwrite<Prepared[]>(kChunk));
-        Prepared& entry = at(mCount++);
-        entry = prepare(index);
-        return entry;
-      }
-    }
-  }
-
- private:
-  static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
-  static constexpr std::size_t kChunk = 64;
-  Prepared& at(std::size_t slot) { return mChunks[slot / kChunk][slot % kChunk]; }
-  void grow() {
-    const std::size_t size = std::max<std::size_t>(64, 2 * mKeys.size());
-    std::vector<std::uint32_t> keys(size, kEmpty), slots(size);
-    for (std::size_t h = 0; h < mKeys.size(); ++h) {
-      if (mKeys[h] == kEmpty) continue;
-      std::size_t g = (mKeys[h] * std::size_t{0x9E3779B1u}) & (size - 1);
-      while (keys[g] != kEmpty) g = (g + 1) & (size - 1);
-      keys[g] = mKeys[h];
-      slots[g] = mSlots[h];
-    }
-    mKeys = std::move(keys);
-    mSlots = std::move(slots);
-  }
-  std::vector<std::uint32_t> mKeys;   ///< node index per table slot, kEmpty when free
-  std::vector<std::uint32_t> mSlots;  ///< its entry in the store
-  std::vector<std::unique_ptr<Prepared[]>> mChunks;
-  std::size_t mCount = 0;
-};
-
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
   util::GapBuckets<NodePair> waiting;  ///< distance traversal: the nodes waiting, by gap
   PreparedNodes<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
   PreparedNodes<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
+
+  /// Bytes held that grow with the largest traversal so far (not the buckets' fixed tables).
+  [[nodiscard]] std::size_t footprint() const {
+    return stack.capacity() * sizeof(NodePair) + waiting.footprint() + near_a.footprint() + near_b.footprint();
+  }
 };
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it

@@ -31,11 +31,13 @@ class GapBuckets {
 
   GapBuckets() = default;
 
-  /// The bucket of a key (>= 0, or +infinity).
+  /// The bucket of a key: by its representation where it is >= +0 (or +infinity); a key with
+  /// the sign bit set (-0, or a negative lower bound) goes to bucket 0, the nearest, not past
+  /// every positive one.
   static std::uint32_t bucket_of(double key) {
     std::uint64_t bits;
     std::memcpy(&bits, &key, sizeof bits);
-    return static_cast<std::uint32_t>(bits >> (64 - kBits));
+    return (bits >> 63) != 0 ? 0u : static_cast<std::uint32_t>(bits >> (64 - kBits));
   }
   /// The smallest key bucket b can hold.
   static double floor_of(std::uint32_t b) {
@@ -54,6 +56,9 @@ class GapBuckets {
     const auto i0 = i1 * 64 + static_cast<std::uint32_t>(std::countr_zero(mMiddle[i1]));
     return i0 * 64 + static_cast<std::uint32_t>(std::countr_zero(mBottom[i0]));
   }
+
+  /// Bytes held by the entries' store (the largest number pushed between two clears).
+  [[nodiscard]] std::size_t footprint() const { return mPool.capacity() * sizeof(Node); }
 
   /// Forgets every entry (keeps the memory).
   void clear() {

@@ -71,6 +71,13 @@ TEST(GapBuckets, ABucketHoldsTheKeysFromItsFloorToTheNext) {
     ASSERT_LT(k, Buckets::floor_of(b) * (1.0 + 1.0 / 256.0) * (1.0 + 1e-15));
   }
   EXPECT_EQ(Buckets::bucket_of(0.0), 0u);
+  // Keys with the sign bit set come out first, not last.
+  EXPECT_EQ(Buckets::bucket_of(-0.0), 0u);
+  EXPECT_EQ(Buckets::bucket_of(-1.0), 0u);
+  Buckets queue;
+  queue.push(1.0, 1);
+  queue.push(-0.0, 2);
+  EXPECT_EQ(queue.pop().value, 2u);
   EXPECT_LT(Buckets::bucket_of(1.0), Buckets::bucket_of(std::numeric_limits<double>::infinity()));
 }
 
