@@ -15,6 +15,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <cstddef>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -39,7 +40,8 @@ class GapBuckets {
     std::memcpy(&bits, &key, sizeof bits);
     return (bits >> 63) != 0 ? 0u : static_cast<std::uint32_t>(bits >> (64 - kBits));
   }
-  /// The smallest key bucket b can hold.
+  /// The smallest nonnegative key bucket b holds (bucket 0 also holds the keys with the sign bit
+  /// set, all below its floor 0: a lower bound, so they come out no later than they should).
   static double floor_of(std::uint32_t b) {
     const std::uint64_t bits = std::uint64_t{b} << (64 - kBits);
     double key;
