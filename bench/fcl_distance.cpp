@@ -56,6 +56,14 @@ Pose place(const Case& c, const Mesh& a, const Mesh& b, double gap) {
   return Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
 }
 
+/// The query both sides answer: the exact distance, unbounded.
+QueryRequest distance_request() {
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  request.tolerance = kUnbounded;
+  return request;
+}
+
 struct Row {
   std::string name;
   double gap;
@@ -81,9 +89,7 @@ void fcl_counts(const FclModel& fa, const FclModel& fb, const Pose& pose_b, cons
 Row run(const Case& c, double gap, const Model& a, const Model& b, const std::shared_ptr<FclModel>& fa,
         const std::shared_ptr<FclModel>& fb, int repeat) {
   const Pose pose_b = place(c, a.mesh, b.mesh, gap);
-  QueryRequest request;
-  request.kind = QueryKind::distance;
-  request.tolerance = kUnbounded;
+  const QueryRequest request = distance_request();
   fcl::CollisionObjectd oa(fa, bench::to_fcl(Pose{}));
   fcl::CollisionObjectd ob(fb, bench::to_fcl(pose_b));
   fcl::DistanceRequestd freq(true, true, 0.0, 0.0);
@@ -153,9 +159,7 @@ int main(int argc, char** argv) {
     if (ours_only) {
       for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
         const Pose pose_b = place(c, a->mesh, b->mesh, gap);
-        QueryRequest request;
-        request.kind = QueryKind::distance;
-        request.tolerance = kUnbounded;
+        const QueryRequest request = distance_request();
         QueryResult ours;
         const double ms = bench::median_ms(repeat, [&] { ours = query(*a, Pose{}, *b, pose_b, request); });
         std::printf("%s gap %g: %.12g in %.3f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,

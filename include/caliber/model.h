@@ -106,10 +106,9 @@ inline void turn_lateral_axes(const float turn[2], double u[3], double v[3]) {
   }
 }
 
-/// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
-/// axis, turned by the stored turn, by the same formulas at build and at query time. Both 0 when
-/// the axis is 0.
-inline void lateral_axes(const float axis[3], const float turn[2], double u[3], double v[3]) {
+/// The lateral axes of a stored float cone axis before their turn: those of the normalized axis
+/// (lateral_axes_of_unit). Both 0 when the axis is 0.
+inline void unturned_lateral_axes(const float axis[3], double u[3], double v[3]) {
   const double x = axis[0], y = axis[1], z = axis[2];
   const double len = std::sqrt(x * x + y * y + z * z);
   if (!(len > 0.0)) {
@@ -117,6 +116,13 @@ inline void lateral_axes(const float axis[3], const float turn[2], double u[3], 
     return;
   }
   lateral_axes_of_unit(x / len, y / len, z / len, u, v);
+}
+
+/// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
+/// axis, turned by the stored turn, by the same formulas at build and at query time. Both 0 when
+/// the axis is 0.
+inline void lateral_axes(const float axis[3], const float turn[2], double u[3], double v[3]) {
+  unturned_lateral_axes(axis, u, v);
   turn_lateral_axes(turn, u, v);
 }
 

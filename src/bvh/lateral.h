@@ -18,15 +18,8 @@ using Vec3 = Eigen::Vector3d;
 /// The unturned lateral axes of a cone axis already rounded to float (Duff et al.'s basis of the
 /// stored axis): what a turn is measured from.
 inline void unturned_axes(const Vec3& axis, Vec3& u0, Vec3& v0) {
-  // caliber::lateral_axes before its turn, step by step.
-  const double x = static_cast<float>(axis.x()), y = static_cast<float>(axis.y()), z = static_cast<float>(axis.z());
-  const double len = std::sqrt(x * x + y * y + z * z);
-  if (!(len > 0.0)) {
-    u0.setZero();
-    v0.setZero();
-    return;
-  }
-  caliber::lateral_axes_of_unit(x / len, y / len, z / len, u0.data(), v0.data());
+  const float stored[3] = {static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z())};
+  caliber::unturned_lateral_axes(stored, u0.data(), v0.data());
 }
 
 /// The lateral axes the query computes from the stored axis and turn (`turn` holds float values),

@@ -122,6 +122,21 @@ template <class PrepareA, class PrepareB, class Test>
   }
 }
 
+/// The four children of a visit where both sides split (A's a0 and a0 + 1 against B's b0 and
+/// b0 + 1, in cd_children order) that are not on the taboo list (those marked reached), each
+/// counted in stats.node_tests: calls take(k, child) with k = 2i + j, the lane of the four-at-once
+/// tests that computed it.
+template <class Take>
+[[gnu::always_inline]] inline void for_each_child_2x2(std::uint32_t a0, std::uint32_t b0, QueryStats& stats, TabooView taboo,
+                                                      Take&& take) {
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    const NodePair child{a0 + k / 2, b0 + k % 2};
+    if (on_taboo(taboo, child)) continue;
+    ++stats.node_tests;
+    take(k, child);
+  }
+}
+
 /// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
 /// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
 /// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
@@ -147,12 +162,9 @@ template <class PrepareA, class PrepareB, class Test>
     // entered). (Where one side does not split, the scalar tests below were measured faster than
     // four lanes with two wasted: step 1.01-1.03, queries up to 1.05.)
     const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
-    for (std::uint32_t k = 0; k < 4; ++k) {
-      const NodePair child{a.index + k / 2, b.index + k % 2};
-      if (on_taboo(taboo, child)) continue;
-      ++stats.node_tests;
+    for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
-    }
+    });
     return count;
   }
   for_each_child(
@@ -306,12 +318,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       // as for_each_child takes them (a child on the taboo list marked reached, not counted).
       double gaps[4];
       ctx.gaps_2x2(*near_a(a.index), *near_a(a.index + 1), *near_b(b.index), *near_b(b.index + 1), reach, gaps);
-      for (std::uint32_t k = 0; k < 4; ++k) {
-        const NodePair child{a.index + k / 2, b.index + k % 2};
-        if (on_taboo(taboo, child)) continue;
-        ++stats.node_tests;
-        wait(gaps[k], child);
-      }
+      for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) { wait(gaps[k], child); });
     } else {
       for_each_child(n, a, b, stats, taboo, near_a, near_b,
                      [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
