@@ -1,6 +1,6 @@
 // The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
-// PairContext::gap's three bounds (spheres, object-frame boxes, Frames) in every lane, their
-// largest, no early exit, each with the scalar's operations in its order (this file is built with
+// PairContext::gap's bounds (spheres, object-frame boxes, Frames along their axes, frames_apart)
+// in every lane, their largest, no early exit, each with the scalar's operations in its order (this file is built with
 // -ffp-contract=off, like the rest, and only "avx2" is enabled here, not "fma").
 
 #include "narrow/distance_bound_avx2.h"
@@ -28,6 +28,46 @@ CALIBER_AVX2 inline __m256d square_of_positive(__m256d u) {
 }
 CALIBER_AVX2 inline __m256d dot3(__m256d x0, __m256d x1, __m256d x2, __m256d y0, __m256d y1, __m256d y2) {
   return add(add(mul(x0, y0), mul(x1, y1)), mul(x2, y2));
+}
+
+/// std::clamp(s, -h, h), as the scalar's comparisons take it (s < -h, then h < s).
+CALIBER_AVX2 inline __m256d clamp_half(__m256d s, __m256d h) {
+  const __m256d lo = _mm256_xor_pd(h, _mm256_set1_pd(-0.0));
+  return _mm256_blendv_pd(_mm256_blendv_pd(s, h, _mm256_cmp_pd(h, s, _CMP_LT_OQ)), lo, _mm256_cmp_pd(s, lo, _CMP_LT_OQ));
+}
+
+/// Frame::clamp_into in four lanes: the point of the box (axes f, center c, half-extents h) nearest
+/// to x, as frame coordinates clamped and brought back.
+CALIBER_AVX2 inline void clamp_into(const __m256d f[3][3], const __m256d c[3], const __m256d h[3], const __m256d x[3],
+                                    __m256d out[3]) {
+  __m256d t[3];
+  const __m256d r[3] = {sub(x[0], c[0]), sub(x[1], c[1]), sub(x[2], c[2])};
+  for (int k = 0; k < 3; ++k) t[k] = clamp_half(dot3(f[k][0], f[k][1], f[k][2], r[0], r[1], r[2]), h[k]);
+  for (int i = 0; i < 3; ++i) out[i] = add(add(add(c[i], mul(t[0], f[0][i])), mul(t[1], f[1][i])), mul(t[2], f[2][i]));
+}
+
+/// PairContext::frames_apart in four lanes (d: B's frame center less A's).
+CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d ax[3][3], const __m256d d[3], const __m256d ah[3],
+                                         const __m256d bx[3][3], const __m256d bh[3], const NearA& a0, const NearA& a1,
+                                         const NearB& b0, const NearB& b1) {
+  __m256d ac[3], bc[3], p[3], q[3];
+  for (int i = 0; i < 3; ++i) {
+    ac[i] = lanes_a(a0.frame.center[i], a1.frame.center[i]);
+    bc[i] = lanes_b(b0.frame.center[i], b1.frame.center[i]);
+  }
+  clamp_into(ax, ac, ah, bc, p);
+  clamp_into(bx, bc, bh, p, q);
+  __m256d n[3] = {sub(q[0], p[0]), sub(q[1], p[1]), sub(q[2], p[2])};
+  const __m256d len = _mm256_sqrt_pd(dot3(n[0], n[1], n[2], n[0], n[1], n[2]));
+  const __m256d some = _mm256_cmp_pd(len, _mm256_setzero_pd(), _CMP_GT_OQ);
+  __m256d at = dot3(n[0], n[1], n[2], d[0], d[1], d[2]);
+  const __m256d hair = mul(_mm256_set1_pd(k.hair), len);
+  for (int j = 0; j < 3; ++j) {
+    at = sub(at, mul(ah[j], add(magnitude(dot3(n[0], n[1], n[2], ax[j][0], ax[j][1], ax[j][2])), hair)));
+    at = sub(at, mul(bh[j], add(magnitude(dot3(n[0], n[1], n[2], bx[j][0], bx[j][1], bx[j][2])), hair)));
+  }
+  const __m256d apart = _mm256_max_pd(mul(_mm256_div_pd(at, len), _mm256_set1_pd(k.apart_shrink)), _mm256_setzero_pd());
+  return _mm256_and_pd(apart, some);
 }
 
 CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
@@ -80,7 +120,8 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
   const __m256d frames = mul(_mm256_max_pd(in_a, in_b), _mm256_set1_pd(k.frame_shrink));
   const __m256d squared = _mm256_max_pd(_mm256_max_pd(boxes_a, boxes_b), frames);
   const __m256d bound = _mm256_max_pd(_mm256_max_pd(spheres, _mm256_sqrt_pd(squared)), _mm256_setzero_pd());
-  _mm256_storeu_pd(out, bound);
+  // As the scalar's std::max(cheap, apart): the cheap bound where they are equal or it is NaN.
+  _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, ax, d, ah, bx, bh, a0, a1, b0, b1), bound));
 }
 
 #undef CALIBER_AVX2

@@ -14,6 +14,7 @@ namespace caliber::narrow::detail {
 struct BoundConstants {
   double hair;          ///< added to |axis . axis| products (rounding in rotated axes)
   double frame_shrink;  ///< factor on the frames' squared gaps (axes orthonormal up to rounding)
+  double apart_shrink;  ///< factor on frames_apart's separation
 };
 
 /// out[2i + j] = the bound between ai and bj, before groups.

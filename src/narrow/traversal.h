@@ -320,9 +320,17 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       ctx.gaps_2x2(*near_a(a.index), *near_a(a.index + 1), *near_b(b.index), *near_b(b.index + 1), reach, gaps);
       for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) { wait(gaps[k], child); });
     } else {
+      // One side splits: its two children against the other node, in the four lanes with the
+      // other node twice (lanes 0 and 2, or 0 and 1, hold the two child pairs).
+      const auto* a0 = near_a(split_a ? a.index : n.a);
+      const auto* a1 = split_a ? near_a(a.index + 1) : a0;
+      const auto* b0 = near_b(split_b ? b.index : n.b);
+      const auto* b1 = split_b ? near_b(b.index + 1) : b0;
+      double gaps[4];
+      ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
       for_each_child(n, a, b, stats, taboo, near_a, near_b,
                      [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
-                       wait(ctx.gap(*sa, *sb, reach), child);
+                       wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], child);
                      });
     }
     // The nearest child is visited next without going through the queue when no waiting node is
