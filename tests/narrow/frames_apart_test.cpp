@@ -1,4 +1,4 @@
-// PairContext::frames_apart, the distance bound's separation of two Frames along the direction
+// frames_apart, the distance bound's separation of two Frames along the direction
 // between a point of each: never above the distance of any two points of the boxes (corners,
 // points on faces, inside), on random boxes at random poses, some overlapping; and tight where the
 // Frames' own axes are not (two flat squares offset along a diagonal).
@@ -10,10 +10,13 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "narrow/pair_context.h"
+#include "narrow/frames_apart.h"
 
 namespace caliber::narrow {
 namespace {
+
+/// frames_apart with PairContext's allowances.
+double apart_of(const Frame& a, const Frame& b, const double d[3]) { return frames_apart(a, b, d, 1e-12, 1.0 - 3e-9); }
 
 Frame random_frame(std::mt19937_64& rng, double spread) {
   std::normal_distribution<double> normal;
@@ -45,7 +48,7 @@ TEST(FramesApart, NeverAboveThePointsDistance) {
   for (int trial = 0; trial < 4000; ++trial) {
     const Frame a = random_frame(rng, 1.0), b = random_frame(rng, trial % 2 == 0 ? 1.0 : 4.0);
     const double d[3] = {b.center[0] - a.center[0], b.center[1] - a.center[1], b.center[2] - a.center[2]};
-    const double apart = PairContext::frames_apart(a, b, d);
+    const double apart = apart_of(a, b, d);
     ASSERT_GE(apart, 0.0);
     positive += apart > 0.0;
     // Corners against corners, points on faces (one coordinate at +-1) and inside.
@@ -77,13 +80,13 @@ TEST(FramesApart, TightWhereTheFramesAxesAreNot) {
   a.half[0] = a.half[1] = b.half[0] = b.half[1] = 1.0;
   b.center[0] = b.center[1] = 3.0;
   const double d[3] = {3.0, 3.0, 0.0};
-  const double apart = PairContext::frames_apart(a, b, d);
+  const double apart = apart_of(a, b, d);
   EXPECT_LE(apart, std::sqrt(2.0));
   EXPECT_GT(apart, std::sqrt(2.0) * (1.0 - 1e-8));
   // Overlapping: nothing.
   b.center[0] = b.center[1] = 1.5;
   const double near[3] = {1.5, 1.5, 0.0};
-  EXPECT_EQ(PairContext::frames_apart(a, b, near), 0.0);
+  EXPECT_EQ(apart_of(a, b, near), 0.0);
 }
 
 }  // namespace
