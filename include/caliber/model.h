@@ -73,7 +73,9 @@ struct BvhNodeFilter {
 /// narrow box whatever its direction. All 0 when the cone axis is 0.
 struct BvhNodeLateral {
   float lateral_lo[2], lateral_hi[2];
-  float turn[2];  ///< (cos, sin) of the turn, up to scale (normalized in double where used)
+  /// (cos, sin) of the turn, up to scale, as integers of at most 32767 in magnitude (normalized
+  /// in double where used).
+  std::int16_t turn[2];
 };
 
 /// The two axes that complete a unit axis (nx, ny, nz) to an orthonormal frame (Duff et al. 2017's
@@ -93,7 +95,7 @@ inline void lateral_axes_of_unit(double nx, double ny, double nz, double u[3], d
 /// Turns the orthonormal pair (u, v) about their normal by the angle whose (cos, sin) is `turn` up
 /// to scale (normalized here in double, so the pair stays orthonormal up to double rounding; a zero
 /// turn leaves it as it is).
-inline void turn_lateral_axes(const float turn[2], double u[3], double v[3]) {
+inline void turn_lateral_axes(const std::int16_t turn[2], double u[3], double v[3]) {
   double c = turn[0], s = turn[1];
   const double r = std::sqrt(c * c + s * s);
   if (!(r > 0.0)) return;
@@ -121,7 +123,7 @@ inline void unturned_lateral_axes(const float axis[3], double u[3], double v[3])
 /// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
 /// axis, turned by the stored turn, by the same formulas at build and at query time. Both 0 when
 /// the axis is 0.
-inline void lateral_axes(const float axis[3], const float turn[2], double u[3], double v[3]) {
+inline void lateral_axes(const float axis[3], const std::int16_t turn[2], double u[3], double v[3]) {
   unturned_lateral_axes(axis, u, v);
   turn_lateral_axes(turn, u, v);
 }

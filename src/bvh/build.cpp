@@ -63,7 +63,7 @@ struct WorkNode {
   double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
   double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
   double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along the turned lateral axes
-  double turn[2] = {1.0, 0.0};                ///< the lateral axes' turn, float values
+  double turn[2] = {1.0, 0.0};                ///< the lateral axes' turn, the stored integers
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -347,7 +347,7 @@ class Builder {
     for (int k = 0; k < 2; ++k) {
       lateral.lateral_lo[k] = w.cone >= 0.0 ? round_down(w.lateral_lo[k] - slab_pad) : 0.0f;
       lateral.lateral_hi[k] = w.cone >= 0.0 ? round_up(w.lateral_hi[k] + slab_pad) : 0.0f;
-      lateral.turn[k] = static_cast<float>(w.turn[k]);  // already float values
+      lateral.turn[k] = static_cast<std::int16_t>(w.turn[k]);  // already integers within 32767
     }
   }
 

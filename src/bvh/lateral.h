@@ -5,7 +5,9 @@
 /// A turn is a heuristic: any turn gives valid ranges, since they are measured along the turned
 /// axes, which the query computes by the same formulas (caliber::lateral_axes).
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Core>
 
@@ -22,24 +24,25 @@ inline void unturned_axes(const Vec3& axis, Vec3& u0, Vec3& v0) {
   caliber::unturned_lateral_axes(stored, u0.data(), v0.data());
 }
 
-/// The lateral axes the query computes from the stored axis and turn (`turn` holds float values),
-/// from the unturned ones: the same turn_lateral_axes that caliber::lateral_axes ends with.
+/// The lateral axes the query computes from the stored axis and turn (`turn` holds the stored
+/// integers), from the unturned ones: the same turn_lateral_axes that caliber::lateral_axes ends
+/// with.
 inline void turned_axes(const Vec3& u0, const Vec3& v0, const double turn[2], Vec3& u, Vec3& v) {
-  const float stored_turn[2] = {static_cast<float>(turn[0]), static_cast<float>(turn[1])};
+  const std::int16_t stored_turn[2] = {static_cast<std::int16_t>(turn[0]), static_cast<std::int16_t>(turn[1])};
   u = u0;
   v = v0;
   caliber::turn_lateral_axes(stored_turn, u.data(), v.data());
 }
 
-/// The turn, as (cos, sin) rounded to float, of the direction (x, y) in the (u0, v0) plane; no
-/// turn where it vanishes.
+/// The turn, as (cos, sin) times 32767 rounded to integers (BvhNodeLateral::turn), of the
+/// direction (x, y) in the (u0, v0) plane; no turn where it vanishes.
 inline void turn_towards(double x, double y, double turn[2]) {
   turn[0] = 1.0;
   turn[1] = 0.0;
   const double len = std::sqrt(x * x + y * y);
   if (!(len > 0.0) || !std::isfinite(len)) return;
-  turn[0] = static_cast<float>(x / len);
-  turn[1] = static_cast<float>(y / len);
+  turn[0] = std::nearbyint(32767.0 * std::clamp(x / len, -1.0, 1.0));
+  turn[1] = std::nearbyint(32767.0 * std::clamp(y / len, -1.0, 1.0));
 }
 
 /// A triangle's turn: along the principal direction of its corners' spread in the (u0, v0)
