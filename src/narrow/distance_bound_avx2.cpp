@@ -1,6 +1,6 @@
 // The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
 // PairContext::gap's bounds (spheres, object-frame boxes, Frames along their axes, frames_apart)
-// in every lane, their largest, no early exit, each with the scalar's operations in its order (this file is built with
+// in every lane, their largest, each stage skipped once every lane is beyond the reach, each with the scalar's operations in its order (this file is built with
 // -ffp-contract=off, like the rest, and only "avx2" is enabled here, not "fma").
 
 #include "narrow/distance_bound_avx2.h"
@@ -70,8 +70,12 @@ CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d 
   return _mm256_and_pd(apart, some);
 }
 
+/// Whether every lane of u is above `reach`.
+CALIBER_AVX2 inline bool all_beyond(__m256d u, __m256d reach) { return _mm256_movemask_pd(_mm256_cmp_pd(u, reach, _CMP_GT_OQ)) == 0xF; }
+
 CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
-                           double out[4]) {
+                           double reach_, double out[4]) {
+  const __m256d reach = _mm256_set1_pd(reach_);
   // Spheres: |ca - cb| - ra - rb.
   __m256d dist2 = _mm256_setzero_pd();
   for (int i = 0; i < 3; ++i) {
@@ -80,6 +84,11 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
   }
   const __m256d spheres =
       sub(sub(_mm256_sqrt_pd(dist2), lanes_a(a0.radius, a1.radius)), lanes_b(b0.radius, b1.radius));
+  // Every lane beyond the reach already (where the scalar stops too): the rest is not needed.
+  if (all_beyond(spheres, reach)) {
+    _mm256_storeu_pd(out, spheres);
+    return;
+  }
   // Object-frame boxes: each box against the other's box seen along its axes.
   __m256d boxes_a = _mm256_setzero_pd(), boxes_b = _mm256_setzero_pd();
   for (int i = 0; i < 3; ++i) {
@@ -89,6 +98,11 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
     const __m256d along_b = magnitude(sub(lanes_b(b0.box[i], b1.box[i]), lanes_a(a0.box_in_b[i], a1.box_in_b[i])));
     boxes_b = add(boxes_b, square_of_positive(sub(sub(along_b, lanes_b(b0.half[i], b1.half[i])),
                                                   lanes_a(a0.reach_on_b[i], a1.reach_on_b[i]))));
+  }
+  const __m256d cheapest = _mm256_max_pd(spheres, _mm256_sqrt_pd(_mm256_max_pd(boxes_a, boxes_b)));
+  if (all_beyond(cheapest, reach)) {
+    _mm256_storeu_pd(out, cheapest);
+    return;
   }
   // Frames: along A's frame axes, then B's; |a_i . b_j| grown by the hair.
   __m256d ax[3][3], bx[3][3], d[3], ah[3], bh[3];
@@ -120,7 +134,12 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
   const __m256d frames = mul(_mm256_max_pd(in_a, in_b), _mm256_set1_pd(k.frame_shrink));
   const __m256d squared = _mm256_max_pd(_mm256_max_pd(boxes_a, boxes_b), frames);
   const __m256d bound = _mm256_max_pd(_mm256_max_pd(spheres, _mm256_sqrt_pd(squared)), _mm256_setzero_pd());
-  // As the scalar's std::max(cheap, apart): the cheap bound where they are equal or it is NaN.
+  // frames_apart where some lane is within the reach (the scalar computes it only there); as the
+  // scalar's std::max(cheap, apart): the cheap bound where they are equal or it is NaN.
+  if (all_beyond(bound, reach)) {
+    _mm256_storeu_pd(out, bound);
+    return;
+  }
   _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, ax, d, ah, bx, bh, a0, a1, b0, b1), bound));
 }
 

@@ -1,10 +1,11 @@
 #pragma once
 /// \file
 /// The distance bound (PairContext::gap, before groups) of a visit's four child pairs at once, in
-/// AVX2. Every stage is computed in every lane (no early exit), each with the scalar bound's
-/// operations in its order, so a lane gives the scalar's value, bit for bit, wherever that is
-/// within the reach the scalar was given; beyond it both are some value beyond the reach (the
-/// scalar stops at the first stage that proves it). Tested against the scalar bound.
+/// AVX2. Each stage is computed in every lane, with the scalar bound's operations in its order,
+/// and the next stage is skipped only once every lane is beyond the reach; so a lane gives the
+/// scalar's value, bit for bit, wherever that is within the reach the scalar was given, and beyond
+/// it both are some value beyond the reach (the scalar stops at the first stage that proves it).
+/// Tested against the scalar bound.
 
 #include "narrow/prepared.h"
 
@@ -17,9 +18,9 @@ struct BoundConstants {
   double apart_shrink;  ///< factor on frames_apart's separation
 };
 
-/// out[2i + j] = the bound between ai and bj, before groups.
+/// out[2i + j] = the bound between ai and bj, before groups (beyond `reach` where that is).
 using Gaps2x2 = void (*)(const BoundConstants& constants, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
-                         double out[4]);
+                         double reach, double out[4]);
 
 /// The AVX2 form, or nullptr where this build or this CPU has none.
 Gaps2x2 gaps_2x2_avx2_if_supported();
