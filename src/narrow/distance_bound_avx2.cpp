@@ -57,6 +57,7 @@ CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d 
   }
   clamp_into(ax, ac, ah, bc, p);
   clamp_into(bx, bc, bh, p, q);
+  clamp_into(ax, ac, ah, q, p);
   __m256d n[3] = {sub(q[0], p[0]), sub(q[1], p[1]), sub(q[2], p[2])};
   const __m256d len = _mm256_sqrt_pd(dot3(n[0], n[1], n[2], n[0], n[1], n[2]));
   const __m256d some = _mm256_cmp_pd(len, _mm256_setzero_pd(), _CMP_GT_OQ);

@@ -11,8 +11,10 @@
 namespace caliber::narrow {
 
 /// A lower bound on the distance between two Frames, both in A's frame (d: b's center less
-/// a's): how far apart they are along the direction from p to q, where p is the point of a's
-/// box nearest to b's center and q the point of b's box nearest to p. Along any unit direction
+/// a's): how far apart they are along the direction from p to q, found by alternating between
+/// the boxes: p the point of a's box nearest to b's center, q the point of b's box nearest to p,
+/// then p the point of a's box nearest to q (a third step: armadillo node tests 1,297 -> 1,165
+/// at gap 1e-6, a fourth saved little more). Along any unit direction
 /// n, a Frame's triangles lie within center . n +- sum_k half_k |n . axis_k| (its axes
 /// orthonormal: the hair covers their rounding), so the gap between the two intervals bounds
 /// the distance; for n along the boxes' closest pair it is their distance, and p to q is near
@@ -31,6 +33,7 @@ inline double frames_apart(const Frame& a, const Frame& b, const double d[3], do
   double p[3], q[3];
   clamp_into(a, b.center, p);
   clamp_into(b, p, q);
+  clamp_into(a, q, p);
   const double n[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
   const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (!(len > 0.0)) return 0.0;
