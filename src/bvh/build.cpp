@@ -12,12 +12,15 @@
 #include "caliber/model.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
+#include "util/float_round.h"
 #include "parallel/executor.h"
 
 namespace caliber {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
+using util::round_down;
+using util::round_up;
 using bvh::split_turn;
 using bvh::triangle_turn;
 using bvh::turned_axes;
@@ -33,19 +36,6 @@ double angle_between(const Vec3& u, const Vec3& v) {
   return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
 }
 
-/// A float that is >= x, so that a stored bound never shrinks.
-float round_up(double x) {
-  auto f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
-
-/// A float that is <= x.
-float round_down(double x) {
-  auto f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
-}
 
 Vec3 to_float_axis(const Vec3& axis) {
   Vec3 rounded(static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z()));
@@ -221,7 +211,10 @@ class Builder {
     node.radius = std::numeric_limits<double>::infinity();
     for (int i = 0; i < count; ++i) {
       if (!candidates[i].allFinite()) continue;
-      const double r = std::max({(a - candidates[i]).norm(), (b - candidates[i]).norm(), (c - candidates[i]).norm()});
+      // The largest of the three norms: one square root of the largest square (sqrt is monotone
+      // and correctly rounded, as norm() takes it).
+      const double r = std::sqrt(std::max({(a - candidates[i]).squaredNorm(), (b - candidates[i]).squaredNorm(),
+                                           (c - candidates[i]).squaredNorm()}));
       if (r < node.radius) {
         node.radius = r;
         node.center = candidates[i];
