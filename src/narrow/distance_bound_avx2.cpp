@@ -1,7 +1,8 @@
 // The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
 // PairContext::gap's bounds (spheres, object-frame boxes, Frames along their axes, frames_apart)
-// in every lane, their largest, each stage skipped once every lane is beyond the reach, each with the scalar's operations in its order (this file is built with
-// -ffp-contract=off, like the rest, and only "avx2" is enabled here, not "fma").
+// in every lane, their largest, each stage skipped once every lane is beyond the reach, each with
+// the scalar's operations in its order (this file is built with -ffp-contract=off, like the rest,
+// and only "avx2" is enabled here, not "fma").
 
 #include "narrow/distance_bound_avx2.h"
 
@@ -36,7 +37,7 @@ CALIBER_AVX2 inline __m256d clamp_half(__m256d s, __m256d h) {
   return _mm256_blendv_pd(_mm256_blendv_pd(s, h, _mm256_cmp_pd(h, s, _CMP_LT_OQ)), lo, _mm256_cmp_pd(s, lo, _CMP_LT_OQ));
 }
 
-/// Frame::clamp_into in four lanes: the point of the box (axes f, center c, half-extents h) nearest
+/// frames_apart's clamp_into in four lanes: the point of the box (axes f, center c, half-extents h) nearest
 /// to x, as frame coordinates clamped and brought back.
 CALIBER_AVX2 inline void clamp_into(const __m256d f[3][3], const __m256d c[3], const __m256d h[3], const __m256d x[3],
                                     __m256d out[3]) {
@@ -46,7 +47,7 @@ CALIBER_AVX2 inline void clamp_into(const __m256d f[3][3], const __m256d c[3], c
   for (int i = 0; i < 3; ++i) out[i] = add(add(add(c[i], mul(t[0], f[0][i])), mul(t[1], f[1][i])), mul(t[2], f[2][i]));
 }
 
-/// PairContext::frames_apart in four lanes (d: B's frame center less A's).
+/// narrow::frames_apart in four lanes (d: B's frame center less A's).
 CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d ax[3][3], const __m256d d[3], const __m256d ah[3],
                                          const __m256d bx[3][3], const __m256d bh[3], const NearA& a0, const NearA& a1,
                                          const NearB& b0, const NearB& b1) {

@@ -49,8 +49,8 @@ class PairContext {
   /// by (1 + 1e-9)^2 covers it; multiplying by 1 - 3e-9, below 1 / (1 + 1e-9)^2 by far more than a
   /// rounding, shrinks them a little more and costs no division.
   static constexpr double kFrameShrink2 = 1.0 - 3e-9;
-  /// The same on frames_apart's separation, whose direction is normalized in double (unit up to
-  /// a few ulps).
+  /// The same on frames_apart's separation, divided once by its direction's length (a square
+  /// root and a division, each rounded).
   static constexpr double kApartShrink = 1.0 - 3e-9;
 
  public:
