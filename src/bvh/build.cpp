@@ -36,7 +36,6 @@ double angle_between(const Vec3& u, const Vec3& v) {
   return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
 }
 
-
 Vec3 to_float_axis(const Vec3& axis) {
   Vec3 rounded(static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z()));
   return rounded;

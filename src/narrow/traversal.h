@@ -321,14 +321,17 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) { wait(gaps[k], child); });
     } else {
       // One side splits: its two children against the other node, in the four lanes with the
-      // other node twice (lanes 0 and 2, or 0 and 1, hold the two child pairs).
+      // other node twice (lanes 0 and 2, or 0 and 1, hold the two child pairs). The children's
+      // enumeration then takes the nodes prepared here, not a second lookup.
       const auto* a0 = near_a(split_a ? a.index : n.a);
       const auto* a1 = split_a ? near_a(a.index + 1) : a0;
       const auto* b0 = near_b(split_b ? b.index : n.b);
       const auto* b1 = split_b ? near_b(b.index + 1) : b0;
       double gaps[4];
       ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
-      for_each_child(n, a, b, stats, taboo, near_a, near_b,
+      const auto prepared_a = [&](std::uint32_t i) { return i == a0->index ? a0 : a1; };
+      const auto prepared_b = [&](std::uint32_t j) { return j == b0->index ? b0 : b1; };
+      for_each_child(n, a, b, stats, taboo, prepared_a, prepared_b,
                      [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
                        wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], child);
                      });
