@@ -320,9 +320,8 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       ctx.gaps_2x2(*near_a(a.index), *near_a(a.index + 1), *near_b(b.index), *near_b(b.index + 1), reach, gaps);
       for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) { wait(gaps[k], child); });
     } else {
-      // One side splits: its two children against the other node, in the four lanes with the
-      // other node twice (lanes 0 and 2, or 0 and 1, hold the two child pairs). The children's
-      // enumeration then takes the nodes prepared here, not a second lookup.
+      // One side splits: its two children against the other node twice in the four lanes (lanes
+      // 0 and 2, or 0 and 1); the enumeration below takes these prepared nodes, no second lookup.
       const auto* a0 = near_a(split_a ? a.index : n.a);
       const auto* a1 = split_a ? near_a(a.index + 1) : a0;
       const auto* b0 = near_b(split_b ? b.index : n.b);
