@@ -148,12 +148,10 @@ struct EdgeVectors {
 /// pierces the other; its crossing point is a candidate.
 void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
                         Nearest& nearest) {
-  const Vec3 na = fa.ab.cross(fa.ac);
-  const Vec3 nb = fb.ab.cross(fb.ac);
   Vec3 x;
   for (int i = 0; i < 3; ++i) {
-    if (crossing_point(a[i], a[(i + 1) % 3], b[0], nb, x)) nearest.consider(x, closest_point_on_frame(x, fb));
-    if (crossing_point(b[i], b[(i + 1) % 3], a[0], na, x)) nearest.consider(closest_point_on_frame(x, fa), x);
+    if (crossing_point(a[i], a[(i + 1) % 3], b[0], fb.normal, x)) nearest.consider(x, closest_point_on_frame(x, fb));
+    if (crossing_point(b[i], b[(i + 1) % 3], a[0], fa.normal, x)) nearest.consider(closest_point_on_frame(x, fa), x);
   }
 }
 
@@ -172,7 +170,10 @@ void closest_points_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, con
 
 namespace detail {
 
-ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]) {
+namespace {
+
+ClosestPoints nearest_of_frames(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa,
+                                const kernel::TriangleFrame& fb) {
   using namespace kernel;
   const EdgeVectors e(a, b);
   Nearest nearest(a[0], b[0]);
@@ -183,7 +184,6 @@ ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]
       nearest.consider(c1, c2);
     }
   }
-  const TriangleFrame fa(a), fb(b);
   for (int i = 0; i < 3; ++i) {
     nearest.consider(a[i], closest_point_on_frame(a[i], fb));
     nearest.consider(closest_point_on_frame(b[i], fa), b[i]);
@@ -192,7 +192,23 @@ ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]
   return nearest.best;
 }
 
+}  // namespace
+
+ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]) {
+  const kernel::TriangleFrame fa(a), fb(b);
+  return nearest_of_frames(a, b, fa, fb);
+}
+
+bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
+  const kernel::TriangleFrame fa(a), fb(b);
+  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach)) return false;
+  out = nearest_of_frames(a, b, fa, fb);
+  return true;
+}
+
 }  // namespace detail
+
+bool beyond_plane(const Vec3 p[3], const Vec3 q[3], double reach) { return kernel::beyond_plane(kernel::TriangleFrame(p), q, reach); }
 
 /// The AVX2 kernel where the CPU has it, the portable one elsewhere: chosen at the first call.
 ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
@@ -201,6 +217,14 @@ ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
     return avx2 != nullptr ? avx2 : &detail::closest_points_triangles_portable;
   }();
   return chosen(a, b);
+}
+
+bool closest_points_triangles_within(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
+  static const detail::WithinKernel chosen = [] {
+    const detail::WithinKernel avx2 = detail::closest_points_triangles_within_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : &detail::closest_points_triangles_within_portable;
+  }();
+  return chosen(a, b, reach, out);
 }
 
 }  // namespace caliber::geometry

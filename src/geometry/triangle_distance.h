@@ -32,12 +32,28 @@ struct ClosestPoints {
 /// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
+/// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
+/// untouched) when a plane of one triangle certifiably has the whole other triangle farther than
+/// `reach` on one side (then the triangles are farther apart than `reach`), else true with `out`
+/// exactly what closest_points_triangles returns. The plane test shares the kernel's normals and
+/// signed distances; it may also return true for pairs farther apart than `reach`.
+bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);
+
+/// The plane test alone: true when every corner of q is on one side of the plane of triangle p,
+/// certifiably farther than `reach` from it (false for a degenerate p).
+bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double reach);
+
 namespace detail {
-/// The two forms of closest_points_triangles, for tests and benchmarks.
+/// The two forms of closest_points_triangles and of closest_points_triangles_within, for tests and
+/// benchmarks.
 using TriangleKernel = ClosestPoints (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
+using WithinKernel = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);
 ClosestPoints closest_points_triangles_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
-/// The AVX2 form, or nullptr where this build or this CPU has none.
+bool closest_points_triangles_within_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach,
+                                              ClosestPoints& out);
+/// The AVX2 forms, or nullptr where this build or this CPU has none.
 TriangleKernel closest_points_triangles_avx2_if_supported();
+WithinKernel closest_points_triangles_within_avx2_if_supported();
 }  // namespace detail
 
 }  // namespace caliber::geometry

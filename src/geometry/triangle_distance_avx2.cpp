@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "geometry/lanes_avx2.h"
 #include "geometry/triangle_kernel.h"
 
 namespace caliber::geometry {
@@ -21,60 +22,15 @@ using kernel::Vec3;
 // NaN, as in C++), and clamp01 is max then min with the operands in the order of the scalar
 // maxsd/minsd of clamp01 (triangle_distance.cpp), so NaN falls to 0 in every lane as it does
 // there. The candidates are then taken by the same Nearest in the portable order, so the same pair
-// wins. Eigen computes a
-// 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does dot() here
-// (tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
+// wins. Eigen computes a 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does dot()
+// (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389
+// kernel bit for bit).
 namespace {
 
 #define CALIBER_AVX2 __attribute__((target("avx2")))
 
-struct Pack3 {
-  __m256d x, y, z;
-};
-
-CALIBER_AVX2 inline __m256d lanes(double l0, double l1, double l2, double l3) { return _mm256_setr_pd(l0, l1, l2, l3); }
-CALIBER_AVX2 inline Pack3 lanes(const Vec3& l0, const Vec3& l1, const Vec3& l2, const Vec3& l3) {
-  return {lanes(l0.x(), l1.x(), l2.x(), l3.x()), lanes(l0.y(), l1.y(), l2.y(), l3.y()), lanes(l0.z(), l1.z(), l2.z(), l3.z())};
-}
-CALIBER_AVX2 inline Pack3 operator+(const Pack3& u, const Pack3& v) {
-  return {_mm256_add_pd(u.x, v.x), _mm256_add_pd(u.y, v.y), _mm256_add_pd(u.z, v.z)};
-}
-CALIBER_AVX2 inline Pack3 operator-(const Pack3& u, const Pack3& v) {
-  return {_mm256_sub_pd(u.x, v.x), _mm256_sub_pd(u.y, v.y), _mm256_sub_pd(u.z, v.z)};
-}
-/// s * v, as Eigen's scalar times vector: s * v[k] for each coordinate.
-CALIBER_AVX2 inline Pack3 operator*(__m256d s, const Pack3& v) {
-  return {_mm256_mul_pd(s, v.x), _mm256_mul_pd(s, v.y), _mm256_mul_pd(s, v.z)};
-}
-CALIBER_AVX2 inline __m256d dot(const Pack3& u, const Pack3& v) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(u.x, v.x), _mm256_mul_pd(u.y, v.y)), _mm256_mul_pd(u.z, v.z));
-}
-/// mask ? u : v, lane by lane.
-CALIBER_AVX2 inline __m256d pick(__m256d mask, __m256d u, __m256d v) { return _mm256_blendv_pd(v, u, mask); }
-CALIBER_AVX2 inline Pack3 pick(__m256d mask, const Pack3& u, const Pack3& v) {
-  return {pick(mask, u.x, v.x), pick(mask, u.y, v.y), pick(mask, u.z, v.z)};
-}
-CALIBER_AVX2 inline __m256d clamp01x4(__m256d t) {
-  // _mm256_max_pd(t, 0) returns its second operand where either is NaN, as maxsd does in clamp01
-  // (triangle_distance.cpp).
-  return _mm256_min_pd(_mm256_max_pd(t, _mm256_setzero_pd()), _mm256_set1_pd(1.0));
-}
-CALIBER_AVX2 inline __m256d gt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GT_OQ); }
-CALIBER_AVX2 inline __m256d ge(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GE_OQ); }
-CALIBER_AVX2 inline __m256d lt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LT_OQ); }
-CALIBER_AVX2 inline __m256d le(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LE_OQ); }
-/// Every mask's lanes anded, or ored.
-template <class... Masks>
-CALIBER_AVX2 inline __m256d all(__m256d m, Masks... rest) {
-  ((m = _mm256_and_pd(m, rest)), ...);
-  return m;
-}
-template <class... Masks>
-CALIBER_AVX2 inline __m256d any(__m256d m, Masks... rest) {
-  ((m = _mm256_or_pd(m, rest)), ...);
-  return m;
-}
-CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_set1_pd(-0.0)); }
+using namespace lanes4;
+using lanes4::pick;  // beside pick on Frame4 below, which would hide it
 
 /// Four candidates' points and squared distances, lane by lane, for Nearest.
 struct Candidates4 {
@@ -314,14 +270,26 @@ CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& e, __m256d sp, __m2
   }
 }
 
-#undef CALIBER_AVX2
+/// kernel::beyond_plane of the corners w (relative to the plane's first corner; lanes 0-2) with
+/// their signed distances s along the plane's normal, given the normal's length and
+/// uv = sqrt(|ab|^2 |ac|^2): the scalar's expressions in its order, so the same verdict.
+CALIBER_AVX2 inline bool beyond_plane_x4(const Pack3& w, __m256d s, double len, double uv, double reach) {
+  if (!(len > 0.0)) return false;
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  const __m256d one_norm =
+      _mm256_add_pd(_mm256_add_pd(_mm256_andnot_pd(sign, w.x), _mm256_andnot_pd(sign, w.y)), _mm256_andnot_pd(sign, w.z));
+  const __m256d need = _mm256_add_pd(_mm256_set1_pd(kernel::plane_need(reach, len)),
+                                     _mm256_mul_pd(_mm256_set1_pd(kernel::plane_slack(uv)), one_norm));
+  const int above = _mm256_movemask_pd(gt(s, need)) & 0x7, below = _mm256_movemask_pd(lt(s, negate(need))) & 0x7;
+  return (above == 0x7) | (below == 0x7);
+}
 
-}  // namespace
-
-namespace detail {
-
-__attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
-  const Triangle4 ta = load(a), tb = load(b);
+/// The kernel's candidates once the frames, the corners' lanes and their signed distances along
+/// the other's normal (sa: A's corners against B's plane, sb: B's against A's) are known.
+CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(const Vec3 a[3], const Vec3 b[3],
+                                                                            const Triangle4& ta, const Triangle4& tb,
+                                                                            const TriangleFrame& fa, const TriangleFrame& fb,
+                                                                            __m256d sa, __m256d sb) {
   Nearest nearest(a[0], b[0]);
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
@@ -339,7 +307,6 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
 
   // Vertex-face candidates, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
-  const TriangleFrame fa(a), fb(b);
   Projections points;
   const Pack3 corners01 = interleave<0, 1>(ta.v, tb.v), corners2 = interleave<2, 2>(ta.v, tb.v);
   _mm256_store_pd(points.x, corners01.x);
@@ -350,9 +317,6 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   _mm256_store_pd(points.z + 4, corners2.z);
   for (int i = 0; i < 6; ++i) points.of_a[i] = i % 2 == 0 ? -1 : 0;
   points.count = 6;
-  // Each corner's signed distance along the other's normal, as crossing_point computes it.
-  const __m256d sa = dot(broadcast(fb.ab.cross(fb.ac)), ta.v - broadcast(b[0]));
-  const __m256d sb = dot(broadcast(fa.ab.cross(fa.ac)), tb.v - broadcast(a[0]));
   add_crossings(corners01, interleave<0, 1>(ta.e, tb.e), interleave<0, 1>(sa, sb), interleave<1, 2>(sa, sb), 4, points);
   add_crossings(corners2, interleave<2, 2>(ta.e, tb.e), interleave<2, 2>(sa, sb), interleave<0, 0>(sa, sb), 2, points);
   points.pad();
@@ -368,6 +332,44 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   return nearest.best;
 }
 
+/// A triangle pair's lanes, frames and signed distances: what the plane test and the candidates
+/// share. Each corner's signed distance along the other's normal is computed as crossing_point and
+/// beyond_plane compute it.
+struct Pair4 {
+  Triangle4 ta, tb;
+  TriangleFrame fa, fb;
+  Pack3 wa, wb;  ///< A's corners less B's first, B's less A's
+  __m256d sa, sb;
+
+  CALIBER_AVX2 Pair4(const Vec3 a[3], const Vec3 b[3])
+      : ta(load(a)), tb(load(b)), fa(a), fb(b), wa(ta.v - broadcast(b[0])), wb(tb.v - broadcast(a[0])),
+        sa(dot(broadcast(fb.normal), wa)), sb(dot(broadcast(fa.normal), wb)) {}
+};
+
+#undef CALIBER_AVX2
+
+}  // namespace
+
+namespace detail {
+
+__attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
+  const Pair4 p(a, b);
+  return nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
+}
+
+__attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
+                                                                         ClosestPoints& out) {
+  const Pair4 p(a, b);
+  // Both planes' lengths and uv in one square root of four lanes (correctly rounded, as std::sqrt).
+  alignas(32) double roots[4];
+  _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
+  if (beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach)) {
+    return false;
+  }
+  out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
+  return true;
+}
+
 }  // namespace detail
 
 namespace detail {
@@ -377,6 +379,11 @@ TriangleKernel closest_points_triangles_avx2_if_supported() {
   return __builtin_cpu_supports("avx2") ? &closest_points_triangles_avx2 : nullptr;
 }
 
+WithinKernel closest_points_triangles_within_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &closest_points_triangles_within_avx2 : nullptr;
+}
+
 }  // namespace detail
 }  // namespace caliber::geometry
 
@@ -384,6 +391,7 @@ TriangleKernel closest_points_triangles_avx2_if_supported() {
 
 namespace caliber::geometry::detail {
 TriangleKernel closest_points_triangles_avx2_if_supported() { return nullptr; }
+WithinKernel closest_points_triangles_within_avx2_if_supported() { return nullptr; }
 }  // namespace caliber::geometry::detail
 
 #endif

@@ -21,14 +21,48 @@ using Vec3 = Eigen::Vector3d;
 struct TriangleFrame {
   const Vec3* v;   ///< the three corners
   Vec3 ab, ac;     ///< v[1] - v[0], v[2] - v[0]
+  Vec3 normal;     ///< ab x ac
+  double normal2;  ///< |normal|^2
+  double ab2, ac2; ///< |ab|^2, |ac|^2
   bool solid;      ///< far enough from degenerate for the region test (else: nearest edge point)
 
-  explicit TriangleFrame(const Vec3 corners[3]) : v(corners), ab(corners[1] - corners[0]), ac(corners[2] - corners[0]) {
-    const double area2 = ab.cross(ac).squaredNorm();
-    const double scale2 = std::max(ab.squaredNorm(), ac.squaredNorm());
-    solid = area2 > 1e-24 * scale2 * scale2;
+  explicit TriangleFrame(const Vec3 corners[3])
+      : v(corners), ab(corners[1] - corners[0]), ac(corners[2] - corners[0]), normal(ab.cross(ac)),
+        normal2(normal.squaredNorm()), ab2(ab.squaredNorm()), ac2(ac.squaredNorm()) {
+    const double scale2 = std::max(ab2, ac2);
+    solid = normal2 > 1e-24 * scale2 * scale2;
   }
 };
+
+/// beyond_plane's allowance for the three corners of q against the plane of p (frame fp), whose
+/// normal has length `len`, with uv = sqrt(|ab|^2 |ac|^2): a corner w (relative to p's first
+/// corner) is beyond the plane when |normal . w| exceeds reach len (1 + 1e-12) + 1e-13 uv |w|_1.
+/// 1e-13 |ab| |ac| |w| is some hundred times the rounding error of normal . w (a cross product then
+/// a 3-term dot product); uv is a few ulps off |ab| |ac|, and |w|_1 >= |w|, both well within that
+/// slack. The AVX2 kernel computes the same expressions in the same order.
+inline double plane_need(double reach, double len) { return reach * len * (1.0 + 1e-12); }
+inline double plane_slack(double uv) { return 1e-13 * uv; }
+inline double one_norm(const Vec3& w) { return (std::abs(w.x()) + std::abs(w.y())) + std::abs(w.z()); }
+
+/// True when every corner of q lies on one side of the plane of p (frame fp), farther than `reach`
+/// from it, certified: the float signed distances are trusted only beyond plane_slack's allowance.
+/// Then every point of q is farther than `reach` from every point of p. False for a degenerate p.
+inline bool beyond_plane(const TriangleFrame& fp, const Vec3 q[3], double reach) {
+  const double len = std::sqrt(fp.normal2);
+  if (!(len > 0.0)) return false;
+  const double base = plane_need(reach, len), slack = plane_slack(std::sqrt(fp.ab2 * fp.ac2));
+  // All three corners decided at once (& and |, not && and ||): which corner fails first is data,
+  // and a branch on it mispredicts.
+  bool above = true, below = true;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 w = q[i] - fp.v[0];
+    const double s = fp.normal.dot(w);
+    const double need = base + slack * one_norm(w);
+    above &= s > need;
+    below &= s < -need;
+  }
+  return above | below;
+}
 
 /// The nearest pair found so far. A new pair replaces it when its distance (the square root of its
 /// squared length, as Eigen's norm() computes it) is strictly smaller; the square root is taken

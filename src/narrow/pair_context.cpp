@@ -14,30 +14,6 @@ namespace caliber::narrow {
 namespace {
 /// Margin on the cosine in the cone test: covers float-rounded cone axes (|axis| = 1 +- 2e-7).
 constexpr double kConeCosMargin = 1e-6;
-/// True when every vertex of q lies on one side of the plane of p, farther than `reach` from it,
-/// certified: the float signed distances are trusted only beyond a generous rounding bound.
-bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double reach) {
-  const Eigen::Vector3d u = p[1] - p[0], v = p[2] - p[0];
-  const Eigen::Vector3d n = u.cross(v);
-  const double len = n.norm();
-  if (!(len > 0.0)) return false;
-  // The rounding bound below is 1e-13 |u| |v| |w|, some hundred times the error of n.dot(w); two
-  // square roots fewer than the norms would take: |u| |v| as one root of the product (a few ulps
-  // off, within the slack), and |w| bounded above by its 1-norm (a larger bound only rejects less).
-  const double uv = std::sqrt(u.squaredNorm() * v.squaredNorm());
-  // All three vertices beyond the plane on one side, decided once (& and |, not && and ||): which
-  // vertex fails first is data, and a branch on it mispredicts.
-  bool above = true, below = true;
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d w = q[i] - p[0];
-    const double s = n.dot(w);
-    const double need = reach * len * (1.0 + 1e-12) + 1e-13 * uv * w.lpNorm<1>();
-    above &= s > need;
-    below &= s < -need;
-  }
-  return above | below;
-}
-
 }  // namespace
 
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
@@ -152,11 +128,11 @@ bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, 
   const auto& tri_a = mA.mesh.triangles[ta];
   const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
   const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
-  // Most pairs that reach here are farther apart than the bound: a plane of one triangle with the
-  // other triangle beyond it by more than the bound (plus the margin, with the rounding certified)
-  // proves the true distance exceeds it, so the full computation below would reject the pair too.
-  if (beyond_plane(a, b, reach) || beyond_plane(b, a, reach)) return false;
-  const geometry::ClosestPoints closest = geometry::closest_points_triangles(a, b);
+  // A plane of one triangle with the other triangle beyond it by more than the bound (plus the
+  // margin, with the rounding certified) proves the true distance exceeds it, so the full
+  // computation would reject the pair too: the kernel tests that first, with its own normals.
+  geometry::ClosestPoints closest;
+  if (!geometry::closest_points_triangles_within(a, b, reach, closest)) return false;
   // The exact intersection test decides whether the pair is at distance 0; a plane between the
   // closest points that certifiably separates the triangles says "no" without it.
   const bool intersecting = !geometry::certainly_separated(closest.on_b - closest.on_a, a, b) &&

@@ -90,13 +90,67 @@ namespace {
 
 bool same_bits(const Vec3& x, const Vec3& y) { return std::memcmp(x.data(), y.data(), 3 * sizeof(double)) == 0; }
 
+/// A random triangle pair of one of the kinds the leaf test meets (returned: 0-7): apart,
+/// touching, crossing, coplanar, nearly parallel at small gaps, sharing corners, degenerate
+/// (segments, points, slivers), at scales from 1e-6 to 1e6 (`scale`).
+int random_pair(std::mt19937_64& rng, int iter, Vec3 (&a)[3], Vec3 (&b)[3], double& scale) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> kind(0, 7);
+  const auto random_point = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  for (auto& v : a) v = random_point();
+  const int k = kind(rng);
+  scale = std::pow(10.0, std::uniform_int_distribution<int>(-6, 6)(rng));
+  switch (k) {
+    case 0:  // anywhere
+      for (auto& v : b) v = random_point();
+      break;
+    case 1: {  // a copy of A lifted along its normal by a small gap, shifted in its plane
+      const Vec3 n = (a[1] - a[0]).cross(a[2] - a[0]).normalized();
+      const double gap = std::pow(10.0, std::uniform_real_distribution<double>(-12, -1)(rng)) * (u(rng) > 0 ? 1 : -1);
+      const Vec3 shift = 0.3 * random_point();
+      for (int i = 0; i < 3; ++i) b[i] = a[(i + 1) % 3] + gap * n + shift - n * n.dot(shift);
+      break;
+    }
+    case 2:  // shares a corner with A
+      b[0] = a[iter % 3];
+      b[1] = random_point();
+      b[2] = random_point();
+      break;
+    case 3:  // shares an edge with A
+      b[0] = a[1];
+      b[1] = a[0];
+      b[2] = random_point();
+      break;
+    case 4:  // degenerate: a segment or a point
+      b[0] = random_point();
+      b[1] = (iter % 2 == 0) ? b[0] : random_point();
+      b[2] = 0.5 * (b[0] + b[1]);
+      break;
+    case 5:  // sliver: nearly collinear corners
+      b[0] = random_point();
+      b[1] = random_point();
+      b[2] = 0.5 * (b[0] + b[1]) + 1e-9 * random_point();
+      break;
+    case 6:  // coplanar with A
+      for (auto& v : b) {
+        const double s = u(rng), t = u(rng);
+        v = a[0] + s * (a[1] - a[0]) + t * (a[2] - a[0]);
+      }
+      break;
+    default:  // small and close: a mesh's neighbouring faces
+      for (auto& v : b) v = a[0] + 0.05 * random_point();
+      break;
+  }
+  for (auto& v : a) v *= scale;
+  for (auto& v : b) v *= scale;
+  return k;
+}
+
 /// The kernel against its 2a20389 form, bit for bit, on triangle pairs of every kind the leaf test
-/// meets: apart, touching, crossing, coplanar, nearly parallel at small gaps, sharing corners,
-/// degenerate (segments, points, slivers), at scales from 1e-6 to 1e6.
+/// meets (random_pair).
 TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
   std::mt19937_64 rng(20261123);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::uniform_int_distribution<int> kind(0, 7);
   const auto random_point = [&] { return Vec3(u(rng), u(rng), u(rng)); };
   int differing = 0;
   // Every form this build and this CPU have: the one the library calls, the portable one, AVX2.
@@ -105,52 +159,8 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
   if (const detail::TriangleKernel avx2 = detail::closest_points_triangles_avx2_if_supported()) kernels.emplace_back("avx2", avx2);
   for (int iter = 0; iter < 200000; ++iter) {
     Vec3 a[3], b[3];
-    for (auto& v : a) v = random_point();
-    const int k = kind(rng);
-    const double scale = std::pow(10.0, std::uniform_int_distribution<int>(-6, 6)(rng));
-    switch (k) {
-      case 0:  // anywhere
-        for (auto& v : b) v = random_point();
-        break;
-      case 1: {  // a copy of A lifted along its normal by a small gap, shifted in its plane
-        const Vec3 n = (a[1] - a[0]).cross(a[2] - a[0]).normalized();
-        const double gap = std::pow(10.0, std::uniform_real_distribution<double>(-12, -1)(rng)) * (u(rng) > 0 ? 1 : -1);
-        const Vec3 shift = 0.3 * random_point();
-        for (int i = 0; i < 3; ++i) b[i] = a[(i + 1) % 3] + gap * n + shift - n * n.dot(shift);
-        break;
-      }
-      case 2:  // shares a corner with A
-        b[0] = a[iter % 3];
-        b[1] = random_point();
-        b[2] = random_point();
-        break;
-      case 3:  // shares an edge with A
-        b[0] = a[1];
-        b[1] = a[0];
-        b[2] = random_point();
-        break;
-      case 4:  // degenerate: a segment or a point
-        b[0] = random_point();
-        b[1] = (iter % 2 == 0) ? b[0] : random_point();
-        b[2] = 0.5 * (b[0] + b[1]);
-        break;
-      case 5:  // sliver: nearly collinear corners
-        b[0] = random_point();
-        b[1] = random_point();
-        b[2] = 0.5 * (b[0] + b[1]) + 1e-9 * random_point();
-        break;
-      case 6:  // coplanar with A
-        for (auto& v : b) {
-          const double s = u(rng), t = u(rng);
-          v = a[0] + s * (a[1] - a[0]) + t * (a[2] - a[0]);
-        }
-        break;
-      default:  // small and close: a mesh's neighbouring faces
-        for (auto& v : b) v = a[0] + 0.05 * random_point();
-        break;
-    }
-    for (auto& v : a) v *= scale;
-    for (auto& v : b) v *= scale;
+    double scale = 1.0;
+    const int k = random_pair(rng, iter, a, b, scale);
     const ClosestPoints want = reference::closest_points_triangles(a, b);
     for (const auto& [form, kernel] : kernels) {
       const ClosestPoints got = kernel(a, b);
@@ -168,6 +178,64 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
     }
   }
   EXPECT_EQ(differing, 0);
+}
+
+/// closest_points_triangles_within, every form: where it computes, exactly the kernel's result;
+/// where it refuses, the pair is farther apart than the reach (the reference kernel's distance,
+/// strictly); the forms refuse the same pairs. Reaches on both sides of each pair's distance, the
+/// nearest a relative 1e-9 away.
+TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
+  std::mt19937_64 rng(20261125);
+  std::vector<std::pair<const char*, detail::WithinKernel>> kernels{
+      {"dispatched", &closest_points_triangles_within}, {"portable", &detail::closest_points_triangles_within_portable}};
+  if (const detail::WithinKernel avx2 = detail::closest_points_triangles_within_avx2_if_supported()) {
+    kernels.emplace_back("avx2", avx2);
+  }
+  const double factors[] = {0.0, 0.5, 0.9, 1.0 - 1e-9, 1.0, 1.0 + 1e-9, 2.0};
+  int failures = 0, refused = 0, refused_near = 0;
+  for (int iter = 0; iter < 100000; ++iter) {
+    Vec3 a[3], b[3];
+    double scale = 1.0;
+    const int k = random_pair(rng, iter, a, b, scale);
+    const ClosestPoints want = reference::closest_points_triangles(a, b);
+    const double reach = want.distance * factors[iter % 7];
+    int first_verdict = -1;
+    for (const auto& [form, within] : kernels) {
+      ClosestPoints got{};
+      const bool computed = within(a, b, reach, got);
+      const bool ok = computed ? same_bits(got.on_a, want.on_a) && same_bits(got.on_b, want.on_b) &&
+                                     std::memcmp(&got.distance, &want.distance, sizeof(double)) == 0
+                               : want.distance > reach;
+      const bool agrees = first_verdict < 0 || first_verdict == int(computed);
+      if ((!ok || !agrees) && ++failures <= 5) {
+        ADD_FAILURE() << form << ", iteration " << iter << " kind " << k << ": computed " << computed << ", distance "
+                      << want.distance << ", reach " << reach;
+      }
+      first_verdict = int(computed);
+    }
+    if (first_verdict == 0) {
+      ++refused;
+      refused_near += iter % 7 == 3;
+    }
+  }
+  EXPECT_EQ(failures, 0);
+  // The plane test does refuse: most pairs apart (kinds 0 and 1) have a separating plane of a face.
+  EXPECT_GT(refused, 10000);
+  EXPECT_GT(refused_near, 1000);  // ... even at a reach a relative 1e-9 below their distance
+}
+
+TEST(TriangleDistance, BeyondPlaneOfParallelFaces) {
+  const Vec3 a[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Vec3 b[3] = {{5, 0, 0.25}, {6, 0, 0.25}, {5, 1, 0.25}};
+  EXPECT_TRUE(beyond_plane(a, b, 0.2499));
+  EXPECT_TRUE(beyond_plane(b, a, 0.2499));
+  EXPECT_FALSE(beyond_plane(a, b, 0.25));  // not beyond 0.25: the plane is not a certificate there
+  const Vec3 segment[3] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  EXPECT_FALSE(beyond_plane(segment, b, 0.0));  // a degenerate triangle has no plane
+  ClosestPoints out{};
+  EXPECT_FALSE(closest_points_triangles_within(a, b, 0.2499, out));
+  EXPECT_TRUE(closest_points_triangles_within(a, b, 0.2501, out));
+  EXPECT_NEAR(out.distance, std::sqrt(16 + 0.0625), 1e-12);  // (1,0,0) to (5,0,0.25)
 }
 
 }  // namespace

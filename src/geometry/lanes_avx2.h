@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// Three-vectors in four AVX2 lanes for the triangle kernel (triangle_distance_avx2.cpp): a lane
+/// per candidate, each operation the IEEE operation the portable code does (no FMA), so that every
+/// lane computes its candidate's bits. Included only by code built for x86-64 with GNU C++; every
+/// function is compiled for AVX2 alone, chosen at run time.
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+#include <Eigen/Core>
+
+namespace caliber::geometry::lanes4 {
+
+#define CALIBER_AVX2 __attribute__((target("avx2")))
+
+using Vec3 = Eigen::Vector3d;
+
+struct Pack3 {
+  __m256d x, y, z;
+};
+
+CALIBER_AVX2 inline __m256d lanes(double l0, double l1, double l2, double l3) { return _mm256_setr_pd(l0, l1, l2, l3); }
+CALIBER_AVX2 inline Pack3 lanes(const Vec3& l0, const Vec3& l1, const Vec3& l2, const Vec3& l3) {
+  return {lanes(l0.x(), l1.x(), l2.x(), l3.x()), lanes(l0.y(), l1.y(), l2.y(), l3.y()), lanes(l0.z(), l1.z(), l2.z(), l3.z())};
+}
+CALIBER_AVX2 inline Pack3 operator+(const Pack3& u, const Pack3& v) {
+  return {_mm256_add_pd(u.x, v.x), _mm256_add_pd(u.y, v.y), _mm256_add_pd(u.z, v.z)};
+}
+CALIBER_AVX2 inline Pack3 operator-(const Pack3& u, const Pack3& v) {
+  return {_mm256_sub_pd(u.x, v.x), _mm256_sub_pd(u.y, v.y), _mm256_sub_pd(u.z, v.z)};
+}
+/// s * v, as Eigen's scalar times vector: s * v[k] for each coordinate.
+CALIBER_AVX2 inline Pack3 operator*(__m256d s, const Pack3& v) {
+  return {_mm256_mul_pd(s, v.x), _mm256_mul_pd(s, v.y), _mm256_mul_pd(s, v.z)};
+}
+CALIBER_AVX2 inline __m256d dot(const Pack3& u, const Pack3& v) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(u.x, v.x), _mm256_mul_pd(u.y, v.y)), _mm256_mul_pd(u.z, v.z));
+}
+/// mask ? u : v, lane by lane.
+CALIBER_AVX2 inline __m256d pick(__m256d mask, __m256d u, __m256d v) { return _mm256_blendv_pd(v, u, mask); }
+CALIBER_AVX2 inline Pack3 pick(__m256d mask, const Pack3& u, const Pack3& v) {
+  return {pick(mask, u.x, v.x), pick(mask, u.y, v.y), pick(mask, u.z, v.z)};
+}
+CALIBER_AVX2 inline __m256d clamp01x4(__m256d t) {
+  // _mm256_max_pd(t, 0) returns its second operand where either is NaN, as maxsd does in clamp01
+  // (triangle_distance.cpp).
+  return _mm256_min_pd(_mm256_max_pd(t, _mm256_setzero_pd()), _mm256_set1_pd(1.0));
+}
+CALIBER_AVX2 inline __m256d gt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GT_OQ); }
+CALIBER_AVX2 inline __m256d ge(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_GE_OQ); }
+CALIBER_AVX2 inline __m256d lt(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LT_OQ); }
+CALIBER_AVX2 inline __m256d le(__m256d u, __m256d v) { return _mm256_cmp_pd(u, v, _CMP_LE_OQ); }
+/// Every mask's lanes anded, or ored.
+template <class... Masks>
+CALIBER_AVX2 inline __m256d all(__m256d m, Masks... rest) {
+  ((m = _mm256_and_pd(m, rest)), ...);
+  return m;
+}
+template <class... Masks>
+CALIBER_AVX2 inline __m256d any(__m256d m, Masks... rest) {
+  ((m = _mm256_or_pd(m, rest)), ...);
+  return m;
+}
+CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_set1_pd(-0.0)); }
+
+#undef CALIBER_AVX2
+
+}  // namespace caliber::geometry::lanes4
+
+#endif
