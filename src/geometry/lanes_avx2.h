@@ -64,6 +64,48 @@ CALIBER_AVX2 inline __m256d any(__m256d m, Masks... rest) {
 }
 CALIBER_AVX2 inline __m256d negate(__m256d u) { return _mm256_xor_pd(u, _mm256_set1_pd(-0.0)); }
 
+/// A triangle's corners in lanes 0-2 (lane 3 repeats corner 0), each edge vector (corner i to
+/// corner i + 1, the same subtraction as the portable form's) and its squared length.
+struct Triangle4 {
+  Pack3 v, e;
+  __m256d len2;
+};
+
+template <int kImm>
+CALIBER_AVX2 inline Pack3 permute(const Pack3& u) {
+  return {_mm256_permute4x64_pd(u.x, kImm), _mm256_permute4x64_pd(u.y, kImm), _mm256_permute4x64_pd(u.z, kImm)};
+}
+
+/// Lanes i0, i1, i2, i3 of u (each 0-3).
+template <int i0, int i1, int i2, int i3>
+CALIBER_AVX2 inline Pack3 gather(const Pack3& u) {
+  return permute<i0 | (i1 << 2) | (i2 << 4) | (i3 << 6)>(u);
+}
+template <int i0, int i1, int i2, int i3>
+CALIBER_AVX2 inline __m256d gather(__m256d u) {
+  return _mm256_permute4x64_pd(u, i0 | (i1 << 2) | (i2 << 4) | (i3 << 6));
+}
+
+/// (u_i, w_i, u_j, w_j): a lane of A and of B, twice.
+template <int i, int j>
+CALIBER_AVX2 inline Pack3 interleave(const Pack3& u, const Pack3& w) {
+  const Pack3 pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
+  return {_mm256_blend_pd(pu.x, pw.x, 0b1010), _mm256_blend_pd(pu.y, pw.y, 0b1010), _mm256_blend_pd(pu.z, pw.z, 0b1010)};
+}
+template <int i, int j>
+CALIBER_AVX2 inline __m256d interleave(__m256d u, __m256d w) {
+  const __m256d pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
+  return _mm256_blend_pd(pu, pw, 0b1010);
+}
+
+CALIBER_AVX2 inline Triangle4 load(const Vec3 t[3]) {
+  Triangle4 r;
+  r.v = lanes(t[0], t[1], t[2], t[0]);
+  r.e = gather<1, 2, 0, 1>(r.v) - r.v;
+  r.len2 = dot(r.e, r.e);
+  return r;
+}
+
 #undef CALIBER_AVX2
 
 }  // namespace caliber::geometry::lanes4

@@ -1,4 +1,5 @@
 #include "geometry/triangle_distance.h"
+#include "geometry/edge_axes.h"
 #include "geometry/triangle_kernel.h"
 
 #include <algorithm>
@@ -201,7 +202,9 @@ ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]
 
 bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
   const kernel::TriangleFrame fa(a), fb(b);
-  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach)) return false;
+  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(a, b, reach)) {
+    return false;
+  }
   out = nearest_of_frames(a, b, fa, fb);
   return true;
 }

@@ -3,8 +3,10 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
+#include <cfloat>
 #include <cstdint>
 
+#include "geometry/edge_axes.h"
 #include "geometry/lanes_avx2.h"
 #include "geometry/triangle_kernel.h"
 
@@ -210,48 +212,6 @@ CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, co
   }
 }
 
-/// A triangle's corners in lanes 0-2 (lane 3 repeats corner 0), each edge vector (corner i to
-/// corner i + 1, the same subtraction as the portable form's) and its squared length.
-struct Triangle4 {
-  Pack3 v, e;
-  __m256d len2;
-};
-
-template <int kImm>
-CALIBER_AVX2 inline Pack3 permute(const Pack3& u) {
-  return {_mm256_permute4x64_pd(u.x, kImm), _mm256_permute4x64_pd(u.y, kImm), _mm256_permute4x64_pd(u.z, kImm)};
-}
-
-/// Lanes i0, i1, i2, i3 of u (each 0-3).
-template <int i0, int i1, int i2, int i3>
-CALIBER_AVX2 inline Pack3 gather(const Pack3& u) {
-  return permute<i0 | (i1 << 2) | (i2 << 4) | (i3 << 6)>(u);
-}
-template <int i0, int i1, int i2, int i3>
-CALIBER_AVX2 inline __m256d gather(__m256d u) {
-  return _mm256_permute4x64_pd(u, i0 | (i1 << 2) | (i2 << 4) | (i3 << 6));
-}
-
-/// (u_i, w_i, u_j, w_j): a lane of A and of B, twice.
-template <int i, int j>
-CALIBER_AVX2 inline Pack3 interleave(const Pack3& u, const Pack3& w) {
-  const Pack3 pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
-  return {_mm256_blend_pd(pu.x, pw.x, 0b1010), _mm256_blend_pd(pu.y, pw.y, 0b1010), _mm256_blend_pd(pu.z, pw.z, 0b1010)};
-}
-template <int i, int j>
-CALIBER_AVX2 inline __m256d interleave(__m256d u, __m256d w) {
-  const __m256d pu = gather<i, i, j, j>(u), pw = gather<i, i, j, j>(w);
-  return _mm256_blend_pd(pu, pw, 0b1010);
-}
-
-CALIBER_AVX2 Triangle4 load(const Vec3 t[3]) {
-  Triangle4 r;
-  r.v = lanes(t[0], t[1], t[2], t[0]);
-  r.e = gather<1, 2, 0, 1>(r.v) - r.v;
-  r.len2 = dot(r.e, r.e);
-  return r;
-}
-
 /// crossing_point in four lanes: edges p to p + e (e = q - p) whose ends lie sp and sq along the
 /// other's normal. Appends the crossing points of the first `count` lanes, in lane order, to
 /// `points` (lane l from A where l is even).
@@ -282,6 +242,36 @@ CALIBER_AVX2 inline bool beyond_plane_x4(const Pack3& w, __m256d s, double len, 
                                      _mm256_mul_pd(_mm256_set1_pd(kernel::plane_slack(uv)), one_norm));
   const int above = _mm256_movemask_pd(gt(s, need)) & 0x7, below = _mm256_movemask_pd(lt(s, negate(need))) & 0x7;
   return (above == 0x7) | (below == 0x7);
+}
+
+/// kernel::axis_apart on four axes at once (edge e of A and f of B in each lane): bit l set where
+/// lane l's axis puts the pair apart. The portable form's expressions in its order.
+CALIBER_AVX2 inline int axes_apart_x4(const Pack3& e, const Pack3& f, const kernel::EdgeAxesPair& pair, double reach) {
+  const Pack3 n{_mm256_sub_pd(_mm256_mul_pd(e.y, f.z), _mm256_mul_pd(e.z, f.y)),
+                _mm256_sub_pd(_mm256_mul_pd(e.z, f.x), _mm256_mul_pd(e.x, f.z)),
+                _mm256_sub_pd(_mm256_mul_pd(e.x, f.y), _mm256_mul_pd(e.y, f.x))};
+  const __m256d pa1 = dot(n, broadcast(pair.ab)), pa2 = dot(n, broadcast(pair.ac));
+  const __m256d pb0 = dot(n, broadcast(pair.wb[0])), pb1 = dot(n, broadcast(pair.wb[1])), pb2 = dot(n, broadcast(pair.wb[2]));
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d amin = _mm256_min_pd(_mm256_min_pd(zero, pa1), pa2), amax = _mm256_max_pd(_mm256_max_pd(zero, pa1), pa2);
+  const __m256d bmin = _mm256_min_pd(_mm256_min_pd(pb0, pb1), pb2), bmax = _mm256_max_pd(_mm256_max_pd(pb0, pb1), pb2);
+  const __m256d gap = _mm256_max_pd(_mm256_sub_pd(bmin, amax), _mm256_sub_pd(amin, bmax));
+  const __m256d len2 = dot(n, n), len = _mm256_sqrt_pd(len2);
+  const __m256d need = _mm256_add_pd(
+      _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(reach), len), _mm256_set1_pd(1.0 + 1e-12)),
+      _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(1e-13), len), _mm256_set1_pd(pair.scale)), _mm256_set1_pd(1e-300)));
+  return _mm256_movemask_pd(
+      all(gt(len2, _mm256_set1_pd(kernel::kAxisLength2Floor)), gt(gap, need), le(gap, _mm256_set1_pd(DBL_MAX))));
+}
+
+/// kernel::edges_apart: the nine edge pairs' axes in the kernel's batches, stopping at the first
+/// batch with an axis that puts the pair apart (which one does not matter: the verdict is an or).
+CALIBER_AVX2 inline bool edges_apart_x4(const Vec3 a[3], const Vec3 b[3], const Triangle4& ta, const Triangle4& tb,
+                                        double reach) {
+  const kernel::EdgeAxesPair pair(a, b);
+  if (axes_apart_x4(gather<0, 0, 0, 1>(ta.e), gather<0, 1, 2, 0>(tb.e), pair, reach) != 0) return true;
+  if (axes_apart_x4(gather<1, 1, 2, 2>(ta.e), gather<1, 2, 0, 1>(tb.e), pair, reach) != 0) return true;
+  return (axes_apart_x4(gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(tb.e), pair, reach) & 1) != 0;
 }
 
 /// The kernel's candidates once the frames, the corners' lanes and their signed distances along
@@ -363,7 +353,8 @@ __attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const 
   // Both planes' lengths and uv in one square root of four lanes (correctly rounded, as std::sqrt).
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
-  if (beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach)) {
+  if (beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
+      edges_apart_x4(a, b, p.ta, p.tb, reach)) {
     return false;
   }
   out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);

@@ -224,6 +224,25 @@ TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
   EXPECT_GT(refused_near, 1000);  // ... even at a reach a relative 1e-9 below their distance
 }
 
+TEST(TriangleDistance, EdgeAxesSeparateSkewEdges) {
+  // Closest features: edge (-1,0,0)-(1,0,0) of A and edge (0,-1,.5)-(0,1,.5) of B, 0.5 apart. Each
+  // triangle's plane cuts the other, so only the edges' cross product (along z) separates them.
+  const Vec3 a[3] = {{-1, 0, 0}, {1, 0, 0}, {0, 0, -1}};
+  const Vec3 b[3] = {{0, -1, 0.5}, {0, 1, 0.5}, {0, 0, 1.5}};
+  EXPECT_FALSE(beyond_plane(a, b, 0.0));
+  EXPECT_FALSE(beyond_plane(b, a, 0.0));
+  ClosestPoints out{};
+  EXPECT_FALSE(closest_points_triangles_within(a, b, 0.49, out));
+  EXPECT_FALSE(detail::closest_points_triangles_within_portable(a, b, 0.49, out));
+  EXPECT_TRUE(closest_points_triangles_within(a, b, 0.5, out));  // not beyond 0.5: no certificate
+  EXPECT_NEAR(out.distance, 0.5, 1e-15);
+  // Far from the origin the projections are taken from A's first corner: the same verdicts.
+  Vec3 fa[3], fb[3];
+  for (int i = 0; i < 3; ++i) fa[i] = a[i] + Vec3(1e6, -2e6, 3e6), fb[i] = b[i] + Vec3(1e6, -2e6, 3e6);
+  EXPECT_FALSE(closest_points_triangles_within(fa, fb, 0.49, out));
+  EXPECT_TRUE(closest_points_triangles_within(fa, fb, 0.5, out));
+}
+
 TEST(TriangleDistance, BeyondPlaneOfParallelFaces) {
   const Vec3 a[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   const Vec3 b[3] = {{5, 0, 0.25}, {6, 0, 0.25}, {5, 1, 0.25}};
