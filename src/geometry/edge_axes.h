@@ -21,6 +21,8 @@
 
 #include <Eigen/Core>
 
+#include "geometry/triangle_kernel.h"
+
 namespace caliber::geometry::kernel {
 
 /// The smallest n . n the test trusts: far above where squares lose precision to underflow.
@@ -42,7 +44,6 @@ struct EdgeAxesPair {
 
   EdgeAxesPair(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3])
       : ab(a[1] - a[0]), ac(a[2] - a[0]), wb{b[0] - a[0], b[1] - a[0], b[2] - a[0]} {
-    const auto one_norm = [](const Eigen::Vector3d& w) { return (std::abs(w.x()) + std::abs(w.y())) + std::abs(w.z()); };
     scale = lane_max(lane_max(one_norm(ab), one_norm(ac)), lane_max(lane_max(one_norm(wb[0]), one_norm(wb[1])), one_norm(wb[2])));
   }
 };

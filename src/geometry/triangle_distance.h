@@ -33,10 +33,11 @@ struct ClosestPoints {
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
 /// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
-/// untouched) when a plane of one triangle certifiably has the whole other triangle farther than
-/// `reach` on one side (then the triangles are farther apart than `reach`), else true with `out`
-/// exactly what closest_points_triangles returns. The plane test shares the kernel's normals and
-/// signed distances; it may also return true for pairs farther apart than `reach`.
+/// untouched) when a direction certifiably puts the triangles farther apart than `reach` (a plane
+/// of one triangle with the whole other triangle beyond it, or the cross product of an edge of
+/// each with the corners' projections apart: edge_axes.h), else true with `out` exactly what
+/// closest_points_triangles returns. The plane test shares the kernel's normals and signed
+/// distances; it may also return true for pairs farther apart than `reach`.
 bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);
 
 /// The plane test alone: true when every corner of q is on one side of the plane of triangle p,
