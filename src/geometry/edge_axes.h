@@ -36,14 +36,16 @@ inline double lane_max(double x, double y) { return x > y ? x : y; }
 /// u . v as Eigen and the AVX2 lanes compute it: (x0 y0 + x1 y1) + x2 y2.
 inline double dot3(const Eigen::Vector3d& u, const Eigen::Vector3d& v) { return (u.x() * v.x() + u.y() * v.y()) + u.z() * v.z(); }
 
-/// What the axis test needs of a triangle pair: A's edge vectors from its first corner, B's corners
-/// less A's first, and S, the largest 1-norm among them (|a0 - a0| = 0 left out).
+/// What the axis test needs of a triangle pair: A's edge vectors from its first corner (its
+/// frame's), B's corners less A's first, and S, the largest 1-norm among them (|a0 - a0| = 0 left
+/// out).
 struct EdgeAxesPair {
-  Eigen::Vector3d ab, ac, wb[3];
+  const Eigen::Vector3d &ab, &ac;
+  Eigen::Vector3d wb[3];
   double scale;
 
-  EdgeAxesPair(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3])
-      : ab(a[1] - a[0]), ac(a[2] - a[0]), wb{b[0] - a[0], b[1] - a[0], b[2] - a[0]} {
+  EdgeAxesPair(const TriangleFrame& fa, const Eigen::Vector3d b[3])
+      : ab(fa.ab), ac(fa.ac), wb{b[0] - fa.v[0], b[1] - fa.v[0], b[2] - fa.v[0]} {
     scale = lane_max(lane_max(one_norm(ab), one_norm(ac)), lane_max(lane_max(one_norm(wb[0]), one_norm(wb[1])), one_norm(wb[2])));
   }
 };
@@ -71,10 +73,12 @@ inline Eigen::Vector3d cross3(const Eigen::Vector3d& e, const Eigen::Vector3d& f
   return {e.y() * f.z() - e.z() * f.y(), e.z() * f.x() - e.x() * f.z(), e.x() * f.y() - e.y() * f.x()};
 }
 
-/// True when some edge pair's cross product certifiably puts triangles a and b farther apart than
-/// reach (the axes in the kernel's edge-pair order: A's edge i = a[i] to a[i + 1], B's edge j).
-inline bool edges_apart(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach) {
-  const EdgeAxesPair p(a, b);
+/// True when some edge pair's cross product certifiably puts triangle A (frame fa) and b farther
+/// apart than reach (the axes in the kernel's edge-pair order: A's edge i = a[i] to a[i + 1], B's
+/// edge j).
+inline bool edges_apart(const TriangleFrame& fa, const Eigen::Vector3d b[3], double reach) {
+  const Eigen::Vector3d* a = fa.v;
+  const EdgeAxesPair p(fa, b);
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d e = a[(i + 1) % 3] - a[i];
     for (int j = 0; j < 3; ++j) {

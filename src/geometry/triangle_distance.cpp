@@ -202,7 +202,7 @@ ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]
 
 bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
   const kernel::TriangleFrame fa(a), fb(b);
-  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(a, b, reach)) {
+  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(fa, b, reach)) {
     return false;
   }
   out = nearest_of_frames(a, b, fa, fb);

@@ -266,9 +266,9 @@ CALIBER_AVX2 inline int axes_apart_x4(const Pack3& e, const Pack3& f, const kern
 
 /// kernel::edges_apart: the nine edge pairs' axes in the kernel's batches, stopping at the first
 /// batch with an axis that puts the pair apart (which one does not matter: the verdict is an or).
-CALIBER_AVX2 inline bool edges_apart_x4(const Vec3 a[3], const Vec3 b[3], const Triangle4& ta, const Triangle4& tb,
+CALIBER_AVX2 inline bool edges_apart_x4(const TriangleFrame& fa, const Vec3 b[3], const Triangle4& ta, const Triangle4& tb,
                                         double reach) {
-  const kernel::EdgeAxesPair pair(a, b);
+  const kernel::EdgeAxesPair pair(fa, b);
   if (axes_apart_x4(gather<0, 0, 0, 1>(ta.e), gather<0, 1, 2, 0>(tb.e), pair, reach) != 0) return true;
   if (axes_apart_x4(gather<1, 1, 2, 2>(ta.e), gather<1, 2, 0, 1>(tb.e), pair, reach) != 0) return true;
   return (axes_apart_x4(gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(tb.e), pair, reach) & 1) != 0;
@@ -354,7 +354,7 @@ __attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const 
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
   if (beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
-      edges_apart_x4(a, b, p.ta, p.tb, reach)) {
+      edges_apart_x4(p.fa, b, p.ta, p.tb, reach)) {
     return false;
   }
   out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
