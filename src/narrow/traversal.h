@@ -93,7 +93,7 @@ std::uint32_t index_of(const Side& side) {
   return side.index;
 }
 template <class Side>
-std::uint32_t index_of(const Side* side) {
+std::uint32_t index_of(Side* side) {
   return side->index;
 }
 
@@ -191,9 +191,16 @@ struct PairLimit {
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
 struct TraversalScratch {
   std::vector<NodePair> stack;  ///< explicit depth-first stack
-  util::GapBuckets<NodePair> waiting;  ///< distance traversal: the nodes waiting, by gap
-  PreparedNodes<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
-  PreparedNodes<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
+  using NearA = PreparedTree<PairContext::NearA>::Node;
+  using NearB = PreparedTree<PairContext::NearB>::Node;
+  /// A CD-tree node waiting in the distance traversal: its prepared nodes of A and of B.
+  struct Reached {
+    NearA* a;
+    NearB* b;
+  };
+  util::GapBuckets<Reached> waiting;  ///< distance traversal: the nodes waiting, by gap
+  PreparedTree<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
+  PreparedTree<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
 
   /// Bytes held that grow with the largest traversal so far (not the buckets' fixed tables).
   [[nodiscard]] std::size_t footprint() const {
@@ -255,6 +262,47 @@ struct Nearest {
   [[nodiscard]] double bound(const PairContext& ctx) const { return found ? best.distance : ctx.request().tolerance; }
 };
 
+/// The distance bounds of the children of CD-tree node r (prepared nodes of A and B; a and b its
+/// BVH nodes, not both leaves): calls wait(gap, child) for each in cd_children order, except those
+/// on the taboo list (skipped and marked reached), each counted in stats.node_tests. The
+/// children's prepared nodes are made by the first visit that splits a node, found by its link
+/// after that; a side that does not split brings its own node.
+template <class Wait>
+[[gnu::always_inline]] inline void near_children(const PairContext& ctx, TraversalScratch& scratch, TraversalScratch::Reached r,
+                                                 const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats, TabooView taboo,
+                                                 Wait&& wait) {
+  using Reached = TraversalScratch::Reached;
+  const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
+  const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
+  bool split_a, split_b;
+  cd_split(a, b, split_a, split_b);
+  TraversalScratch::NearA* const ka = split_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
+  TraversalScratch::NearB* const kb = split_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
+  if (split_a && split_b) {
+    // Both sides split: the four child pairs' bounds at once, then taken in cd_children order
+    // as for_each_child takes them (a child on the taboo list marked reached, not counted).
+    double gaps[4];
+    ctx.gaps_2x2(ka[0], ka[1], kb[0], kb[1], reach, gaps);
+    for_each_child_2x2(a.index, b.index, stats, taboo,
+                       [&](std::uint32_t k, NodePair) { wait(gaps[k], Reached{&ka[k / 2], &kb[k % 2]}); });
+    return;
+  }
+  // One side splits: its two children against the other node twice in the four lanes (lanes
+  // 0 and 2, or 0 and 1); the enumeration below takes these prepared nodes.
+  TraversalScratch::NearA* const a0 = split_a ? &ka[0] : r.a;
+  TraversalScratch::NearA* const a1 = split_a ? &ka[1] : r.a;
+  TraversalScratch::NearB* const b0 = split_b ? &kb[0] : r.b;
+  TraversalScratch::NearB* const b1 = split_b ? &kb[1] : r.b;
+  double gaps[4];
+  ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
+  const auto prepared_a = [&](std::uint32_t i) { return i == a0->index ? a0 : a1; };
+  const auto prepared_b = [&](std::uint32_t j) { return j == b0->index ? b0 : b1; };
+  for_each_child(NodePair{r.a->index, r.b->index}, a, b, stats, taboo, prepared_a, prepared_b,
+                 [&](TraversalScratch::NearA* sa, TraversalScratch::NearB* sb, NodePair) {
+                   wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], Reached{sa, sb});
+                 });
+}
+
 /// The distance traversal (branch and bound, best first) of the CD subtree rooted at `root`: the
 /// nodes that pass their test wait by their gap (PairContext::gap, a lower bound on the distance
 /// below them) in buckets of gaps within 1/256 of each other (util::GapBuckets); a node of the
@@ -268,22 +316,24 @@ struct Nearest {
 /// sift was a third of the bunny's time; with the buckets, 0.57-0.62 of the 4-ary heap's time.)
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
-  using Waiting = util::GapBuckets<NodePair>::Entry;
-  util::GapBuckets<NodePair>& queue = scratch.waiting;
+  using Reached = TraversalScratch::Reached;
+  using Waiting = util::GapBuckets<Reached>::Entry;
+  util::GapBuckets<Reached>& queue = scratch.waiting;
   queue.clear();
   scratch.near_a.clear();
   scratch.near_b.clear();
-  const auto near_a = [&](std::uint32_t i) { return &scratch.near_a.get(i, [&](std::uint32_t k) { return ctx.near_a(k); }); };
-  const auto near_b = [&](std::uint32_t j) { return &scratch.near_b.get(j, [&](std::uint32_t k) { return ctx.near_b(k); }); };
+  const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
+  const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
   // Nearest bucket first (within a bucket, last in first out: an order that depends only on the
   // order they came in, the same on every run).
   Waiting next;  // the node to visit next
   bool have_next = false;
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
-    const double root_gap = ctx.gap(*near_a(root.a), *near_b(root.b), reach);
+    const Reached r{scratch.near_a.root(root.a, prepare_a), scratch.near_b.root(root.b, prepare_b)};
+    const double root_gap = ctx.gap(*r.a, *r.b, reach);
     if (root_tested || (++stats.node_tests, root_gap <= reach)) {
-      next = Waiting{root_gap, root};
+      next = Waiting{root_gap, r};
       have_next = true;
     }
   }
@@ -295,8 +345,9 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       next = queue.pop();
     }
     have_next = false;
-    const auto [gap, n] = next;
+    const auto [gap, r] = next;
     if (gap > reach) continue;
+    const NodePair n{r.a->index, r.b->index};
     const BvhNode& a = ctx.a().nodes[n.a];
     const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) {
@@ -306,35 +357,12 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     }
     Waiting kids[4];
     int count = 0, nearest_kid = -1;
-    const auto wait = [&](double child_gap, NodePair child) {
+    const auto wait = [&](double child_gap, Reached child) {
       if (child_gap > reach) return;
       if (nearest_kid < 0 || child_gap < kids[nearest_kid].key) nearest_kid = count;
       kids[count++] = Waiting{child_gap, child};
     };
-    bool split_a, split_b;
-    cd_split(a, b, split_a, split_b);
-    if (split_a && split_b) {
-      // Both sides split: the four child pairs' bounds at once, then taken in cd_children order
-      // as for_each_child takes them (a child on the taboo list marked reached, not counted).
-      double gaps[4];
-      ctx.gaps_2x2(*near_a(a.index), *near_a(a.index + 1), *near_b(b.index), *near_b(b.index + 1), reach, gaps);
-      for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) { wait(gaps[k], child); });
-    } else {
-      // One side splits: its two children against the other node twice in the four lanes (lanes
-      // 0 and 2, or 0 and 1); the enumeration below takes these prepared nodes, no second lookup.
-      const auto* a0 = near_a(split_a ? a.index : n.a);
-      const auto* a1 = split_a ? near_a(a.index + 1) : a0;
-      const auto* b0 = near_b(split_b ? b.index : n.b);
-      const auto* b1 = split_b ? near_b(b.index + 1) : b0;
-      double gaps[4];
-      ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
-      const auto prepared_a = [&](std::uint32_t i) { return i == a0->index ? a0 : a1; };
-      const auto prepared_b = [&](std::uint32_t j) { return j == b0->index ? b0 : b1; };
-      for_each_child(n, a, b, stats, taboo, prepared_a, prepared_b,
-                     [&](const PairContext::NearA* sa, const PairContext::NearB* sb, NodePair child) {
-                       wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], child);
-                     });
-    }
+    near_children(ctx, scratch, r, a, b, reach, stats, taboo, wait);
     // The nearest child is visited next without going through the queue when no waiting node is
     // in a nearer bucket (popping could give it next); the others wait.
     if (nearest_kid >= 0 && (queue.empty() || queue.bucket_of(kids[nearest_kid].key) <= queue.min_bucket())) {
