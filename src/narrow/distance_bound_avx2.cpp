@@ -37,36 +37,27 @@ CALIBER_AVX2 inline __m256d clamp_half(__m256d s, __m256d h) {
   return _mm256_blendv_pd(_mm256_blendv_pd(s, h, _mm256_cmp_pd(h, s, _CMP_LT_OQ)), lo, _mm256_cmp_pd(s, lo, _CMP_LT_OQ));
 }
 
-/// frames_apart's clamp_into in four lanes: the point of the box (axes f, center c, half-extents h) nearest
-/// to x, as frame coordinates clamped and brought back.
-CALIBER_AVX2 inline void clamp_into(const __m256d f[3][3], const __m256d c[3], const __m256d h[3], const __m256d x[3],
-                                    __m256d out[3]) {
-  __m256d t[3];
-  const __m256d r[3] = {sub(x[0], c[0]), sub(x[1], c[1]), sub(x[2], c[2])};
-  for (int k = 0; k < 3; ++k) t[k] = clamp_half(dot3(f[k][0], f[k][1], f[k][2], r[0], r[1], r[2]), h[k]);
-  for (int i = 0; i < 3; ++i) out[i] = add(add(add(c[i], mul(t[0], f[0][i])), mul(t[1], f[1][i])), mul(t[2], f[2][i]));
-}
-
-/// narrow::frames_apart in four lanes (d: B's frame center less A's).
-CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d ax[3][3], const __m256d d[3], const __m256d ah[3],
-                                         const __m256d bx[3][3], const __m256d bh[3], const NearA& a0, const NearA& a1,
-                                         const NearB& b0, const NearB& b1) {
-  __m256d ac[3], bc[3], p[3], q[3];
+/// narrow::frames_apart in four lanes (a's coordinates: r[i][k] = a's axis i . b's axis k, t[i] =
+/// a's axis i . d; ah, bh the half-extents).
+CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d r[3][3], const __m256d t[3], const __m256d ah[3],
+                                         const __m256d bh[3]) {
+  __m256d p[3], v[3], u[3], q[3], n[3];
   for (int i = 0; i < 3; ++i) {
-    ac[i] = lanes_a(a0.frame.center[i], a1.frame.center[i]);
-    bc[i] = lanes_b(b0.frame.center[i], b1.frame.center[i]);
+    p[i] = clamp_half(t[i], ah[i]);
+    v[i] = sub(p[i], t[i]);
   }
-  clamp_into(ax, ac, ah, bc, p);
-  clamp_into(bx, bc, bh, p, q);
-  clamp_into(ax, ac, ah, q, p);
-  __m256d n[3] = {sub(q[0], p[0]), sub(q[1], p[1]), sub(q[2], p[2])};
+  for (int j = 0; j < 3; ++j) u[j] = clamp_half(dot3(r[0][j], r[1][j], r[2][j], v[0], v[1], v[2]), bh[j]);
+  for (int i = 0; i < 3; ++i) {
+    q[i] = add(add(add(t[i], mul(r[i][0], u[0])), mul(r[i][1], u[1])), mul(r[i][2], u[2]));
+    n[i] = sub(q[i], clamp_half(q[i], ah[i]));
+  }
   const __m256d len = _mm256_sqrt_pd(dot3(n[0], n[1], n[2], n[0], n[1], n[2]));
   const __m256d some = _mm256_cmp_pd(len, _mm256_setzero_pd(), _CMP_GT_OQ);
-  __m256d at = dot3(n[0], n[1], n[2], d[0], d[1], d[2]);
+  __m256d at = dot3(n[0], n[1], n[2], t[0], t[1], t[2]);
   const __m256d hair = mul(_mm256_set1_pd(k.hair), len);
   for (int j = 0; j < 3; ++j) {
-    at = sub(at, mul(ah[j], add(magnitude(dot3(n[0], n[1], n[2], ax[j][0], ax[j][1], ax[j][2])), hair)));
-    at = sub(at, mul(bh[j], add(magnitude(dot3(n[0], n[1], n[2], bx[j][0], bx[j][1], bx[j][2])), hair)));
+    at = sub(at, mul(ah[j], add(magnitude(n[j]), hair)));
+    at = sub(at, mul(bh[j], add(magnitude(dot3(r[0][j], r[1][j], r[2][j], n[0], n[1], n[2])), hair)));
   }
   const __m256d apart = _mm256_max_pd(mul(_mm256_div_pd(at, len), _mm256_set1_pd(k.apart_shrink)), _mm256_setzero_pd());
   return _mm256_and_pd(apart, some);
@@ -117,18 +108,20 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
     ah[i] = lanes_a(a0.frame.half[i], a1.frame.half[i]);
     bh[i] = lanes_b(b0.frame.half[i], b1.frame.half[i]);
   }
+  // r: a's axis i . b's axis j; t: b's center along a's axes (frames_relative).
   const __m256d hair = _mm256_set1_pd(k.hair);
-  __m256d dots[3][3];
+  __m256d r[3][3], t[3], dots[3][3];
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      dots[i][j] = add(magnitude(dot3(ax[i][0], ax[i][1], ax[i][2], bx[j][0], bx[j][1], bx[j][2])), hair);
+      r[i][j] = dot3(ax[i][0], ax[i][1], ax[i][2], bx[j][0], bx[j][1], bx[j][2]);
+      dots[i][j] = add(magnitude(r[i][j]), hair);
     }
+    t[i] = dot3(ax[i][0], ax[i][1], ax[i][2], d[0], d[1], d[2]);
   }
   __m256d in_a = _mm256_setzero_pd(), in_b = _mm256_setzero_pd();
   for (int i = 0; i < 3; ++i) {
-    const __m256d along_a = magnitude(dot3(ax[i][0], ax[i][1], ax[i][2], d[0], d[1], d[2]));
     const __m256d reach_b = dot3(dots[i][0], dots[i][1], dots[i][2], bh[0], bh[1], bh[2]);
-    in_a = add(in_a, square_of_positive(sub(sub(along_a, ah[i]), reach_b)));
+    in_a = add(in_a, square_of_positive(sub(sub(magnitude(t[i]), ah[i]), reach_b)));
     const __m256d along_b = magnitude(dot3(bx[i][0], bx[i][1], bx[i][2], d[0], d[1], d[2]));
     const __m256d reach_a = dot3(dots[0][i], dots[1][i], dots[2][i], ah[0], ah[1], ah[2]);
     in_b = add(in_b, square_of_positive(sub(sub(along_b, bh[i]), reach_a)));
@@ -142,7 +135,7 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
     _mm256_storeu_pd(out, bound);
     return;
   }
-  _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, ax, d, ah, bx, bh, a0, a1, b0, b1), bound));
+  _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, r, t, ah, bh), bound));
 }
 
 #undef CALIBER_AVX2

@@ -182,19 +182,16 @@ class PairContext {
     }
     const double boxes2 = std::max(boxes_a, boxes_b);
     if (boxes2 > reach * reach) return std::sqrt(boxes2);
-    double d[3], dots[3][3], in_a = 0.0, in_b = 0.0;
+    double d[3], r[3][3], t[3], dots[3][3], in_a = 0.0, in_b = 0.0;
     for (int i = 0; i < 3; ++i) d[i] = b.frame.center[i] - a.frame.center[i];
+    frames_relative(a.frame, b.frame, d, r, t);
     // |a's axis i . b's axis k|, grown by a hair for rounding in the rotated axes.
     for (int i = 0; i < 3; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        dots[i][k] = std::abs(a.frame.axis[i][0] * b.frame.axis[k][0] + a.frame.axis[i][1] * b.frame.axis[k][1] +
-                              a.frame.axis[i][2] * b.frame.axis[k][2]) + kRotationHair;
-      }
+      for (int k = 0; k < 3; ++k) dots[i][k] = std::abs(r[i][k]) + kRotationHair;
     }
     for (int i = 0; i < 3; ++i) {
-      const double along_a = a.frame.axis[i][0] * d[0] + a.frame.axis[i][1] * d[1] + a.frame.axis[i][2] * d[2];
       const double reach_b = dots[i][0] * b.frame.half[0] + dots[i][1] * b.frame.half[1] + dots[i][2] * b.frame.half[2];
-      in_a += square(std::max(0.0, std::abs(along_a) - a.frame.half[i] - reach_b));
+      in_a += square(std::max(0.0, std::abs(t[i]) - a.frame.half[i] - reach_b));
     }
     in_a *= kFrameShrink2;
     if (in_a > reach * reach) return std::sqrt(in_a);
@@ -209,7 +206,7 @@ class PairContext {
     }
     const double cheap = std::max({spheres, std::sqrt(std::max({boxes2, in_a, in_b})), 0.0});
     if (cheap > reach) return cheap;
-    return std::max(cheap, frames_apart(a.frame, b.frame, d, kRotationHair, kApartShrink));
+    return std::max(cheap, frames_apart(a.frame.half, b.frame.half, r, t, kRotationHair, kApartShrink));
   }
 
 

@@ -16,7 +16,11 @@ namespace caliber::narrow {
 namespace {
 
 /// frames_apart with PairContext's allowances.
-double apart_of(const Frame& a, const Frame& b, const double d[3]) { return frames_apart(a, b, d, 1e-12, 1.0 - 3e-9); }
+double apart_of(const Frame& a, const Frame& b, const double d[3]) {
+  double r[3][3], t[3];
+  frames_relative(a, b, d, r, t);
+  return frames_apart(a.half, b.half, r, t, 1e-12, 1.0 - 3e-9);
+}
 
 Frame random_frame(std::mt19937_64& rng, double spread) {
   std::normal_distribution<double> normal;
