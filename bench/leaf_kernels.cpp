@@ -89,7 +89,7 @@ void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t c
       continue;
     }
     NodePair children[4];
-    const int count = caliber::narrow::cd_children(ctx.a(), ctx.b(), n, children);
+    const int count = caliber::narrow::cd_children(ctx, n, children);
     for (int i = count - 1; i >= 0; --i) stack.push_back(children[i]);
   }
 }

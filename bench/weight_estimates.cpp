@@ -29,7 +29,7 @@ double below(const caliber::narrow::PairContext& ctx, caliber::narrow::NodePair 
   const caliber::Model& b = ctx.b();
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return 0.0;
   caliber::narrow::NodePair kids[4];
-  const int count = caliber::narrow::cd_children(a, b, n, kids);
+  const int count = caliber::narrow::cd_children(ctx, n, kids);
   double tests = 0.0;
   for (int k = 0; k < count; ++k) {
     tests += 1.0;

@@ -12,74 +12,12 @@
 #include <vector>
 
 #include "caliber/query.h"
+#include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
 #include "util/assert.h"
 #include "util/gap_buckets.h"
 
 namespace caliber::narrow {
-
-/// A node of the CD tree: a node of A's BVH paired with a node of B's.
-struct NodePair {
-  std::uint32_t a;  ///< node index in A's BVH
-  std::uint32_t b;  ///< node index in B's BVH
-  friend bool operator==(const NodePair&, const NodePair&) = default;
-  friend auto operator<=>(const NodePair&, const NodePair&) = default;
-};
-
-/// The a posteriori method's taboo list: CD-tree nodes that sub-tasks own. A traversal that meets
-/// one skips it without testing it (its sub-task tests it) and says so in its "reached" output.
-struct Taboo {
-  std::vector<NodePair> nodes;  ///< sorted, distinct
-
-  /// Index of n in the list, or -1.
-  [[nodiscard]] int find(NodePair n) const {
-    const auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
-    return (it != nodes.end() && *it == n) ? static_cast<int>(it - nodes.begin()) : -1;
-  }
-};
-
-/// What a traversal skips, and where it records that it met them: `reached[i]` is set when the
-/// traversal meets taboo->nodes[i] (the caller sizes it; one thread writes it). Empty: skip nothing.
-struct TabooView {
-  const Taboo* taboo = nullptr;
-  char* reached = nullptr;
-};
-
-/// Whether `child` is on the taboo list; if so it is marked reached (the traversal neither tests
-/// nor enters it).
-inline bool on_taboo(TabooView taboo, NodePair child) {
-  if (taboo.taboo == nullptr) return false;
-  const int t = taboo.taboo->find(child);
-  if (t < 0) return false;
-  taboo.reached[t] = 1;
-  return true;
-}
-
-/// A node whose sphere is more than this many times larger than its partner's descends alone.
-inline constexpr double kDescendAloneRatio = 2.0;
-
-/// Which sides of CD-tree node n split: both (up to 4 children) unless one is a leaf or much larger
-/// than the other, in which case only the larger one splits. Depends only on object-space radii,
-/// so the CD tree's shape does not depend on the poses. n must not be a pair of leaves.
-inline void cd_split(const BvhNode& a, const BvhNode& b, bool& split_a, bool& split_b) {
-  split_a = !a.is_leaf() && (b.is_leaf() || double(a.radius) * kDescendAloneRatio >= double(b.radius));
-  split_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * kDescendAloneRatio >= double(a.radius));
-}
-
-/// The children of CD-tree node n (not a pair of leaves), written to out; returns how many.
-inline int cd_children(const Model& ma, const Model& mb, NodePair n, NodePair out[4]) {
-  const BvhNode& a = ma.nodes[n.a];
-  const BvhNode& b = mb.nodes[n.b];
-  bool split_a, split_b;
-  cd_split(a, b, split_a, split_b);
-  int count = 0;
-  for (std::uint32_t i = 0; i < (split_a ? 2u : 1u); ++i) {
-    for (std::uint32_t j = 0; j < (split_b ? 2u : 1u); ++j) {
-      out[count++] = NodePair{split_a ? a.index + i : n.a, split_b ? b.index + j : n.b};
-    }
-  }
-  return count;
-}
 
 /// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root).
 inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
@@ -97,16 +35,15 @@ std::uint32_t index_of(Side* side) {
   return side->index;
 }
 
-/// The children of CD-tree node n (not a pair of leaves), each child node of A and of B prepared
-/// once (by prepare_a / prepare_b: the node test's sides, or the distance bound's) for the (up to)
+/// The children of CD-tree node n (not a pair of leaves; split_a and split_b from cd_split), each
+/// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the distance bound's) for the (up to)
 /// four pairs it takes part in: calls test(side_a, side_b, child) for each in cd_children order,
 /// except those on the taboo list (skipped and marked reached), each counted in stats.node_tests.
 /// The one enumeration of children, for the node visit and the distance traversal.
 template <class PrepareA, class PrepareB, class Test>
-[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, QueryStats& stats, TabooView taboo,
-                                                  PrepareA&& prepare_a, PrepareB&& prepare_b, Test&& test) {
-  bool split_a, split_b;
-  cd_split(a, b, split_a, split_b);
+[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool split_a, bool split_b,
+                                                  QueryStats& stats, TabooView taboo, PrepareA&& prepare_a, PrepareB&& prepare_b,
+                                                  Test&& test) {
   decltype(prepare_a(std::uint32_t{})) sa[2];
   decltype(prepare_b(std::uint32_t{})) sb[2];
   const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
@@ -155,7 +92,7 @@ template <class Take>
   }
   int count = 0;
   bool split_a, split_b;
-  cd_split(a, b, split_a, split_b);
+  cd_split(a, b, descend_alone_ratio(ctx), split_a, split_b);
   if (split_a && split_b) {
     // Both sides split: the four child pairs tested at once, then taken in cd_children order as
     // for_each_child takes them (a child on the taboo list marked reached, neither counted nor
@@ -168,7 +105,7 @@ template <class Take>
     return count;
   }
   for_each_child(
-      n, a, b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); }, [&](std::uint32_t j) { return ctx.prepare_b(j); },
+      n, a, b, split_a, split_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); }, [&](std::uint32_t j) { return ctx.prepare_b(j); },
       [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
         if (ctx.node_test(sa, sb)) passed[count++] = child;
       });
@@ -275,7 +212,7 @@ template <class Wait>
   const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
   const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
   bool split_a, split_b;
-  cd_split(a, b, split_a, split_b);
+  cd_split(a, b, descend_alone_ratio(ctx), split_a, split_b);
   TraversalScratch::NearA* const ka = split_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
   TraversalScratch::NearB* const kb = split_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
   if (split_a && split_b) {
@@ -297,7 +234,7 @@ template <class Wait>
   ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
   const auto prepared_a = [&](std::uint32_t i) { return i == a0->index ? a0 : a1; };
   const auto prepared_b = [&](std::uint32_t j) { return j == b0->index ? b0 : b1; };
-  for_each_child(NodePair{r.a->index, r.b->index}, a, b, stats, taboo, prepared_a, prepared_b,
+  for_each_child(NodePair{r.a->index, r.b->index}, a, b, split_a, split_b, stats, taboo, prepared_a, prepared_b,
                  [&](TraversalScratch::NearA* sa, TraversalScratch::NearB* sb, NodePair) {
                    wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], Reached{sa, sb});
                  });

@@ -125,7 +125,7 @@ void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& l
         continue;
       }
       o.kind = StageOutcome::Kind::split;
-      o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx.a(), ctx.b(), e.node, o.all));
+      o.tested = static_cast<std::uint8_t>(narrow::cd_children(ctx, e.node, o.all));
       CALIBER_ASSERT(o.stats.node_tests == o.tested, "a visit tests each child once");
       o.children = static_cast<std::uint8_t>(count);
       t.children += static_cast<std::size_t>(count);
@@ -272,13 +272,15 @@ namespace {
 /// Fills summary[slot] for CD node n with the reported pairs in [first, last) below it, then its
 /// children. The pairs are partitioned in place (each goes to the first child that holds both
 /// triangles, as a traversal would meet it), so the tree costs no allocation per node.
-void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::NodePair n, TrianglePair* first,
+void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, TrianglePair* first,
                   TrianglePair* last, std::vector<SummaryNode>& summary) {
+  const Model& a = ctx.a();
+  const Model& b = ctx.b();
   summary[slot].node = n;
   summary[slot].contacts = static_cast<std::uint32_t>(last - first);
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return;
   narrow::NodePair kids[4];
-  const int count = narrow::cd_children(a, b, n, kids);
+  const int count = narrow::cd_children(ctx, n, kids);
   TrianglePair* bounds[5] = {first};
   for (int k = 0; k < count; ++k) {
     bounds[k + 1] = std::partition(bounds[k], last, [&](const TrianglePair& p) {
@@ -293,19 +295,19 @@ void fill_summary(const Model& a, const Model& b, std::uint32_t slot, narrow::No
   summary.resize(summary.size() + children);
   std::uint32_t next = at;
   for (int k = 0; k < count; ++k) {
-    if (bounds[k + 1] != bounds[k]) fill_summary(a, b, next++, kids[k], bounds[k], bounds[k + 1], summary);
+    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], bounds[k], bounds[k + 1], summary);
   }
 }
 
 }  // namespace
 
-std::vector<SummaryNode> build_summary(const Model& a, const Model& b, const std::vector<TrianglePair>& reported) {
+std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std::vector<TrianglePair>& reported) {
   std::vector<SummaryNode> summary;
   if (reported.empty()) return summary;
   std::vector<TrianglePair> items = reported;
   summary.reserve(2 * items.size() + 1);
   summary.resize(1);
-  fill_summary(a, b, 0, narrow::NodePair{0, 0}, items.data(), items.data() + items.size(), summary);
+  fill_summary(ctx, 0, narrow::NodePair{0, 0}, items.data(), items.data() + items.size(), summary);
   return summary;
 }
 

@@ -135,8 +135,9 @@ struct SummaryNode {
   std::uint32_t children = 0;   ///< how many children (only those with contacts below)
 };
 
-/// Builds the summary tree from the previous step's reported pairs (empty if there were none).
-std::vector<SummaryNode> build_summary(const Model& a, const Model& b, const std::vector<TrianglePair>& reported);
+/// Builds the summary tree of pair context ctx's CD tree from the previous step's reported pairs
+/// (empty if there were none).
+std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std::vector<TrianglePair>& reported);
 
 /// The a posteriori split of one heavy task: sub-task roots chosen on its summary tree by weight
 /// (a node's weight is the task's weight times its share of the contacts), the original task keeping

@@ -65,7 +65,7 @@ void split_by_summary(const EngineOptions& options, const std::vector<Task>& pai
     const std::size_t i = to_split[s];
     const auto it = history.reported.find(pairs[i]);
     if (it == history.reported.end()) return;
-    const auto summary = build_summary(contexts[i].a(), contexts[i].b(), it->second);
+    const auto summary = build_summary(contexts[i], it->second);
     chosen[s] = split_aposteriori(summary, static_cast<std::uint32_t>(i), weight[i], plan.omega, options.epsilon * plan.omega,
                                   static_cast<std::size_t>(options.taboo_cap));
     chosen[s].rest = chosen[s].taboo.empty() ? weight[i] : chosen[s].rest;

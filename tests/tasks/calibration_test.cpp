@@ -91,7 +91,27 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   const auto b = build_model(make_torus(1.0, 0.3, 10, 8));
   std::vector<TrianglePair> reported;
   for (std::uint32_t i = 0; i < 40; ++i) reported.push_back({(i * 7) % 192, (i * 13) % 160});
-  const auto summary = build_summary(*a, *b, reported);
+  // The summary follows the CD tree of the query's kind (the distance query descends both sides
+  // more often): every child is a child of its node there, and the two trees differ here.
+  std::vector<std::vector<narrow::NodePair>> nodes_of_kind;
+  for (const QueryKind kind : {QueryKind::distance, QueryKind::interference}) {
+    QueryRequest request;
+    request.kind = kind;
+    const narrow::PairContext kind_ctx(*a, Pose{}, *b, Pose{}, request);
+    const auto kind_summary = build_summary(kind_ctx, reported);
+    nodes_of_kind.emplace_back();
+    for (const SummaryNode& s : kind_summary) {
+      nodes_of_kind.back().push_back(s.node);
+      narrow::NodePair kids[4];
+      const int count = s.children == 0 ? 0 : narrow::cd_children(kind_ctx, s.node, kids);
+      for (std::uint32_t c = 0; c < s.children; ++c) {
+        EXPECT_NE(std::find(kids, kids + count, kind_summary[s.first + c].node), kids + count) << to_string(kind);
+      }
+    }
+  }
+  EXPECT_NE(nodes_of_kind[0], nodes_of_kind[1]);
+  const narrow::PairContext ctx(*a, Pose{}, *b, Pose{}, QueryRequest{});
+  const auto summary = build_summary(ctx, reported);
   ASSERT_FALSE(summary.empty());
   EXPECT_EQ(summary[0].contacts, reported.size());
   for (const SummaryNode& s : summary) {
@@ -103,7 +123,7 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
     for (std::uint32_t c = 0; c < s.children; ++c) below += summary[s.first + c].contacts;
     EXPECT_EQ(below, s.contacts);
   }
-  EXPECT_TRUE(build_summary(*a, *b, {}).empty());
+  EXPECT_TRUE(build_summary(ctx, {}).empty());
   // Splitting it: chosen roots are distinct, sorted on the taboo list, and never the root.
   const PosterioriSplit split = split_aposteriori(summary, 0, 4000.0, 500.0, 50.0, 64);
   EXPECT_FALSE(split.taboo.empty());
@@ -146,7 +166,7 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
     }
     const Verdict v = classify(e.weight, omega, eps);
     if (v == Verdict::split) {
-      const int count = narrow::cd_children(ctx.a(), ctx.b(), e.node, kids);
+      const int count = narrow::cd_children(ctx, e.node, kids);
       for (int i = 0; i < count; ++i) queue.push(Entry{scale * apriori_weight(ctx, kids[i]), kids[i]});
     } else {
       (v == Verdict::keep ? out.roots : out.cart).push_back(Root{pair, e.node, true, e.weight});
