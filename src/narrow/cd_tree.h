@@ -52,26 +52,10 @@ inline bool on_taboo(TabooView taboo, NodePair child) {
   return true;
 }
 
-/// A node whose sphere is more than this many times larger than its partner's descends alone (its
-/// partner waits): in the queries that collect pairs.
-inline constexpr double kDescendAloneRatio = 2.0;
-/// The same in the distance query, whose visits where one side splits cost nearly as much as
-/// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance,
-/// two runs, Intel Xeon VM): the bunny at gap 1 0.82-0.86, the rest within 0.94-1.00 on the
-/// armadillo and dragon, 0.86-1.07 on the turbine and blade, 0.92-1.11 on the fandisk and rotor.
-/// (In the queries that collect pairs, 4 was within 0.97-1.02 of 2 on the scenes and the FCL
-/// cases, except the turbine and blade, 1.07, and the fandisk and rotor, 0.91: they keep 2.)
-inline constexpr double kDescendAloneRatioDistance = 4.0;
-
-/// The ratio of pair context ctx's query (kDescendAloneRatio or kDescendAloneRatioDistance).
-inline double descend_alone_ratio(const PairContext& ctx) {
-  return ctx.request().kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
-}
-
-/// Which sides of CD-tree node n split: both (up to 4 children) unless one is a leaf or more
-/// than `ratio` times larger than the other (descend_alone_ratio), in which case only the larger
-/// one splits. Depends only on object-space radii and the query's kind, so the CD tree's shape
-/// does not depend on the poses. n must not be a pair of leaves.
+/// Which sides of CD-tree node n split: both (up to 4 children) unless one is a leaf or its
+/// sphere is more than `ratio` times the other's (PairContext::descend_alone_ratio), in which
+/// case only the larger one splits. Depends only on object-space radii and the query's kind, so
+/// the CD tree's shape does not depend on the poses. n must not be a pair of leaves.
 inline void cd_split(const BvhNode& a, const BvhNode& b, double ratio, bool& split_a, bool& split_b) {
   split_a = !a.is_leaf() && (b.is_leaf() || double(a.radius) * ratio >= double(b.radius));
   split_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * ratio >= double(a.radius));
@@ -83,7 +67,7 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   bool split_a, split_b;
-  cd_split(a, b, descend_alone_ratio(ctx), split_a, split_b);
+  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
   int count = 0;
   for (std::uint32_t i = 0; i < (split_a ? 2u : 1u); ++i) {
     for (std::uint32_t j = 0; j < (split_b ? 2u : 1u); ++j) {

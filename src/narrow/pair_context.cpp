@@ -28,6 +28,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
   mScale = a.extent + b.extent + mTrans.norm();
+  mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
   mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {},

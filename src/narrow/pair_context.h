@@ -40,6 +40,17 @@ struct Candidate {
   return x.tri_b < y.tri_b;
 }
 
+/// A node whose sphere is more than this many times larger than its partner's descends alone (its
+/// partner waits): in the queries that collect pairs.
+inline constexpr double kDescendAloneRatio = 2.0;
+/// The same in the distance query, whose visits where one side splits cost nearly as much as
+/// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance,
+/// two runs, Intel Xeon VM): the bunny at gap 1 0.82-0.86, the rest within 0.94-1.00 on the
+/// armadillo and dragon, 0.86-1.07 on the turbine and blade, 0.92-1.11 on the fandisk and rotor.
+/// (In the queries that collect pairs, 4 was within 0.97-1.02 of 2 on the scenes and the FCL
+/// cases, except the turbine and blade, 1.07, and the fandisk and rotor, 0.91: they keep 2.)
+inline constexpr double kDescendAloneRatioDistance = 4.0;
+
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
 /// disjoint parts of one pair's CD tree with the same context.
 class PairContext {
@@ -123,6 +134,10 @@ class PairContext {
 
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
+
+  /// The CD tree's ratio for descending alone (cd_split): kDescendAloneRatioDistance in a
+  /// distance query, kDescendAloneRatio in the others.
+  [[nodiscard]] double descend_alone_ratio() const { return mDescendAlone; }
 
   /// The distance within which the node and leaf tests keep what a distance d keeps: d plus the
   /// safety margin (rounding in the transformed centers and vertices, certified far below it).
@@ -361,6 +376,7 @@ class PairContext {
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
   Eigen::Vector3d mTrans;
+  double mDescendAlone;  ///< descend_alone_ratio()
   double mScale;       ///< extents of A and B plus their distance: what the safety margin is relative to
   double mReach;       ///< tolerance + safety margin added to the sum of radii
   double mSlabReach;   ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)

@@ -92,7 +92,7 @@ template <class Take>
   }
   int count = 0;
   bool split_a, split_b;
-  cd_split(a, b, descend_alone_ratio(ctx), split_a, split_b);
+  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
   if (split_a && split_b) {
     // Both sides split: the four child pairs tested at once, then taken in cd_children order as
     // for_each_child takes them (a child on the taboo list marked reached, neither counted nor
@@ -212,7 +212,7 @@ template <class Wait>
   const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
   const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
   bool split_a, split_b;
-  cd_split(a, b, descend_alone_ratio(ctx), split_a, split_b);
+  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
   TraversalScratch::NearA* const ka = split_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
   TraversalScratch::NearB* const kb = split_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
   if (split_a && split_b) {
