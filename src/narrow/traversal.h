@@ -36,10 +36,11 @@ std::uint32_t index_of(Side* side) {
 }
 
 /// The children of CD-tree node n (not a pair of leaves; split_a and split_b from cd_split), each
-/// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the distance bound's) for the (up to)
-/// four pairs it takes part in: calls test(side_a, side_b, child) for each in cd_children order,
-/// except those on the taboo list (skipped and marked reached), each counted in stats.node_tests.
-/// The one enumeration of children, for the node visit and the distance traversal.
+/// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the
+/// distance bound's) for the (up to) four pairs it takes part in: calls test(side_a, side_b,
+/// child) for each in cd_children order, except those on the taboo list (skipped and marked
+/// reached), each counted in stats.node_tests. The one enumeration of children, for the node
+/// visit and the distance traversal.
 template <class PrepareA, class PrepareB, class Test>
 [[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool split_a, bool split_b,
                                                   QueryStats& stats, TabooView taboo, PrepareA&& prepare_a, PrepareB&& prepare_b,
@@ -105,7 +106,8 @@ template <class Take>
     return count;
   }
   for_each_child(
-      n, a, b, split_a, split_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); }, [&](std::uint32_t j) { return ctx.prepare_b(j); },
+      n, a, b, split_a, split_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); },
+      [&](std::uint32_t j) { return ctx.prepare_b(j); },
       [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
         if (ctx.node_test(sa, sb)) passed[count++] = child;
       });
