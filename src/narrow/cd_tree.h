@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "caliber/model.h"
-#include "caliber/query.h"
 #include "narrow/pair_context.h"
 
 namespace caliber::narrow {

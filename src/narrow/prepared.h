@@ -55,9 +55,10 @@ struct NearB : NodeB {
 /// visit has split it, and every later visit that splits it follows the link. So each node is
 /// prepared once however many partners it meets (the traversal meets a node 7-10 times on the
 /// bunny), with no lookup by index (against a hash table by index: 0.89-0.98 of the distance
-/// query's time on the bench's cases). A node is only ever reached through its parent's link (or as the traversal's root), so
-/// it has one entry. Entries never move, so a pointer to one stays valid while others are added.
-/// Cleared per traversal: a prepared node depends on the pair's relative pose.
+/// query's time on the bench's cases). A node is only ever reached through its parent's link (or
+/// as the traversal's root), so it has one entry. Entries never move, so a pointer to one stays
+/// valid while others are added. Cleared per traversal: a prepared node depends on the pair's
+/// relative pose.
 template <class Prepared>
 class PreparedTree {
  public:
@@ -74,24 +75,15 @@ class PreparedTree {
   /// Bytes held, for a caller that keeps the scratch between calls.
   [[nodiscard]] std::size_t footprint() const { return mChunks.size() * kChunk * sizeof(Node); }
 
-  /// A new entry for node `index` (a traversal's root), made by prepare(index).
-  template <class Prepare>
-  Node* root(std::uint32_t index, Prepare&& prepare) {
-    Node* node = take(1);
-    static_cast<Prepared&>(*node) = prepare(index);
-    node->kids = nullptr;
-    return node;
-  }
+  /// A new entry holding `prepared` (a traversal's root).
+  Node* root(const Prepared& prepared) { return hold(take(1), prepared); }
   /// The entries of the children `first` and `first + 1` of `parent`'s node, made by prepare the
   /// first time they are asked for (from then on, the same two).
   template <class Prepare>
   Node* kids(Node& parent, std::uint32_t first, Prepare&& prepare) {
     if (parent.kids == nullptr) {
       Node* pair = take(2);
-      for (std::uint32_t i = 0; i < 2; ++i) {
-        static_cast<Prepared&>(pair[i]) = prepare(first + i);
-        pair[i].kids = nullptr;
-      }
+      for (std::uint32_t i = 0; i < 2; ++i) hold(pair + i, prepare(first + i));
       parent.kids = pair;
     }
     return parent.kids;
@@ -99,6 +91,12 @@ class PreparedTree {
 
  private:
   static constexpr std::size_t kChunk = 64;
+  /// Fills a taken entry: the prepared node, no children yet.
+  static Node* hold(Node* node, const Prepared& prepared) {
+    static_cast<Prepared&>(*node) = prepared;
+    node->kids = nullptr;
+    return node;
+  }
   /// n (1 or 2) adjacent entries in the current chunk, or at the start of the next.
   Node* take(std::size_t n) {
     if (mUsed + n > kChunk) {

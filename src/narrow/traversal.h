@@ -261,15 +261,13 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   queue.clear();
   scratch.near_a.clear();
   scratch.near_b.clear();
-  const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
-  const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
   // Nearest bucket first (within a bucket, last in first out: an order that depends only on the
   // order they came in, the same on every run).
   Waiting next;  // the node to visit next
   bool have_next = false;
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
-    const Reached r{scratch.near_a.root(root.a, prepare_a), scratch.near_b.root(root.b, prepare_b)};
+    const Reached r{scratch.near_a.root(ctx.near_a(root.a)), scratch.near_b.root(ctx.near_b(root.b))};
     const double root_gap = ctx.gap(*r.a, *r.b, reach);
     if (root_tested || (++stats.node_tests, root_gap <= reach)) {
       next = Waiting{root_gap, r};

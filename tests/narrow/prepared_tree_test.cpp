@@ -33,7 +33,7 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
   for (int round = 0; round < 2; ++round) {
     tree.clear();
     std::fill(made.begin(), made.end(), 0);
-    Tree::Node* root = tree.root(0, prepare);
+    Tree::Node* root = tree.root(prepare(0));
     std::vector<std::pair<Tree::Node*, Tree::Node*>> seen;  // (parent, its kids) as first made
     for (int walk = 0; walk < 3000; ++walk) {
       Tree::Node* node = root;
@@ -62,11 +62,11 @@ TEST(PreparedTree, ClearForgetsEveryEntry) {
     ++made;
     return Entry{i, double(made)};
   };
-  Tree::Node* root = tree.root(7, prepare);
+  Tree::Node* root = tree.root(prepare(7));
   EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
   EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
   tree.clear();
-  root = tree.root(7, prepare);
+  root = tree.root(prepare(7));
   EXPECT_EQ(root->value, 4.0) << "made again after clear: a prepared node belongs to one pose";
   EXPECT_EQ(tree.kids(*root, 20, prepare)[0].value, 5.0);
   EXPECT_EQ(made, 6);
