@@ -209,7 +209,49 @@ bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], 
   return true;
 }
 
+void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
+  for (int l = 0; l < batch.size; ++l) {
+    Vec3 a[3], b[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = Vec3(batch.a[k][0][l], batch.a[k][1][l], batch.a[k][2][l]);
+      b[k] = Vec3(batch.b[k][0][l], batch.b[k][1][l], batch.b[k][2][l]);
+    }
+    out[l] = closest_points_triangles(a, b);
+  }
+}
+
 }  // namespace detail
+
+void TriangleBatch::add(const Vec3 pa[3], const Vec3 pb[3]) {
+  for (int k = 0; k < 3; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      a[k][c][size] = pa[k][c];
+      b[k][c][size] = pb[k][c];
+    }
+  }
+  ++size;
+}
+
+void TriangleBatch::pad() {
+  for (int k = 0; k < 3; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      for (int l = size; l < kLanes; ++l) {
+        a[k][c][l] = a[k][c][0];
+        b[k][c][l] = b[k][c][0];
+      }
+    }
+  }
+}
+
+void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
+  static const detail::BatchKernel chosen = [] {
+    const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported();
+    return avx512 != nullptr ? avx512 : &detail::closest_points_triangles_batch_by_pair;
+  }();
+  if (batch.size == 0) return;
+  batch.pad();
+  chosen(batch, out);
+}
 
 bool beyond_plane(const Vec3 p[3], const Vec3 q[3], double reach) { return kernel::beyond_plane(kernel::TriangleFrame(p), q, reach); }
 

@@ -32,6 +32,27 @@ struct ClosestPoints {
 /// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
+/// Up to kLanes triangle pairs for closest_points_triangles_batch, corner by corner, coordinate by
+/// coordinate, lane by lane (so that a kernel loads a coordinate of every pair at once).
+struct TriangleBatch {
+  static constexpr int kLanes = 8;
+  alignas(64) double a[3][3][kLanes];  ///< [corner][coordinate][pair]: triangle A of each pair
+  alignas(64) double b[3][3][kLanes];  ///< the same for triangle B
+  int size = 0;                        ///< pairs added (0..kLanes)
+
+  [[nodiscard]] bool full() const { return size == kLanes; }
+  /// Appends a pair (the batch must not be full).
+  void add(const Eigen::Vector3d pa[3], const Eigen::Vector3d pb[3]);
+  /// Copies pair 0 into the lanes past `size`, so that a kernel reads only defined values.
+  void pad();
+};
+
+/// closest_points_triangles of every pair of `batch`: out[i] is exactly (the same bits) what
+/// closest_points_triangles returns for pair i. Where the CPU has AVX-512, one pair per lane (the
+/// kernel's candidates in its order, each lane's the same IEEE operations), else pair by pair.
+/// Pads the batch (TriangleBatch::pad) first.
+void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+
 /// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
 /// untouched) when a direction certifiably puts the triangles farther apart than `reach` (a plane
 /// of one triangle with the whole other triangle beyond it, or the cross product of an edge of
@@ -52,6 +73,11 @@ using WithinKernel = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d 
 ClosestPoints closest_points_triangles_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 bool closest_points_triangles_within_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach,
                                               ClosestPoints& out);
+using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+/// The batch kernel pair by pair, through closest_points_triangles.
+void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+/// The AVX-512 batch kernel, or nullptr where this build or this CPU has none.
+BatchKernel closest_points_triangles_batch_avx512_if_supported();
 /// The AVX2 forms, or nullptr where this build or this CPU has none.
 TriangleKernel closest_points_triangles_avx2_if_supported();
 WithinKernel closest_points_triangles_within_avx2_if_supported();

@@ -180,6 +180,50 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
   EXPECT_EQ(differing, 0);
 }
 
+/// The batch kernel, every form, against the 2a20389 kernel bit for bit: the same pairs as
+/// SameBitsAsTheReferenceKernel, in batches of every size from 1 to 8 (a lane of a partial batch
+/// must not depend on the padding), each pair's kind in different lanes from batch to batch.
+TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
+  std::mt19937_64 rng(20261123);
+  std::vector<std::pair<const char*, detail::BatchKernel>> kernels{
+      {"dispatched", nullptr}, {"by pair", &detail::closest_points_triangles_batch_by_pair}};
+  if (const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported()) {
+    kernels.emplace_back("avx512", avx512);
+  }
+  int differing = 0, iter = 0, batches = 0;
+  while (iter < 200000) {
+    const int size = 1 + batches++ % TriangleBatch::kLanes;
+    TriangleBatch batch;
+    ClosestPoints want[TriangleBatch::kLanes];
+    int kinds[TriangleBatch::kLanes];
+    for (int l = 0; l < size; ++l, ++iter) {
+      Vec3 a[3], b[3];
+      double scale = 1.0;
+      kinds[l] = random_pair(rng, iter, a, b, scale);
+      want[l] = reference::closest_points_triangles(a, b);
+      batch.add(a, b);
+    }
+    for (const auto& [form, kernel] : kernels) {
+      ClosestPoints got[TriangleBatch::kLanes];
+      if (kernel == nullptr) {
+        closest_points_triangles_batch(batch, got);
+      } else {
+        batch.pad();
+        kernel(batch, got);
+      }
+      for (int l = 0; l < size; ++l) {
+        const bool same = same_bits(got[l].on_a, want[l].on_a) && same_bits(got[l].on_b, want[l].on_b) &&
+                          std::memcmp(&got[l].distance, &want[l].distance, sizeof(double)) == 0;
+        if (!same && ++differing <= 5) {
+          ADD_FAILURE() << form << ", batch " << batches << " lane " << l << " kind " << kinds[l] << ": " << got[l].distance
+                        << " vs " << want[l].distance;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0);
+}
+
 /// closest_points_triangles_within, every form: where it computes, exactly the kernel's result;
 /// where it refuses, the pair is farther apart than the reach (the reference kernel's distance,
 /// strictly); the forms refuse the same pairs. Reaches on both sides of each pair's distance, the
