@@ -200,13 +200,22 @@ ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]
   return nearest_of_frames(a, b, fa, fb);
 }
 
+namespace {
+bool frames_apart(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa, const kernel::TriangleFrame& fb,
+                  double reach) {
+  return kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(fa, b, reach);
+}
+}  // namespace
+
 bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
   const kernel::TriangleFrame fa(a), fb(b);
-  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(fa, b, reach)) {
-    return false;
-  }
+  if (frames_apart(a, b, fa, fb, reach)) return false;
   out = nearest_of_frames(a, b, fa, fb);
   return true;
+}
+
+bool triangles_apart_portable(const Vec3 a[3], const Vec3 b[3], double reach) {
+  return frames_apart(a, b, kernel::TriangleFrame(a), kernel::TriangleFrame(b), reach);
 }
 
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
@@ -262,6 +271,14 @@ ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
     return avx2 != nullptr ? avx2 : &detail::closest_points_triangles_portable;
   }();
   return chosen(a, b);
+}
+
+bool triangles_apart(const Vec3 a[3], const Vec3 b[3], double reach) {
+  static const detail::ApartTest chosen = [] {
+    const detail::ApartTest avx2 = detail::triangles_apart_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : &detail::triangles_apart_portable;
+  }();
+  return chosen(a, b, reach);
 }
 
 bool closest_points_triangles_within(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {

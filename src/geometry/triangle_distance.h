@@ -61,6 +61,10 @@ void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[Tria
 /// distances; it may also return true for pairs farther apart than `reach`.
 bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);
 
+/// closest_points_triangles_within's refusal alone: true exactly where it returns false (the
+/// triangles certifiably farther apart than `reach`), without computing the closest points.
+bool triangles_apart(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
+
 /// The plane test alone: true when every corner of q is on one side of the plane of triangle p,
 /// certifiably farther than `reach` from it (false for a degenerate p).
 bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double reach);
@@ -78,7 +82,10 @@ using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPoints out[Trian
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
 /// The AVX-512 batch kernel, or nullptr where this build or this CPU has none.
 BatchKernel closest_points_triangles_batch_avx512_if_supported();
+using ApartTest = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
+bool triangles_apart_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 /// The AVX2 forms, or nullptr where this build or this CPU has none.
+ApartTest triangles_apart_avx2_if_supported();
 TriangleKernel closest_points_triangles_avx2_if_supported();
 WithinKernel closest_points_triangles_within_avx2_if_supported();
 }  // namespace detail

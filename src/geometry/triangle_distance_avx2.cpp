@@ -347,23 +347,36 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   return nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
 }
 
-__attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
-                                                                         ClosestPoints& out) {
-  const Pair4 p(a, b);
+/// The refusal of closest_points_triangles_within_avx2 on the pair's lanes.
+__attribute__((target("avx2"))) __attribute__((always_inline)) inline bool pair_apart(const Pair4& p, const Vec3 b[3],
+                                                                                       double reach) {
   // Both planes' lengths and uv in one square root of four lanes (correctly rounded, as std::sqrt).
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
-  if (beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
-      edges_apart_x4(p.fa, b, p.ta, p.tb, reach)) {
-    return false;
-  }
+  return beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
+         edges_apart_x4(p.fa, b, p.ta, p.tb, reach);
+}
+
+__attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
+                                                                         ClosestPoints& out) {
+  const Pair4 p(a, b);
+  if (pair_apart(p, b, reach)) return false;
   out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
   return true;
+}
+
+__attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const Vec3 b[3], double reach) {
+  return pair_apart(Pair4(a, b), b, reach);
 }
 
 }  // namespace detail
 
 namespace detail {
+
+ApartTest triangles_apart_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &triangles_apart_avx2 : nullptr;
+}
 
 TriangleKernel closest_points_triangles_avx2_if_supported() {
   __builtin_cpu_init();
@@ -381,6 +394,7 @@ WithinKernel closest_points_triangles_within_avx2_if_supported() {
 #else
 
 namespace caliber::geometry::detail {
+ApartTest triangles_apart_avx2_if_supported() { return nullptr; }
 TriangleKernel closest_points_triangles_avx2_if_supported() { return nullptr; }
 WithinKernel closest_points_triangles_within_avx2_if_supported() { return nullptr; }
 }  // namespace caliber::geometry::detail

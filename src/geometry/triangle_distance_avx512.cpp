@@ -199,8 +199,7 @@ CALIBER_AVX512 P3 closest_point_on_triangle(const P3& x, const Triangle8& t) {
   const D vsum = add(add(va, vb), vc);
 
   // Each region's lanes, less those of the regions before it.
-  M taken = le(d1, zero) & le(d2, zero);
-  const M in_a = taken;
+  M taken = le(d1, zero) & le(d2, zero);  // corner a
   const M in_b = ge(d3, zero) & le(d4, d3) & ~taken;
   taken |= in_b;
   const M in_ab = le(vc, zero) & ge(d1, zero) & le(d3, zero) & gt(d1_d3, zero) & ~taken;

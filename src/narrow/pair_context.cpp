@@ -123,6 +123,22 @@ bool PairContext::groups_allow(std::uint32_t ta, std::uint32_t tb) const {
   return mGroups->allows(ga, gb);
 }
 
+namespace {
+/// The leaf test after the closest points: whether the pair intersects (the exact test decides; a
+/// plane between the closest points that certifiably separates the triangles says "no" without
+/// it), then whether it is within `bound`; keep(candidate) where it is.
+template <class Keep>
+bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3], const Eigen::Vector3d b[3],
+                 const geometry::ClosestPoints& closest, double bound, Keep&& keep) {
+  const bool intersecting = !geometry::certainly_separated(closest.on_b - closest.on_a, a, b) &&
+                            geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
+  const double distance = intersecting ? 0.0 : closest.distance;
+  if (!(distance <= bound)) return false;
+  keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
+  return true;
+}
+}  // namespace
+
 template <class Keep>
 bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const {
   if (!groups_allow(ta, tb)) return false;
@@ -134,24 +150,20 @@ bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, 
   // computation would reject the pair too: the kernel tests that first, with its own normals.
   geometry::ClosestPoints closest;
   if (!geometry::closest_points_triangles_within(a, b, reach, closest)) return false;
-  // The exact intersection test decides whether the pair is at distance 0; a plane between the
-  // closest points that certifiably separates the triangles says "no" without it.
-  const bool intersecting = !geometry::certainly_separated(closest.on_b - closest.on_a, a, b) &&
-                            geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
-  const double distance = intersecting ? 0.0 : closest.distance;
-  if (!(distance <= bound)) return false;
-  keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
-  return true;
+  return finish_leaf(ta, tb, a, b, closest, bound, keep);
+}
+
+bool PairContext::normals_allow(std::uint32_t ta, std::uint32_t tb) const {
+  if (mKind != QueryKind::contact) return true;
+  const Eigen::Vector3d& na = mA.normals[ta];
+  const Eigen::Vector3d& nb = mB.normals[tb];
+  if (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0) return false;  // degenerate: no normal
+  return !(na.dot(mRot * nb) > -mCosTheta);
 }
 
 bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const {
   if (mKind != QueryKind::interference) {
-    if (mKind == QueryKind::contact) {
-      const Eigen::Vector3d& na = mA.normals[ta];
-      const Eigen::Vector3d& nb = mB.normals[tb];
-      if (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0) return false;  // degenerate: no normal
-      if (na.dot(mRot * nb) > -mCosTheta) return false;
-    }
+    if (!normals_allow(ta, tb)) return false;
     // Proximity, contact and distance keep the pairs within the tolerance (mReach is its reach).
     return leaf_within(ta, tb, mRequest.tolerance, mReach, [&](Candidate&& c) { out.push_back(std::move(c)); });
   }
@@ -162,6 +174,37 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   if (!geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) return false;
   out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   return true;
+}
+
+void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const {
+  if (mKind == QueryKind::interference) {
+    leaf_test(ta, tb, out);
+    return;
+  }
+  // leaf_within's steps up to the kernel, which waits for the batch.
+  if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
+  const auto& tri_a = mA.mesh.triangles[ta];
+  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
+  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  if (geometry::triangles_apart(a, b, mReach)) return;
+  stage.ta[stage.batch.size] = ta;
+  stage.tb[stage.batch.size] = tb;
+  stage.batch.add(a, b);
+  if (stage.batch.full()) flush_leaves(stage, out);
+}
+
+void PairContext::flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const {
+  geometry::ClosestPoints closest[geometry::TriangleBatch::kLanes];
+  geometry::closest_points_triangles_batch(stage.batch, closest);
+  for (int l = 0; l < stage.batch.size; ++l) {
+    Eigen::Vector3d a[3], b[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = Eigen::Vector3d(stage.batch.a[k][0][l], stage.batch.a[k][1][l], stage.batch.a[k][2][l]);
+      b[k] = Eigen::Vector3d(stage.batch.b[k][0][l], stage.batch.b[k][1][l], stage.batch.b[k][2][l]);
+    }
+    finish_leaf(stage.ta[l], stage.tb[l], a, b, closest[l], mRequest.tolerance, [&](Candidate&& c) { out.push_back(std::move(c)); });
+  }
+  stage.batch.size = 0;
 }
 
 bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {

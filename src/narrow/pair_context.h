@@ -19,6 +19,7 @@
 #include "narrow/distance_bound_avx2.h"
 #include "narrow/node_test_avx2.h"
 #include "narrow/frames_apart.h"
+#include "narrow/leaf_stage.h"
 #include "narrow/prepared.h"
 
 namespace caliber::narrow {
@@ -234,6 +235,11 @@ class PairContext {
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
+  /// The same, except that a pair needing its closest points waits in `stage` until the stage is
+  /// full or flush_leaves is called: then `out` gets what leaf_test would have appended, in order.
+  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const;
+  /// Finishes the pairs waiting in `stage` (their candidates appended to `out`) and empties it.
+  void flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const;
 
   /// The leaf test of a distance traversal: when the triangles are within `bound` (and allowed by
   /// groups), writes their distance and closest points to `out` and returns true. The arithmetic of
@@ -289,6 +295,8 @@ class PairContext {
   /// only place that calls it.
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
+  /// The contact kind's normal test on a leaf pair (true for the other kinds).
+  [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   static double square(double x) { return x * x; }
   /// The NodeA part of a prepared node of A (SideA or NearA).
