@@ -221,12 +221,19 @@ bool triangles_apart_portable(const Vec3 a[3], const Vec3 b[3], double reach) {
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
   for (int l = 0; l < batch.size; ++l) {
     Vec3 a[3], b[3];
-    for (int k = 0; k < 3; ++k) {
-      a[k] = Vec3(batch.a[k][0][l], batch.a[k][1][l], batch.a[k][2][l]);
-      b[k] = Vec3(batch.b[k][0][l], batch.b[k][1][l], batch.b[k][2][l]);
-    }
+    batch.get(l, a, b);
     out[l] = closest_points_triangles(a, b);
   }
+}
+
+unsigned triangles_apart_batch_by_pair(const TriangleBatch& batch, double reach) {
+  unsigned apart = 0;
+  for (int l = 0; l < batch.size; ++l) {
+    Vec3 a[3], b[3];
+    batch.get(l, a, b);
+    apart |= static_cast<unsigned>(triangles_apart(a, b, reach)) << l;
+  }
+  return apart;
 }
 
 }  // namespace detail
@@ -239,6 +246,23 @@ void TriangleBatch::add(const Vec3 pa[3], const Vec3 pb[3]) {
     }
   }
   ++size;
+}
+
+void TriangleBatch::add(const TriangleBatch& from, int lane) {
+  for (int k = 0; k < 3; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      a[k][c][size] = from.a[k][c][lane];
+      b[k][c][size] = from.b[k][c][lane];
+    }
+  }
+  ++size;
+}
+
+void TriangleBatch::get(int lane, Vec3 pa[3], Vec3 pb[3]) const {
+  for (int k = 0; k < 3; ++k) {
+    pa[k] = Vec3(a[k][0][lane], a[k][1][lane], a[k][2][lane]);
+    pb[k] = Vec3(b[k][0][lane], b[k][1][lane], b[k][2][lane]);
+  }
 }
 
 void TriangleBatch::pad() {
@@ -260,6 +284,16 @@ void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[Tria
   if (batch.size == 0) return;
   batch.pad();
   chosen(batch, out);
+}
+
+unsigned triangles_apart_batch(TriangleBatch& batch, double reach) {
+  static const detail::ApartBatchTest chosen = [] {
+    const detail::ApartBatchTest avx512 = detail::triangles_apart_batch_avx512_if_supported();
+    return avx512 != nullptr ? avx512 : &detail::triangles_apart_batch_by_pair;
+  }();
+  if (batch.size == 0) return 0;
+  batch.pad();
+  return chosen(batch, reach);
 }
 
 bool beyond_plane(const Vec3 p[3], const Vec3 q[3], double reach) { return kernel::beyond_plane(kernel::TriangleFrame(p), q, reach); }

@@ -43,8 +43,12 @@ struct TriangleBatch {
   [[nodiscard]] bool full() const { return size == kLanes; }
   /// Appends a pair (the batch must not be full).
   void add(const Eigen::Vector3d pa[3], const Eigen::Vector3d pb[3]);
+  /// Appends pair `lane` of `from`.
+  void add(const TriangleBatch& from, int lane);
   /// Copies pair 0 into the lanes past `size`, so that a kernel reads only defined values.
   void pad();
+  /// The corners of pair `lane`.
+  void get(int lane, Eigen::Vector3d pa[3], Eigen::Vector3d pb[3]) const;
 };
 
 /// closest_points_triangles of every pair of `batch`: out[i] is exactly (the same bits) what
@@ -65,6 +69,11 @@ bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Ve
 /// triangles certifiably farther apart than `reach`), without computing the closest points.
 bool triangles_apart(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 
+/// triangles_apart of every pair of `batch` (reach >= 0): bit i set where pair i is apart. Eight
+/// AVX-512 lanes where the CPU has them, else pair by pair; the same verdicts either way. Pads the
+/// batch (TriangleBatch::pad) first.
+unsigned triangles_apart_batch(TriangleBatch& batch, double reach);
+
 /// The plane test alone: true when every corner of q is on one side of the plane of triangle p,
 /// certifiably farther than `reach` from it (false for a degenerate p).
 bool beyond_plane(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3], double reach);
@@ -82,6 +91,11 @@ using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPoints out[Trian
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
 /// The AVX-512 batch kernel, or nullptr where this build or this CPU has none.
 BatchKernel closest_points_triangles_batch_avx512_if_supported();
+using ApartBatchTest = unsigned (*)(const TriangleBatch& batch, double reach);
+/// triangles_apart_batch pair by pair, through triangles_apart.
+unsigned triangles_apart_batch_by_pair(const TriangleBatch& batch, double reach);
+/// Its AVX-512 form, or nullptr where this build or this CPU has none.
+ApartBatchTest triangles_apart_batch_avx512_if_supported();
 using ApartTest = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 bool triangles_apart_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 /// The AVX2 forms, or nullptr where this build or this CPU has none.

@@ -347,10 +347,9 @@ __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(cons
   return nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
 }
 
-/// The refusal of closest_points_triangles_within_avx2 on the pair's lanes.
-__attribute__((target("avx2"))) __attribute__((always_inline)) inline bool pair_apart(const Pair4& p, const Vec3 b[3],
-                                                                                       double reach) {
-  // Both planes' lengths and uv in one square root of four lanes (correctly rounded, as std::sqrt).
+/// The refusal of closest_points_triangles_within_avx2 on the pair's lanes. Both planes' lengths
+/// and uv in one square root of four lanes (correctly rounded, as std::sqrt).
+__attribute__((target("avx2"), always_inline)) inline bool pair_apart(const Pair4& p, const Vec3 b[3], double reach) {
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
   return beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
@@ -368,10 +367,6 @@ __attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const 
 __attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const Vec3 b[3], double reach) {
   return pair_apart(Pair4(a, b), b, reach);
 }
-
-}  // namespace detail
-
-namespace detail {
 
 ApartTest triangles_apart_avx2_if_supported() {
   __builtin_cpu_init();

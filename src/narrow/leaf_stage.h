@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// Leaf tests waiting for their closest points: the pairs of one traversal that passed the leaf
-/// test's cheap refusals, computed eight at a time by geometry::closest_points_triangles_batch
+/// Leaf tests waiting for the batch kernels: the pairs of one traversal that passed the leaf
+/// test's first checks wait for the refusal test (geometry::triangles_apart_batch), those it does
+/// not refuse for their closest points (geometry::closest_points_triangles_batch), eight at a time
 /// (PairContext::leaf_test with a stage, PairContext::flush_leaves).
 
 #include <cstdint>
@@ -10,10 +11,28 @@
 
 namespace caliber::narrow {
 
+/// Triangle pairs with their ids, in the order they came.
+struct StagedPairs {
+  geometry::TriangleBatch batch;                      ///< the corners (B's in A's frame)
+  std::uint32_t ta[geometry::TriangleBatch::kLanes];  ///< the triangles of A
+  std::uint32_t tb[geometry::TriangleBatch::kLanes];  ///< the triangles of B
+
+  void add(std::uint32_t a_id, std::uint32_t b_id, const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]) {
+    ta[batch.size] = a_id;
+    tb[batch.size] = b_id;
+    batch.add(a, b);
+  }
+  /// Appends pair `lane` of `from`.
+  void add(const StagedPairs& from, int lane) {
+    ta[batch.size] = from.ta[lane];
+    tb[batch.size] = from.tb[lane];
+    batch.add(from.batch, lane);
+  }
+};
+
 struct LeafStage {
-  geometry::TriangleBatch batch;  ///< the waiting pairs' corners (B's in A's frame)
-  std::uint32_t ta[geometry::TriangleBatch::kLanes];  ///< their triangles of A
-  std::uint32_t tb[geometry::TriangleBatch::kLanes];  ///< their triangles of B
+  StagedPairs refusal;  ///< waiting for the refusal test
+  StagedPairs closest;  ///< not refused, waiting for their closest points
 };
 
 }  // namespace caliber::narrow

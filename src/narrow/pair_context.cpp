@@ -181,30 +181,41 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     leaf_test(ta, tb, out);
     return;
   }
-  // leaf_within's steps up to the kernel, which waits for the batch.
+  // leaf_within's steps up to the refusal, which waits for the batch.
   if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
   const auto& tri_a = mA.mesh.triangles[ta];
   const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
   const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
-  if (geometry::triangles_apart(a, b, mReach)) return;
-  stage.ta[stage.batch.size] = ta;
-  stage.tb[stage.batch.size] = tb;
-  stage.batch.add(a, b);
-  if (stage.batch.full()) flush_leaves(stage, out);
+  stage.refusal.add(ta, tb, a, b);
+  if (stage.refusal.batch.full()) refuse_staged(stage, out);
+}
+
+void PairContext::refuse_staged(LeafStage& stage, std::vector<Candidate>& out) const {
+  const unsigned apart = geometry::triangles_apart_batch(stage.refusal.batch, mReach);
+  for (int l = 0; l < stage.refusal.batch.size; ++l) {
+    if ((apart >> l) & 1u) continue;
+    stage.closest.add(stage.refusal, l);
+    if (stage.closest.batch.full()) finish_staged(stage, out);
+  }
+  stage.refusal.batch.size = 0;
+}
+
+void PairContext::finish_staged(LeafStage& stage, std::vector<Candidate>& out) const {
+  StagedPairs& waiting = stage.closest;
+  geometry::ClosestPoints closest[geometry::TriangleBatch::kLanes];
+  geometry::closest_points_triangles_batch(waiting.batch, closest);
+  for (int l = 0; l < waiting.batch.size; ++l) {
+    Eigen::Vector3d a[3], b[3];
+    waiting.batch.get(l, a, b);
+    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest[l], mRequest.tolerance,
+                [&](Candidate&& c) { out.push_back(std::move(c)); });
+  }
+  waiting.batch.size = 0;
 }
 
 void PairContext::flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const {
-  geometry::ClosestPoints closest[geometry::TriangleBatch::kLanes];
-  geometry::closest_points_triangles_batch(stage.batch, closest);
-  for (int l = 0; l < stage.batch.size; ++l) {
-    Eigen::Vector3d a[3], b[3];
-    for (int k = 0; k < 3; ++k) {
-      a[k] = Eigen::Vector3d(stage.batch.a[k][0][l], stage.batch.a[k][1][l], stage.batch.a[k][2][l]);
-      b[k] = Eigen::Vector3d(stage.batch.b[k][0][l], stage.batch.b[k][1][l], stage.batch.b[k][2][l]);
-    }
-    finish_leaf(stage.ta[l], stage.tb[l], a, b, closest[l], mRequest.tolerance, [&](Candidate&& c) { out.push_back(std::move(c)); });
-  }
-  stage.batch.size = 0;
+  refuse_staged(stage, out);
+  finish_staged(stage, out);
 }
 
 bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {

@@ -18,28 +18,12 @@
 #include "caliber/query.h"
 #include "narrow/distance_bound_avx2.h"
 #include "narrow/node_test_avx2.h"
+#include "narrow/candidate.h"
 #include "narrow/frames_apart.h"
 #include "narrow/leaf_stage.h"
 #include "narrow/prepared.h"
 
 namespace caliber::narrow {
-
-/// A triangle pair kept by the leaf test, in model A's frame.
-struct Candidate {
-  std::uint32_t tri_a;      ///< triangle of A
-  std::uint32_t tri_b;      ///< triangle of B
-  double distance;          ///< 0 when the triangles intersect
-  Eigen::Vector3d point_a;  ///< closest point on A (A's frame); unset for interference
-  Eigen::Vector3d point_b;  ///< closest point on B (A's frame); unset for interference
-};
-
-/// The order of closeness every traversal and the finalization agree on: closer first, then lower
-/// triangle ids (a strict total order on a pair's candidates).
-[[nodiscard]] inline bool closer(const Candidate& x, const Candidate& y) {
-  if (x.distance != y.distance) return x.distance < y.distance;
-  if (x.tri_a != y.tri_a) return x.tri_a < y.tri_a;
-  return x.tri_b < y.tri_b;
-}
 
 /// A node whose sphere is more than this many times larger than its partner's descends alone (its
 /// partner waits): in the queries that collect pairs.
@@ -225,7 +209,6 @@ class PairContext {
     return std::max(cheap, frames_apart(a.frame.half, b.frame.half, r, t, kRotationHair, kApartShrink));
   }
 
-
   /// gap on the four pairs of prepared nodes a0 or a1 of A with b0 or b1 of B (a visit's children
   /// where both sides split): out[2i + j] for ai and bj. The same value as gap(ai, bj, reach)
   /// wherever that is within `reach`, and beyond `reach` where that is; four lanes of AVX2 where the
@@ -235,8 +218,8 @@ class PairContext {
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
-  /// The same, except that a pair needing its closest points waits in `stage` until the stage is
-  /// full or flush_leaves is called: then `out` gets what leaf_test would have appended, in order.
+  /// The same, the pair waiting in `stage` for the batch kernels: once they run (a full batch, or
+  /// flush_leaves), `out` has what leaf_test would have appended, in the same order.
   void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const;
   /// Finishes the pairs waiting in `stage` (their candidates appended to `out`) and empties it.
   void flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const;
@@ -295,6 +278,10 @@ class PairContext {
   /// only place that calls it.
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
+  /// The staged refusal (the pairs it does not refuse move on), the staged closest points (the
+  /// kept pairs appended to `out`).
+  void refuse_staged(LeafStage& stage, std::vector<Candidate>& out) const;
+  void finish_staged(LeafStage& stage, std::vector<Candidate>& out) const;
   /// The contact kind's normal test on a leaf pair (true for the other kinds).
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;

@@ -268,6 +268,51 @@ TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
   EXPECT_GT(refused_near, 1000);  // ... even at a reach a relative 1e-9 below their distance
 }
 
+/// triangles_apart_batch, every form, against the portable refusal pair by pair (and so against
+/// closest_points_triangles_within, which the test above checks): the same verdict in every lane of
+/// batches of every size, at reaches on both sides of each pair's distance.
+TEST(TriangleDistance, BatchApartSameVerdictsAsThePortableTest) {
+  std::mt19937_64 rng(20261126);
+  std::vector<std::pair<const char*, detail::ApartBatchTest>> forms{{"dispatched", nullptr},
+                                                                    {"by pair", &detail::triangles_apart_batch_by_pair}};
+  if (const detail::ApartBatchTest avx512 = detail::triangles_apart_batch_avx512_if_supported()) {
+    forms.emplace_back("avx512", avx512);
+  }
+  const double factors[] = {0.0, 0.5, 0.9, 1.0 - 1e-9, 1.0, 1.0 + 1e-9, 2.0};
+  int failures = 0, iter = 0, batches = 0, apart = 0;
+  while (iter < 100000) {
+    // One reach a batch (as the leaf test has): a lane's pair from each kind, the reach from the
+    // first pair's distance.
+    const int size = 1 + batches++ % TriangleBatch::kLanes;
+    TriangleBatch batch;
+    unsigned want = 0;
+    double reach = 0.0;
+    for (int l = 0; l < size; ++l, ++iter) {
+      Vec3 a[3], b[3];
+      double scale = 1.0;
+      random_pair(rng, iter, a, b, scale);
+      if (l == 0) reach = reference::closest_points_triangles(a, b).distance * factors[batches % 7];
+      batch.add(a, b);
+      want |= static_cast<unsigned>(detail::triangles_apart_portable(a, b, reach)) << l;
+    }
+    apart += __builtin_popcount(want);
+    for (const auto& [form, test] : forms) {
+      unsigned got = 0;
+      if (test == nullptr) {
+        got = triangles_apart_batch(batch, reach);
+      } else {
+        batch.pad();
+        got = test(batch, reach);
+      }
+      if (got != want && ++failures <= 5) {
+        ADD_FAILURE() << form << ", batch " << batches << " of " << size << ": verdicts " << got << " vs " << want;
+      }
+    }
+  }
+  EXPECT_EQ(failures, 0);
+  EXPECT_GT(apart, 10000);  // the test does refuse
+}
+
 TEST(TriangleDistance, EdgeAxesSeparateSkewEdges) {
   // Closest features: edge (-1,0,0)-(1,0,0) of A and edge (0,-1,.5)-(0,1,.5) of B, 0.5 apart. Each
   // triangle's plane cuts the other, so only the edges' cross product (along z) separates them.
