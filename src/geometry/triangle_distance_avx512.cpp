@@ -117,7 +117,7 @@ CALIBER_AVX512 P3 nearest_edge_point(const P3& x, const Triangle8& t) {
 /// kernel::closest_point_on_frame per lane: its regions in its order, the first that holds wins;
 /// the nearest edge point where none does or the triangle is not solid. Of the quotients the
 /// regions divide, each lane needs at most one: the first region's that holds, else the face's.
-CALIBER_AVX512 P3 closest_point_on_triangle(const P3& x, const Triangle8& t) {
+CALIBER_AVX512 __attribute__((always_inline)) inline P3 closest_point_on_triangle(const P3& x, const Triangle8& t) {
   const D zero = _mm512_setzero_pd(), one = all_lanes(1.0);
   const P3 &a = t.v[0], &b = t.v[1], &c = t.v[2];
   const P3 ax = x - a, bx = x - b, cx = x - c;
