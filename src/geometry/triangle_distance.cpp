@@ -218,11 +218,11 @@ bool triangles_apart_portable(const Vec3 a[3], const Vec3 b[3], double reach) {
   return frames_apart(a, b, kernel::TriangleFrame(a), kernel::TriangleFrame(b), reach);
 }
 
-void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
+void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPointsBatch& out) {
   for (int l = 0; l < batch.size; ++l) {
     Vec3 a[3], b[3];
     batch.get(l, a, b);
-    out[l] = closest_points_triangles(a, b);
+    out.set(l, closest_points_triangles(a, b));
   }
 }
 
@@ -276,7 +276,7 @@ void TriangleBatch::pad() {
   }
 }
 
-void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
+void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out) {
   static const detail::BatchKernel chosen = [] {
     const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported();
     return avx512 != nullptr ? avx512 : &detail::closest_points_triangles_batch_by_pair;

@@ -51,11 +51,30 @@ struct TriangleBatch {
   void get(int lane, Eigen::Vector3d pa[3], Eigen::Vector3d pb[3]) const;
 };
 
-/// closest_points_triangles of every pair of `batch`: out[i] is exactly (the same bits) what
+/// closest_points_triangles_batch's results, coordinate by coordinate, lane by lane.
+struct ClosestPointsBatch {
+  alignas(64) double on_a[3][TriangleBatch::kLanes];  ///< [coordinate][pair]: the point on A
+  alignas(64) double on_b[3][TriangleBatch::kLanes];  ///< the point on B
+  alignas(64) double distance[TriangleBatch::kLanes];
+
+  /// Pair `lane`'s result.
+  [[nodiscard]] ClosestPoints get(int lane) const {
+    return {{on_a[0][lane], on_a[1][lane], on_a[2][lane]}, {on_b[0][lane], on_b[1][lane], on_b[2][lane]}, distance[lane]};
+  }
+  void set(int lane, const ClosestPoints& c) {
+    for (int k = 0; k < 3; ++k) {
+      on_a[k][lane] = c.on_a[k];
+      on_b[k][lane] = c.on_b[k];
+    }
+    distance[lane] = c.distance;
+  }
+};
+
+/// closest_points_triangles of every pair of `batch`: out.get(i) is exactly (the same bits) what
 /// closest_points_triangles returns for pair i. Where the CPU has AVX-512, one pair per lane (the
 /// kernel's candidates in its order, each lane's the same IEEE operations), else pair by pair.
 /// Pads the batch (TriangleBatch::pad) first.
-void closest_points_triangles_batch(TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out);
 
 /// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
 /// untouched) when a direction certifiably puts the triangles farther apart than `reach` (a plane
@@ -86,9 +105,9 @@ using WithinKernel = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d 
 ClosestPoints closest_points_triangles_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 bool closest_points_triangles_within_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach,
                                               ClosestPoints& out);
-using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPointsBatch& out);
 /// The batch kernel pair by pair, through closest_points_triangles.
-void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]);
+void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPointsBatch& out);
 /// The AVX-512 batch kernel, or nullptr where this build or this CPU has none.
 BatchKernel closest_points_triangles_batch_avx512_if_supported();
 using ApartBatchTest = unsigned (*)(const TriangleBatch& batch, double reach);

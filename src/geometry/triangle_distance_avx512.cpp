@@ -176,7 +176,7 @@ CALIBER_AVX512 inline M crossing(D sp, D sq) {
   return static_cast<M>(~apart);
 }
 
-CALIBER_AVX512 void batch_avx512(const TriangleBatch& batch, ClosestPoints out[TriangleBatch::kLanes]) {
+CALIBER_AVX512 void batch_avx512(const TriangleBatch& batch, ClosestPointsBatch& out) {
   const Triangle8 ta(batch.a), tb(batch.b);
   Best best{ta.v[0], tb.v[0], _mm512_setzero_pd()};
   {
@@ -209,12 +209,13 @@ CALIBER_AVX512 void batch_avx512(const TriangleBatch& batch, ClosestPoints out[T
     }
   }
 
-  alignas(64) double lanes[7][TriangleBatch::kLanes];
-  const D coords[7] = {best.p.x, best.p.y, best.p.z, best.q.x, best.q.y, best.q.z, _mm512_sqrt_pd(best.d2)};
-  for (int k = 0; k < 7; ++k) _mm512_store_pd(lanes[k], coords[k]);
-  for (int l = 0; l < batch.size; ++l) {
-    out[l] = ClosestPoints{{lanes[0][l], lanes[1][l], lanes[2][l]}, {lanes[3][l], lanes[4][l], lanes[5][l]}, lanes[6][l]};
-  }
+  _mm512_store_pd(out.on_a[0], best.p.x);
+  _mm512_store_pd(out.on_a[1], best.p.y);
+  _mm512_store_pd(out.on_a[2], best.p.z);
+  _mm512_store_pd(out.on_b[0], best.q.x);
+  _mm512_store_pd(out.on_b[1], best.q.y);
+  _mm512_store_pd(out.on_b[2], best.q.z);
+  _mm512_store_pd(out.distance, _mm512_sqrt_pd(best.d2));
 }
 
 #undef CALIBER_AVX512

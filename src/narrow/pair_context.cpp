@@ -202,12 +202,12 @@ void PairContext::refuse_staged(LeafStage& stage, std::vector<Candidate>& out) c
 
 void PairContext::finish_staged(LeafStage& stage, std::vector<Candidate>& out) const {
   StagedPairs& waiting = stage.closest;
-  geometry::ClosestPoints closest[geometry::TriangleBatch::kLanes];
+  geometry::ClosestPointsBatch closest;
   geometry::closest_points_triangles_batch(waiting.batch, closest);
   for (int l = 0; l < waiting.batch.size; ++l) {
     Eigen::Vector3d a[3], b[3];
     waiting.batch.get(l, a, b);
-    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest[l], mRequest.tolerance,
+    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest.get(l), mRequest.tolerance,
                 [&](Candidate&& c) { out.push_back(std::move(c)); });
   }
   waiting.batch.size = 0;

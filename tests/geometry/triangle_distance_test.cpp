@@ -204,18 +204,19 @@ TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
       batch.add(a, b);
     }
     for (const auto& [form, kernel] : kernels) {
-      ClosestPoints got[TriangleBatch::kLanes];
+      ClosestPointsBatch lanes;
       if (kernel == nullptr) {
-        closest_points_triangles_batch(batch, got);
+        closest_points_triangles_batch(batch, lanes);
       } else {
         batch.pad();
-        kernel(batch, got);
+        kernel(batch, lanes);
       }
       for (int l = 0; l < size; ++l) {
-        const bool same = same_bits(got[l].on_a, want[l].on_a) && same_bits(got[l].on_b, want[l].on_b) &&
-                          std::memcmp(&got[l].distance, &want[l].distance, sizeof(double)) == 0;
+        const ClosestPoints got = lanes.get(l);
+        const bool same = same_bits(got.on_a, want[l].on_a) && same_bits(got.on_b, want[l].on_b) &&
+                          std::memcmp(&got.distance, &want[l].distance, sizeof(double)) == 0;
         if (!same && ++differing <= 5) {
-          ADD_FAILURE() << form << ", batch " << batches << " lane " << l << " kind " << kinds[l] << ": " << got[l].distance
+          ADD_FAILURE() << form << ", batch " << batches << " lane " << l << " kind " << kinds[l] << ": " << got.distance
                         << " vs " << want[l].distance;
         }
       }
