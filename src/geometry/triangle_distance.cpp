@@ -1,6 +1,7 @@
 #include "geometry/triangle_distance.h"
 #include "geometry/edge_axes.h"
 #include "geometry/triangle_kernel.h"
+#include "util/assert.h"
 
 #include <algorithm>
 #include <cmath>
@@ -239,6 +240,7 @@ unsigned triangles_apart_batch_by_pair(const TriangleBatch& batch, double reach)
 }  // namespace detail
 
 void TriangleBatch::add(const Vec3 pa[3], const Vec3 pb[3]) {
+  CALIBER_ASSERT(size < kLanes, "a triangle batch takes at most kLanes pairs");
   for (int k = 0; k < 3; ++k) {
     for (int c = 0; c < 3; ++c) {
       a[k][c][size] = pa[k][c];
@@ -249,6 +251,7 @@ void TriangleBatch::add(const Vec3 pa[3], const Vec3 pb[3]) {
 }
 
 void TriangleBatch::add(const TriangleBatch& from, int lane) {
+  CALIBER_ASSERT(size < kLanes && lane >= 0 && lane < from.size, "a triangle batch takes at most kLanes pairs");
   for (int k = 0; k < 3; ++k) {
     for (int c = 0; c < 3; ++c) {
       a[k][c][size] = from.a[k][c][lane];

@@ -16,11 +16,11 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
-#include "narrow/distance_bound_avx2.h"
-#include "narrow/node_test_avx2.h"
 #include "narrow/candidate.h"
+#include "narrow/distance_bound_avx2.h"
 #include "narrow/frames_apart.h"
 #include "narrow/leaf_stage.h"
+#include "narrow/node_test_avx2.h"
 #include "narrow/prepared.h"
 
 namespace caliber::narrow {
