@@ -77,10 +77,10 @@ struct Triangle8 {
       e[i] = v[(i + 1) % 3] - v[i];
       len2[i] = dot(e[i], e[i]);
     }
-    ab = v[1] - v[0];
+    ab = e[0];  // v1 - v0, the same subtraction
     ac = v[2] - v[0];
     normal = cross(ab, ac);
-    ab2 = dot(ab, ab);
+    ab2 = len2[0];
     ac2 = dot(ac, ac);
     normal2 = dot(normal, normal);
     // std::max(ab2, ac2) is ab2 < ac2 ? ac2 : ab2; vmaxpd(ac2, ab2) is ac2 > ab2 ? ac2 : ab2.

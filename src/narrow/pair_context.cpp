@@ -116,6 +116,14 @@ bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {
   return false;
 }
 
+void PairContext::corners(std::uint32_t ta, std::uint32_t tb, Eigen::Vector3d a[3], Eigen::Vector3d b[3]) const {
+  const auto& tri_a = mA.mesh.triangles[ta];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = mA.mesh.vertices[tri_a[k]];
+    b[k] = b_vertex(tb, k);
+  }
+}
+
 bool PairContext::groups_allow(std::uint32_t ta, std::uint32_t tb) const {
   if (mGroups == nullptr) return true;
   const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
@@ -142,9 +150,8 @@ bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3],
 template <class Keep>
 bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const {
   if (!groups_allow(ta, tb)) return false;
-  const auto& tri_a = mA.mesh.triangles[ta];
-  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
-  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  Eigen::Vector3d a[3], b[3];
+  corners(ta, tb, a, b);
   // A plane of one triangle with the other triangle beyond it by more than the bound (plus the
   // margin, with the rounding certified) proves the true distance exceeds it, so the full
   // computation would reject the pair too: the kernel tests that first, with its own normals.
@@ -168,9 +175,8 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     return leaf_within(ta, tb, mRequest.tolerance, mReach, [&](Candidate&& c) { out.push_back(std::move(c)); });
   }
   if (!groups_allow(ta, tb)) return false;
-  const auto& tri_a = mA.mesh.triangles[ta];
-  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
-  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  Eigen::Vector3d a[3], b[3];
+  corners(ta, tb, a, b);
   if (!geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) return false;
   out.push_back(Candidate{ta, tb, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   return true;
@@ -183,9 +189,8 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   }
   // leaf_within's steps up to the refusal, which waits for the batch.
   if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
-  const auto& tri_a = mA.mesh.triangles[ta];
-  const Eigen::Vector3d a[3] = {mA.mesh.vertices[tri_a[0]], mA.mesh.vertices[tri_a[1]], mA.mesh.vertices[tri_a[2]]};
-  const Eigen::Vector3d b[3] = {b_vertex(tb, 0), b_vertex(tb, 1), b_vertex(tb, 2)};
+  Eigen::Vector3d a[3], b[3];
+  corners(ta, tb, a, b);
   stage.refusal.add(ta, tb, a, b);
   if (stage.refusal.batch.full()) refuse_staged(stage, out);
 }

@@ -271,6 +271,8 @@ class PairContext {
     return true;
   }
   bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;
+  /// The corners of triangle ta of A and of tb of B, B's in A's frame (b_vertex).
+  void corners(std::uint32_t ta, std::uint32_t tb, Eigen::Vector3d a[3], Eigen::Vector3d b[3]) const;
   /// Whether the groups of triangles ta (of A) and tb (of B) may touch (always without groups).
   [[nodiscard]] bool groups_allow(std::uint32_t ta, std::uint32_t tb) const;
   /// The leaf test within `bound` (its reach given: leaf_test passes mReach, computed once): calls
