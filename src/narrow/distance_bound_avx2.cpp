@@ -1,6 +1,6 @@
 // The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
-// PairContext::gap's bounds (spheres, object-frame boxes, Frames along their axes, frames_apart)
-// in every lane, their largest, each stage skipped once every lane is beyond the reach, each with
+// PairContext::gap's bounds (object-frame boxes, then frames_apart) in every lane, their larger,
+// frames_apart skipped once every lane is beyond the reach with the boxes' bound, each with
 // the scalar's operations in its order (this file is built with -ffp-contract=off, like the rest,
 // and only "avx2" is enabled here, not "fma").
 
@@ -69,19 +69,6 @@ CALIBER_AVX2 inline bool all_beyond(__m256d u, __m256d reach) { return _mm256_mo
 CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
                            double reach_, double out[4]) {
   const __m256d reach = _mm256_set1_pd(reach_);
-  // Spheres: |ca - cb| - ra - rb.
-  __m256d dist2 = _mm256_setzero_pd();
-  for (int i = 0; i < 3; ++i) {
-    const __m256d d = sub(lanes_a(a0.center[i], a1.center[i]), lanes_b(b0.center[i], b1.center[i]));
-    dist2 = add(dist2, mul(d, d));
-  }
-  const __m256d spheres =
-      sub(sub(_mm256_sqrt_pd(dist2), lanes_a(a0.radius, a1.radius)), lanes_b(b0.radius, b1.radius));
-  // Every lane beyond the reach already (where the scalar stops too): the rest is not needed.
-  if (all_beyond(spheres, reach)) {
-    _mm256_storeu_pd(out, spheres);
-    return;
-  }
   // Object-frame boxes: each box against the other's box seen along its axes.
   __m256d boxes_a = _mm256_setzero_pd(), boxes_b = _mm256_setzero_pd();
   for (int i = 0; i < 3; ++i) {
@@ -92,12 +79,14 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
     boxes_b = add(boxes_b, square_of_positive(sub(sub(along_b, lanes_b(b0.half[i], b1.half[i])),
                                                   lanes_a(a0.reach_on_b[i], a1.reach_on_b[i]))));
   }
-  const __m256d cheapest = _mm256_max_pd(spheres, _mm256_sqrt_pd(_mm256_max_pd(boxes_a, boxes_b)));
-  if (all_beyond(cheapest, reach)) {
-    _mm256_storeu_pd(out, cheapest);
+  const __m256d boxes = _mm256_sqrt_pd(_mm256_max_pd(boxes_a, boxes_b));
+  // Every lane beyond the reach already (where the scalar stops too): the rest is not needed.
+  if (all_beyond(boxes, reach)) {
+    _mm256_storeu_pd(out, boxes);
     return;
   }
-  // Frames: along A's frame axes, then B's; |a_i . b_j| grown by the hair.
+  // frames_apart in a's coordinates: r, a's axis i . b's axis j; t, b's center along a's axes
+  // (frames_relative).
   __m256d ax[3][3], bx[3][3], d[3], ah[3], bh[3];
   for (int i = 0; i < 3; ++i) {
     for (int c = 0; c < 3; ++c) {
@@ -108,34 +97,13 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
     ah[i] = lanes_a(a0.frame.half[i], a1.frame.half[i]);
     bh[i] = lanes_b(b0.frame.half[i], b1.frame.half[i]);
   }
-  // r: a's axis i . b's axis j; t: b's center along a's axes (frames_relative).
-  const __m256d hair = _mm256_set1_pd(k.hair);
-  __m256d r[3][3], t[3], dots[3][3];
+  __m256d r[3][3], t[3];
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      r[i][j] = dot3(ax[i][0], ax[i][1], ax[i][2], bx[j][0], bx[j][1], bx[j][2]);
-      dots[i][j] = add(magnitude(r[i][j]), hair);
-    }
+    for (int j = 0; j < 3; ++j) r[i][j] = dot3(ax[i][0], ax[i][1], ax[i][2], bx[j][0], bx[j][1], bx[j][2]);
     t[i] = dot3(ax[i][0], ax[i][1], ax[i][2], d[0], d[1], d[2]);
   }
-  __m256d in_a = _mm256_setzero_pd(), in_b = _mm256_setzero_pd();
-  for (int i = 0; i < 3; ++i) {
-    const __m256d reach_b = dot3(dots[i][0], dots[i][1], dots[i][2], bh[0], bh[1], bh[2]);
-    in_a = add(in_a, square_of_positive(sub(sub(magnitude(t[i]), ah[i]), reach_b)));
-    const __m256d along_b = magnitude(dot3(bx[i][0], bx[i][1], bx[i][2], d[0], d[1], d[2]));
-    const __m256d reach_a = dot3(dots[0][i], dots[1][i], dots[2][i], ah[0], ah[1], ah[2]);
-    in_b = add(in_b, square_of_positive(sub(sub(along_b, bh[i]), reach_a)));
-  }
-  const __m256d frames = mul(_mm256_max_pd(in_a, in_b), _mm256_set1_pd(k.frame_shrink));
-  const __m256d squared = _mm256_max_pd(_mm256_max_pd(boxes_a, boxes_b), frames);
-  const __m256d bound = _mm256_max_pd(_mm256_max_pd(spheres, _mm256_sqrt_pd(squared)), _mm256_setzero_pd());
-  // frames_apart where some lane is within the reach (the scalar computes it only there); as the
-  // scalar's std::max(cheap, apart): the cheap bound where they are equal or it is NaN.
-  if (all_beyond(bound, reach)) {
-    _mm256_storeu_pd(out, bound);
-    return;
-  }
-  _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, r, t, ah, bh), bound));
+  // As the scalar's std::max(boxes, apart): the boxes' bound where they are equal or apart is NaN.
+  _mm256_storeu_pd(out, _mm256_max_pd(frames_apart(k, r, t, ah, bh), boxes));
 }
 
 #undef CALIBER_AVX2

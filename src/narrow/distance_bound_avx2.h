@@ -14,7 +14,6 @@ namespace caliber::narrow::detail {
 /// The constants the bound's allowances use (PairContext's).
 struct BoundConstants {
   double hair;          ///< added to |axis . axis| products (rounding in rotated axes)
-  double frame_shrink;  ///< factor on the frames' squared gaps (axes orthonormal up to rounding)
   double apart_shrink;  ///< factor on frames_apart's separation
 };
 

@@ -97,7 +97,7 @@ void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, co
     for (int k = 0; k < 4; ++k) out[k] = gap(*as[k / 2], *bs[k % 2], reach);
     return;
   }
-  avx2(detail::BoundConstants{kRotationHair, kFrameShrink2, kApartShrink}, a0, a1, b0, b1, reach, out);
+  avx2(detail::BoundConstants{kRotationHair, kApartShrink}, a0, a1, b0, b1, reach, out);
   // What gap adds to the geometry: groups that forbid every pair below.
   if (mGroups == nullptr) return;
   for (int k = 0; k < 4; ++k) {
