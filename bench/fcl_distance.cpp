@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
         const QueryRequest request = distance_request();
         QueryResult ours;
         const double ms = bench::median_ms(repeat, [&] { ours = query(*a, Pose{}, *b, pose_b, request); });
-        std::printf("%s gap %g: %.12g in %.3f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,
+        std::printf("%s gap %g: %.12g in %.4f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,
                     ours.contacts.front().distance, ms, repeat, static_cast<unsigned long long>(ours.stats.node_tests),
                     static_cast<unsigned long long>(ours.stats.leaf_tests));
       }

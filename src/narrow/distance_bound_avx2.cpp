@@ -53,13 +53,15 @@ CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d 
   }
   const __m256d len = _mm256_sqrt_pd(dot3(n[0], n[1], n[2], n[0], n[1], n[2]));
   const __m256d some = _mm256_cmp_pd(len, _mm256_setzero_pd(), _CMP_GT_OQ);
-  __m256d at = dot3(n[0], n[1], n[2], t[0], t[1], t[2]);
-  const __m256d hair = mul(_mm256_set1_pd(k.hair), len);
+  const __m256d at = dot3(n[0], n[1], n[2], t[0], t[1], t[2]);
+  __m256d spread_a = _mm256_setzero_pd(), spread_b = _mm256_setzero_pd();
   for (int j = 0; j < 3; ++j) {
-    at = sub(at, mul(ah[j], add(magnitude(n[j]), hair)));
-    at = sub(at, mul(bh[j], add(magnitude(dot3(r[0][j], r[1][j], r[2][j], n[0], n[1], n[2])), hair)));
+    spread_a = add(spread_a, mul(ah[j], magnitude(n[j])));
+    spread_b = add(spread_b, mul(bh[j], magnitude(dot3(r[0][j], r[1][j], r[2][j], n[0], n[1], n[2]))));
   }
-  const __m256d apart = _mm256_max_pd(mul(_mm256_div_pd(at, len), _mm256_set1_pd(k.apart_shrink)), _mm256_setzero_pd());
+  const __m256d halves = add(add(add(ah[0], ah[1]), ah[2]), add(add(bh[0], bh[1]), bh[2]));
+  const __m256d within = sub(_mm256_div_pd(sub(at, add(spread_a, spread_b)), len), mul(_mm256_set1_pd(k.hair), halves));
+  const __m256d apart = _mm256_max_pd(mul(within, _mm256_set1_pd(k.apart_shrink)), _mm256_setzero_pd());
   return _mm256_and_pd(apart, some);
 }
 

@@ -48,13 +48,16 @@ inline double frames_apart(const double a_half[3], const double b_half[3], const
   const double n[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
   const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (!(len > 0.0)) return 0.0;
-  double at = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
-  const double hair = hair_per_length * len;
+  // The hair's share, hair_per_length |n| (sum of the half-extents), comes off after the division:
+  // the same bound, and the square root and the division no longer wait for each other's terms.
+  const double at = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
+  double spread_a = 0.0, spread_b = 0.0;
   for (int k = 0; k < 3; ++k) {
-    at -= a_half[k] * (std::abs(n[k]) + hair);
-    at -= b_half[k] * (std::abs(r[0][k] * n[0] + r[1][k] * n[1] + r[2][k] * n[2]) + hair);
+    spread_a += a_half[k] * std::abs(n[k]);
+    spread_b += b_half[k] * std::abs(r[0][k] * n[0] + r[1][k] * n[1] + r[2][k] * n[2]);
   }
-  return std::max(0.0, at / len * shrink);
+  const double halves = (a_half[0] + a_half[1] + a_half[2]) + (b_half[0] + b_half[1] + b_half[2]);
+  return std::max(0.0, ((at - (spread_a + spread_b)) / len - hair_per_length * halves) * shrink);
 }
 
 }  // namespace caliber::narrow
