@@ -51,6 +51,8 @@ class PairContext {
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
 
+  using BoxA = narrow::BoxA;
+  using BoxB = narrow::BoxB;
   using NodeA = narrow::NodeA;
   using NodeB = narrow::NodeB;
   /// A node of A with what the node-node test needs of it precomputed. Prepared once per node and
@@ -133,7 +135,7 @@ class PairContext {
   /// Prepares node ia of A for the distance bound.
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
     NearA s;
-    fill_a(ia, s);
+    fill_box_a(ia, s);
     own_frame(mA.nodes[ia], mA.filters[ia], mA.laterals[ia], s.frame);
     return s;
   }
@@ -141,7 +143,7 @@ class PairContext {
   /// Prepares node ib of B for the distance bound.
   [[nodiscard]] NearB near_b(std::uint32_t ib) const {
     NearB s;
-    fill_b(ib, s);
+    fill_box_b(ib, s);
     Frame own;
     own_frame(mB.nodes[ib], mB.filters[ib], mB.laterals[ib], own);
     for (int i = 0; i < 3; ++i) {
@@ -262,13 +264,11 @@ class PairContext {
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   static double square(double x) { return x * x; }
-  /// The NodeA part of a prepared node of A (SideA or NearA).
-  void fill_a(std::uint32_t ia, NodeA& s) const {
+  /// The box of a prepared node of A (SideA or NearA).
+  void fill_box_a(std::uint32_t ia, BoxA& s) const {
     const BvhNode& n = mA.nodes[ia];
     s.index = ia;
-    s.radius = n.radius;
     for (int i = 0; i < 3; ++i) {
-      s.center[i] = n.center[i];
       s.box[i] = n.box_center[i];
       s.half[i] = n.box_half[i];
     }
@@ -279,21 +279,33 @@ class PairContext {
       s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
     }
   }
-  /// The NodeB part of a prepared node of B (SideB or NearB), brought into A's frame.
-  void fill_b(std::uint32_t ib, NodeB& s) const {
+  /// The NodeA part of a prepared node of A (SideA): its box and its sphere.
+  void fill_a(std::uint32_t ia, NodeA& s) const {
+    fill_box_a(ia, s);
+    const BvhNode& n = mA.nodes[ia];
+    s.radius = n.radius;
+    for (int i = 0; i < 3; ++i) s.center[i] = n.center[i];
+  }
+  /// The box of a prepared node of B (SideB or NearB), brought into A's frame.
+  void fill_box_b(std::uint32_t ib, BoxB& s) const {
     const BvhNode& n = mB.nodes[ib];
     s.index = ib;
-    s.radius = n.radius;
-    const double c[3] = {n.center[0], n.center[1], n.center[2]};
     for (int i = 0; i < 3; ++i) {
       s.box[i] = n.box_center[i];
       s.half[i] = n.box_half[i];
     }
     for (int i = 0; i < 3; ++i) {
-      s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
       s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
       s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
     }
+  }
+  /// The NodeB part of a prepared node of B (SideB): its box and its sphere, brought into A's frame.
+  void fill_b(std::uint32_t ib, NodeB& s) const {
+    fill_box_b(ib, s);
+    const BvhNode& n = mB.nodes[ib];
+    s.radius = n.radius;
+    const double c[3] = {n.center[0], n.center[1], n.center[2]};
+    for (int i = 0; i < 3; ++i) s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
   }
   /// A node's Frame in its own model's frame: the box in its slab's frame (the slab along the
   /// normalized cone axis, the lateral ranges along lateral_axes) where it has a slab, else its own

@@ -12,26 +12,32 @@
 
 namespace caliber::narrow {
 
-/// What every prepared node of A holds: its sphere, its box, and that box seen from B's frame
-/// (center, and extent along each of B's axes).
-struct NodeA {
+/// A prepared node of A's box: its box, and that box seen from B's frame (center, and extent
+/// along each of B's axes).
+struct BoxA {
   std::uint32_t index;   ///< node index in A
-  double center[3];      ///< sphere center (A's frame)
-  double radius;         ///< sphere radius
   double box[3];         ///< box center (A's frame)
   double half[3];        ///< box half-extents (A's axes)
   double box_in_b[3];    ///< box center in B's frame
   double reach_on_b[3];  ///< half-extent of A's box along each of B's axes
 };
-/// What every prepared node of B holds, the same brought into A's frame.
-struct NodeB {
+/// The same of B, brought into A's frame.
+struct BoxB {
   std::uint32_t index;   ///< node index in B
-  double center[3];      ///< sphere center in A's frame
-  double radius;         ///< sphere radius
   double box[3];         ///< box center (B's own frame)
   double half[3];        ///< box half-extents (B's axes)
   double box_in_a[3];    ///< box center in A's frame
   double reach_on_a[3];  ///< half-extent of B's box along each of A's axes
+};
+/// What the node test's prepared node of A holds: its box and its sphere.
+struct NodeA : BoxA {
+  double center[3];  ///< sphere center (A's frame)
+  double radius;     ///< sphere radius
+};
+/// The same of B, its sphere brought into A's frame.
+struct NodeB : BoxB {
+  double center[3];  ///< sphere center in A's frame
+  double radius;     ///< sphere radius
 };
 /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
 /// rounding), center and half-extents along them. The box in the frame of the node's slab (the
@@ -41,12 +47,13 @@ struct Frame {
   double center[3];
   double half[3];
 };
-/// A node of A prepared for the distance bound: NodeA and its Frame.
-struct NearA : NodeA {
+/// A node of A prepared for the distance bound: its box and its Frame (no sphere: the bound does not
+/// use it).
+struct NearA : BoxA {
   Frame frame;
 };
-/// A node of B prepared for the distance bound: NodeB and its Frame brought into A's frame.
-struct NearB : NodeB {
+/// A node of B prepared for the distance bound: its box and its Frame brought into A's frame.
+struct NearB : BoxB {
   Frame frame;
 };
 
