@@ -12,7 +12,7 @@ namespace caliber::narrow {
 
 /// How Frame b lies against Frame a (both in A's frame; d: b's center less a's): r[i][k], a's
 /// axis i . b's axis k, and t[i], a's axis i . d (b's center in a's coordinates). What
-/// frames_apart reads, and what PairContext::gap's bound along the Frames' axes is made of.
+/// frames_apart reads.
 inline void frames_relative(const Frame& a, const Frame& b, const double d[3], double r[3][3], double t[3]) {
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) r[i][k] = a.axis[i][0] * b.axis[k][0] + a.axis[i][1] * b.axis[k][1] + a.axis[i][2] * b.axis[k][2];
