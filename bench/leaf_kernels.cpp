@@ -74,11 +74,12 @@ std::map<std::string, Sample> g_samples;
 /// leaf test), in the traversal's order.
 void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t context, std::vector<TrianglePair>& out) {
   using caliber::narrow::NodePair;
-  std::vector<NodePair> stack{NodePair{0, 0}};
+  // Each node with its parent (the root's its own: tested by node_test).
+  std::vector<std::pair<NodePair, NodePair>> stack{{NodePair{0, 0}, NodePair{0, 0}}};
   while (!stack.empty()) {
-    const NodePair n = stack.back();
+    const auto [n, parent] = stack.back();
     stack.pop_back();
-    if (!ctx.node_test(n.a, n.b)) continue;
+    if (!caliber::narrow::child_test(ctx, parent, n)) continue;
     const caliber::BvhNode& a = ctx.a().nodes[n.a];
     const caliber::BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) {
@@ -96,7 +97,7 @@ void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t c
     }
     NodePair children[4];
     const int count = caliber::narrow::cd_children(ctx, n, children);
-    for (int i = count - 1; i >= 0; --i) stack.push_back(children[i]);
+    for (int i = count - 1; i >= 0; --i) stack.emplace_back(children[i], n);
   }
 }
 

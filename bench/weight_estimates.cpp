@@ -33,7 +33,7 @@ double below(const caliber::narrow::PairContext& ctx, caliber::narrow::NodePair 
   double tests = 0.0;
   for (int k = 0; k < count; ++k) {
     tests += 1.0;
-    if (ctx.node_test(kids[k].a, kids[k].b)) tests += below(ctx, kids[k], out);
+    if (caliber::narrow::child_test(ctx, n, kids[k])) tests += below(ctx, kids[k], out);
   }
   out.push_back({caliber::tasks::apriori_weight(ctx, n), tests + 1.0});
   return tests;

@@ -76,4 +76,13 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
   return count;
 }
 
+/// The node test that a visit of `parent` makes on `child` (one of its cd_children): with the
+/// disks where both sides split (PairContext::node_test_2x2_lane), node_test where one does. For
+/// code that walks the CD tree its own way and must make the decisions narrow::visit makes (tests,
+/// benches).
+inline bool child_test(const PairContext& ctx, NodePair parent, NodePair child) {
+  return child.a != parent.a && child.b != parent.b ? ctx.node_test_2x2_lane(child.a, child.b)
+                                                    : ctx.node_test(child.a, child.b);
+}
+
 }  // namespace caliber::narrow

@@ -1,5 +1,5 @@
 // The node test of a visit's child pairs, four at a time (AVX2, chosen at run time where the CPU has it):
-// the same decisions as PairContext::node_within on each pair, bit for bit.
+// the same decisions as PairContext::node_within and disks_beyond_slabs on each pair, bit for bit.
 
 #include "narrow/node_test_avx2.h"
 
@@ -58,8 +58,22 @@ CALIBER_AVX2 inline __m256d beyond_slab(const __m256d axis[3], const __m256d on[
   return either(gt(sub(at, reach), add(hi, slab_reach)), lt(add(at, reach), sub(lo, slab_reach)));
 }
 
-/// PairContext::prepare_a / prepare_b and node_within on the four node pairs, lane by lane the
-/// scalar code's operations in its order (fill_a, fill_b, box_beyond_slab).
+/// narrow::disk_beyond_slab (disks.h) in four lanes.
+CALIBER_AVX2 inline __m256d disk_beyond_slab(__m256d at, __m256d disk_lo, __m256d disk_hi, __m256d along, __m256d r,
+                                             __m256d len2, __m256d cross2, __m256d lo, __m256d hi, __m256d slab_reach) {
+  const __m256d s0 = mul(disk_lo, along), s1 = mul(disk_hi, along);
+  const __m256d at2 = mul(at, len2);
+  const __m256d low = add(at2, _mm256_min_pd(s0, s1)), high = add(at2, _mm256_max_pd(s0, s1));
+  const __m256d rim2 = mul(mul(mul(r, r), cross2), len2);
+  const __m256d above = sub(low, mul(add(hi, slab_reach), len2)), below = sub(mul(sub(lo, slab_reach), len2), high);
+  const __m256d zero = _mm256_setzero_pd();
+  return either(_mm256_and_pd(gt(above, zero), gt(mul(above, above), rim2)),
+                _mm256_and_pd(gt(below, zero), gt(mul(below, below), rim2)));
+}
+
+/// PairContext::prepare_a / prepare_b (with their disks) and node_within with disks_beyond_slabs
+/// on the four node pairs, lane by lane the scalar code's operations in its order (fill_a, fill_b,
+/// box_beyond_slab, disk_beyond_slab).
 CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                                      std::uint32_t b1) {
   const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
@@ -67,7 +81,7 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, 
   const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach);
   const __m256d hair = _mm256_set1_pd(f.hair);
   __m256d a_center[3], a_box[3], a_half[3], a_rel[3], a_axis[3], a_box_in_b[3], a_reach_on_b[3], a_slab_on_b[3];
-  __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3];
+  __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3], b_axis_in_a[3];
   for (int k = 0; k < 3; ++k) {
     a_center[k] = lanes_a(na0, na1, &BvhNode::center, k);
     a_box[k] = lanes_a(na0, na1, &BvhNode::box_center, k);
@@ -88,7 +102,8 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, 
     b_center[k] = add(row_dot(f.rot, k, b_c), t);
     b_box_in_a[k] = add(row_dot(f.rot, k, b_box), t);
     b_reach_on_a[k] = row_dot(f.abs_rot, k, b_half);
-    b_slab_on_a[k] = add(magnitude(row_dot(f.rot, k, b_axis)), hair);
+    b_axis_in_a[k] = row_dot(f.rot, k, b_axis);
+    b_slab_on_a[k] = add(magnitude(b_axis_in_a[k]), hair);
   }
   // Spheres: dist2 accumulates from 0 (0 + x is x), the radii summed before the reach is added.
   __m256d d[3];
@@ -102,10 +117,23 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, 
   for (int k = 0; k < 3; ++k) {
     apart = either(apart, gt(magnitude(sub(b_box[k], a_box_in_b[k])), add(add(b_half[k], a_reach_on_b[k]), reach)));
   }
-  apart = either(apart, beyond_slab(a_axis, a_slab_on_b, lanes_a(fa0, fa1, &BvhNodeFilter::slab_lo), lanes_a(fa0, fa1, &BvhNodeFilter::slab_hi),
-                                    b_box_in_a, b_half, slab_reach));
-  apart = either(apart, beyond_slab(b_axis, b_slab_on_a, lanes_b(fb0, fb1, &BvhNodeFilter::slab_lo), lanes_b(fb0, fb1, &BvhNodeFilter::slab_hi),
-                                    a_box_in_b, a_half, slab_reach));
+  const __m256d a_lo = lanes_a(fa0, fa1, &BvhNodeFilter::slab_lo), a_hi = lanes_a(fa0, fa1, &BvhNodeFilter::slab_hi);
+  const __m256d b_lo = lanes_b(fb0, fb1, &BvhNodeFilter::slab_lo), b_hi = lanes_b(fb0, fb1, &BvhNodeFilter::slab_hi);
+  apart = either(apart, beyond_slab(a_axis, a_slab_on_b, a_lo, a_hi, b_box_in_a, b_half, slab_reach));
+  apart = either(apart, beyond_slab(b_axis, b_slab_on_a, b_lo, b_hi, a_box_in_b, a_half, slab_reach));
+  // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs).
+  __m256d center_from_b[3];
+  for (int k = 0; k < 3; ++k) center_from_b[k] = sub(a_center[k], _mm256_set1_pd(f.trans[k]));
+  const __m256d a_mid = dot3(a_axis, a_center), b_mid = dot3(b_axis, b_c);
+  const __m256d along = dot3(a_axis, b_axis_in_a);
+  const __m256d x = sub(mul(a_axis[1], b_axis_in_a[2]), mul(a_axis[2], b_axis_in_a[1]));
+  const __m256d y = sub(mul(a_axis[2], b_axis_in_a[0]), mul(a_axis[0], b_axis_in_a[2]));
+  const __m256d z = sub(mul(a_axis[0], b_axis_in_a[1]), mul(a_axis[1], b_axis_in_a[0]));
+  const __m256d cross2 = add(add(mul(x, x), mul(y, y)), mul(z, z));
+  apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), sub(b_lo, b_mid), sub(b_hi, b_mid), along,
+                                         lanes_b(nb0, nb1, &BvhNode::radius), dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
+  apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), sub(a_lo, a_mid), sub(a_hi, a_mid), along,
+                                         lanes_a(na0, na1, &BvhNode::radius), dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
   return ~_mm256_movemask_pd(apart) & 0xF;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// The geometric part of the node test (PairContext::node_within: spheres, boxes, slabs) on the
-/// child pairs of a visit, four at a time, in AVX2: the same decisions as the scalar test, bit for
-/// bit (each lane does the scalar test's operations in its order).
+/// The geometric part of the node test of a visit where both sides split (PairContext::node_within
+/// and disks_beyond_slabs: spheres, boxes, slabs, disks) on its four child pairs at once, in AVX2:
+/// the same decisions as the scalar test, bit for bit (each lane does the scalar test's operations
+/// in its order).
 
 #include <cstdint>
 
@@ -21,8 +22,9 @@ struct NodeTestFrame {
   double hair, reach, slab_reach;
 };
 
-/// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes and slabs:
-/// PairContext::node_within on prepare_a(ai) and prepare_b(bj).
+/// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes, slabs and disks:
+/// PairContext::node_within and !disks_beyond_slabs on prepare_a(ai) and prepare_b(bj) with their
+/// disks.
 using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                               std::uint32_t b1);
 

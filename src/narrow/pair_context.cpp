@@ -81,10 +81,14 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
 }
 
 int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
-  const SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
-  const SideB sb[2] = {prepare_b(b0), prepare_b(b1)};
+  SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
+  SideB sb[2] = {prepare_b(b0), prepare_b(b1)};
+  for (int i = 0; i < 2; ++i) {
+    prepare_disk_a(sa[i]);
+    prepare_disk_b(sb[i]);
+  }
   int pass = 0;
-  for (int k = 0; k < 4; ++k) pass |= node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
+  for (int k = 0; k < 4; ++k) pass |= node_test_2x2_lane(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
   return pass;
 }
 

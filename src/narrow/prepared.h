@@ -39,6 +39,28 @@ struct NodeB : BoxB {
   double center[3];  ///< sphere center in A's frame
   double radius;     ///< sphere radius
 };
+/// A node of A with what the node-node test needs of it precomputed (PairContext::prepare_a).
+/// Prepared once per node and reused against every node of B it meets (the traversal tests two
+/// children of A against two of B).
+struct SideA : NodeA {
+  double slab_axis[3];  ///< slab axis (A's frame), 0 when the node has none
+  double slab_on_b[3];  ///< |slab axis . B's axis k|: how much of B's half-extent k it sees
+  double slab_lo, slab_hi;
+  // Its disk (disks.h), filled by PairContext::prepare_disk_a: for the four-at-once tests only.
+  double center_from_b[3];  ///< sphere center less B's origin (A's frame): what B's slab sees of it
+  double disk_lo, disk_hi;  ///< slab bounds less slab axis . sphere center
+  double axis_len2;         ///< slab axis . slab axis (0 when the node has no slab)
+};
+/// A node of B, prepared the same way (PairContext::prepare_b): centers brought into A's frame.
+struct SideB : NodeB {
+  double slab_axis[3];  ///< slab axis (B's own frame), 0 when the node has none
+  double slab_on_a[3];  ///< |slab axis . A's axis k|
+  double slab_lo, slab_hi;
+  double axis_in_a[3];  ///< slab axis brought into A's frame (rotated)
+  // Its disk, filled by PairContext::prepare_disk_b.
+  double disk_lo, disk_hi;  ///< slab bounds less slab axis . sphere center (B's own frame)
+  double axis_len2;         ///< slab axis . slab axis (0 when the node has no slab)
+};
 /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
 /// rounding), center and half-extents along them. The box in the frame of the node's slab (the
 /// slab and the lateral ranges) where the node has one, else its own box.

@@ -62,7 +62,7 @@ QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose
   QueryStats stats;
   narrow::PairLimit limit;
   limit.max = request.max_pairs;
-  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats, false, {},
+  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats, narrow::RootTest::as_root, {},
                    request.max_pairs != 0 ? &limit : nullptr);
   // A large query's scratch is let go: the thread would hold it, and every later query would
   // clear its tables. (Such a query takes far longer than making them again.)

@@ -19,10 +19,16 @@
 
 namespace caliber::narrow {
 
-/// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root).
-inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats) {
+/// How a traversal's root is tested: not at all (it was tested, and passed, earlier), as a pair's
+/// root (node_test), or as a child of a visit where both sides split (node_test_2x2_lane: a root
+/// that its parent's visit would have tested with the disks, as narrow::child_test).
+enum class RootTest : std::uint8_t { done, as_root, with_disks };
+
+/// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root),
+/// as `how` says (not RootTest::done).
+inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, RootTest how = RootTest::as_root) {
   ++stats.node_tests;
-  return ctx.node_test(n.a, n.b);
+  return how == RootTest::with_disks ? ctx.node_test_2x2_lane(n.a, n.b) : ctx.node_test(n.a, n.b);
 }
 
 /// The node index of a prepared node, held or pointed to.
@@ -153,12 +159,12 @@ struct TraversalScratch {
   }
 };
 
-/// Depth-first traversal of the CD subtree rooted at `root`: tests root (unless `root_tested`: it
-/// was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
+/// Depth-first traversal of the CD subtree rooted at `root`: tests root as `root_test` says (not
+/// when RootTest::done: it was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
 /// on passing leaf pairs, the kept pairs appended to `out`, every node and leaf test counted in
 /// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
-                                 std::vector<Candidate>& out, QueryStats& stats, bool root_tested = false,
+                                 std::vector<Candidate>& out, QueryStats& stats, RootTest root_test = RootTest::as_root,
                                  TabooView taboo = {}, PairLimit* limit = nullptr) {
   // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
   // more than 3 * (height A + height B) + 1 nodes.
@@ -168,7 +174,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   NodePair* const base = stack.data();
   NodePair* top = base;
   QueryStats counted;
-  if (root_tested || test_root(ctx, root, counted)) *top++ = root;
+  if (root_test == RootTest::done || test_root(ctx, root, counted, root_test)) *top++ = root;
   NodePair passed[4];
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
@@ -265,7 +271,7 @@ template <class Wait>
 /// and leaf tests like traverse_depth_first; honours a taboo list the same way. (A binary heap's
 /// sift was a third of the bunny's time; with the buckets, 0.57-0.62 of the 4-ary heap's time.)
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
-                             QueryStats& stats, bool root_tested = false, TabooView taboo = {}) {
+                             QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}) {
   using Reached = TraversalScratch::Reached;
   using Waiting = util::GapBuckets<Reached>::Entry;
   util::GapBuckets<Reached>& queue = scratch.waiting;
@@ -280,7 +286,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     const double reach = ctx.reach_for(nearest.bound(ctx));
     const Reached r{scratch.near_a.root(ctx.near_a(root.a)), scratch.near_b.root(ctx.near_b(root.b))};
     const double root_gap = ctx.gap(*r.a, *r.b, reach);
-    if (root_tested || (++stats.node_tests, root_gap <= reach)) {
+    if (root_test == RootTest::done || (++stats.node_tests, root_gap <= reach)) {
       next = Waiting{root_gap, r};
       have_next = true;
     }
@@ -328,14 +334,14 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
 /// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first (stopping
 /// early at the pair's limit, if one is given).
 inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
-                     QueryStats& stats, bool root_tested = false, TabooView taboo = {}, PairLimit* limit = nullptr) {
+                     QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}, PairLimit* limit = nullptr) {
   if (ctx.request().kind == QueryKind::distance) {
     Nearest nearest;
-    traverse_nearest(ctx, root, scratch, nearest, stats, root_tested, taboo);
+    traverse_nearest(ctx, root, scratch, nearest, stats, root_test, taboo);
     if (nearest.found) out.push_back(nearest.best);
     return;
   }
-  traverse_depth_first(ctx, root, scratch, out, stats, root_tested, taboo, limit);
+  traverse_depth_first(ctx, root, scratch, out, stats, root_test, taboo, limit);
 }
 
 }  // namespace caliber::narrow

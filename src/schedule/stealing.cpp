@@ -22,7 +22,8 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
     if (depth >= cutoff) {
       state.timeline.record(TaskSpan::Phase::traverse, pair, [&] {
         const std::uint64_t before = w.stats[pair].node_tests;
-        narrow::traverse(ctx, n, w.scratch, w.candidates[pair], w.stats[pair], tested, {}, state.limit(pair));
+        narrow::traverse(ctx, n, w.scratch, w.candidates[pair], w.stats[pair],
+                         tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.limit(pair));
         w.pieces.push_back(w.stats[pair].node_tests - before);
       });
       return;

@@ -272,11 +272,12 @@ namespace {
 /// Fills summary[slot] for CD node n with the reported pairs in [first, last) below it, then its
 /// children. The pairs are partitioned in place (each goes to the first child that holds both
 /// triangles, as a traversal would meet it), so the tree costs no allocation per node.
-void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, TrianglePair* first,
+void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, bool disks, TrianglePair* first,
                   TrianglePair* last, std::vector<SummaryNode>& summary) {
   const Model& a = ctx.a();
   const Model& b = ctx.b();
   summary[slot].node = n;
+  summary[slot].disks = disks;
   summary[slot].contacts = static_cast<std::uint32_t>(last - first);
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return;
   narrow::NodePair kids[4];
@@ -294,8 +295,9 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   summary[slot].children = children;
   summary.resize(summary.size() + children);
   std::uint32_t next = at;
+  const bool both = count == 4;  // both sides split: the visit tests the children with the disks
   for (int k = 0; k < count; ++k) {
-    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], bounds[k], bounds[k + 1], summary);
+    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], both, bounds[k], bounds[k + 1], summary);
   }
 }
 
@@ -307,7 +309,7 @@ std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std
   std::vector<TrianglePair> items = reported;
   summary.reserve(2 * items.size() + 1);
   summary.resize(1);
-  fill_summary(ctx, 0, narrow::NodePair{0, 0}, items.data(), items.data() + items.size(), summary);
+  fill_summary(ctx, 0, narrow::NodePair{0, 0}, false, items.data(), items.data() + items.size(), summary);
   return summary;
 }
 
@@ -338,6 +340,7 @@ PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::
       continue;
     }
     Root r{pair, s.node, false, e.weight};
+    r.disks = s.disks;
     (v == Verdict::cart ? out.cart : out.roots).push_back(r);
     out.taboo.push_back(s.node);
     out.rest -= e.weight;

@@ -1,5 +1,5 @@
 // PairContext::node_tests_2x2 (the four child pairs of a visit prepared and tested at once, AVX2
-// where the CPU has it) against prepare_a, prepare_b and node_test on each pair: the same decision for every pair, on overlapping and nearby
+// where the CPU has it) against prepare_a, prepare_b (with their disks) and node_test_2x2_lane on each pair: the same decision for every pair, on overlapping and nearby
 // objects, for every depth-first kind.
 
 #include <random>
@@ -21,7 +21,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
   std::mt19937_64 rng(20261125);
-  long passed = 0, failed = 0, differing = 0;
+  long passed = 0, failed = 0, differing = 0, by_disks = 0;
   for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
     QueryRequest request;
     request.kind = kind;
@@ -42,14 +42,20 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
                                            {wa, wa, nb.index, nb.index + 1}};
         for (int c = 0; c < 3; ++c) {
           const auto& [a0, a1, b0, b1] = cases[c];
-          const PairContext::SideA sa[2] = {ctx.prepare_a(a0), ctx.prepare_a(a1)};
-          const PairContext::SideB sb[2] = {ctx.prepare_b(b0), ctx.prepare_b(b1)};
+          PairContext::SideA sa[2] = {ctx.prepare_a(a0), ctx.prepare_a(a1)};
+          PairContext::SideB sb[2] = {ctx.prepare_b(b0), ctx.prepare_b(b1)};
+          for (int i = 0; i < 2; ++i) {
+            ctx.prepare_disk_a(sa[i]);
+            ctx.prepare_disk_b(sb[i]);
+          }
           const int mask = ctx.node_tests_2x2(a0, a1, b0, b1);
           if (ctx.node_tests_2x2_scalar(a0, a1, b0, b1) != mask && ++differing <= 5) {
             ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": the scalar form differs";
           }
           for (std::uint32_t k = 0; k < 4; ++k) {
-            const bool want = ctx.node_test(sa[k / 2], sb[k % 2]);
+            const bool want = ctx.node_test_2x2_lane(sa[k / 2], sb[k % 2]);
+            if (want && !ctx.node_test(sa[k / 2], sb[k % 2])) ++differing;  // the disks only add refusals
+            if (!want && ctx.node_test(sa[k / 2], sb[k % 2])) ++by_disks;
             (want ? passed : failed) += 1;
             if (want && c == 0) work.emplace_back(na.index + k / 2, nb.index + k % 2);
             if (want != (((mask >> k) & 1) != 0) && ++differing <= 5) {
@@ -65,6 +71,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   // Both outcomes occur often, so the comparison says something.
   EXPECT_GT(passed, 10000);
   EXPECT_GT(failed, 10000);
+  EXPECT_GT(by_disks, 1000) << "the disks refuse some pairs the rest of the test lets through";
 }
 
 }  // namespace

@@ -94,6 +94,8 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   // The summary follows the CD tree of the query's kind (the distance query descends both sides
   // more often): every child is a child of its node there, and the two trees differ here.
   std::vector<std::vector<narrow::NodePair>> nodes_of_kind;
+  int both_and_one[2] = {0, 0};
+  const narrow::PairContext ctx_for_root(*a, Pose{}, *b, Pose{}, QueryRequest{});
   for (const QueryKind kind : {QueryKind::distance, QueryKind::interference}) {
     QueryRequest request;
     request.kind = kind;
@@ -106,10 +108,16 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
       const int count = s.children == 0 ? 0 : narrow::cd_children(kind_ctx, s.node, kids);
       for (std::uint32_t c = 0; c < s.children; ++c) {
         EXPECT_NE(std::find(kids, kids + count, kind_summary[s.first + c].node), kids + count) << to_string(kind);
+        // A child of a visit where both sides split is tested with the disks (narrow::child_test).
+        EXPECT_EQ(kind_summary[s.first + c].disks, count == 4) << to_string(kind);
+        both_and_one[count == 4] += 1;
       }
     }
   }
   EXPECT_NE(nodes_of_kind[0], nodes_of_kind[1]);
+  EXPECT_GT(both_and_one[0], 0);
+  EXPECT_GT(both_and_one[1], 0);
+  EXPECT_FALSE(build_summary(ctx_for_root, reported)[0].disks) << "the root is tested as a root";
   const narrow::PairContext ctx(*a, Pose{}, *b, Pose{}, QueryRequest{});
   const auto summary = build_summary(ctx, reported);
   ASSERT_FALSE(summary.empty());
@@ -131,6 +139,15 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   EXPECT_EQ(split.taboo.size(), split.roots.size() + split.cart.size());
   for (const narrow::NodePair& n : split.taboo) EXPECT_FALSE(n.a == 0 && n.b == 0);
   EXPECT_LE(split_aposteriori(summary, 0, 4000.0, 500.0, 50.0, 3).taboo.size(), 3u) << "the cap holds";
+  // Each root is tested as its parent's visit would test it.
+  for (const std::vector<Root>* list : {&split.roots, &split.cart}) {
+    for (const Root& r : *list) {
+      const auto s = std::find_if(summary.begin(), summary.end(), [&](const SummaryNode& x) { return x.node == r.node; });
+      ASSERT_NE(s, summary.end());
+      EXPECT_EQ(r.disks, s->disks);
+      EXPECT_EQ(r.root_test(), s->disks ? narrow::RootTest::with_disks : narrow::RootTest::as_root);
+    }
+  }
 }
 
 
@@ -142,6 +159,7 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
   struct Entry {
     double weight;
     narrow::NodePair node;
+    narrow::NodePair parent;  ///< whose visit tests it (narrow::child_test); the root's its own
     bool operator<(const Entry& o) const {
       if (weight != o.weight) return weight < o.weight;
       if (node.a != o.node.a) return node.a > o.node.a;
@@ -150,13 +168,13 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
   };
   SplitResult out;
   std::priority_queue<Entry> queue;
-  queue.push(Entry{root_weight, narrow::NodePair{0, 0}});
+  queue.push(Entry{root_weight, narrow::NodePair{0, 0}, narrow::NodePair{0, 0}});
   narrow::NodePair kids[4];
   while (!queue.empty()) {
     const Entry e = queue.top();
     queue.pop();
     ++out.stats.node_tests;
-    if (!ctx.node_test(e.node.a, e.node.b)) continue;
+    if (!narrow::child_test(ctx, e.parent, e.node)) continue;
     const BvhNode& a = ctx.a().nodes[e.node.a];
     const BvhNode& b = ctx.b().nodes[e.node.b];
     if (a.is_leaf() && b.is_leaf()) {
@@ -167,7 +185,7 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
     const Verdict v = classify(e.weight, omega, eps);
     if (v == Verdict::split) {
       const int count = narrow::cd_children(ctx, e.node, kids);
-      for (int i = 0; i < count; ++i) queue.push(Entry{scale * apriori_weight(ctx, kids[i]), kids[i]});
+      for (int i = 0; i < count; ++i) queue.push(Entry{scale * apriori_weight(ctx, kids[i]), kids[i], e.node});
     } else {
       (v == Verdict::keep ? out.roots : out.cart).push_back(Root{pair, e.node, true, e.weight});
     }

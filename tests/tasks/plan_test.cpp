@@ -49,7 +49,7 @@ std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(co
     for (const Root& r : t.roots) {
       std::vector<char> reached(r.taboo >= 0 ? plan.taboos[r.taboo].nodes.size() : 0);
       const narrow::TabooView taboo = r.taboo >= 0 ? narrow::TabooView{&plan.taboos[r.taboo], reached.data()} : narrow::TabooView{};
-      narrow::traverse_depth_first(p.contexts[r.pair], r.node, scratch, found[r.pair], stats[r.pair], r.tested, taboo);
+      narrow::traverse_depth_first(p.contexts[r.pair], r.node, scratch, found[r.pair], stats[r.pair], r.root_test(), taboo);
     }
   }
   std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> out;
