@@ -67,6 +67,7 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
   if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
   const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
   int pass = within(mNodeFrame, a0, a1, b0, b1);
+  if (mGroups == nullptr && mKind != QueryKind::contact) return pass;
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
     const int k = __builtin_ctz(static_cast<unsigned>(left));
