@@ -28,7 +28,13 @@ struct NodeTestFrame {
 using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                               std::uint32_t b1);
 
-/// The AVX2 form, or nullptr where this build or this CPU has none.
+/// The four-lane form compiled for AVX2 (`wide_registers` false) or for AVX-512VL (true: the same
+/// code and operations with 32 vector registers, so fewer spills), or nullptr where this build or
+/// this CPU has none.
+NodeWithin2x2 node_within_2x2_form(bool wide_registers);
+
+/// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else
+/// nullptr.
 NodeWithin2x2 node_within_2x2_avx2_if_supported();
 
 }  // namespace caliber::narrow::detail

@@ -137,6 +137,8 @@ class PairContext {
   /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp), the same
   /// decisions.
   [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
+  /// What node_tests_2x2's four-lane forms read of this context (detail::node_within_2x2_form).
+  [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
   /// The same, one pair at a time: what node_tests_2x2 runs where the CPU has no AVX2.
   [[nodiscard]] int node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
 

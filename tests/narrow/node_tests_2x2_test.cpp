@@ -21,7 +21,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
   std::mt19937_64 rng(20261125);
-  long passed = 0, failed = 0, differing = 0, by_disks = 0;
+  long passed = 0, failed = 0, differing = 0, by_disks = 0, forms_checked = 0;
   for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
     QueryRequest request;
     request.kind = kind;
@@ -49,6 +49,17 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
             ctx.prepare_disk_b(sb[i]);
           }
           const int mask = ctx.node_tests_2x2(a0, a1, b0, b1);
+          // Both four-lane forms (AVX2, AVX-512VL registers) where this CPU has them: their
+          // geometric mask is the node test's, less groups and cones (none here but contact's).
+          for (const bool wide : {false, true}) {
+            if (const auto form = detail::node_within_2x2_form(wide)) {
+              const int geometric = form(ctx.node_test_frame(), a0, a1, b0, b1);
+              ++forms_checked;
+              if ((kind == QueryKind::contact ? (geometric & mask) != mask : geometric != mask) && ++differing <= 5) {
+                ADD_FAILURE() << "form " << wide << " kind " << static_cast<int>(kind) << " pose " << p << " case " << c;
+              }
+            }
+          }
           if (ctx.node_tests_2x2_scalar(a0, a1, b0, b1) != mask && ++differing <= 5) {
             ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": the scalar form differs";
           }
@@ -72,6 +83,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   EXPECT_GT(passed, 10000);
   EXPECT_GT(failed, 10000);
   EXPECT_GT(by_disks, 1000) << "the disks refuse some pairs the rest of the test lets through";
+  if (detail::node_within_2x2_form(false) != nullptr) EXPECT_GT(forms_checked, 10000);
 }
 
 }  // namespace
