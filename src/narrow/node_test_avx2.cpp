@@ -6,28 +6,47 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
+#include <cstddef>
+
 namespace caliber::narrow::detail {
 namespace {
 
 #define CALIBER_AVX2 __attribute__((target("avx2")))
 
 /// Lanes of the four node pairs (a0 b0, a0 b1, a1 b0, a1 b1): A's nodes a0 a0 a1 a1, B's b0 b1 b0 b1.
-/// A float field of two records (nodes or filters), converted to double (exactly).
+/// The records' floats come in blocks of four (a vector load of each record, then shuffles), each
+/// float converted to double (exactly). The blocks' positions in BvhNode and BvhNodeFilter:
+static_assert(offsetof(BvhNode, center) == 0 && offsetof(BvhNode, radius) == 12 && offsetof(BvhNode, box_center) == 16 &&
+              offsetof(BvhNode, box_half) == 28 && sizeof(BvhNode) == 48);
+static_assert(offsetof(BvhNodeFilter, cone_axis) == 0 && offsetof(BvhNodeFilter, slab_lo) == 24 &&
+              offsetof(BvhNodeFilter, slab_hi) == 28);
+
+/// Floats 4 block .. 4 block + 3 of two records, in A's lane order (r0 r0 r1 r1).
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_a(const Record& r0, const Record& r1, const float Record::*field) {
-  return _mm256_cvtps_pd(_mm_setr_ps(r0.*field, r0.*field, r1.*field, r1.*field));
+CALIBER_AVX2 inline void block_a(const Record& r0, const Record& r1, int block, __m256d out[4]) {
+  const __m128 x0 = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
+  const __m128 x1 = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
+  out[0] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(0, 0, 0, 0)));
+  out[1] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(1, 1, 1, 1)));
+  out[2] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(2, 2, 2, 2)));
+  out[3] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(3, 3, 3, 3)));
 }
+/// The same in B's lane order (r0 r1 r0 r1).
 template <class Record>
-CALIBER_AVX2 inline __m256d lanes_b(const Record& r0, const Record& r1, const float Record::*field) {
-  return _mm256_cvtps_pd(_mm_setr_ps(r0.*field, r1.*field, r0.*field, r1.*field));
+CALIBER_AVX2 inline void block_b(const Record& r0, const Record& r1, int block, __m256d out[4]) {
+  const __m128 x0 = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
+  const __m128 x1 = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
+  const __m128 lo = _mm_unpacklo_ps(x0, x1), hi = _mm_unpackhi_ps(x0, x1);
+  out[0] = _mm256_cvtps_pd(_mm_movelh_ps(lo, lo));
+  out[1] = _mm256_cvtps_pd(_mm_movehl_ps(lo, lo));
+  out[2] = _mm256_cvtps_pd(_mm_movelh_ps(hi, hi));
+  out[3] = _mm256_cvtps_pd(_mm_movehl_ps(hi, hi));
 }
-template <class Record>
-CALIBER_AVX2 inline __m256d lanes_a(const Record& r0, const Record& r1, const float (Record::*field)[3], int k) {
-  return _mm256_cvtps_pd(_mm_setr_ps((r0.*field)[k], (r0.*field)[k], (r1.*field)[k], (r1.*field)[k]));
-}
-template <class Record>
-CALIBER_AVX2 inline __m256d lanes_b(const Record& r0, const Record& r1, const float (Record::*field)[3], int k) {
-  return _mm256_cvtps_pd(_mm_setr_ps((r0.*field)[k], (r1.*field)[k], (r0.*field)[k], (r1.*field)[k]));
+/// A node's floats 0..11 (center, radius, box center, box half-extents; the last two are the
+/// index and count, unused) and a filter's 0..7 (cone axis, angle, cos, sin, slab lo and hi).
+template <bool kA, class Record>
+CALIBER_AVX2 inline void blocks(const Record& r0, const Record& r1, int count, __m256d* out) {
+  for (int b = 0; b < count; ++b) kA ? block_a(r0, r1, b, out + 4 * b) : block_b(r0, r1, b, out + 4 * b);
 }
 
 CALIBER_AVX2 inline __m256d add(__m256d u, __m256d v) { return _mm256_add_pd(u, v); }
@@ -83,16 +102,21 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   const __m256d hair = _mm256_set1_pd(f.hair);
   __m256d a_center[3], a_box[3], a_half[3], a_rel[3], a_axis[3], a_box_in_b[3], a_reach_on_b[3], a_slab_on_b[3];
   __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3], b_axis_in_a[3];
+  __m256d an[12], bn[12], af[8], bf[8];  // the records' floats, in lanes
+  blocks<true>(na0, na1, 3, an);
+  blocks<false>(nb0, nb1, 3, bn);
+  blocks<true>(fa0, fa1, 2, af);
+  blocks<false>(fb0, fb1, 2, bf);
   for (int k = 0; k < 3; ++k) {
-    a_center[k] = lanes_a(na0, na1, &BvhNode::center, k);
-    a_box[k] = lanes_a(na0, na1, &BvhNode::box_center, k);
-    a_half[k] = lanes_a(na0, na1, &BvhNode::box_half, k);
+    a_center[k] = an[k];
+    a_box[k] = an[4 + k];
+    a_half[k] = an[7 + k];
     a_rel[k] = sub(a_box[k], _mm256_set1_pd(f.trans[k]));
-    a_axis[k] = lanes_a(fa0, fa1, &BvhNodeFilter::cone_axis, k);
-    b_c[k] = lanes_b(nb0, nb1, &BvhNode::center, k);
-    b_box[k] = lanes_b(nb0, nb1, &BvhNode::box_center, k);
-    b_half[k] = lanes_b(nb0, nb1, &BvhNode::box_half, k);
-    b_axis[k] = lanes_b(fb0, fb1, &BvhNodeFilter::cone_axis, k);
+    a_axis[k] = af[k];
+    b_c[k] = bn[k];
+    b_box[k] = bn[4 + k];
+    b_half[k] = bn[7 + k];
+    b_axis[k] = bf[k];
   }
   for (int k = 0; k < 3; ++k) {
     // A's box seen from B: x_b = R^T (x_a - T); B's node brought into A's frame: R x_b + T.
@@ -110,7 +134,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   __m256d d[3];
   for (int k = 0; k < 3; ++k) d[k] = sub(a_center[k], b_center[k]);
   const __m256d dist2 = add(add(mul(d[0], d[0]), mul(d[1], d[1])), mul(d[2], d[2]));
-  const __m256d spheres = add(add(lanes_a(na0, na1, &BvhNode::radius), lanes_b(nb0, nb1, &BvhNode::radius)), reach);
+  const __m256d spheres = add(add(an[3], bn[3]), reach);
   __m256d apart = gt(dist2, mul(spheres, spheres));
   for (int k = 0; k < 3; ++k) {  // A's axes, then B's
     apart = either(apart, gt(magnitude(sub(b_box_in_a[k], a_box[k])), add(add(a_half[k], b_reach_on_a[k]), reach)));
@@ -118,8 +142,8 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   for (int k = 0; k < 3; ++k) {
     apart = either(apart, gt(magnitude(sub(b_box[k], a_box_in_b[k])), add(add(b_half[k], a_reach_on_b[k]), reach)));
   }
-  const __m256d a_lo = lanes_a(fa0, fa1, &BvhNodeFilter::slab_lo), a_hi = lanes_a(fa0, fa1, &BvhNodeFilter::slab_hi);
-  const __m256d b_lo = lanes_b(fb0, fb1, &BvhNodeFilter::slab_lo), b_hi = lanes_b(fb0, fb1, &BvhNodeFilter::slab_hi);
+  const __m256d a_lo = af[6], a_hi = af[7];
+  const __m256d b_lo = bf[6], b_hi = bf[7];
   apart = either(apart, beyond_slab(a_axis, a_slab_on_b, a_lo, a_hi, b_box_in_a, b_half, slab_reach));
   apart = either(apart, beyond_slab(b_axis, b_slab_on_a, b_lo, b_hi, a_box_in_b, a_half, slab_reach));
   // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs).
@@ -132,9 +156,9 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   const __m256d z = sub(mul(a_axis[0], b_axis_in_a[1]), mul(a_axis[1], b_axis_in_a[0]));
   const __m256d cross2 = add(add(mul(x, x), mul(y, y)), mul(z, z));
   apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), sub(b_lo, b_mid), sub(b_hi, b_mid), along,
-                                         lanes_b(nb0, nb1, &BvhNode::radius), dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
+                                         bn[3], dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
   apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), sub(a_lo, a_mid), sub(a_hi, a_mid), along,
-                                         lanes_a(na0, na1, &BvhNode::radius), dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
+                                         an[3], dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
   return ~_mm256_movemask_pd(apart) & 0xF;
 }
 
