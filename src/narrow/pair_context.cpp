@@ -81,6 +81,22 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
   return pass;
 }
 
+void PairContext::prepare_disk_a(SideA& s) const {
+  for (int i = 0; i < 3; ++i) s.center_from_b[i] = s.center[i] - mTrans[i];
+  const double mid = s.slab_axis[0] * s.center[0] + s.slab_axis[1] * s.center[1] + s.slab_axis[2] * s.center[2];
+  s.disk_lo = s.slab_lo - mid;
+  s.disk_hi = s.slab_hi - mid;
+  s.axis_len2 = s.slab_axis[0] * s.slab_axis[0] + s.slab_axis[1] * s.slab_axis[1] + s.slab_axis[2] * s.slab_axis[2];
+}
+
+void PairContext::prepare_disk_b(SideB& s) const {
+  const float* c = mB.nodes[s.index].center;
+  const double mid = s.slab_axis[0] * c[0] + s.slab_axis[1] * c[1] + s.slab_axis[2] * c[2];
+  s.disk_lo = s.slab_lo - mid;
+  s.disk_hi = s.slab_hi - mid;
+  s.axis_len2 = s.slab_axis[0] * s.slab_axis[0] + s.slab_axis[1] * s.slab_axis[1] + s.slab_axis[2] * s.slab_axis[2];
+}
+
 int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
   SideA sa[2] = {prepare_a(a0), prepare_a(a1)};
   SideB sb[2] = {prepare_b(b0), prepare_b(b1)};

@@ -89,21 +89,9 @@ class PairContext {
   }
 
   /// Adds its disk to a prepared node of A (for node_test_2x2_lane).
-  void prepare_disk_a(SideA& s) const {
-    for (int i = 0; i < 3; ++i) s.center_from_b[i] = s.center[i] - mTrans[i];
-    const double mid = s.slab_axis[0] * s.center[0] + s.slab_axis[1] * s.center[1] + s.slab_axis[2] * s.center[2];
-    s.disk_lo = s.slab_lo - mid;
-    s.disk_hi = s.slab_hi - mid;
-    s.axis_len2 = s.slab_axis[0] * s.slab_axis[0] + s.slab_axis[1] * s.slab_axis[1] + s.slab_axis[2] * s.slab_axis[2];
-  }
+  void prepare_disk_a(SideA& s) const;
   /// Adds its disk to a prepared node of B (its sphere's center in B's own frame).
-  void prepare_disk_b(SideB& s) const {
-    const float* c = mB.nodes[s.index].center;
-    const double mid = s.slab_axis[0] * c[0] + s.slab_axis[1] * c[1] + s.slab_axis[2] * c[2];
-    s.disk_lo = s.slab_lo - mid;
-    s.disk_hi = s.slab_hi - mid;
-    s.axis_len2 = s.slab_axis[0] * s.slab_axis[0] + s.slab_axis[1] * s.slab_axis[1] + s.slab_axis[2] * s.slab_axis[2];
-  }
+  void prepare_disk_b(SideB& s) const;
 
   /// The node-node test on prepared nodes: spheres within the tolerance, boxes not separated by a
   /// face axis, each box not separated from the other node's slab, some compatible groups, normal
