@@ -129,6 +129,53 @@ void plane_signs(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3 q[3]
 
 bool same_strict_side(const int s[3]) { return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0); }
 
+/// The edge tests: two closed triangles meet iff an edge of one meets the other (the intersection
+/// is convex, and its boundary points lie on an edge of one triangle, or one triangle holds the
+/// other whole). Given the plane signs sa (A's corners against B's plane) and sb.
+bool edges_meet(const Vec3 a[3], const Vec3 b[3], const int sa[3], const int sb[3]) {
+  // Coplanar, non-degenerate triangles: one 2-D test instead of six edge tests.
+  const bool a_in_plane_of_b = sa[0] == 0 && sa[1] == 0 && sa[2] == 0;
+  if (a_in_plane_of_b && !collinear(b[0], b[1], b[2])) return coplanar_hulls_intersect(a, b);
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (segment_triangle(a[i], a[j], b[0], b[1], b[2], sa[i], sa[j])) return true;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    if (segment_triangle(b[i], b[j], a[0], a[1], a[2], sb[i], sb[j])) return true;
+  }
+  return false;
+}
+
+/// The corner whose sign differs from the other two (signs nonzero, not all equal).
+int lone(const int s[3]) { return s[0] == s[1] ? 2 : (s[0] == s[2] ? 1 : 0); }
+
+/// Guigue and Devillers' test ("Fast and robust triangle-triangle overlap test using orientation
+/// predicates", 2003) where no corner lies in the other triangle's plane and each plane cuts the
+/// other triangle (every sign nonzero, neither set all equal): both triangles are then proper, and
+/// each meets the planes' common line in a segment; they meet iff the two segments overlap, which
+/// two orientations decide. A is turned (a rotation keeps its plane's side) so that its lone corner
+/// p1 comes first, and B's order reversed where p1 is on the negative side of B's plane; then B
+/// the same way against A. Two orient3d instead of up to eighteen for the edge tests.
+bool planes_cross_meet(const Vec3 a[3], const Vec3 b[3], const int sa[3], const int sb[3]) {
+  const int i = lone(sa);
+  const Vec3* t1[3] = {&a[i], &a[(i + 1) % 3], &a[(i + 2) % 3]};
+  const bool keep_b = sa[i] > 0;
+  const Vec3* t2[3] = {&b[0], keep_b ? &b[1] : &b[2], keep_b ? &b[2] : &b[1]};
+  const int d2[3] = {sb[0], keep_b ? sb[1] : sb[2], keep_b ? sb[2] : sb[1]};
+  const int k = lone(d2);
+  const Vec3& p2 = *t2[k];
+  const Vec3& q2 = *t2[(k + 1) % 3];
+  const Vec3& r2 = *t2[(k + 2) % 3];
+  const Vec3& p1 = *t1[0];
+  const Vec3& q1 = d2[k] > 0 ? *t1[1] : *t1[2];
+  const Vec3& r1 = d2[k] > 0 ? *t1[2] : *t1[1];
+  return orient3d(p1.data(), q1.data(), p2.data(), q2.data()) <= 0 &&
+         orient3d(p1.data(), r1.data(), r2.data(), p2.data()) <= 0;
+}
+
+bool no_zero(const int s[3]) { return s[0] != 0 && s[1] != 0 && s[2] != 0; }
+
 }  // namespace
 
 bool segment_intersects_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -146,22 +193,24 @@ bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
   if (same_strict_side(sa)) return false;
   plane_signs(a0, a1, a2, b, sb);
   if (same_strict_side(sb)) return false;
-
-  // Coplanar, non-degenerate triangles: one 2-D test instead of six edge tests.
-  const bool a_in_plane_of_b = sa[0] == 0 && sa[1] == 0 && sa[2] == 0;
-  if (a_in_plane_of_b && !collinear(b0, b1, b2)) return coplanar_hulls_intersect(a, b);
-
-  // Two closed triangles meet iff an edge of one meets the other: the intersection is convex, and
-  // its boundary points lie on an edge of one triangle (or one triangle holds the other whole).
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    if (segment_triangle(a[i], a[j], b0, b1, b2, sa[i], sa[j])) return true;
-  }
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    if (segment_triangle(b[i], b[j], a0, a1, a2, sb[i], sb[j])) return true;
-  }
-  return false;
+  if (no_zero(sa) && no_zero(sb)) return planes_cross_meet(a, b, sa, sb);
+  return edges_meet(a, b, sa, sb);
 }
 
+namespace detail {
+
+bool triangles_intersect_by_edges(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
+                                  const Vec3& b2) {
+  const Vec3 a[3] = {a0, a1, a2};
+  const Vec3 b[3] = {b0, b1, b2};
+  int sa[3], sb[3];
+  for (int i = 0; i < 3; ++i) {
+    sa[i] = orient3d(b0.data(), b1.data(), b2.data(), a[i].data());
+    sb[i] = orient3d(a0.data(), a1.data(), a2.data(), b[i].data());
+  }
+  if (same_strict_side(sa) || same_strict_side(sb)) return false;
+  return edges_meet(a, b, sa, sb);
+}
+
+}  // namespace detail
 }  // namespace caliber::geometry

@@ -41,4 +41,12 @@ inline bool certainly_separated(const Eigen::Vector3d& n, const Eigen::Vector3d 
   return apart;
 }
 
+namespace detail {
+/// triangles_intersect by the edge tests alone (every sign from orient3d, then each edge of one
+/// triangle against the other), the form it takes where a corner lies in the other's plane: the
+/// reference for the planes-crossing case's two-orientation test.
+bool triangles_intersect_by_edges(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& a2,
+                                  const Eigen::Vector3d& b0, const Eigen::Vector3d& b1, const Eigen::Vector3d& b2);
+}  // namespace detail
+
 }  // namespace caliber::geometry

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "geometry/predicates.h"
 #include "geometry/triangle_distance.h"
 
 namespace caliber::geometry {
@@ -158,6 +159,79 @@ TEST(TriangleIntersect, RandomAgreesWithDistanceWherePlain) {
   EXPECT_GT(no, 1000);
 }
 
+
+/// Whether the pair takes the planes-crossing test: every corner strictly off the other's plane, and
+/// each plane with corners of the other triangle on both sides.
+bool planes_cross(const Vec3 a[3], const Vec3 b[3]) {
+  int sa[3], sb[3];
+  for (int i = 0; i < 3; ++i) {
+    sa[i] = orient3d(b[0].data(), b[1].data(), b[2].data(), a[i].data());
+    sb[i] = orient3d(a[0].data(), a[1].data(), a[2].data(), b[i].data());
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (sa[i] == 0 || sb[i] == 0) return false;
+  }
+  return !(sa[0] == sa[1] && sa[1] == sa[2]) && !(sb[0] == sb[1] && sb[1] == sb[2]);
+}
+
+/// triangles_intersect against the edge tests alone, in every argument and corner order.
+void expect_as_edge_tests(const Vec3 a[3], const Vec3 b[3], int iter) {
+  const int perms[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+  for (const auto& pa : perms) {
+    for (const auto& pb : perms) {
+      const Vec3 ra[3] = {a[pa[0]], a[pa[1]], a[pa[2]]};
+      const Vec3 rb[3] = {b[pb[0]], b[pb[1]], b[pb[2]]};
+      const bool want = detail::triangles_intersect_by_edges(ra[0], ra[1], ra[2], rb[0], rb[1], rb[2]);
+      ASSERT_EQ(tri_tri(ra, rb), want) << "iteration " << iter;
+      ASSERT_EQ(tri_tri(rb, ra), want) << "iteration " << iter;
+    }
+  }
+}
+
+// Small integer coordinates make exact coincidences common: the two segments on the planes' common
+// line touching at an end (an orientation of the two-orientation test exactly 0), corners in the
+// other's plane (the edge tests' cases). Every kind must give the edge tests' answer.
+TEST(TriangleIntersect, PlanesCrossingTestAgreesWithEdgeTestsOnAGrid) {
+  std::mt19937_64 rng(23);
+  std::uniform_int_distribution<int> u(-2, 2);
+  int crossing_yes = 0, crossing_no = 0, touching = 0;
+  for (int iter = 0; iter < 20000; ++iter) {
+    Vec3 a[3], b[3];
+    for (auto& v : a) v = Vec3(u(rng), u(rng), u(rng));
+    for (auto& v : b) v = Vec3(u(rng), u(rng), u(rng));
+    expect_as_edge_tests(a, b, iter);
+    if (HasFatalFailure()) return;
+    if (!planes_cross(a, b)) continue;
+    const bool hit = tri_tri(a, b);
+    (hit ? crossing_yes : crossing_no) += 1;
+    bool coplanar_edges = false;  // an edge of A and an edge of B on one plane: a touching candidate
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        coplanar_edges |= orient3d(a[i].data(), a[(i + 1) % 3].data(), b[j].data(), b[(j + 1) % 3].data()) == 0;
+      }
+    }
+    touching += hit && coplanar_edges;
+  }
+  EXPECT_GT(crossing_yes, 1000);
+  EXPECT_GT(crossing_no, 1000);
+  EXPECT_GT(touching, 200);
+}
+
+TEST(TriangleIntersect, PlanesCrossingTestAgreesWithEdgeTestsOnRandomPairs) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int crossing_yes = 0, crossing_no = 0;
+  for (int iter = 0; iter < 20000; ++iter) {
+    Vec3 a[3], b[3];
+    for (auto& v : a) v = Vec3(u(rng), u(rng), u(rng));
+    for (auto& v : b) v = Vec3(u(rng), u(rng), u(rng)) * 0.5 + Vec3(0.3, 0, 0);
+    expect_as_edge_tests(a, b, iter);
+    if (HasFatalFailure()) return;
+    if (planes_cross(a, b)) (tri_tri(a, b) ? crossing_yes : crossing_no) += 1;
+  }
+  EXPECT_GT(crossing_yes, 1000);
+  EXPECT_GT(crossing_no, 1000);
+}
 
 // certainly_separated may skip triangles_intersect only where it would say false: it must never
 // certify triangles that meet, for the closest points' direction or any other.
