@@ -154,9 +154,12 @@ int lone(const int s[3]) { return s[0] == s[1] ? 2 : (s[0] == s[2] ? 1 : 0); }
 /// predicates", 2003) where no corner lies in the other triangle's plane and each plane cuts the
 /// other triangle (every sign nonzero, neither set all equal): both triangles are then proper, and
 /// each meets the planes' common line in a segment; they meet iff the two segments overlap, which
-/// two orientations decide. A is turned (a rotation keeps its plane's side) so that its lone corner
-/// p1 comes first, and B's order reversed where p1 is on the negative side of B's plane; then B
-/// the same way against A. Two orient3d instead of up to eighteen for the edge tests.
+/// two orientations decide. A is turned (a rotation keeps its plane's orientation) so that its lone
+/// corner p1 comes first, and B's order reversed where orient3d puts p1 on B's negative side (so
+/// that orient3d(p2, q2, r2, p1) > 0); then B the same way against A. The paper's two conditions,
+/// [p1, q1, p2, q2] <= 0 and [p1, r1, r2, p2] <= 0, hold for any one orientation determinant used
+/// throughout (a mirror image flips every sign), here orient3d's. Two orient3d instead of up to
+/// eighteen for the edge tests.
 bool planes_cross_meet(const Vec3 a[3], const Vec3 b[3], const int sa[3], const int sb[3]) {
   const int i = lone(sa);
   const Vec3* t1[3] = {&a[i], &a[(i + 1) % 3], &a[(i + 2) % 3]};
