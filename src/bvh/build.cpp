@@ -1,10 +1,12 @@
-// Sphere-tree BVH build: top-down split at the centroids' mean (the median where that is lopsided), exact covering radii, normal cones and slabs, group masks.
+// Sphere-tree BVH build: top-down binned surface-area split (bvh/split.h), exact covering radii, normal cones and slabs, group masks.
 
 #include <numbers>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <span>
 
 #include <Eigen/Geometry>
 
@@ -12,6 +14,7 @@
 #include "caliber/model.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
+#include "bvh/split.h"
 #include "util/float_round.h"
 #include "parallel/executor.h"
 
@@ -21,6 +24,8 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using util::round_down;
 using util::round_up;
+using bvh::split_binned;
+using bvh::split_items;
 using bvh::split_turn;
 using bvh::triangle_turn;
 using bvh::turned_axes;
@@ -59,11 +64,18 @@ struct WorkNode {
   std::uint32_t first = 0;  ///< first position of its triangles in leaf order
 };
 
+/// Room for a WorkNode, which the build constructs there (std::construct_at) when it makes the
+/// node: the 2 n - 1 nodes' memory is written once, in the (parallel) build, instead of also being
+/// value-initialized first in one thread.
+union WorkSlot {
+  WorkSlot() {}   // NOLINT(modernize-use-equals-default): leaves `node` unconstructed on purpose
+  ~WorkSlot() {}  // NOLINT(modernize-use-equals-default)
+  WorkNode node;
+};
+
 /// Subtrees over more triangles than this build their two halves in parallel (on the executor the
 /// caller runs in); smaller ones, and every leaf-level pass, in a loop of their own.
 constexpr std::uint32_t kParallelBuildCount = 2048;
-/// A split leaves each side at least 1/kSplitBalance of the triangles (Builder::split).
-constexpr std::uint32_t kSplitBalance = 16;
 /// Items per chunk for the build's per-triangle and per-node loops.
 constexpr std::size_t kBuildGrain = 4096;
 
@@ -73,27 +85,22 @@ class Builder {
     const std::size_t n = mesh.triangles.size();
     mOrder.resize(n);
     std::iota(mOrder.begin(), mOrder.end(), 0u);
-    mCentroids.resize(n);
-    parallel::parallel_for(0, n, kBuildGrain, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t t = lo; t != hi; ++t) {
-        const auto& tri = mesh.triangles[t];
-        mCentroids[t] = (mesh.vertices[tri[0]] + mesh.vertices[tri[1]] + mesh.vertices[tri[2]]) / 3.0;
-      }
-    });
-    mWork.resize(2 * n - 1);
+    mItems = split_items(mesh);
+    mWork = std::make_unique_for_overwrite<WorkSlot[]>(2 * n - 1);
+    mWorkCount = 2 * n - 1;
   }
 
   void build(Model& model) {
-    model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()));
-    model.nodes.resize(mWork.size());
-    model.filters.resize(mWork.size());
-    model.laterals.resize(mWork.size());
-    model.first_leaf.resize(mWork.size());
+    model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()), bvh::centroid_bounds(mOrder, mItems));
+    model.nodes.resize(mWorkCount);
+    model.filters.resize(mWorkCount);
+    model.laterals.resize(mWorkCount);
+    model.first_leaf.resize(mWorkCount);
     model.leaf_position.resize(mOrder.size());
-    parallel::parallel_for(0, mWork.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
+    parallel::parallel_for(0, mWorkCount, kBuildGrain, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
-        convert(mWork[i], model.nodes[i], model.filters[i], model.laterals[i]);
-        model.first_leaf[i] = mWork[i].first;
+        convert(mWork[i].node, model.nodes[i], model.filters[i], model.laterals[i]);
+        model.first_leaf[i] = mWork[i].node.first;
       }
     });
     for (std::uint32_t p = 0; p < mOrder.size(); ++p) model.leaf_position[mOrder[p]] = p;
@@ -105,60 +112,30 @@ class Builder {
   /// two children of a node, then builds the left subtree, then the right one: a subtree over m
   /// triangles holds 2 m - 1 nodes, so the right subtree's nodes start 2 (left count) - 2 after the
   /// left's, and both halves can be built at once, into the same places, whatever the threads.
-  int build_range(std::uint32_t slot, std::uint32_t next, std::uint32_t begin, std::uint32_t end) {
+  /// `bounds`: the box of the range's centroids.
+  int build_range(std::uint32_t slot, std::uint32_t next, std::uint32_t begin, std::uint32_t end,
+                  const bvh::CentroidBounds& bounds) {
     if (end - begin == 1) {
-      mWork[slot].first = begin;
-      make_leaf(slot, mOrder[begin]);
+      make_leaf(slot, mOrder[begin], begin);
       return 1;
     }
-    const std::uint32_t mid = split(begin, end);
+    bvh::CentroidBounds left, right;
+    const std::uint32_t mid =
+        begin + split_binned(std::span<std::uint32_t>(mOrder.data() + begin, end - begin), mItems, bounds, left, right);
     const std::uint32_t first = next;
     const std::uint32_t left_next = first + 2, right_next = left_next + 2 * (mid - begin) - 2;
     int hl = 0, hr = 0;
     if (end - begin > kParallelBuildCount) {
       parallel::TaskGroup halves;
-      halves.run([&] { hl = build_range(first, left_next, begin, mid); });
-      hr = build_range(first + 1, right_next, mid, end);
+      halves.run([&] { hl = build_range(first, left_next, begin, mid, left); });
+      hr = build_range(first + 1, right_next, mid, end, right);
       halves.wait();
     } else {
-      hl = build_range(first, left_next, begin, mid);
-      hr = build_range(first + 1, right_next, mid, end);
+      hl = build_range(first, left_next, begin, mid, left);
+      hr = build_range(first + 1, right_next, mid, end, right);
     }
     make_internal(slot, first, begin, end);
-    mWork[slot].first = begin;
     return 1 + std::max(hl, hr);
-  }
-
-  /// Splits at the mean of the centroids along the longest axis of their bounds (FCL's default for
-  /// its OBBRSS trees), those below the mean first; where that leaves either side fewer than a
-  /// 1/kSplitBalance share, at the median instead (ties by triangle id), so the tree's height stays
-  /// within log base 16/15 of the count. Against the median everywhere (bench_fcl_compare, Intel
-  /// Xeon VM, five alternating runs): node tests 136k-153k -> 112k-124k on the four large pairs
-  /// of the FCL cases, their queries 0.83-0.88 of the time; the balance rule changed a few
-  /// hundred of those node tests.
-  std::uint32_t split(std::uint32_t begin, std::uint32_t end) {
-    Vec3 lo = mCentroids[mOrder[begin]], hi = lo, sum = lo;
-    for (std::uint32_t i = begin + 1; i < end; ++i) {
-      const Vec3& c = mCentroids[mOrder[i]];
-      lo = lo.cwiseMin(c);
-      hi = hi.cwiseMax(c);
-      sum += c;
-    }
-    int axis = 0;
-    (hi - lo).maxCoeff(&axis);
-    const std::uint32_t count = end - begin, least = std::max<std::uint32_t>(1, count / kSplitBalance);
-    const double mean = sum[axis] / count;
-    const auto below = std::partition(mOrder.begin() + begin, mOrder.begin() + end,
-                                      [&](std::uint32_t t) { return mCentroids[t][axis] < mean; });
-    const auto at = static_cast<std::uint32_t>(below - mOrder.begin());
-    if (at >= begin + least && at <= end - least) return at;
-    const std::uint32_t mid = begin + count / 2;
-    std::nth_element(mOrder.begin() + begin, mOrder.begin() + mid, mOrder.begin() + end,
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       const double ca = mCentroids[a][axis], cb = mCentroids[b][axis];
-                       return ca < cb || (ca == cb && a < b);
-                     });
-    return mid;
   }
 
   /// One pass over the vertices of the triangles in mOrder[begin, end): the largest distances from
@@ -208,12 +185,13 @@ class Builder {
     }
   }
 
-  void make_leaf(std::uint32_t slot, std::uint32_t tri) {
+  void make_leaf(std::uint32_t slot, std::uint32_t tri, std::uint32_t position) {
     const auto& t = mMesh.triangles[tri];
     const Vec3& a = mMesh.vertices[t[0]];
     const Vec3& b = mMesh.vertices[t[1]];
     const Vec3& c = mMesh.vertices[t[2]];
-    WorkNode& node = mWork[slot];
+    WorkNode node;
+    node.first = position;
     node.lo = a.cwiseMin(b).cwiseMin(c);
     node.hi = a.cwiseMax(b).cwiseMax(c);
     // Candidate centers: the box center, the circumcenter and the edge midpoints (the smallest
@@ -258,11 +236,12 @@ class Builder {
         node.lateral_hi[k] = std::max({at[0], at[1], at[2]});
       }
     }
+    std::construct_at(&mWork[slot].node, node);
   }
 
   void make_internal(std::uint32_t slot, std::uint32_t first, std::uint32_t begin, std::uint32_t end) {
-    const WorkNode& l = mWork[first];
-    const WorkNode& r = mWork[first + 1];
+    const WorkNode& l = mWork[first].node;
+    const WorkNode& r = mWork[first + 1].node;
     WorkNode node;
     node.index = first;
     node.count = l.count + r.count;
@@ -324,7 +303,8 @@ class Builder {
     }
     node.center = r_box < r_merged ? box : merged;
     node.radius = std::min(r_box, r_merged);
-    mWork[slot] = node;
+    node.first = begin;
+    std::construct_at(&mWork[slot].node, node);
   }
 
   /// Rounds the volumes outward to floats: the stored radius and half-extents also cover the
@@ -362,8 +342,9 @@ class Builder {
   const Mesh& mMesh;
   const std::vector<Vec3>& mNormals;
   std::vector<std::uint32_t> mOrder;
-  std::vector<Vec3> mCentroids;
-  std::vector<WorkNode> mWork;
+  std::vector<bvh::SplitItem> mItems;  ///< what the split reads of each triangle
+  std::unique_ptr<WorkSlot[]> mWork;  ///< node i in mWork[i].node, once made
+  std::size_t mWorkCount = 0;
 };
 
 }  // namespace
@@ -376,9 +357,9 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   builder.build(*model);
   double extent = 0.0;
   for (const auto& tri : mesh.triangles) {
-    for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].norm());
+    for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].squaredNorm());
   }
-  model->extent = extent;
+  model->extent = std::sqrt(extent);  // sqrt is monotone and correctly rounded: the largest norm
   if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;
