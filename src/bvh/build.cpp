@@ -91,7 +91,7 @@ class Builder {
   }
 
   void build(Model& model) {
-    model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()), bvh::centroid_bounds(mOrder, mItems));
+    model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()), bvh::centroid_bounds(mItems));
     model.nodes.resize(mWorkCount);
     model.filters.resize(mWorkCount);
     model.laterals.resize(mWorkCount);
@@ -121,7 +121,8 @@ class Builder {
     }
     bvh::CentroidBounds left, right;
     const std::uint32_t mid =
-        begin + split_binned(std::span<std::uint32_t>(mOrder.data() + begin, end - begin), mItems, bounds, left, right);
+        begin + split_binned(std::span<std::uint32_t>(mOrder.data() + begin, end - begin),
+                             std::span<bvh::SplitItem>(mItems.data() + begin, end - begin), bounds, left, right);
     const std::uint32_t first = next;
     const std::uint32_t left_next = first + 2, right_next = left_next + 2 * (mid - begin) - 2;
     int hl = 0, hr = 0;
@@ -342,7 +343,7 @@ class Builder {
   const Mesh& mMesh;
   const std::vector<Vec3>& mNormals;
   std::vector<std::uint32_t> mOrder;
-  std::vector<bvh::SplitItem> mItems;  ///< what the split reads of each triangle
+  std::vector<bvh::SplitItem> mItems;  ///< what the split reads of triangle mOrder[i], in mItems[i]
   std::unique_ptr<WorkSlot[]> mWork;  ///< node i in mWork[i].node, once made
   std::size_t mWorkCount = 0;
 };

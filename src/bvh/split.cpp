@@ -114,13 +114,40 @@ CentroidBounds empty_bounds() {
   return b;
 }
 
-std::uint32_t split_at_median(std::span<std::uint32_t> order, const std::vector<SplitItem>& items, int axis) {
+/// The median cut along `axis` (ties by id), both arrays reordered alike.
+std::uint32_t split_at_median(std::span<std::uint32_t> order, std::span<SplitItem> items, int axis) {
+  struct Entry {
+    float key;
+    std::uint32_t id;
+    SplitItem item;
+  };
+  std::vector<Entry> entries(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) entries[i] = {items[i].centroid[axis], order[i], items[i]};
   const auto mid = static_cast<std::ptrdiff_t>(order.size() / 2);
-  std::nth_element(order.begin(), order.begin() + mid, order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const float ca = items[a].centroid[axis], cb = items[b].centroid[axis];
-    return ca < cb || (ca == cb && a < b);
-  });
+  std::nth_element(entries.begin(), entries.begin() + mid, entries.end(),
+                   [](const Entry& a, const Entry& b) { return a.key < b.key || (a.key == b.key && a.id < b.id); });
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = entries[i].id;
+    items[i] = entries[i].item;
+  }
   return static_cast<std::uint32_t>(mid);
+}
+
+/// Moves the places where `first` holds to the front of both arrays (Hoare's two-finger
+/// partition: the same result for the same input); returns how many.
+template <class First>
+std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first) {
+  std::size_t lo = 0, hi = order.size();
+  for (;;) {
+    while (lo < hi && first(items[lo])) ++lo;
+    while (lo < hi && !first(items[hi - 1])) --hi;
+    if (lo >= hi) break;
+    std::swap(order[lo], order[hi - 1]);
+    std::swap(items[lo], items[hi - 1]);
+    ++lo;
+    --hi;
+  }
+  return static_cast<std::uint32_t>(lo);
 }
 
 }  // namespace
@@ -157,24 +184,23 @@ std::vector<SplitItem> split_items(const Mesh& mesh) {
   return items;
 }
 
-CentroidBounds centroid_bounds(std::span<const std::uint32_t> order, const std::vector<SplitItem>& items) {
+CentroidBounds centroid_bounds(std::span<const SplitItem> items) {
   CentroidBounds b = empty_bounds();
-  for (const std::uint32_t t : order) grow(b, items[t]);
+  for (const SplitItem& item : items) grow(b, item);
   return b;
 }
 
-std::uint32_t split_binned(std::span<std::uint32_t> order, const std::vector<SplitItem>& items, const CentroidBounds& bounds,
+std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items, const CentroidBounds& bounds,
                            CentroidBounds& first, CentroidBounds& second) {
   const auto count = static_cast<std::uint32_t>(order.size());
   if (count == 2) {  // a third of the calls, and only one cut (the order of the children aside)
-    first = centroid_bounds(order.first(1), items);
-    second = centroid_bounds(order.subspan(1), items);
+    first = centroid_bounds(items.first(1));
+    second = centroid_bounds(items.subspan(1));
     return 1;
   }
   const Binning binning(bounds);
   std::array<std::array<Bin, kSplitBins>, 3> bins;
-  for (const std::uint32_t t : order) {
-    const SplitItem& item = items[t];
+  for (const SplitItem& item : items) {
     std::int32_t b[4];
     binning.bins(item, b);
     for (int k = 0; k < 3; ++k) {
@@ -216,16 +242,14 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, const std::vector<Spl
     cut = split_at_median(order, items, longest);
   } else {
     const int k = best_axis;
-    cut = static_cast<std::uint32_t>(std::partition(order.begin(), order.end(),
-                                                    [&](std::uint32_t t) {
-                                                      std::int32_t b[4];
-                                                      binning.bins(items[t], b);
-                                                      return b[k] <= best_plane;
-                                                    }) -
-                                     order.begin());
+    cut = partition_both(order, items, [&](const SplitItem& item) {
+      std::int32_t b[4];
+      binning.bins(item, b);
+      return b[k] <= best_plane;
+    });
   }
-  first = centroid_bounds(order.first(cut), items);
-  second = centroid_bounds(order.subspan(cut), items);
+  first = centroid_bounds(items.first(cut));
+  second = centroid_bounds(items.subspan(cut));
   return cut;
 }
 

@@ -36,18 +36,21 @@ inline constexpr int kSplitBins = 8;
 /// within log base 16/15 of the count (where no plane does, the range is cut at its median).
 inline constexpr std::uint32_t kSplitBalance = 16;
 
-/// The split items of every triangle of `mesh` (in parallel, on the caller's executor).
+/// The split items of every triangle of `mesh`, item t for triangle t (in parallel, on the
+/// caller's executor).
 [[nodiscard]] std::vector<SplitItem> split_items(const Mesh& mesh);
 
-/// The box of the centroids of the triangles in `order` (not empty).
-[[nodiscard]] CentroidBounds centroid_bounds(std::span<const std::uint32_t> order, const std::vector<SplitItem>& items);
+/// The box of the centroids of `items` (not empty).
+[[nodiscard]] CentroidBounds centroid_bounds(std::span<const SplitItem> items);
 
-/// Reorders `order` (triangle ids, at least two; `bounds` the box of their centroids) so that the
-/// first part comes first and returns its size (1 to order.size() - 1), with the boxes of each
-/// part's centroids: the plane among kSplitBins - 1 per axis that minimizes the surface-area cost
-/// (each side's box area times its count), of those that leave each side at least
-/// 1/kSplitBalance; where none does, the median along the centroids' longest axis (ties by id).
-[[nodiscard]] std::uint32_t split_binned(std::span<std::uint32_t> order, const std::vector<SplitItem>& items,
+/// Reorders `order` (triangle ids, at least two) and `items` (their split items, in the same
+/// places: the two move together, so every pass reads the items in memory order) so that the
+/// first part comes first, and returns its size (1 to order.size() - 1), with the boxes of each
+/// part's centroids; `bounds` is the box of all of them. The cut: the plane among kSplitBins - 1
+/// per axis that minimizes the surface-area cost (each side's box area times its count), of those
+/// that leave each side at least 1/kSplitBalance; where none does, the median along the
+/// centroids' longest axis (ties by id).
+[[nodiscard]] std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items,
                                          const CentroidBounds& bounds, CentroidBounds& first, CentroidBounds& second);
 
 }  // namespace caliber::bvh

@@ -29,15 +29,20 @@ struct Cut {
 };
 
 Cut cut(const Mesh& mesh, std::vector<std::uint32_t> order) {
-  const std::vector<SplitItem> items = split_items(mesh);
-  const CentroidBounds bounds = centroid_bounds(order, items);
+  const std::vector<SplitItem> all = split_items(mesh);
+  std::vector<SplitItem> items;  // in the places of `order`, as the build keeps them
+  for (const std::uint32_t t : order) items.push_back(all[t]);
+  const CentroidBounds bounds = centroid_bounds(items);
   CentroidBounds a, b;
   Cut c;
-  c.first = split_binned(std::span<std::uint32_t>(order), items, bounds, a, b);
+  c.first = split_binned(std::span<std::uint32_t>(order), std::span<SplitItem>(items), bounds, a, b);
   c.order = std::move(order);
+  for (std::size_t i = 0; i < c.order.size(); ++i) {  // the items moved with their ids
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(items[i].centroid[k], all[c.order[i]].centroid[k]);
+  }
   // The boxes returned are those of each part's centroids.
-  const CentroidBounds want_a = centroid_bounds(std::span(c.order).first(c.first), items);
-  const CentroidBounds want_b = centroid_bounds(std::span(c.order).subspan(c.first), items);
+  const CentroidBounds want_a = centroid_bounds(std::span<const SplitItem>(items).first(c.first));
+  const CentroidBounds want_b = centroid_bounds(std::span<const SplitItem>(items).subspan(c.first));
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(a.lo[k], want_a.lo[k]);
     EXPECT_EQ(a.hi[k], want_a.hi[k]);
