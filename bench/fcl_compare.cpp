@@ -245,7 +245,7 @@ std::vector<std::string> split_list(const std::string& text) {
 }
 
 int main(int argc, char** argv) {
-  std::filesystem::path dir = "data/meshes";
+  std::filesystem::path dir = caliber::bench::default_meshes_dir();
   std::string out;
   int repeat = 5;
   std::vector<std::string> scenes;
@@ -281,10 +281,12 @@ int main(int argc, char** argv) {
            "first pair ours (ms) | first pair FCL (ms) | first / full query, ours | first agrees |\n";
   table += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
+  int skipped = 0;
   for (const Case& c : meshes ? cases : std::vector<Case>{}) {
     if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {
       std::fprintf(stderr, "skipping %s: meshes missing in %s (run scripts/fetch_meshes.sh)\n", c.name.c_str(),
                    dir.c_str());
+      ++skipped;
       continue;
     }
     const std::string line = format_row(run_case(c, dir, repeat), false);
@@ -299,6 +301,11 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       table += line;
     }
+  }
+  if (meshes && skipped == static_cast<int>(cases.size()) && scenes.empty()) {
+    std::fprintf(stderr, "bench_fcl_compare: none of the meshes is in %s and no --scenes were given: nothing to compare "
+                         "(run scripts/fetch_meshes.sh, or pass --meshes DIR)\n", dir.c_str());
+    return 2;
   }
   if (!out.empty()) {
     std::ofstream file(out);

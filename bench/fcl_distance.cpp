@@ -125,7 +125,7 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::filesystem::path dir = "data/meshes";
+  std::filesystem::path dir = bench::default_meshes_dir();
   int repeat = 7;
   std::string out, only;
   bool ours_only = false;
@@ -152,8 +152,17 @@ int main(int argc, char** argv) {
                       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   BuildOptions bvh_only;
   bvh_only.adjacency = false;
+  int selected = 0;
   for (const Case& c : cases) {
     if (c.name.find(only) == std::string::npos) continue;
+    ++selected;
+    for (const std::string& mesh : {c.mesh_a, c.mesh_b}) {
+      if (!std::filesystem::exists(dir / mesh)) {
+        std::fprintf(stderr, "bench_fcl_distance: %s is missing (run scripts/fetch_meshes.sh, or pass --meshes DIR)\n",
+                     (dir / mesh).c_str());
+        return 2;
+      }
+    }
     const auto a = build_model(load_mesh(dir / c.mesh_a), bvh_only);
     const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(dir / c.mesh_b), bvh_only);
     if (ours_only) {
@@ -183,6 +192,10 @@ int main(int argc, char** argv) {
       std::fputs(line, stdout);
       std::fflush(stdout);
     }
+  }
+  if (selected == 0) {
+    std::fprintf(stderr, "bench_fcl_distance: no case's name contains \"%s\" (--only)\n", only.c_str());
+    return 2;
   }
   if (!out.empty()) {
     std::ofstream f(out);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -17,6 +18,17 @@
 namespace caliber::bench {
 
 using FclModel = fcl::BVHModel<fcl::OBBRSSd>;
+
+/// Where the benches look for the CGAL meshes without --meshes: data/meshes under the working
+/// directory where there is one (a device pack, a checkout's root), else the source tree's
+/// (CALIBER_BENCH_MESHES: the benches run from build/ too).
+inline std::filesystem::path default_meshes_dir() {
+  const std::filesystem::path here = "data/meshes";
+#ifdef CALIBER_BENCH_MESHES
+  if (!std::filesystem::is_directory(here)) return CALIBER_BENCH_MESHES;
+#endif
+  return here;
+}
 
 /// Median wall time of `repeat` runs of f, in milliseconds.
 inline double median_ms(int repeat, const std::function<void()>& f) {
