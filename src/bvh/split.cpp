@@ -134,18 +134,20 @@ std::uint32_t split_at_median(std::span<std::uint32_t> order, std::span<SplitIte
 }
 
 /// Moves the places where `first` holds to the front of both arrays (Hoare's two-finger
-/// partition: the same result for the same input); returns how many.
+/// partition: the same result for the same input) and returns how many, with the boxes of the
+/// two parts' centroids grown as the items are placed.
 template <class First>
-std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first) {
+std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first,
+                             CentroidBounds& front, CentroidBounds& back) {
   std::size_t lo = 0, hi = order.size();
   for (;;) {
-    while (lo < hi && first(items[lo])) ++lo;
-    while (lo < hi && !first(items[hi - 1])) --hi;
+    while (lo < hi && first(items[lo])) grow(front, items[lo++]);
+    while (lo < hi && !first(items[hi - 1])) grow(back, items[--hi]);
     if (lo >= hi) break;
     std::swap(order[lo], order[hi - 1]);
     std::swap(items[lo], items[hi - 1]);
-    ++lo;
-    --hi;
+    grow(front, items[lo++]);
+    grow(back, items[--hi]);
   }
   return static_cast<std::uint32_t>(lo);
 }
@@ -235,19 +237,21 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> 
       }
     }
   }
-  std::uint32_t cut;
-  if (best_axis < 0) {
-    int longest = 0;
-    for (int k = 1; k < 3; ++k) longest = binning.extent(k) > binning.extent(longest) ? k : longest;
-    cut = split_at_median(order, items, longest);
-  } else {
+  if (best_axis >= 0) {
     const int k = best_axis;
-    cut = partition_both(order, items, [&](const SplitItem& item) {
-      std::int32_t b[4];
-      binning.bins(item, b);
-      return b[k] <= best_plane;
-    });
+    first = second = empty_bounds();
+    return partition_both(
+        order, items,
+        [&](const SplitItem& item) {
+          std::int32_t b[4];
+          binning.bins(item, b);
+          return b[k] <= best_plane;
+        },
+        first, second);
   }
+  int longest = 0;
+  for (int k = 1; k < 3; ++k) longest = binning.extent(k) > binning.extent(longest) ? k : longest;
+  const std::uint32_t cut = split_at_median(order, items, longest);
   first = centroid_bounds(items.first(cut));
   second = centroid_bounds(items.subspan(cut));
   return cut;
