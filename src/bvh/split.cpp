@@ -75,7 +75,7 @@ struct Bin {
 };
 
 /// Each axis's bin of a centroid: (c - lo) times the axis's scale, within [0, kSplitBins - 1],
-/// truncated (a NaN lane, from a zero extent, is bin 0).
+/// truncated (an axis without extent has scale 0: every centroid in bin 0).
 class Binning {
  public:
   explicit Binning(const CentroidBounds& b) : mLo(load(b.lo)) {
@@ -195,7 +195,7 @@ CentroidBounds centroid_bounds(std::span<const SplitItem> items) {
 std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items, const CentroidBounds& bounds,
                            CentroidBounds& first, CentroidBounds& second) {
   const auto count = static_cast<std::uint32_t>(order.size());
-  if (count == 2) {  // a third of the calls, and only one cut (the order of the children aside)
+  if (count == 2) {  // only one cut (the children's order aside)
     first = centroid_bounds(items.first(1));
     second = centroid_bounds(items.subspan(1));
     return 1;
