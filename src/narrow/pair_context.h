@@ -171,11 +171,6 @@ class PairContext {
     return s;
   }
 
-  /// near_a (near_b) of a node's two children, `first` and `first + 1`: the same values, a child
-  /// per SSE2 lane (near_pair.cpp).
-  void near_a_pair(std::uint32_t first, NearA& a0, NearA& a1) const;
-  void near_b_pair(std::uint32_t first, NearB& b0, NearB& b1) const;
-
   /// A lower bound on the distance between any triangles below two nodes, before the safety
   /// margin, when it is at most `reach` (reach_for of a distance); otherwise some number above
   /// `reach` (the boxes' bound is tried first and ends the test when beyond), and +infinity when

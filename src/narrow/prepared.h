@@ -106,15 +106,13 @@ class PreparedTree {
 
   /// A new entry holding `prepared` (a traversal's root).
   Node* root(const Prepared& prepared) { return hold(take(1), prepared); }
-  /// The entries of the children `first` and `first + 1` of `parent`'s node, made in place by
-  /// prepare_pair(first, entry0, entry1) the first time they are asked for (from then on, the same
-  /// two).
-  template <class PreparePair>
-  Node* kids(Node& parent, std::uint32_t first, PreparePair&& prepare_pair) {
+  /// The entries of the children `first` and `first + 1` of `parent`'s node, made by prepare the
+  /// first time they are asked for (from then on, the same two).
+  template <class Prepare>
+  Node* kids(Node& parent, std::uint32_t first, Prepare&& prepare) {
     if (parent.kids == nullptr) {
       Node* pair = take(2);
-      prepare_pair(first, static_cast<Prepared&>(pair[0]), static_cast<Prepared&>(pair[1]));
-      pair[0].kids = pair[1].kids = nullptr;
+      for (std::uint32_t i = 0; i < 2; ++i) hold(pair + i, prepare(first + i));
       parent.kids = pair;
     }
     return parent.kids;

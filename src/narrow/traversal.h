@@ -228,8 +228,8 @@ template <class Wait>
                                                  const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats, TabooView taboo,
                                                  Wait&& wait) {
   using Reached = TraversalScratch::Reached;
-  const auto prepare_a = [&](std::uint32_t i, PairContext::NearA& a0, PairContext::NearA& a1) { ctx.near_a_pair(i, a0, a1); };
-  const auto prepare_b = [&](std::uint32_t j, PairContext::NearB& b0, PairContext::NearB& b1) { ctx.near_b_pair(j, b0, b1); };
+  const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
+  const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
   bool split_a, split_b;
   cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
   TraversalScratch::NearA* const ka = split_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;

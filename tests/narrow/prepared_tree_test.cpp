@@ -1,5 +1,5 @@
 // The distance traversal's store of prepared nodes: each node prepared once per traversal (its
-// children made together by the first visit that splits it, found again by every later one), entries that
+// children made by the first visit that splits it, found again by every later one), entries that
 // stay put while others are added, and nothing left over after clear().
 
 #include <cstdint>
@@ -29,10 +29,6 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
     ++made[i];
     return Entry{i, 0.5 * i};
   };
-  const auto pair = [&](std::uint32_t i, Entry& e0, Entry& e1) {
-    e0 = prepare(i);
-    e1 = prepare(i + 1);
-  };
   std::mt19937 rng(9);
   for (int round = 0; round < 2; ++round) {
     tree.clear();
@@ -43,7 +39,7 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
       Tree::Node* node = root;
       for (std::uint32_t depth = 0; depth < kDepth; ++depth) {
         const std::uint32_t first = 2 * node->index + 1;
-        Tree::Node* kids = tree.kids(*node, first, pair);
+        Tree::Node* kids = tree.kids(*node, first, prepare);
         ASSERT_EQ(kids[0].index, first);
         ASSERT_EQ(kids[1].index, first + 1);
         ASSERT_EQ(kids[1].value, 0.5 * (first + 1));
@@ -52,7 +48,7 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
       }
     }
     for (const auto& [parent, kids] : seen) {
-      EXPECT_EQ(tree.kids(*parent, 2 * parent->index + 1, pair), kids) << "an entry stays where it was made";
+      EXPECT_EQ(tree.kids(*parent, 2 * parent->index + 1, prepare), kids) << "an entry stays where it was made";
     }
     for (std::size_t i = 0; i < made.size(); ++i) ASSERT_LE(made[i], 1) << "node " << i << " prepared once";
     EXPECT_EQ(made[0], 1);
@@ -66,17 +62,13 @@ TEST(PreparedTree, ClearForgetsEveryEntry) {
     ++made;
     return Entry{i, double(made)};
   };
-  const auto pair = [&](std::uint32_t i, Entry& e0, Entry& e1) {
-    e0 = prepare(i);
-    e1 = prepare(i + 1);
-  };
   Tree::Node* root = tree.root(prepare(7));
-  EXPECT_EQ(tree.kids(*root, 20, pair)[1].value, 3.0);
-  EXPECT_EQ(tree.kids(*root, 20, pair)[1].value, 3.0);
+  EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
+  EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
   tree.clear();
   root = tree.root(prepare(7));
   EXPECT_EQ(root->value, 4.0) << "made again after clear: a prepared node belongs to one pose";
-  EXPECT_EQ(tree.kids(*root, 20, pair)[0].value, 5.0);
+  EXPECT_EQ(tree.kids(*root, 20, prepare)[0].value, 5.0);
   EXPECT_EQ(made, 6);
 }
 
