@@ -4,8 +4,11 @@
 // Reports both distances, their relative difference, whether the closest triangle pair is the same,
 // and warm median times of interleaved runs.
 //
-//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--ours-only]
+//   bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--warm] [--ours-only]
 //
+// Each round times one caliber query, then one fcl::distance; the medians over R rounds are
+// reported. With --warm, each timed query follows an untimed run of itself, so it finds the caches
+// and branch history as it left them; without, it follows the other library's query.
 // --only runs the cases whose name contains NAME. --ours-only runs caliber's query alone, R times
 // per case and gap, and prints its median time (no FCL model, no table): for `perf record`.
 
@@ -87,7 +90,7 @@ void fcl_counts(const FclModel& fa, const FclModel& fb, const Pose& pose_b, cons
 }
 
 Row run(const Case& c, double gap, const Model& a, const Model& b, const std::shared_ptr<FclModel>& fa,
-        const std::shared_ptr<FclModel>& fb, int repeat) {
+        const std::shared_ptr<FclModel>& fb, int repeat, bool warm) {
   const Pose pose_b = place(c, a.mesh, b.mesh, gap);
   const QueryRequest request = distance_request();
   fcl::CollisionObjectd oa(fa, bench::to_fcl(Pose{}));
@@ -96,14 +99,19 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
   QueryResult ours = query(a, Pose{}, b, pose_b, request);
   fcl::DistanceResultd fres;
   fcl::distance(&oa, &ob, freq, fres);
-  // Interleaved, one of each per round; medians.
+  // Interleaved, one of each per round; medians. Warm: each timed run right after an untimed run of
+  // the same query (its caches and branch history its own, not the other library's).
+  const auto ours_once = [&] { ours = query(a, Pose{}, b, pose_b, request); };
+  const auto fcl_once = [&] {
+    fres.clear();
+    fcl::distance(&oa, &ob, freq, fres);
+  };
   std::vector<double> t_ours, t_fcl;
   for (int r = 0; r < repeat; ++r) {
-    t_ours.push_back(bench::median_ms(1, [&] { ours = query(a, Pose{}, b, pose_b, request); }));
-    t_fcl.push_back(bench::median_ms(1, [&] {
-      fres.clear();
-      fcl::distance(&oa, &ob, freq, fres);
-    }));
+    if (warm) ours_once();
+    t_ours.push_back(bench::median_ms(1, ours_once));
+    if (warm) fcl_once();
+    t_fcl.push_back(bench::median_ms(1, fcl_once));
   }
   std::sort(t_ours.begin(), t_ours.end());
   std::sort(t_fcl.begin(), t_fcl.end());
@@ -128,15 +136,16 @@ int main(int argc, char** argv) {
   std::filesystem::path dir = bench::default_meshes_dir();
   int repeat = 7;
   std::string out, only;
-  bool ours_only = false;
+  bool ours_only = false, warm = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!std::strcmp(argv[i], "--ours-only")) ours_only = true;
+    else if (!std::strcmp(argv[i], "--warm")) warm = true;
     else {
-      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--ours-only]\n");
+      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--warm] [--ours-only]\n");
       return 2;
     }
   }
@@ -180,7 +189,7 @@ int main(int argc, char** argv) {
     const auto fa = bench::build_fcl(a->mesh);
     const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh);
     for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
-      const Row r = run(c, gap, *a, *b, fa, fb, repeat);
+      const Row r = run(c, gap, *a, *b, fa, fb, repeat, warm);
       const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);
       char line[512];
       std::snprintf(line, sizeof line, "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n",
@@ -202,7 +211,9 @@ int main(int argc, char** argv) {
     f << "# Distance query against FCL\n\n" << caliber::bench::machine_description() << "\n\n"
       << "caliber::query (QueryKind::distance, unbounded) against fcl::distance (BVHModel<OBBRSS>, rel_err = abs_err = 0, "
          "nearest points on); B turned, then moved along +x to start `gap` × A's box diagonal beyond A's box. Times: median of "
-      << repeat << " interleaved runs, warm.\n\n"
+      << repeat << " rounds, each timing one caliber query then one FCL query"
+      << (warm ? ", each right after an untimed run of itself (--warm)" : ", each right after the other library's (alternating)")
+      << ".\n\n"
       << table;
   }
   return 0;

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstddef>
 #include <cstring>
+#include <iterator>
 #include <memory>
 #include <vector>
 
@@ -62,9 +63,21 @@ class GapBuckets {
   /// Bytes held by the entries' store (the largest number pushed between two clears).
   [[nodiscard]] std::size_t footprint() const { return mPool.capacity() * sizeof(Node); }
 
-  /// Forgets every entry (keeps the memory).
+  /// Forgets every entry (keeps the memory): the bitmaps' nonzero words zeroed through the levels
+  /// above them, a word at a time (not a bucket at a time: a distance traversal leaves hundreds
+  /// of entries waiting, and emptying them bucket by bucket took about a tenth of its time).
   void clear() {
-    while (!empty()) unmark(min_bucket());
+    for (std::size_t t = 0; t < std::size(mTop); ++t) {
+      for (std::uint64_t top = mTop[t]; top != 0; top &= top - 1) {
+        const std::size_t m = t * 64 + static_cast<std::size_t>(std::countr_zero(top));
+        for (std::uint64_t middle = mMiddle[m]; middle != 0; middle &= middle - 1) {
+          mBottom[m * 64 + static_cast<std::size_t>(std::countr_zero(middle))] = 0;
+        }
+        mMiddle[m] = 0;
+      }
+      mTop[t] = 0;
+    }
+    mCount = 0;
     mPool.clear();
   }
 
