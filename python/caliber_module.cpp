@@ -187,13 +187,15 @@ PYBIND11_MODULE(caliber, m) {
       .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); });
 
   py::class_<PyModel>(m, "Model", "A mesh with its BVH, built once; immutable, shareable between threads, picklable.")
-      .def(py::init([](const caliber::Mesh& mesh, bool adjacency) {
+      .def(py::init([](const caliber::Mesh& mesh, bool adjacency, bool oriented_boxes) {
              caliber::BuildOptions options;
              options.adjacency = adjacency;
+             options.oriented_boxes = oriented_boxes;
              py::gil_scoped_release release;
              return PyModel{caliber::build_model(mesh, options)};
            }),
-           py::arg("mesh"), py::arg("adjacency") = true)
+           py::arg("mesh"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false,
+           "adjacency: for contact queries; oriented_boxes: kept per node (120 bytes each), for faster distance queries")
       .def_static("load", [](const std::string& path) {
              caliber::Mesh mesh = caliber::load_mesh(path);
              py::gil_scoped_release release;
@@ -202,12 +204,18 @@ PYBIND11_MODULE(caliber, m) {
       .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh; })
       .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh.triangles.size(); })
       .def_property_readonly("height", [](const PyModel& p) { return p.model->height; })
+      .def_property_readonly("oriented_boxes", [](const PyModel& p) { return !p.model->oriented_boxes.empty(); },
+                             "whether each node's oriented box is kept (for faster distance queries)")
       .def(py::pickle(
-          [](const PyModel& p) { return py::make_tuple(vertices_of(p.model->mesh), faces_of(p.model->mesh), p.model->has_adjacency()); },
+          [](const PyModel& p) {
+            return py::make_tuple(vertices_of(p.model->mesh), faces_of(p.model->mesh), p.model->has_adjacency(),
+                                  !p.model->oriented_boxes.empty());
+          },
           [](const py::tuple& t) {
-            if (t.size() != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
+            if (t.size() != 3 && t.size() != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
             caliber::BuildOptions options;
             options.adjacency = t[2].cast<bool>();
+            options.oriented_boxes = t.size() == 4 && t[3].cast<bool>();
             return PyModel{caliber::build_model(mesh_from_arrays(t[0].cast<Vertices>(), t[1].cast<Faces>()), options)};
           }));
 

@@ -86,6 +86,7 @@ int run_query(const QueryOptions& opt) {
   const auto build_start = Clock::now();
   caliber::BuildOptions build;
   build.adjacency = request.kind == caliber::QueryKind::contact;  // only the contact reduction reads it
+  build.oriented_boxes = request.kind == caliber::QueryKind::distance;  // only the distance bound reads them
   const auto model_of = [&](const std::string& path) {
     try {
       return caliber::build_model(caliber::load_mesh(path), build);

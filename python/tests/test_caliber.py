@@ -127,6 +127,19 @@ def test_threads_query_at_once_with_the_same_answers():
     assert got == [want] * 4
 
 
+def test_kept_oriented_boxes_give_the_same_distance_and_survive_pickling():
+    mesh = caliber.Mesh.load(FAN)
+    plain, kept = caliber.Model(mesh), caliber.Model(mesh, oriented_boxes=True)
+    assert not plain.oriented_boxes and kept.oriented_boxes
+    assert pickle.loads(pickle.dumps(kept)).oriented_boxes
+    near = caliber.Pose((0.1, 0.2, 1.5), (1.0, 0.0, 0.0, 0.0))
+    r1 = caliber.query(plain, caliber.Pose(), plain, near, kind="distance")
+    r2 = caliber.query(kept, caliber.Pose(), kept, near, kind="distance")
+    assert len(r1) == 1 and r1.pairs.tolist() == r2.pairs.tolist() and r1.distances[0] == r2.distances[0]
+    assert np.array_equal(r1.points_a, r2.points_a) and np.array_equal(r1.points_b, r2.points_b)
+    assert r1.node_tests == r2.node_tests
+
+
 def test_distance_without_a_tolerance_takes_any_distance():
     a = caliber.Model.load(TETRA)
     far = caliber.Pose((3.0, 0.5, 0.0), (1.0, 0.0, 0.0, 0.0))

@@ -361,6 +361,13 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].squaredNorm());
   }
   model->extent = std::sqrt(extent);  // sqrt is monotone and correctly rounded: the largest norm
+  if (options.oriented_boxes) {
+    Model& m = *model;
+    m.oriented_boxes.resize(m.nodes.size());
+    parallel::parallel_for(0, m.nodes.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) node_oriented_box(m.nodes[i], m.filters[i], m.laterals[i], m.oriented_boxes[i]);
+    });
+  }
   if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;

@@ -149,7 +149,11 @@ class PairContext {
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
     NearA s;
     fill_box_a(ia, s);
-    own_frame(mA.nodes[ia], mA.filters[ia], mA.laterals[ia], s.frame);
+    if (mA.oriented_boxes.empty()) {
+      node_oriented_box(mA.nodes[ia], mA.filters[ia], mA.laterals[ia], s.frame);
+    } else {
+      s.frame = mA.oriented_boxes[ia];
+    }
     return s;
   }
 
@@ -157,8 +161,8 @@ class PairContext {
   [[nodiscard]] NearB near_b(std::uint32_t ib) const {
     NearB s;
     fill_box_b(ib, s);
-    Frame own;
-    own_frame(mB.nodes[ib], mB.filters[ib], mB.laterals[ib], own);
+    Frame computed;
+    const Frame& own = own_frame(mB, ib, computed);
     for (int i = 0; i < 3; ++i) {
       s.frame.center[i] = mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mTrans[i];
     }
@@ -321,38 +325,12 @@ class PairContext {
     const double c[3] = {n.center[0], n.center[1], n.center[2]};
     for (int i = 0; i < 3; ++i) s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
   }
-  /// A node's Frame in its own model's frame: the box in its slab's frame (the slab along the
-  /// normalized cone axis, the lateral ranges along lateral_axes) where it has a slab, else its own
-  /// box along the model's axes.
-  static void own_frame(const BvhNode& n, const BvhNodeFilter& f, const BvhNodeLateral& l, Frame& out) {
-    const double x = f.cone_axis[0], y = f.cone_axis[1], z = f.cone_axis[2];
-    const double len = std::sqrt(x * x + y * y + z * z);
-    if (len > 0.0) {
-      const double axis[3] = {x / len, y / len, z / len};  // as lateral_axes computes them
-      double u[3], v[3];
-      lateral_axes_of_unit(axis[0], axis[1], axis[2], u, v);
-      turn_lateral_axes(l.turn, u, v);
-      const double lo[3] = {f.slab_lo / len, l.lateral_lo[0], l.lateral_lo[1]};
-      const double hi[3] = {f.slab_hi / len, l.lateral_hi[0], l.lateral_hi[1]};
-      double mid[3], half[3];
-      for (int k = 0; k < 3; ++k) {
-        mid[k] = 0.5 * (lo[k] + hi[k]);
-        half[k] = 0.5 * (hi[k] - lo[k]) * (1.0 + 1e-12);  // the division by len rounds
-      }
-      for (int i = 0; i < 3; ++i) {
-        out.axis[0][i] = axis[i];
-        out.axis[1][i] = u[i];
-        out.axis[2][i] = v[i];
-        out.center[i] = mid[0] * axis[i] + mid[1] * u[i] + mid[2] * v[i];
-      }
-      for (int k = 0; k < 3; ++k) out.half[k] = half[k];
-      return;
-    }
-    for (int k = 0; k < 3; ++k) {
-      for (int i = 0; i < 3; ++i) out.axis[k][i] = k == i ? 1.0 : 0.0;
-      out.center[k] = n.box_center[k];
-      out.half[k] = n.box_half[k];
-    }
+  /// A node's Frame in its own model's frame: the model's oriented box where it keeps them, else
+  /// computed by the same function.
+  static const Frame& own_frame(const Model& m, std::uint32_t i, Frame& computed) {
+    if (!m.oriented_boxes.empty()) return m.oriented_boxes[i];
+    node_oriented_box(m.nodes[i], m.filters[i], m.laterals[i], computed);
+    return computed;
   }
   /// Whether a box lies beyond the slab lo <= axis . x <= hi by more than the reach: `center` is the
   /// box's center in the slab's frame, `half` its half-extents along its own axes, and `on[k]` is

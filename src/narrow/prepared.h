@@ -10,6 +10,8 @@
 #include <memory>
 #include <vector>
 
+#include "caliber/model.h"
+
 namespace caliber::narrow {
 
 /// A prepared node of A's box: its box, and that box seen from B's frame (center, and extent
@@ -62,13 +64,8 @@ struct SideB : NodeB {
   double axis_len2;         ///< slab axis . slab axis (0 when the node has no slab)
 };
 /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
-/// rounding), center and half-extents along them. The box in the frame of the node's slab (the
-/// slab and the lateral ranges) where the node has one, else its own box.
-struct Frame {
-  double axis[3][3];
-  double center[3];
-  double half[3];
-};
+/// rounding), center and half-extents along them (caliber::node_oriented_box).
+using Frame = BvhNodeOrientedBox;
 /// A node of A prepared for the distance bound: its box and its Frame (no sphere: the bound does not
 /// use it).
 struct NearA : BoxA {

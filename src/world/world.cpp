@@ -65,6 +65,7 @@ World::World(Scene scene) : mScene(std::move(scene)) {
       }
       BuildOptions build;
       build.adjacency = mRequest.kind == QueryKind::contact;  // only the contact reduction reads it
+      build.oriented_boxes = mRequest.kind == QueryKind::distance;  // only the distance bound reads them
       it = cache.emplace(key, build_model(std::move(mesh), build)).first;
     } catch (const std::bad_alloc&) {
       throw Error(ErrorCode::out_of_memory, o.mesh.string(),

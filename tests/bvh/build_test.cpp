@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -71,6 +72,24 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
       EXPECT_LE(angle, filter.cone_angle) << "node " << index << " cone must hold the normal of triangle " << t;
     }
   }
+  if (!m.oriented_boxes.empty()) {
+    // The kept oriented box is the one the query would compute, and it covers the vertices.
+    BvhNodeOrientedBox computed;
+    node_oriented_box(node, filter, lateral_range, computed);
+    const BvhNodeOrientedBox& kept = m.oriented_boxes[index];
+    EXPECT_EQ(std::memcmp(&kept, &computed, sizeof kept), 0) << "node " << index << " oriented box as computed";
+    const Eigen::Vector3d center(kept.center[0], kept.center[1], kept.center[2]);
+    for (const std::uint32_t t : below) {
+      for (const std::uint32_t v : m.mesh.triangles[t]) {
+        const Eigen::Vector3d& p = m.mesh.vertices[v];
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d axis_k(kept.axis[k][0], kept.axis[k][1], kept.axis[k][2]);
+          EXPECT_LE(std::abs(axis_k.dot(p - center)), kept.half[k] + 1e-12 * (1.0 + p.norm() + center.norm()))
+              << "node " << index << " oriented box must cover its vertices along axis " << k << " (triangle " << t << ")";
+        }
+      }
+    }
+  }
   EXPECT_EQ(any_normal, filter.cone_angle >= 0.0f) << "node " << index;
   if (!any_normal) {
     EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
@@ -99,6 +118,25 @@ TEST(BuildModel, InvariantsOnProceduralMeshes) {
   check_model(*build_model(make_torus(2.0, 0.5, 16, 10)));
   check_model(*build_model(make_box(1.0, 2.0, 0.5, 3)));
   check_model(*build_model(make_plate(1.0, 0.02, 5)));
+}
+
+TEST(BuildModel, OrientedBoxesOnlyWhenAskedAndCoveringTheirTriangles) {
+  EXPECT_TRUE(build_model(make_sphere(1.0, 12, 16))->oriented_boxes.empty()) << "off by default";
+  BuildOptions options;
+  options.oriented_boxes = true;
+  for (const Mesh& mesh : {make_sphere(1.0, 12, 16), make_torus(2.0, 0.5, 16, 10), make_plate(1.0, 0.02, 5)}) {
+    const auto model = build_model(mesh, options);
+    ASSERT_EQ(model->oriented_boxes.size(), model->nodes.size());
+    check_model(*model);
+  }
+  // Far from the origin, and a node with no normal below (its box is the node's own).
+  Mesh far = make_sphere(0.001, 6, 8);
+  for (auto& v : far.vertices) v += Eigen::Vector3d(1e6, -2e6, 3e5);
+  check_model(*build_model(far, options));
+  Mesh flat;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 1}, {1, 2, 0}, {0, 3, 1}};
+  flat.triangles = {{0, 1, 2}, {3, 4, 5}};
+  check_model(*build_model(flat, options));
 }
 
 TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
