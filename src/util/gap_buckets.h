@@ -13,6 +13,7 @@
 /// sixteenth (16 bits) were measured too coarse: turbine x blade, about 11 apart, took 2.6 times
 /// the node tests.
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstddef>
@@ -51,14 +52,21 @@ class GapBuckets {
   }
 
   [[nodiscard]] bool empty() const { return mCount == 0; }
-  /// The lowest nonempty bucket (the queue must not be empty).
-  [[nodiscard]] std::uint32_t min_bucket() const {
+  /// The lowest nonempty bucket (the queue must not be empty): kept up to date by push and pop,
+  /// so asking costs a load (the distance traversal asks up to three times a visit).
+  [[nodiscard]] std::uint32_t min_bucket() const { return mMin; }
+
+ private:
+  /// The lowest nonempty bucket, found through the bitmaps (the queue must not be empty).
+  [[nodiscard]] std::uint32_t scan_min_bucket() const {
     std::uint32_t i2 = 0;
     while (mTop[i2] == 0) ++i2;
     const auto i1 = i2 * 64 + static_cast<std::uint32_t>(std::countr_zero(mTop[i2]));
     const auto i0 = i1 * 64 + static_cast<std::uint32_t>(std::countr_zero(mMiddle[i1]));
     return i0 * 64 + static_cast<std::uint32_t>(std::countr_zero(mBottom[i0]));
   }
+
+ public:
 
   /// Bytes held by the entries' store (the largest number pushed between two clears).
   [[nodiscard]] std::size_t footprint() const { return mPool.capacity() * sizeof(Node); }
@@ -78,6 +86,7 @@ class GapBuckets {
       mTop[t] = 0;
     }
     mCount = 0;
+    mMin = kBuckets;
     mPool.clear();
   }
 
@@ -87,15 +96,19 @@ class GapBuckets {
     const bool fresh = ((mBottom[b / 64] >> (b % 64)) & 1) == 0;
     mPool.push_back(Node{Entry{key, value}, fresh ? kNone : mHeads[b]});
     if (fresh) mark(b);
+    mMin = std::min(mMin, b);
     mHeads[b] = static_cast<std::uint32_t>(mPool.size() - 1);
   }
 
   /// Removes an entry of the lowest nonempty bucket and returns it (the queue must not be empty).
   Entry pop() {
-    const std::uint32_t b = min_bucket();
+    const std::uint32_t b = mMin;
     const Node& node = mPool[mHeads[b]];
     mHeads[b] = node.next;
-    if (node.next == kNone) unmark(b);
+    if (node.next == kNone) {
+      unmark(b);
+      mMin = empty() ? kBuckets : scan_min_bucket();
+    }
     return node.entry;
   }
 
@@ -137,6 +150,7 @@ class GapBuckets {
   std::vector<std::uint64_t> mMiddle;  ///< bit w: word w of mBottom is nonzero
   std::uint64_t mTop[kBuckets / 262144] = {};  ///< bit m: word m of mMiddle is nonzero
   std::uint32_t mCount = 0;                    ///< nonempty buckets
+  std::uint32_t mMin = kBuckets;               ///< the lowest nonempty bucket; kBuckets when none
 };
 
 }  // namespace caliber::util
