@@ -196,11 +196,14 @@ PYBIND11_MODULE(caliber, m) {
            }),
            py::arg("mesh"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false,
            "adjacency: for contact queries; oriented_boxes: kept per node (120 bytes each), for faster distance queries")
-      .def_static("load", [](const std::string& path) {
+      .def_static("load", [](const std::string& path, bool adjacency, bool oriented_boxes) {
              caliber::Mesh mesh = caliber::load_mesh(path);
+             caliber::BuildOptions options;
+             options.adjacency = adjacency;
+             options.oriented_boxes = oriented_boxes;
              py::gil_scoped_release release;
-             return PyModel{caliber::build_model(std::move(mesh))};
-           }, py::arg("path"))
+             return PyModel{caliber::build_model(std::move(mesh), options)};
+           }, py::arg("path"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false)
       .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh; })
       .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh.triangles.size(); })
       .def_property_readonly("height", [](const PyModel& p) { return p.model->height; })

@@ -132,6 +132,7 @@ def test_kept_oriented_boxes_give_the_same_distance_and_survive_pickling():
     plain, kept = caliber.Model(mesh), caliber.Model(mesh, oriented_boxes=True)
     assert not plain.oriented_boxes and kept.oriented_boxes
     assert pickle.loads(pickle.dumps(kept)).oriented_boxes
+    assert caliber.Model.load(FAN, oriented_boxes=True).oriented_boxes and not caliber.Model.load(FAN).oriented_boxes
     near = caliber.Pose((0.1, 0.2, 1.5), (1.0, 0.0, 0.0, 0.0))
     r1 = caliber.query(plain, caliber.Pose(), plain, near, kind="distance")
     r2 = caliber.query(kept, caliber.Pose(), kept, near, kind="distance")

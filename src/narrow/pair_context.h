@@ -149,11 +149,8 @@ class PairContext {
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
     NearA s;
     fill_box_a(ia, s);
-    if (mA.oriented_boxes.empty()) {
-      node_oriented_box(mA.nodes[ia], mA.filters[ia], mA.laterals[ia], s.frame);
-    } else {
-      s.frame = mA.oriented_boxes[ia];
-    }
+    Frame computed;
+    s.frame = own_frame(mA, ia, computed);
     return s;
   }
 
