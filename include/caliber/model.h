@@ -144,8 +144,8 @@ struct BvhNodeOrientedBox {
 
 /// The oriented box of a node from its stored parts: the box of its slab (along the normalized
 /// cone axis, as lateral_axes normalizes it) and lateral ranges where it has a slab, else its
-/// BvhNode box. The half-extents along the cone axis grow by a relative 1e-12 for the rounding of
-/// the division by the axis's length.
+/// BvhNode box. Where it has a slab, each half-extent grows by a relative 1e-12 for the rounding
+/// of the division by the axis's length.
 inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const BvhNodeLateral& l, BvhNodeOrientedBox& out) {
   const double x = f.cone_axis[0], y = f.cone_axis[1], z = f.cone_axis[2];
   const double len = std::sqrt(x * x + y * y + z * z);
