@@ -90,16 +90,19 @@ class Builder {
     mWorkCount = 2 * n - 1;
   }
 
-  void build(Model& model) {
+  /// The tree into model, with each node's oriented box where `oriented_boxes` asks for them.
+  void build(Model& model, bool oriented_boxes) {
     model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()), bvh::centroid_bounds(mItems));
     model.nodes.resize(mWorkCount);
     model.filters.resize(mWorkCount);
     model.laterals.resize(mWorkCount);
     model.first_leaf.resize(mWorkCount);
+    if (oriented_boxes) model.oriented_boxes.resize(mWorkCount);
     model.leaf_position.resize(mOrder.size());
     parallel::parallel_for(0, mWorkCount, kBuildGrain, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
         convert(mWork[i].node, model.nodes[i], model.filters[i], model.laterals[i]);
+        if (oriented_boxes) node_oriented_box(model.nodes[i], model.filters[i], model.laterals[i], model.oriented_boxes[i]);
         model.first_leaf[i] = mWork[i].node.first;
       }
     });
@@ -355,19 +358,12 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   auto model = std::make_shared<Model>();
   model->normals = bvh::face_normals(mesh, kBuildGrain);
   Builder builder(mesh, model->normals);
-  builder.build(*model);
+  builder.build(*model, options.oriented_boxes);
   double extent = 0.0;
   for (const auto& tri : mesh.triangles) {
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].squaredNorm());
   }
   model->extent = std::sqrt(extent);  // sqrt is monotone and correctly rounded: the largest norm
-  if (options.oriented_boxes) {
-    Model& m = *model;
-    m.oriented_boxes.resize(m.nodes.size());
-    parallel::parallel_for(0, m.nodes.size(), kBuildGrain, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t i = lo; i != hi; ++i) node_oriented_box(m.nodes[i], m.filters[i], m.laterals[i], m.oriented_boxes[i]);
-    });
-  }
   if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;

@@ -67,7 +67,6 @@ class GapBuckets {
   }
 
  public:
-
   /// Bytes held by the entries' store (the largest number pushed between two clears).
   [[nodiscard]] std::size_t footprint() const { return mPool.capacity() * sizeof(Node); }
 
