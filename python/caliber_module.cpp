@@ -274,14 +274,16 @@ PYBIND11_MODULE(caliber, m) {
       "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
       "limit_reached (1: any pair).");
 
-  py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on a fixed number of threads; keeps temporal state.")
+  py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on the threads the process allows; keeps temporal state.")
       .def(py::init([](const std::string& method, int threads) {
              caliber::EngineOptions options;
              options.method = caliber::parse_method(method);
              options.threads = threads;
              return std::make_unique<caliber::Engine>(options);
            }),
-           py::arg("method") = "hybrid", py::arg("threads") = 0)
+           py::arg("method") = std::string(caliber::to_string(caliber::kDefaultMethod)), py::arg("threads") = 0,
+           "method: sequential, exploitation, stealing (the default), aposteriori, apriori or hybrid. threads: 0, every "
+           "hardware thread the process may use (oneTBB's arena and limit); 1, the calling thread alone; N, at most N.")
       .def_property_readonly("threads", &caliber::Engine::threads)
       .def("forget", &caliber::Engine::forget)
       .def(

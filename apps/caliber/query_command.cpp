@@ -214,7 +214,7 @@ Runner add_query_command(CLI::App& app) {
                   "sequential (default: caliber::query) or an engine method: exploitation, stealing, aposteriori, "
                   "apriori, hybrid (same pairs; build time then counted in query_ms)")
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Engine threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Engine threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
       ->check(at_least(0))

@@ -29,7 +29,7 @@ namespace {
 
 struct RunOptions {
   std::string scene;
-  std::string method{to_string(kRecommendedMethod)};
+  std::string method{to_string(kDefaultMethod)};
   int threads = 0;
   int stealing_depth = EngineOptions{}.stealing_depth;
   double beta = EngineOptions{}.beta;
@@ -273,7 +273,7 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--simulate-cores", opt->simulate, "Virtual core counts for the load-balance simulation")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
   cmd->add_option("--stealing-depth", opt->stealing_depth, "Stealing: CD-tree depth below which a subtree runs serially")
       ->capture_default_str();
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");

@@ -28,7 +28,7 @@ namespace {
 struct ViewOptions {
   std::string scene;
   std::string out;
-  std::string method = "hybrid";
+  std::string method{caliber::to_string(caliber::kDefaultMethod)};
   int threads = 0;
   int steps = -1;
   int max_boxes = 5000;
@@ -200,7 +200,7 @@ Runner add_view_command(CLI::App& app) {
       ->check(at_least(1));  // -1, the default, stands for the scene's steps: not a value to give
   cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Worker threads (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
   cmd->add_option("--max-boxes", opt->max_boxes, "Most task-root boxes drawn per step")->capture_default_str();
   return [cmd, opt]() { return cmd->parsed() ? view_scene(*opt) : -1; };
 }

@@ -157,18 +157,22 @@ enum class Method : std::uint8_t {
 /// Parses a method name; throws caliber::Error on an unknown one.
 [[nodiscard]] CALIBER_EXPORT Method parse_method(std::string_view name);
 
-/// The method `caliber run` uses unless told otherwise, on the machine's hardware threads: work
-/// stealing, the fastest measured at 16 threads on three of the four scenes (Intel Xeon, 16 cores,
-/// medians of 5 interleaved rounds at 2a20389, issue 14: stealing 7.9 / 6.9 / 9.5 / 10.2x, hybrid
-/// 8.7 / 2.3 / 9.1 / 7.3x on two_large / two_small / funnel / front_car; single runs in
-/// bench/results/intel-xeon-16c/). EngineOptions keeps `sequential`, the reference, as its default.
-inline constexpr Method kRecommendedMethod = Method::stealing;
+/// The default method of the library, the command line and the Python module: work stealing, the
+/// fastest measured at 16 threads on three of the four benchmark scenes (16-core Intel Xeon,
+/// medians of 5 interleaved rounds: stealing 7.9 / 6.9 / 9.5 / 10.2x, hybrid 8.7 / 2.3 / 9.1 /
+/// 7.3x on two_large / two_small / funnel / front_car; bench/results/intel-xeon-16c/).
+inline constexpr Method kDefaultMethod = Method::stealing;
 
 /// Options of the engine.
 struct EngineOptions {
-  /// The method.
-  Method method = Method::sequential;
-  /// Worker threads (1..1024); 0 means the machine's hardware threads. `sequential` always uses one.
+  /// The method (kDefaultMethod unless told otherwise).
+  Method method = kDefaultMethod;
+  /// Where the engine runs (0..1024). 0: in the oneTBB arena step() is called from, with that
+  /// arena's concurrency (a host's own tbb::task_arena, or oneTBB's default one, which follows the
+  /// CPU affinity), at most the process's limit. 1: on the calling thread alone, creating no thread
+  /// (a host that runs caliber from its own threads, such as OpenMP's). N > 1: a oneTBB arena of
+  /// its own of N threads, at most the process's limit. caliber never changes the limit (no
+  /// tbb::global_control). `sequential` always runs on the calling thread.
   int threads = 0;
   /// Calibrated methods: the thread count the cut is made for (Omega = total weight / (beta *
   /// plan_threads)); 0 means `threads`. The cut for P threads run on one thread measures each of
@@ -244,9 +248,9 @@ class CALIBER_EXPORT SimulatedRun {
   int mTimed = 0;
 };
 
-/// Runs frames with a method on a fixed number of threads (a oneTBB task arena of exactly that
-/// many). Keeps, between steps, what the temporal methods learn of each object pair. Not
-/// thread-safe itself: one step at a time (use one engine per thread to step several at once).
+/// Runs frames with a method on the threads the host allows (EngineOptions::threads). Keeps,
+/// between steps, what the temporal methods learn of each object pair. Not thread-safe itself: one
+/// step at a time (use one engine per thread to step several at once).
 class CALIBER_EXPORT Engine {
  public:
   /// Throws caliber::Error on a thread count outside 0..1024, a negative stealing depth, a beta
@@ -264,9 +268,11 @@ class CALIBER_EXPORT Engine {
   /// Drops what the temporal methods remember of every pair (after a jump in the motion, or when
   /// object indices start to denote other objects).
   void forget();
-  /// The number of worker threads.
+  /// The threads a step called from this thread now would run on (the caller included): 1 for
+  /// `sequential` or threads = 1; else the arena's concurrency, at most the process's limit. A
+  /// step cuts its work for that count.
   [[nodiscard]] int threads() const;
-  /// The options in force (threads resolved).
+  /// The options as given.
   [[nodiscard]] const EngineOptions& options() const { return mOptions; }
 
  private:

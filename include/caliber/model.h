@@ -186,6 +186,10 @@ struct BuildOptions {
   /// it meets the node. Same results either way. Off by default; the CLI and scenes turn it on
   /// for distance queries.
   bool oriented_boxes = false;
+  /// Where the build runs, as EngineOptions::threads: 0, in the oneTBB arena build_model is called
+  /// from (the host's); 1, on the calling thread alone, creating no thread; N > 1, an arena of its
+  /// own of N threads, at most the process's limit. The model is the same whatever the count.
+  int threads = 0;
 };
 
 /// A mesh with its BVH, normals and adjacency. Create with build_model; never modified afterwards.

@@ -353,8 +353,10 @@ class Builder {
 
 }  // namespace
 
-std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options) {
-  validate_mesh(mesh);
+namespace {
+
+/// The build, its parallel parts on the executor the caller runs in.
+std::shared_ptr<Model> build_on_this_thread(Mesh mesh, const BuildOptions& options) {
   auto model = std::make_shared<Model>();
   model->normals = bvh::face_normals(mesh, kBuildGrain);
   Builder builder(mesh, model->normals);
@@ -367,6 +369,25 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;
+}
+
+}  // namespace
+
+std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options) {
+  if (options.threads < 0 || options.threads > 1024) {
+    throw Error(ErrorCode::bad_value, "threads", "must be between 0 and 1024 (0: the arena caliber is called from)");
+  }
+  validate_mesh(mesh);
+  std::shared_ptr<Model> out;
+  // Inside an executor already (a step, a World being built on the host's arena), its threads
+  // are this build's too; otherwise the build runs where BuildOptions::threads says.
+  if (parallel::current_thread_index() >= 0 && options.threads == 0) {
+    out = build_on_this_thread(std::move(mesh), options);
+  } else {
+    parallel::Executor executor(options.threads);
+    executor.execute([&] { out = build_on_this_thread(std::move(mesh), options); });
+  }
+  return out;
 }
 
 }  // namespace caliber

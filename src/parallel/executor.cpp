@@ -76,15 +76,18 @@ void Executor::Pool::work() {
   }
 }
 
-Executor::Executor(int threads) : mThreads(threads), mPool(std::make_unique<Pool>()) {
-  if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
-  for (int t = 1; t < threads; ++t) {
+Executor::Executor(int threads) : mRequested(threads), mPool(std::make_unique<Pool>()) {
+  if (threads < 0) throw Error(ErrorCode::bad_value, "threads", "must be >= 0 (0: the machine's hardware threads)");
+  if (threads == 0) mRequested = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  for (int t = 1; t < mRequested; ++t) {
     mPool->workers.emplace_back([pool = mPool.get(), t] {
       t_index = t;
       pool->work();
     });
   }
 }
+
+int Executor::threads() const { return mRequested; }
 
 Executor::~Executor() {
   {
@@ -181,27 +184,59 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
 
 std::string_view backend() { return "oneTBB"; }
 
-Executor::Executor(int threads) : mThreads(threads), mArena(std::max(threads, 1)) {
-  if (threads < 1) throw Error(ErrorCode::bad_value, "threads", "an executor needs at least one thread");
-  const auto limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-  if (static_cast<std::size_t>(threads) > limit) {
-    mLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-  }
+namespace {
+/// The process's limit on oneTBB's threads (max_allowed_parallelism: the CPU affinity's count
+/// unless a host's tbb::global_control lowers it).
+int process_limit() {
+  const std::size_t limit = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  return static_cast<int>(std::clamp<std::size_t>(limit, 1, 1u << 20));
+}
+}  // namespace
+
+Executor::Executor(int threads) : mRequested(threads) {
+  if (threads < 0) throw Error(ErrorCode::bad_value, "threads", "must be >= 0 (0: the arena caliber is called from)");
+  // An arena no wider than the limit in force, so that its slot indices stay below threads().
+  if (threads > 1) mArena = std::make_unique<tbb::task_arena>(std::min(threads, process_limit()));
 }
 
 Executor::~Executor() = default;
 
-void Executor::execute(const std::function<void()>& f) { mArena.execute(f); }
+int Executor::threads() const {
+  if (mRequested == 1) return 1;
+  const int arena = mArena ? mArena->max_concurrency() : tbb::this_task_arena::max_concurrency();
+  return std::max(1, std::min(arena, process_limit()));
+}
+
+void Executor::execute(const std::function<void()>& f) {
+  const int concurrency = threads();
+  if (concurrency > 1 && mArena) {
+    mArena->execute([&] {
+      const detail::ConcurrencyScope scope(concurrency);
+      f();
+    });
+    return;
+  }
+  // The caller's arena (the tasks oneTBB runs go to it), or the calling thread alone.
+  const detail::ConcurrencyScope scope(concurrency);
+  f();
+}
 
 int current_thread_index() {
+  if (detail::t_concurrency == 0) return -1;
+  if (detail::t_concurrency == 1) return 0;
   const int index = tbb::this_task_arena::current_thread_index();
   return index == tbb::task_arena::not_initialized ? -1 : index;
 }
 
-int concurrency() { return tbb::this_task_arena::max_concurrency(); }
+int concurrency() { return std::max(detail::t_concurrency, 1); }
 
 TaskGroup::TaskGroup() = default;
-TaskGroup::~TaskGroup() = default;
+TaskGroup::~TaskGroup() {
+  try {
+    mGroup.wait();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): an unwaited group's error has nowhere to go
+  }
+}
 
 void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
                   const std::function<void(std::size_t, std::size_t)>& body) {
@@ -211,11 +246,19 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
     body(begin, end);
     return;
   }
+  if (!detail::parallel_here()) {  // outside an executor, or a one-thread one: chunk by chunk, here
+    const std::size_t length = end - begin, chunks = (length + grain - 1) / grain;
+    for (std::size_t c = 0; c < chunks; ++c) body(begin + length * c / chunks, begin + length * (c + 1) / chunks);
+    return;
+  }
   // simple_partitioner: split down to the grain. The default (auto) partitioner stops splitting
   // early when nobody steals, so a thread would run ~16 consecutive items as one chunk. Even so the
   // halving hands out contiguous blocks: where the order matters, use for_each_in_order.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
-                    [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); },
+                    [&body, c = detail::t_concurrency](const tbb::blocked_range<std::size_t>& r) {
+                      const detail::ConcurrencyScope scope(c);
+                      body(r.begin(), r.end());
+                    },
                     tbb::simple_partitioner());
 }
 

@@ -1,14 +1,21 @@
 #pragma once
 /// \file
 /// The one seam between "what tasks to run" and "how to run them": every parallel construct in
-/// caliber goes through this header. Two backends, chosen when the library is built:
-///   - oneTBB (default): a tbb::task_arena of exactly N threads, tbb::parallel_for, tbb::task_group
-///     (work stealing), tbb::enumerable_thread_specific. These wrappers add nothing on hot paths.
+/// caliber goes through this header. The host owns the threads: caliber's parallel work runs only
+/// inside Executor::execute, and outside it every construct below runs on the calling thread (so
+/// caliber::query, and any call a host makes from its own threads, creates no thread). Two
+/// backends, chosen when the library is built:
+///   - oneTBB (default): an executor runs its work in the oneTBB arena it is called from
+///     (threads = 0), in a tbb::task_arena of its own (threads > 1, at most the process's limit),
+///     or on the calling thread alone (threads = 1). It never changes process-wide settings (no
+///     tbb::global_control). tbb::parallel_for, tbb::task_group, tbb::enumerable_thread_specific
+///     underneath; these wrappers add nothing on hot paths but a thread-local flag per task.
 ///   - std::thread (`-DCALIBER_EXECUTOR=std`, forced by `-DCALIBER_SANITIZE=thread`): a small pool
 ///     whose every synchronization is a std::mutex / std::condition_variable, so ThreadSanitizer
 ///     sees all of it. Debian's libtbb is not instrumented: under TSan its own hand-offs look like
 ///     races, which would hide the real ones in caliber. Slower, and not work stealing in the
 ///     strict sense (waiting threads help from one shared queue), but it runs the same code paths.
+///     threads = 0 there means the machine's hardware threads.
 /// Results never depend on the backend or on the schedule (tested in both builds).
 
 #include <cstddef>
@@ -17,6 +24,8 @@
 #include <string_view>
 #include <utility>
 #include <vector>
+#include <algorithm>
+#include <exception>
 
 #ifdef CALIBER_EXECUTOR_STD
 #include <algorithm>
@@ -39,25 +48,29 @@ namespace caliber::parallel {
 /// "oneTBB" or "std::thread": the backend this library was built with.
 [[nodiscard]] std::string_view backend();
 
-/// A fixed set of `threads` threads (the caller of execute() being one of them). Parallel work
-/// started inside execute() — parallel_for, TaskGroup — runs on them and on no other thread.
+/// Where a piece of caliber's work runs: `threads` = 0, the oneTBB arena execute() is called from
+/// (the host's: its arena, or oneTBB's default one); 1, the calling thread alone; N > 1, an arena
+/// of its own with N slots, run on at most the process's limit of threads. Parallel work started
+/// inside execute() (parallel_for, TaskGroup, ...) runs there and on no other thread.
 class Executor {
  public:
-  /// `threads` >= 1.
+  /// `threads` >= 0 (see the class comment). Throws caliber::Error on a negative count.
   explicit Executor(int threads);
   ~Executor();
   Executor(const Executor&) = delete;
   Executor& operator=(const Executor&) = delete;
 
-  /// The number of threads, the caller included.
-  [[nodiscard]] int threads() const { return mThreads; }
+  /// The threads execute() would run on if called from this thread now (the caller included):
+  /// 1 for a one-thread executor; otherwise the arena's concurrency, at most the process's limit
+  /// (oneTBB's max_allowed_parallelism, which follows the CPU affinity).
+  [[nodiscard]] int threads() const;
 
   /// Runs `f` on the calling thread, joined by the executor's other threads until it returns.
   /// Exceptions thrown by `f` (or by tasks it waits for) propagate to the caller.
   void execute(const std::function<void()>& f);
 
  private:
-  int mThreads;
+  int mRequested;
 #ifdef CALIBER_EXECUTOR_STD
  public:
   struct Pool;
@@ -65,15 +78,36 @@ class Executor {
  private:
   std::unique_ptr<Pool> mPool;
 #else
-  // oneTBB lets at most (hardware threads - 1) workers join any arena unless told otherwise; above
-  // that, this raises the process-wide limit for the executor's lifetime, so N means N.
-  std::unique_ptr<tbb::global_control> mLimit;
-  tbb::task_arena mArena;
+  std::unique_ptr<tbb::task_arena> mArena;  ///< threads > 1 only
 #endif
 };
 
+#ifndef CALIBER_EXECUTOR_STD
+namespace detail {
+/// The concurrency of the executor whose work the calling thread is doing; 0 outside any. Set by
+/// Executor::execute and carried into every task the wrappers below hand to oneTBB, on whatever
+/// thread runs it (a worker of the host's arena knows nothing of caliber otherwise).
+inline thread_local int t_concurrency = 0;
+
+/// Sets t_concurrency for a scope.
+class ConcurrencyScope {
+ public:
+  explicit ConcurrencyScope(int concurrency) : mSaved(t_concurrency) { t_concurrency = concurrency; }
+  ~ConcurrencyScope() { t_concurrency = mSaved; }
+  ConcurrencyScope(const ConcurrencyScope&) = delete;
+  ConcurrencyScope& operator=(const ConcurrencyScope&) = delete;
+
+ private:
+  int mSaved;
+};
+
+/// Whether parallel constructs should go to oneTBB: inside an executor of more than one thread.
+inline bool parallel_here() { return t_concurrency > 1; }
+}  // namespace detail
+#endif
+
 /// A set of tasks run in parallel (on the executor the caller runs in) and waited for together.
-/// Outside any executor, run() calls the task at once (std backend) or on oneTBB's default arena.
+/// Outside any executor (or in a one-thread executor), run() calls the task at once.
 class TaskGroup {
  public:
   TaskGroup();
@@ -93,28 +127,46 @@ class TaskGroup {
   std::exception_ptr mError;  ///< guarded by the pool's mutex
   friend struct Executor::Pool;
 #else
+  /// Hands `f` to oneTBB (or runs it now, serially); the first exception a task throws is
+  /// rethrown by wait().
   template <class F>
   void run(F&& f) {
-    mGroup.run(std::forward<F>(f));
+    if (!detail::parallel_here()) {
+      try {
+        f();
+      } catch (...) {
+        if (!mError) mError = std::current_exception();
+      }
+      return;
+    }
+    mGroup.run([fn = std::forward<F>(f), c = detail::t_concurrency] {
+      const detail::ConcurrencyScope scope(c);
+      fn();
+    });
   }
-  void wait() { mGroup.wait(); }
+  /// Waits for every task run() so far.
+  void wait() {
+    mGroup.wait();
+    if (mError) std::rethrow_exception(std::exchange(mError, nullptr));
+  }
 
  private:
   tbb::task_group mGroup;
+  std::exception_ptr mError;  ///< of a task run serially
 #endif
 };
 
-/// The calling thread's index in the executor it works for (0 .. threads-1), or -1 outside any.
+/// The calling thread's index in the executor it works for (0 .. threads-1 for an arena of its own;
+/// the slot in the host's arena otherwise), or -1 outside any.
 [[nodiscard]] int current_thread_index();
 
 /// Calls body(lo, hi) on disjoint chunks covering [begin, end), each at most `grain` long (and at
-/// least grain / 2 where the range allows), in parallel on the current executor. A range no longer
-/// than `grain` runs at once on the calling thread.
+/// least grain / 2 where the range allows), in parallel on the current executor (one after the
+/// other outside any). A range no longer than `grain` runs at once on the calling thread.
 void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
                   const std::function<void(std::size_t, std::size_t)>& body);
 
-/// The number of threads of the executor the caller runs in (outside any executor: 1 with the std
-/// backend, the size of oneTBB's default arena with oneTBB).
+/// The number of threads of the executor the caller runs in; 1 outside any executor.
 [[nodiscard]] int concurrency();
 
 /// Greedy list scheduling: calls body(i) for i = 0, 1, ..., n-1, each i taken by whichever of the
@@ -133,18 +185,31 @@ void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {
     for (std::size_t i = lo; i != hi; ++i) f(i);
   });
 #else
-  if (begin < end) tbb::parallel_for(begin, end, std::forward<F>(f));
+  if (begin >= end) return;
+  if (!detail::parallel_here()) {
+    for (std::size_t i = begin; i != end; ++i) f(i);
+    return;
+  }
+  tbb::parallel_for(begin, end, [&f, c = detail::t_concurrency](std::size_t i) {
+    const detail::ConcurrencyScope scope(c);
+    f(i);
+  });
 #endif
 }
 
-/// Sorts [first, last) by `less`, in parallel where the backend can (std backend: one thread).
-/// Only for orders where no two elements compare equal, so that the result is unique.
+/// Sorts [first, last) by `less`, in parallel where the backend can (std backend, or outside an
+/// executor: one thread). Only for orders where no two elements compare equal, so that the result
+/// is unique.
 template <class It, class Less>
 void parallel_sort(It first, It last, Less less) {
 #ifdef CALIBER_EXECUTOR_STD
   std::sort(first, last, less);
 #else
-  tbb::parallel_sort(first, last, less);
+  if (detail::parallel_here()) {
+    tbb::parallel_sort(first, last, less);
+  } else {
+    std::sort(first, last, less);
+  }
 #endif
 }
 

@@ -136,7 +136,7 @@ struct Engine::Impl {
 
 Engine::Engine(const EngineOptions& options) : mOptions(options) {
   if (mOptions.threads < 0 || mOptions.threads > 1024) {
-    throw Error(ErrorCode::bad_value, "threads", "must be between 1 and 1024 (0: one per hardware thread)");
+    throw Error(ErrorCode::bad_value, "threads", "must be between 0 and 1024 (0: the arena caliber is called from)");
   }
   if (mOptions.plan_threads < 0 || mOptions.plan_threads > 1024) {
     throw Error(ErrorCode::bad_value, "plan threads", "must be between 1 and 1024 (0: the engine's threads)");
@@ -147,14 +147,12 @@ Engine::Engine(const EngineOptions& options) : mOptions(options) {
     throw Error(ErrorCode::bad_value, "epsilon", "must be a finite number >= 0");
   }
   if (mOptions.taboo_cap < 1) throw Error(ErrorCode::bad_value, "taboo cap", "must be >= 1");
-  if (mOptions.threads == 0) mOptions.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  if (mOptions.method == Method::sequential) mOptions.threads = 1;
-  mImpl = std::make_unique<Impl>(mOptions.threads);
+  mImpl = std::make_unique<Impl>(mOptions.method == Method::sequential ? 1 : mOptions.threads);
 }
 
 Engine::~Engine() = default;
 
-int Engine::threads() const { return mOptions.threads; }
+int Engine::threads() const { return mImpl->executor.threads(); }
 
 void Engine::forget() { mImpl->history = tasks::History{}; }
 
@@ -186,7 +184,10 @@ StepResult Engine::step(const Frame& frame) {
   mImpl->workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
   mImpl->timeline.begin(mOptions.timeline);
   // Its contexts are made on the executor's threads, inside the step's first parallel region.
-  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, mOptions.threads > 1, nullptr, {}};
+  // The work is cut for the threads this step really has (the host's arena and limit decide).
+  EngineOptions options = mOptions;
+  options.threads = mImpl->executor.threads();
+  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, options.threads > 1, nullptr, {}};
   std::unique_ptr<narrow::PairLimit[]> limits;
   if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);
@@ -206,7 +207,7 @@ StepResult Engine::step(const Frame& frame) {
     if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
       plan = tasks::plan_pairs(n);
     } else {
-      plan = tasks::plan_calibrated(mOptions, frame.pairs, state.contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
+      plan = tasks::plan_calibrated(options, frame.pairs, state.contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
         mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
       });
     }

@@ -70,10 +70,16 @@ struct Timeline {
     origin = util::Clock::now();
   }
 
-  /// All spans, sorted by thread then start.
+  /// All spans, sorted by thread then start; threads numbered 0, 1, ... in the order of their
+  /// executor indices (in a host's arena a thread's slot may lie beyond the step's thread count).
   std::vector<TaskSpan> collect() {
     std::vector<TaskSpan> all;
     spans.for_each([&](const std::vector<TaskSpan>& s) { all.insert(all.end(), s.begin(), s.end()); });
+    std::vector<int> seen;
+    for (const TaskSpan& s : all) seen.push_back(s.thread);
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (TaskSpan& s : all) s.thread = static_cast<int>(std::lower_bound(seen.begin(), seen.end(), s.thread) - seen.begin());
     std::sort(all.begin(), all.end(), [](const TaskSpan& a, const TaskSpan& b) {
       return a.thread != b.thread ? a.thread < b.thread : a.start_ms < b.start_ms;
     });

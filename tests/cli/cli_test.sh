@@ -133,7 +133,7 @@ tmp=$(mktemp -d)
 check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
 contains run "summary over 12 steps"
 contains run "heaviest pair"
-contains run "method stealing on"  # the default: caliber::kRecommendedMethod on the hardware threads
+contains run "method stealing on"  # the default: caliber::kDefaultMethod on the hardware threads
 python3 - "$tmp/report.json" "$tmp/contacts.jsonl" <<'PY' || { echo "FAIL run-files"; failures=$((failures + 1)); }
 import json, sys
 r = json.load(open(sys.argv[1]))
@@ -167,7 +167,7 @@ check run-self 2 "$cli" run "$selfdir/self.json"
 contains run-self "self.json: extension '.json' is not a mesh format caliber reads"
 rm -rf "$selfdir"
 check run-threads-negative 2 "$cli" run "$data/scenes/tetras.json" --threads -1
-contains run-threads-negative "threads: must be between 1 and 1024"
+contains run-threads-negative "threads: must be between 0 and 1024"
 check run-threads-absurd 2 "$cli" run "$data/scenes/tetras.json" --threads 5000 --method hybrid
 check query-threads-absurd 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads 100000 --method stealing
 check run-threads-zero 0 "$cli" run "$data/scenes/tetras.json" --threads 0 --method hybrid --steps 2
@@ -213,7 +213,7 @@ assert set(s["ceiling"]) == {"2"} and len(s["ceiling"]["2"]["copy_step_ms"]) == 
 assert r["runs_done"] == r["runs_planned"] == 2 * (1 + 5 * 2) and "stopped" not in r
 report = open(d + "/report.md").read()
 for heading in ("## Table 1", "## Table 2", "## The machine's ceiling", "## One-thread overhead", "## Simulated speed-up",
-                "## Predicted from measured time per piece", "## Targets", "**all identical**", "Runs done: 22 of 22"):
+                "## Predicted from measured time per piece", "## Measured figures", "**all identical**", "Runs done: 22 of 22"):
     assert heading in report, heading
 # The log: one record per line, as measured; every run is there.
 records = [json.loads(line) for line in open(d + "/runs.jsonl")]
@@ -288,7 +288,7 @@ check bench-bad-threads 2 "$cli" bench "$data/scenes/tetras.json" --threads 0 --
 check bench-bad-repeat 2 "$cli" bench "$data/scenes/tetras.json" --repeat 0 --out "$tmp/bench2"
 rm -rf "$tmp"
 
-# Reliability round 2 (docs/bad_input.md): readers by extension, linear adjacency, exact range,
+# Bad inputs (docs/bad_input.md): readers by extension, linear adjacency, exact range,
 # memory, outputs that are never lost, SIGINT.
 r2=$(mktemp -d)
 asan=0

@@ -77,7 +77,7 @@ contains export-into-file "needs a folder"
 
 # caliber view: the page (the data, the script, and nothing that ends a script early).
 check view 0 "$cli" view "$scene" --out "$tmp/view.html" --steps 3
-contains view "3 steps, 3 objects, hybrid"
+contains view "3 steps, 3 objects, stealing"  # the default method
 grep -q '"schema_version":1' "$tmp/view.html" && passes=$((passes + 1)) || { echo "FAIL view: no schema"; failures=$((failures + 1)); }
 sed 's/"name": "third"/"name": "<\/script><b>third"/; s#"\.\./tetra.off"#"'"$data"'/tetra.off"#g' "$scene" > "$tmp/named.json"
 check view-script-name 0 "$cli" view "$tmp/named.json" --out "$tmp/named.html" --steps 2

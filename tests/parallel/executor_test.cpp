@@ -1,5 +1,6 @@
 // The executor seam (src/parallel/executor.h), whichever backend this build has: every index once,
-// nested task groups, exceptions reaching wait(), and never more threads at once than asked for.
+// nested task groups, exceptions reaching wait(), never more threads at once than asked for, and
+// (oneTBB) never more than the process allows, in the host's arena, with no thread of its own.
 
 #include <algorithm>
 #include <atomic>
@@ -8,6 +9,7 @@
 #include <stdexcept>
 #include <thread>
 #include <vector>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
@@ -63,7 +65,12 @@ long fib(int n) {
 TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
   for (const int threads : {1, 2, 3, 8}) {
     Executor executor(threads);
+#ifdef CALIBER_EXECUTOR_STD
     EXPECT_EQ(executor.threads(), threads);
+#else
+    EXPECT_LE(executor.threads(), threads) << "at most the process's limit";
+    EXPECT_GE(executor.threads(), 1);
+#endif
     long result = 0;
     executor.execute([&] { result = fib(18); });
     EXPECT_EQ(result, 2584);
@@ -82,10 +89,10 @@ TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
   EXPECT_EQ(fib(12), 144) << "task groups work outside any executor too";
 }
 
+#ifdef CALIBER_EXECUTOR_STD
 TEST(Executor, AllNThreadsRunEvenBeyondTheHardwareThreads) {
   // N tasks that each wait (up to 20 s) until all N are running: they can only all finish early if
-  // N distinct threads run them at once, hardware threads or not (oneTBB caps an arena's workers at
-  // the hardware threads - 1 unless the executor lifts that limit).
+  // N distinct threads run them at once, hardware threads or not (the std backend's pool has N).
   const int threads = static_cast<int>(std::max(2u, std::thread::hardware_concurrency())) + 2;
   Executor executor(threads);
   std::atomic<int> arrived{0};
@@ -109,6 +116,73 @@ TEST(Executor, AllNThreadsRunEvenBeyondTheHardwareThreads) {
   EXPECT_TRUE(all_met.load()) << "the " << threads << " tasks never ran on " << threads << " threads at once (waited 20 s)";
   for (int t = 0; t < threads; ++t) EXPECT_EQ(seen[static_cast<std::size_t>(t)].load(), 1) << "thread index " << t;
 }
+#else
+/// Counts the threads of this process (Linux: /proc/self/task).
+std::size_t os_threads() {
+  std::size_t n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) n += entry.is_directory() ? 1 : 0;
+  return n;
+}
+
+TEST(Executor, NeverRaisesTheProcessLimitAndReportsWhatItHas) {
+  const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+  for (const int threads : {2, 4, 8}) {
+    Executor executor(threads);
+    EXPECT_EQ(executor.threads(), 2) << threads << " asked for, under a limit of 2";
+    Occupancy occupancy;
+    executor.execute([&] {
+      EXPECT_EQ(concurrency(), 2);
+      parallel_for(0, 64, 1, [&](std::size_t, std::size_t) {
+        occupancy.enter();
+        EXPECT_GE(current_thread_index(), 0);
+        EXPECT_LT(current_thread_index(), 2);
+        volatile double x = 0;
+        for (int i = 0; i < 20000; ++i) x = x + 1.0;
+        occupancy.leave();
+      });
+    });
+    EXPECT_LE(occupancy.peak.load(), 2);
+    EXPECT_EQ(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 2u) << "the host's limit stands";
+  }
+}
+
+TEST(Executor, ZeroRunsInTheArenaItIsCalledFrom) {
+  tbb::task_arena host(2);
+  host.execute([] { tbb::parallel_for(0, 1000, [](int) {}); });  // the host's worker exists
+  const std::size_t before = os_threads();
+  Executor executor(0);
+  host.execute([&] {
+    EXPECT_EQ(executor.threads(), std::min(2, static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+    executor.execute([&] {
+      std::atomic<int> outside{0};
+      parallel_for(0, 256, 1, [&](std::size_t, std::size_t) {
+        if (tbb::this_task_arena::max_concurrency() != 2) ++outside;  // a task run in another arena
+      });
+      EXPECT_EQ(outside.load(), 0);
+      EXPECT_EQ(fib(16), 987);
+    });
+  });
+  EXPECT_EQ(os_threads(), before) << "caliber ran on the host's arena and started no thread";
+}
+
+TEST(Executor, OneThreadAndNoExecutorRunOnTheCallingThread) {
+  const auto caller = std::this_thread::get_id();
+  std::atomic<int> elsewhere{0};
+  const auto work = [&] {
+    parallel_for(0, 100, 1, [&](std::size_t, std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
+    parallel_for_each(0, 100, [&](std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
+    TaskGroup group;
+    for (int i = 0; i < 10; ++i) group.run([&] { elsewhere += std::this_thread::get_id() != caller; });
+    group.wait();
+    for_each_in_order(10, [&](std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
+  };
+  work();
+  EXPECT_EQ(concurrency(), 1);
+  EXPECT_EQ(current_thread_index(), -1);
+  Executor(1).execute(work);
+  EXPECT_EQ(elsewhere.load(), 0);
+}
+#endif
 
 TEST(Executor, ExceptionsReachTheWaiter) {
   Executor executor(3);
@@ -128,7 +202,7 @@ TEST(Executor, ExceptionsReachTheWaiter) {
   std::atomic<int> sum{0};
   executor.execute([&] { parallel_for_each(0, 100, [&](std::size_t i) { sum += static_cast<int>(i); }); });
   EXPECT_EQ(sum.load(), 4950);
-  EXPECT_THROW(Executor(0), Error);
+  EXPECT_THROW(Executor(-1), Error);
 }
 
 TEST(Executor, ForEachInOrderRunsEveryItemOnceAndRethrows) {
@@ -149,7 +223,7 @@ TEST(Executor, ForEachInOrderRunsEveryItemOnceAndRethrows) {
     }
     int inside = 0;
     executor.execute([&] { inside = concurrency(); });
-    EXPECT_EQ(inside, threads);
+    EXPECT_EQ(inside, executor.threads());
     EXPECT_THROW(executor.execute([] {
       for_each_in_order(100, [](std::size_t i) {
         if (i == 42) throw std::runtime_error("item 42");

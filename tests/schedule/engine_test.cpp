@@ -306,6 +306,7 @@ TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
     EngineOptions wide;
     wide.method = method;
     wide.threads = 4;
+    wide.plan_threads = 4;  // what 4 threads get (this machine may have fewer)
     EngineOptions narrow = wide;
     narrow.threads = 1;
     narrow.plan_threads = 4;
