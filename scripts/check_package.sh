@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
-# Checks caliber as a package used from outside its tree: installs the Release build (static
-# library) into a temporary prefix, configures examples/consumer against it with find_package, runs
-# the consumer and compares its counts with the CLI's; then builds the library shared
-# (-DBUILD_SHARED_LIBS=ON: versioned, internal symbols hidden), installs it, checks the exported
-# symbols and runs the consumer against it too. Called by scripts/test.sh.
+# Checks caliber as a package used from outside its tree, as a consumer meets it:
+#   - installs the Release build (static library) into a temporary prefix, builds examples/ against
+#     it with find_package, runs each example (query_pair's counts against the CLI's; the oneTBB
+#     and OpenMP hosts check themselves that caliber started no thread and got the same contacts);
+#   - builds query_pair with `pkg-config --cflags --libs --static caliber` alone, from that prefix
+#     moved elsewhere (caliber.pc is relocatable);
+#   - builds the examples with -ffast-math (caliber's floating-point flags are its own: nothing
+#     leaks into the consumer, and the answers do not change);
+#   - builds the library shared (-DBUILD_SHARED_LIBS=ON: versioned, internal symbols hidden),
+#     installs it, checks the exported symbols, and does the same with `pkg-config --cflags --libs`.
+# Called by scripts/test.sh.
 #   scripts/check_package.sh [BUILD_DIR]      default build/
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -18,16 +24,37 @@ fail() { echo "check_package: $*" >&2; exit 1; }
 want_i="$("$build/caliber" query "$a" "$b" --pose-b "$pose" --json | python3 -c 'import json,sys; print(len(json.load(sys.stdin)["pairs"]))')"
 want_c="$("$build/caliber" query "$a" "$b" --pose-b "$pose" --kind contact --tolerance 0.3 --json | python3 -c 'import json,sys; print(len(json.load(sys.stdin)["pairs"]))')"
 
-consume() {  # PREFIX TAG: configures, builds and runs the consumer against an installed caliber
-  cmake -S "$root/examples/consumer" -B "$work/consumer-$2" -DCMAKE_PREFIX_PATH="$1" -DCMAKE_BUILD_TYPE=Release >/dev/null ||
-    fail "$2: the consumer does not configure against $1"
-  cmake --build "$work/consumer-$2" -j "${JOBS:-2}" >/dev/null || fail "$2: the consumer does not build"
-  local out
-  out="$("$work/consumer-$2/consumer" "$a" "$b" "$pose" 0.3)" || fail "$2: the consumer failed"
+check_counts() {  # TAG OUTPUT: query_pair's output against the CLI's counts
   [ "$want_i" -gt 0 ] && [ "$want_c" -gt 0 ] || fail "the test pose finds nothing: pick another"
-  grep -qx "interference: $want_i pairs" <<<"$out" || fail "$2: interference differs from the CLI's $want_i: $out"
-  grep -qx "contact: $want_c contacts" <<<"$out" || fail "$2: contacts differ from the CLI's $want_c: $out"
-  echo "check_package: $2: the consumer builds against the installed package and agrees with the CLI ($want_i pairs, $want_c contacts)"
+  grep -qx "interference: $want_i pairs" <<<"$2" || fail "$1: interference differs from the CLI's $want_i: $2"
+  grep -qx "contact: $want_c contacts" <<<"$2" || fail "$1: contacts differ from the CLI's $want_c: $2"
+}
+
+consume() {  # PREFIX TAG [CXXFLAGS]: configures, builds and runs the examples against an installed caliber
+  cmake -S "$root/examples" -B "$work/examples-$2" -DCMAKE_PREFIX_PATH="$1" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_CXX_FLAGS="${3:-}" >/dev/null || fail "$2: the examples do not configure against $1"
+  cmake --build "$work/examples-$2" -j "${JOBS:-2}" >/dev/null || fail "$2: the examples do not build"
+  local out
+  out="$("$work/examples-$2/query_pair" "$a" "$b" "$pose" 0.3)" || fail "$2: query_pair failed"
+  check_counts "$2" "$out"
+  "$work/examples-$2/moving_pair" "$a" "$a" >/dev/null || fail "$2: moving_pair failed"
+  out="$("$work/examples-$2/engine_in_host_arena")" || fail "$2: engine_in_host_arena failed: $out"
+  out="$("$work/examples-$2/openmp_host")" || fail "$2: openmp_host failed: $out"
+  echo "check_package: $2: the examples build against the installed package and pass ($want_i pairs, $want_c contacts as the CLI)"
+}
+
+pkg_consume() {  # PREFIX TAG PKG-CONFIG-ARGS...: query_pair built by pkg-config's flags alone
+  local prefix="$1" tag="$2"
+  shift 2
+  local flags
+  flags="$(PKG_CONFIG_PATH="$(dirname "$(find "$prefix" -name caliber.pc | head -1)")" pkg-config "$@" caliber)" ||
+    fail "$tag: pkg-config $* caliber failed"
+  # shellcheck disable=SC2086
+  g++ -O2 -o "$work/query_pair-$tag" "$root/examples/query_pair.cpp" $flags || fail "$tag: query_pair does not build with pkg-config $*: $flags"
+  local out
+  out="$(LD_LIBRARY_PATH="$prefix/lib" "$work/query_pair-$tag" "$a" "$b" "$pose" 0.3)" || fail "$tag: query_pair (pkg-config) failed"
+  check_counts "$tag" "$out"
+  echo "check_package: $tag: pkg-config $* caliber builds query_pair, which agrees with the CLI"
 }
 
 cmake --install "$build" --prefix "$work/static" >/dev/null
@@ -37,6 +64,10 @@ for f in include/caliber/caliber.h include/caliber/version.h include/caliber/exp
   [ -e "$work/static/$f" ] || fail "static: $f was not installed"
 done
 consume "$work/static" static
+consume "$work/static" static-fast-math "-ffast-math"
+# The prefix moved: caliber.pc finds it from its own place.
+mv "$work/static" "$work/static-moved"
+pkg_consume "$work/static-moved" static-pkg-config --cflags --libs --static
 
 cmake -S "$root" -B "$work/shared-build" -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON -DCALIBER_BUILD_CLI=OFF \
   -DCALIBER_BUILD_TESTS=OFF -DCALIBER_BUILD_BENCH=OFF >/dev/null
@@ -50,3 +81,4 @@ internal="$(grep -c ' caliber::\(narrow\|tasks\|schedule\|parallel\|geometry\|me
 [ "$internal" = 0 ] || fail "shared: $internal internal symbols exported"
 grep -q ' caliber::query(' "$work/symbols" || fail "shared: caliber::query is not exported"
 LD_LIBRARY_PATH="$work/shared/lib" consume "$work/shared" shared
+pkg_consume "$work/shared" shared-pkg-config --cflags --libs

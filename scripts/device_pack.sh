@@ -1,22 +1,22 @@
 #!/usr/bin/env bash
-# Packs what the lent 16-core machine needs to run caliber, into .devicepack/ (git-ignored):
-# the Release binary, every shared library it loads except the C library's own (the device runs
-# Ubuntu 24.04, whose glibc is newer than Debian 12's, without our Debian packages), the four
-# scenes and the meshes they read, and run.sh, the one command to run there:
+# Packs what another machine needs to run caliber without our Debian packages (for example a
+# 16-core Intel Xeon machine running Ubuntu 24.04, whose glibc is newer than Debian 12's), into
+# .devicepack/ (git-ignored): the Release binary, every shared library it loads except the C
+# library's own, the four scenes and the meshes they read, and run.sh, the one command to run there:
 #
 #   scripts/device_pack.sh            # here: build (Release) and pack; prints the pack's size
-#   bash .devicepack/run.sh ARGS...   # there (the device tool, carry [".devicepack"]): runs
+#   bash .devicepack/run.sh ARGS...   # there (.devicepack copied to the other machine): runs
 #                                     # `caliber ARGS...` with the packed libraries; results go
 #                                     # under $OUT when ARGS name $OUT
 #
-# For example, a bench that cannot lose its results when cut at the command's 10-minute limit:
+# For example, a bench that cannot lose its results when a time limit (here 10 minutes) cuts it:
 #
 #   bash .devicepack/run.sh bench --threads 1,4,8,16 --repeat 5 --budget-s 540 --no-figures \
 #        --no-fcl --out "$OUT/bench"
 #
 # The pack is checked before it is declared ready: its binary must start with only the packed
 # libraries and the C library (a clean environment, LD_LIBRARY_PATH set to the pack alone), and
-# the whole pack must stay under the device tool's 64 MiB carry limit.
+# the whole pack must stay under 64 MiB, small enough to copy to a remote machine.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 pack="$root/.devicepack"
@@ -31,7 +31,7 @@ cp "$root/build/caliber" "$pack/bin/"
 strip "$pack/bin/caliber"
 
 # Every library the binary loads, but glibc's own (the C library, its companions, the dynamic
-# loader): those come from the device's system (glibc is backward compatible, not forward).
+# loader): those come from the other machine's system (glibc is backward compatible, not forward).
 is_glibc() {
   case "$(basename "$1")" in
     libc.so.*|libm.so.*|libmvec.so.*|libpthread.so.*|libdl.so.*|librt.so.*|libresolv.so.*|libutil.so.*|libanl.so.*|\
@@ -83,7 +83,7 @@ RUN
 chmod +x "$pack/run.sh"
 
 # The check: with the pack's folder first, every library but glibc's must resolve inside the pack
-# (ldd would otherwise find this machine's copies and hide a library the device lacks).
+# (ldd would otherwise find this machine's copies and hide a library the other machine lacks).
 outside="$(env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/caliber" | awk '/=>/ {print $1, $3}' |
   while read -r name path; do
     is_glibc "$name" && continue
@@ -98,7 +98,7 @@ env -i PATH=/usr/bin:/bin bash "$pack/run.sh" run scenes/two_small.json --steps 
   { echo "device_pack: the packed binary does not run a scene with the packed libraries alone" >&2; exit 1; }
 size_kib="$(du -sk "$pack" | cut -f1)"
 if [ "$size_kib" -gt $((limit_mib * 1024)) ]; then
-  echo "device_pack: the pack is $((size_kib / 1024)) MiB, over the device tool's ${limit_mib} MiB" >&2
+  echo "device_pack: the pack is $((size_kib / 1024)) MiB, over the ${limit_mib} MiB limit" >&2
   exit 1
 fi
 echo "device_pack: $pack ready ($((size_kib / 1024)) MiB; commit $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+dirty'))"

@@ -1,7 +1,7 @@
 // caliber bench: every scene x method x thread count, repeated, medians; the paper's Table 1 and
 // Table 2, the 1-thread overhead, the load-balance simulation beyond this machine's cores, the
 // estimate-vs-effective correlation, a per-thread timeline, the FCL peer comparison (when
-// bench_fcl_compare is built), the targets checked against what was measured; report.md +
+// bench_fcl_compare is built), the run's key figures in one table; report.md +
 // results.json, then figures drawn by scripts/plot_bench.py (matplotlib) when it can run.
 
 #include <algorithm>
@@ -574,7 +574,7 @@ int run_bench(BenchOptions opt) {
     scenes.push_back(load_scene(file));
     if (opt.steps > 0) scenes.back().steps = opt.steps;
   }
-  if (opt.out.empty()) opt.out = "bench/results/" + machine_slug();
+  if (opt.out.empty()) opt.out = "bench/results/" + machine_slug() + "/engine";
   if (std::filesystem::exists(opt.out) && !std::filesystem::is_directory(opt.out)) {
     throw Error(ErrorCode::bad_value, "--out", "'" + opt.out + "' exists and is not a folder");
   }
@@ -655,7 +655,7 @@ Runner add_bench_command(CLI::App& app) {
   cmd->add_option("--steps", opt->steps, "Steps per run (default: the scene's)");
   cmd->add_option("--simulate", opt->simulate, "Virtual core counts for the load-balance simulation")->delimiter(',')->capture_default_str();
   cmd->add_option("--simulate-steps", opt->simulate_steps, "Steps replayed per simulated core count (0: all)")->capture_default_str();
-  cmd->add_option("--out", opt->out, "Output folder (default: bench/results/<machine>)");
+  cmd->add_option("--out", opt->out, "Output folder (default: bench/results/<machine>/engine)");
   cmd->add_option("--fcl-repeat", opt->fcl_repeat, "Runs per FCL comparison")->capture_default_str();
   cmd->add_flag("!--no-figures", opt->figures, "Do not run scripts/plot_bench.py");
   cmd->add_flag("!--no-fcl", opt->fcl, "Do not run the FCL peer comparison");

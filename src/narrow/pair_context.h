@@ -106,7 +106,7 @@ class PairContext {
   /// The node test of a visit where both sides split: node_test, and neither node's disk beyond
   /// the other's slab (disks_beyond_slabs; both nodes prepared with their disks). Visits where one
   /// side splits use node_test alone: on the turbine and blade, whose visits mostly split one side,
-  /// the disks refused no pair and cost about a fifth of the query (stop 37).
+  /// the disks refused no pair and cost about a fifth of the query.
   [[nodiscard]] bool node_test_2x2_lane(const SideA& a, const SideB& b) const {
     return node_test(a, b) && !narrow::disks_beyond_slabs(a, b, mSlabReach);
   }

@@ -28,7 +28,7 @@
 ///    box, the least of them (and of the sphere cap o / 2r): exact for a box-shaped spread of
 ///    triangles cut by one axis, but it overrates flat patches whose boxes overlap though their
 ///    surfaces do not come near (two_large: 1.77x simulated at P = 2 with this share alone).
-/// Measured (bench/results/amd-epyc-2c/issue14/weights.md): the log correlation with the node
+/// Measured (bench/results/amd-epyc-2c/scaling/weights.md): the log correlation with the node
 /// tests each CD node's subtree takes rises on every scene (nodes with >= 1,000 tests: two_large
 /// 0.81 -> 0.83, two_small 0.82 -> 0.86, funnel 0.88 -> 0.92, front_car 0.59 -> 0.69).
 /// The paper's printed formula is garbled; this one keeps its ingredients (P, r, the centers'

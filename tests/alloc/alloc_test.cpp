@@ -1,4 +1,4 @@
-// Allocations in a steady-state step (issue 14): counts every operator new made by Engine::step,
+// Allocations in a steady-state step: counts every operator new made by Engine::step,
 // for every method at 1 and 2 threads, on a scene whose objects keep touching (three procedural
 // meshes), after warm-up steps. Checks that
 //  (1) the count does not grow with the steps: on a fixed frame, steps 80-99 after warm-up allocate
