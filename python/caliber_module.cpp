@@ -139,19 +139,25 @@ PyResult query_result(const caliber::QueryResult& q) {
   return r;
 }
 
-caliber::Pose pose_from_matrix(const py::array_t<double, py::array::c_style | py::array::forcecast>& m) {
-  if (m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
-  const auto a = m.unchecked<2>();
-  Eigen::Matrix3d r;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r(i, j) = a(i, j);
+caliber::Pose pose_from_matrix(const py::array& m) {
+  // float32 matrices are rotations only to float32's rounding: they get that tolerance.
+  const bool single = m.dtype().is(py::dtype::of<float>());
+  const py::array_t<double, py::array::c_style | py::array::forcecast> d(m);
+  if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
+  const auto a = d.unchecked<2>();
+  Eigen::Matrix4d matrix;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) matrix(i, j) = a(i, j);
   }
-  if (!r.allFinite() || (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 || r.determinant() < 0.0 ||
-      a(3, 0) != 0.0 || a(3, 1) != 0.0 || a(3, 2) != 0.0 || a(3, 3) != 1.0) {
-    throw caliber::Error(caliber::ErrorCode::bad_value, "matrix", "is not a rigid transform (a rotation within 1e-9, then a translation; last row 0 0 0 1)");
-  }
-  const Eigen::Quaterniond q(r);
-  return caliber::Pose::from_values(a(0, 3), a(1, 3), a(2, 3), q.w(), q.x(), q.y(), q.z(), "matrix");
+  return caliber::Pose::from_matrix(matrix, single ? 1e-6 : 1e-9, "matrix");
+}
+
+/// The quaternion (w, x, y, z) of `q` given in `order` ("wxyz", caliber's and Eigen's; "xyzw",
+/// scipy's and ROS's).
+std::array<double, 4> quaternion_wxyz(const std::array<double, 4>& q, const std::string& order) {
+  if (order == "wxyz") return q;
+  if (order == "xyzw") return {q[3], q[0], q[1], q[2]};
+  throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
 }
 
 caliber::Frame make_frame(const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
@@ -223,16 +229,32 @@ PYBIND11_MODULE(caliber, m) {
           }));
 
   py::class_<caliber::Pose>(m, "Pose", "A rigid transform: x_world = R x + t.")
-      .def(py::init([](std::array<double, 3> t, std::array<double, 4> q) {
+      .def(py::init([](std::array<double, 3> t, std::array<double, 4> q, const std::string& order) {
+             q = quaternion_wxyz(q, order);
              return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3]);
            }),
            py::arg("translation") = std::array<double, 3>{0, 0, 0}, py::arg("quaternion") = std::array<double, 4>{1, 0, 0, 0},
-           "translation (x, y, z), quaternion (w, x, y, z), normalized")
-      .def_static("from_matrix", &pose_from_matrix, py::arg("matrix"), "from a 4 x 4 rigid transform")
+           py::kw_only(), py::arg("order") = "wxyz",
+           "translation (x, y, z), quaternion normalized, in `order`: 'wxyz' (the default, Eigen's) or 'xyzw' (scipy's "
+           "Rotation.as_quat() and ROS's)")
+      .def_static("from_quaternion", [](std::array<double, 4> q, const std::string& order, std::array<double, 3> t) {
+             q = quaternion_wxyz(q, order);
+             return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3], "quaternion");
+           },
+           py::arg("quaternion"), py::arg("order"), py::arg("translation") = std::array<double, 3>{0, 0, 0},
+           "from a quaternion in an explicit order, 'wxyz' or 'xyzw' (scipy's and ROS's), and a translation")
+      .def_static("from_matrix", &pose_from_matrix, py::arg("matrix"),
+                  "from a 4 x 4 rigid transform; its rotation must be orthonormal within 1e-9 (float64) or 1e-6 (float32)")
       .def_property_readonly("translation", [](const caliber::Pose& p) { return std::array<double, 3>{p.translation.x(), p.translation.y(), p.translation.z()}; })
       .def_property_readonly("quaternion", [](const caliber::Pose& p) {
         return std::array<double, 4>{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
-      })
+      }, "the unit quaternion (w, x, y, z)")
+      .def("as_quaternion", [](const caliber::Pose& p, const std::string& order) {
+        const std::array<double, 4> q{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
+        if (order == "wxyz") return q;
+        if (order == "xyzw") return std::array<double, 4>{q[1], q[2], q[3], q[0]};
+        throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
+      }, py::arg("order"), "the unit quaternion in `order`, 'wxyz' or 'xyzw'")
       .def("matrix", [](const caliber::Pose& p) {
         py::array_t<double> out({py::ssize_t{4}, py::ssize_t{4}});
         auto o = out.mutable_unchecked<2>();
@@ -290,17 +312,21 @@ PYBIND11_MODULE(caliber, m) {
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind,
-             std::optional<double> tolerance, double angle) {
-            const caliber::Frame frame = make_frame(models, poses, pairs, make_request(kind, tolerance, angle));
+             std::optional<double> tolerance, double angle, std::size_t max_pairs) {
+            const caliber::Frame frame = make_frame(models, poses, pairs, make_request(kind, tolerance, angle, max_pairs));
             caliber::StepResult s;
             {
               py::gil_scoped_release release;
               s = engine.step(frame);
             }
-            return to_result(s.contacts, s.stats);
+            PyResult r = to_result(s.contacts, s.stats);
+            r.limit_reached = s.limit_reached;
+            return r;
           },
           py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
-          py::arg("angle") = 30.0, "One frame: every listed object pair (a < b, sorted) tested.");
+          py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
+          "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair past that many "
+          "triangle pairs and sets limit_reached (1: does each pair touch at all?).");
 
   py::class_<caliber::World>(m, "World", "A scene file's objects, poses and broad phase.")
       .def(py::init([](const std::string& path) {

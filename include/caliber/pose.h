@@ -10,7 +10,9 @@
 
 namespace caliber {
 
-/// A rigid transform x_world = rotation * x_object + translation. The rotation is a unit quaternion.
+/// A rigid transform x_world = rotation * x_object + translation. The rotation is a unit quaternion
+/// stored as Eigen's (w, x, y, z); scipy and ROS write quaternions (x, y, z, w): build from those
+/// with from_values(tx, ty, tz, q[3], q[0], q[1], q[2]), or from a matrix.
 struct Pose {
   /// Unit quaternion (w, x, y, z).
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
@@ -22,6 +24,24 @@ struct Pose {
   /// otherwise the quaternion is normalized. `source` names the input in the message.
   CALIBER_EXPORT static Pose from_values(double tx, double ty, double tz, double qw, double qx, double qy, double qz,
                           std::string_view source = "pose");
+
+  /// Builds a pose from a 4 x 4 rigid transform [R t; 0 0 0 1]: R must be a rotation within
+  /// `tolerance` (|R R^T - I| and |det R - 1| at most that; 1e-9 suits doubles, 1e-6 a matrix
+  /// that went through floats), and is then made exactly orthonormal (through its quaternion).
+  /// Throws caliber::Error (bad_value) naming `source` otherwise, or on a non-finite value.
+  CALIBER_EXPORT static Pose from_matrix(const Eigen::Matrix4d& matrix, double tolerance = 1e-9,
+                                         std::string_view source = "matrix");
+  /// Builds a pose from an Eigen isometry (its linear part must be a rotation within `tolerance`,
+  /// as from_matrix).
+  CALIBER_EXPORT static Pose from_isometry(const Eigen::Isometry3d& isometry, double tolerance = 1e-9,
+                                           std::string_view source = "isometry");
+  /// The pose as a 4 x 4 matrix [R t; 0 0 0 1].
+  [[nodiscard]] Eigen::Matrix4d matrix() const {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.topLeftCorner<3, 3>() = rotation_matrix();
+    m.topRightCorner<3, 1>() = translation;
+    return m;
+  }
 
   /// The rotation as a matrix.
   [[nodiscard]] Eigen::Matrix3d rotation_matrix() const { return rotation.toRotationMatrix(); }

@@ -69,6 +69,34 @@ def test_pose_from_a_matrix_round_trips():
         caliber.Pose.from_matrix(np.diag([2.0, 1.0, 1.0, 1.0]))
 
 
+def test_pose_from_a_float32_matrix_and_quaternion_orders():
+    p = caliber.Pose((0.1, -0.2, 0.3), (0.9, 0.1, -0.3, 0.2))  # no entry of its matrix is exact in float32
+    with pytest.raises(caliber.Error, match="not a rigid transform within 1e-09"):
+        caliber.Pose.from_matrix(p.matrix().astype(np.float32).astype(np.float64))  # the same values as float64
+    q = caliber.Pose.from_matrix(p.matrix().astype(np.float32))  # a rotation only to float32's rounding
+    assert np.allclose(q.matrix(), p.matrix(), atol=1e-6)
+    with pytest.raises(caliber.Error, match="not a rigid transform"):
+        caliber.Pose.from_matrix(np.round(p.matrix(), 4))  # float64: within 1e-9
+    w, x, y, z = p.quaternion
+    assert np.allclose(caliber.Pose(p.translation, (x, y, z, w), order="xyzw").matrix(), p.matrix(), atol=1e-15)
+    assert np.allclose(caliber.Pose.from_quaternion((x, y, z, w), "xyzw", p.translation).matrix(), p.matrix(), atol=1e-15)
+    assert np.allclose(p.as_quaternion("xyzw"), (x, y, z, w)) and np.allclose(p.as_quaternion("wxyz"), (w, x, y, z))
+    turned = caliber.Pose.from_quaternion((0.0, 0.0, 1.0, 0.0), "xyzw")  # scipy's order: half a turn about z
+    assert np.allclose(turned.matrix()[:3, :3], np.diag([-1.0, -1.0, 1.0]), atol=1e-15)
+    with pytest.raises(caliber.Error, match="order: must be 'wxyz' or 'xyzw'"):
+        caliber.Pose.from_quaternion((0.0, 0.0, 0.0, 1.0), "zyxw")
+
+
+def test_engine_step_max_pairs_bounds_each_pair():
+    models = [caliber.Model.load(TETRA), caliber.Model.load(FAN)]
+    poses = [caliber.Pose(), pose(POSE)]
+    engine = caliber.Engine()
+    full = engine.step(models, poses, [(0, 1)], kind="proximity", tolerance=0.3)
+    one = engine.step(models, poses, [(0, 1)], kind="proximity", tolerance=0.3, max_pairs=1)
+    assert len(full) > 1 and not full.limit_reached
+    assert len(one) == 1 and one.limit_reached
+
+
 def test_pickled_models_answer_the_same():
     a = caliber.Model.load(FAN)
     b = pickle.loads(pickle.dumps(a))

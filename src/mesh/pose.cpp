@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,30 @@ Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, do
   pose.rotation = unit_quaternion(qw, qx, qy, qz, source);
   pose.translation = Eigen::Vector3d(tx, ty, tz);
   return pose;
+}
+
+Pose Pose::from_matrix(const Eigen::Matrix4d& matrix, double tolerance, std::string_view source) {
+  if (!(tolerance >= 0.0) || !(tolerance < 0.5)) {
+    throw Error(ErrorCode::bad_value, std::string(source), "the rotation's tolerance must be in [0, 0.5)");
+  }
+  if (!matrix.allFinite()) throw Error(ErrorCode::bad_value, std::string(source), "has a value that is not finite");
+  const Eigen::Matrix3d r = matrix.topLeftCorner<3, 3>();
+  const double off = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double det = r.determinant();
+  if (off > tolerance || std::abs(det - 1.0) > tolerance || matrix(3, 0) != 0.0 || matrix(3, 1) != 0.0 ||
+      matrix(3, 2) != 0.0 || matrix(3, 3) != 1.0) {
+    char problem[200];
+    std::snprintf(problem, sizeof problem,
+                  "is not a rigid transform within %g (|R R^T - I| = %.3g, det R = %.17g; last row must be 0 0 0 1)",
+                  tolerance, off, det);
+    throw Error(ErrorCode::bad_value, std::string(source), problem);
+  }
+  const Eigen::Quaterniond q(r);
+  return from_values(matrix(0, 3), matrix(1, 3), matrix(2, 3), q.w(), q.x(), q.y(), q.z(), source);
+}
+
+Pose Pose::from_isometry(const Eigen::Isometry3d& isometry, double tolerance, std::string_view source) {
+  return from_matrix(isometry.matrix(), tolerance, source);
 }
 
 Pose parse_pose(std::string_view text, std::string_view source) {

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -25,6 +26,45 @@ TEST(Pose, NormalizesTheQuaternion) {
   const Pose q = parse_pose("0 0 0 1 1 1 1");
   EXPECT_NEAR(q.rotation.norm(), 1.0, 1e-15);
   EXPECT_NO_THROW(validate_pose(q));
+}
+
+TEST(Pose, FromAMatrixAndAnIsometry) {
+  const Pose p = Pose::from_values(1, -2, 3, 0.9, 0.1, -0.3, 0.2);
+  const Pose q = Pose::from_matrix(p.matrix());
+  EXPECT_LT((q.matrix() - p.matrix()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT(q.rotation.angularDistance(p.rotation), 1e-15);
+  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+  iso.linear() = p.rotation_matrix();
+  iso.translation() = p.translation;
+  EXPECT_LT((Pose::from_isometry(iso).matrix() - p.matrix()).cwiseAbs().maxCoeff(), 1e-15);
+  // A rotation rounded to floats is a rotation within 1e-6, not within 1e-9.
+  const Eigen::Matrix4d rounded = p.matrix().cast<float>().cast<double>();
+  EXPECT_THROW((void)Pose::from_matrix(rounded), Error);
+  EXPECT_LT((Pose::from_matrix(rounded, 1e-6).matrix() - p.matrix()).cwiseAbs().maxCoeff(), 1e-6);
+  const auto message = [](const Eigen::Matrix4d& m) {
+    try {
+      (void)Pose::from_matrix(m, 1e-9, "pose of the arm");
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::bad_value);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  Eigen::Matrix4d scaled = Eigen::Matrix4d::Identity();
+  scaled(0, 0) = 2.0;
+  EXPECT_NE(message(scaled).find("pose of the arm: is not a rigid transform"), std::string::npos) << message(scaled);
+  Eigen::Matrix4d mirror = Eigen::Matrix4d::Identity();
+  mirror(2, 2) = -1.0;
+  EXPECT_NE(message(mirror).find("det R = -1"), std::string::npos) << "a mirror image is no rotation: " << message(mirror);
+  Eigen::Matrix4d projective = Eigen::Matrix4d::Identity();
+  projective(3, 0) = 0.5;
+  EXPECT_NE(message(projective).find("last row"), std::string::npos);
+  Eigen::Matrix4d nan = Eigen::Matrix4d::Identity();
+  nan(1, 3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(nan).find("not finite"), std::string::npos);
+  Eigen::Matrix4d far = Eigen::Matrix4d::Identity();
+  far(0, 3) = 1e300;
+  EXPECT_NE(message(far).find("1e15"), std::string::npos) << "the translation's limits hold too: " << message(far);
 }
 
 TEST(Pose, RejectsBadText) {
