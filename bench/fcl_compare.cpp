@@ -106,8 +106,8 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
     one_result.clear();
     fcl::collide(&obj_a, &obj_b, one_request, one_result);
   });
-  row.first_agrees = row.first_agrees && one.pairs.empty() == ours.pairs.empty() &&
-                     one_result.isCollision() == fcl_result.isCollision();
+  row.first_agrees =
+      row.first_agrees && one.pairs.empty() == ours.pairs.empty() && one_result.isCollision() == fcl_result.isCollision();
 
   std::vector<caliber::TrianglePair> theirs;
   for (std::size_t i = 0; i < fcl_result.numContacts(); ++i) {
@@ -212,22 +212,22 @@ std::string format_row(const Row& r, bool scene) {
   char line[1024];
   const std::string sizes = scene ? std::to_string(r.tris_a) + " (" + std::to_string(r.tris_b) + " pairs)"
                                   : std::to_string(r.tris_a) + " / " + std::to_string(r.tris_b);
-  std::snprintf(line, sizeof line,
-                "| %s | %s | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu / %ld | %llu / %ld | %.4f | %.4f | "
-                "%.4f | %s |\n",
-                r.name.c_str(),
-                sizes.c_str(), r.build_ours, r.build_fcl, r.build_ours / r.build_fcl, r.query_ours, r.query_fcl,
-                r.query_fcl > 0 ? r.query_ours / r.query_fcl : 0.0, r.pairs_ours, r.pairs_fcl,
-                (r.only_ours == 0 && r.only_fcl == 0)
-                    ? "yes"
-                    : ("no: " + std::to_string(r.only_ours) + " only ours, " + std::to_string(r.only_fcl) + " only FCL" +
-                       (r.only_fcl > 0 ? " (" + std::to_string(r.only_fcl_exact_hits) + " of them intersect in world coordinates; " +
-                                             "largest gap " + short_number(r.only_fcl_max_distance) + ")"
-                                       : std::string()))
-                          .c_str(),
-                static_cast<unsigned long long>(r.node_tests), r.fcl_bv_tests, static_cast<unsigned long long>(r.leaf_tests),
-                r.fcl_leaf_tests, r.first_ours, r.first_fcl, r.query_ours > 0 ? r.first_ours / r.query_ours : 0.0,
-                r.first_agrees ? "yes" : "NO");
+  std::snprintf(
+      line, sizeof line,
+      "| %s | %s | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %zu / %zu | %s | %llu / %ld | %llu / %ld | %.4f | %.4f | "
+      "%.4f | %s |\n",
+      r.name.c_str(), sizes.c_str(), r.build_ours, r.build_fcl, r.build_ours / r.build_fcl, r.query_ours, r.query_fcl,
+      r.query_fcl > 0 ? r.query_ours / r.query_fcl : 0.0, r.pairs_ours, r.pairs_fcl,
+      (r.only_ours == 0 && r.only_fcl == 0)
+          ? "yes"
+          : ("no: " + std::to_string(r.only_ours) + " only ours, " + std::to_string(r.only_fcl) + " only FCL" +
+             (r.only_fcl > 0 ? " (" + std::to_string(r.only_fcl_exact_hits) + " of them intersect in world coordinates; " +
+                                   "largest gap " + short_number(r.only_fcl_max_distance) + ")"
+                             : std::string()))
+                .c_str(),
+      static_cast<unsigned long long>(r.node_tests), r.fcl_bv_tests, static_cast<unsigned long long>(r.leaf_tests),
+      r.fcl_leaf_tests, r.first_ours, r.first_fcl, r.query_ours > 0 ? r.first_ours / r.query_ours : 0.0,
+      r.first_agrees ? "yes" : "NO");
   return line;
 }
 
@@ -252,17 +252,23 @@ int main(int argc, char** argv) {
   std::vector<int> steps = {0, 50, 100};
   bool meshes = true;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) scenes = split_list(argv[++i]);
+    if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc)
+      dir = argv[++i];
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+      out = argv[++i];
+    else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc)
+      scenes = split_list(argv[++i]);
     else if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) {
       steps.clear();
       for (const std::string& k : split_list(argv[++i])) steps.push_back(std::atoi(k.c_str()));
-    } else if (!std::strcmp(argv[i], "--no-mesh-pairs")) meshes = false;
+    } else if (!std::strcmp(argv[i], "--no-mesh-pairs"))
+      meshes = false;
     else {
-      std::fprintf(stderr, "usage: bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md] [--scenes A.json,B.json] "
-                           "[--steps 0,50,100] [--no-mesh-pairs]\n");
+      std::fprintf(stderr,
+                   "usage: bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md] [--scenes A.json,B.json] "
+                   "[--steps 0,50,100] [--no-mesh-pairs]\n");
       return 2;
     }
   }
@@ -276,16 +282,16 @@ int main(int argc, char** argv) {
       {"fandisk x rotor", "fandisk_large.off", "rotor_small.off", 15, {1, 0, 0}, {0.02, 0.02, 0.0}},
   };
   std::string table;
-  table += "| case | triangles A / B | build ours (ms) | build FCL (ms) | build ratio | query ours (ms) | query FCL (ms) | "
-           "query ratio | pairs ours / FCL | identical | node tests ours / FCL | leaf tests ours / FCL | "
-           "first pair ours (ms) | first pair FCL (ms) | first / full query, ours | first agrees |\n";
+  table +=
+      "| case | triangles A / B | build ours (ms) | build FCL (ms) | build ratio | query ours (ms) | query FCL (ms) | "
+      "query ratio | pairs ours / FCL | identical | node tests ours / FCL | leaf tests ours / FCL | "
+      "first pair ours (ms) | first pair FCL (ms) | first / full query, ours | first agrees |\n";
   table += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
   int skipped = 0;
   for (const Case& c : meshes ? cases : std::vector<Case>{}) {
     if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {
-      std::fprintf(stderr, "skipping %s: meshes missing in %s (run scripts/fetch_meshes.sh)\n", c.name.c_str(),
-                   dir.c_str());
+      std::fprintf(stderr, "skipping %s: meshes missing in %s (run scripts/fetch_meshes.sh)\n", c.name.c_str(), dir.c_str());
       ++skipped;
       continue;
     }
@@ -303,8 +309,10 @@ int main(int argc, char** argv) {
     }
   }
   if (meshes && skipped == static_cast<int>(cases.size()) && scenes.empty()) {
-    std::fprintf(stderr, "bench_fcl_compare: none of the meshes is in %s and no --scenes were given: nothing to compare "
-                         "(run scripts/fetch_meshes.sh, or pass --meshes DIR)\n", dir.c_str());
+    std::fprintf(stderr,
+                 "bench_fcl_compare: none of the meshes is in %s and no --scenes were given: nothing to compare "
+                 "(run scripts/fetch_meshes.sh, or pass --meshes DIR)\n",
+                 dir.c_str());
     return 2;
   }
   if (!out.empty()) {

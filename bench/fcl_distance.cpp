@@ -115,15 +115,23 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
   }
   std::sort(t_ours.begin(), t_ours.end());
   std::sort(t_fcl.begin(), t_fcl.end());
-  Row row{c.name, gap, ours.contacts.front().distance, fres.min_distance, false, t_ours[repeat / 2], t_fcl[repeat / 2],
-          ours.stats.node_tests, ours.stats.leaf_tests};
+  Row row{c.name,
+          gap,
+          ours.contacts.front().distance,
+          fres.min_distance,
+          false,
+          t_ours[repeat / 2],
+          t_fcl[repeat / 2],
+          ours.stats.node_tests,
+          ours.stats.leaf_tests};
   // FCL keeps the first of several pairs at the same distance (a shared vertex closest, say), we the
   // lowest ids: FCL's pair agrees when our kernel gives it our distance.
   const auto& ta = a.mesh.triangles[static_cast<std::size_t>(fres.b1)];
   const auto& tb = b.mesh.triangles[static_cast<std::size_t>(fres.b2)];
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
   const Eigen::Vector3d va[3] = {a.mesh.vertices[ta[0]], a.mesh.vertices[ta[1]], a.mesh.vertices[ta[2]]};
-  const Eigen::Vector3d vb[3] = {rb * b.mesh.vertices[tb[0]] + pose_b.translation, rb * b.mesh.vertices[tb[1]] + pose_b.translation,
+  const Eigen::Vector3d vb[3] = {rb * b.mesh.vertices[tb[0]] + pose_b.translation,
+                                 rb * b.mesh.vertices[tb[1]] + pose_b.translation,
                                  rb * b.mesh.vertices[tb[2]] + pose_b.translation};
   row.same_pair = geometry::closest_points_triangles(va, vb).distance == row.ours;
   fcl_counts(*fa, *fb, pose_b, freq, row);
@@ -138,14 +146,21 @@ int main(int argc, char** argv) {
   std::string out, only;
   bool ours_only = false, warm = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc) dir = argv[++i];
-    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else if (!std::strcmp(argv[i], "--ours-only")) ours_only = true;
-    else if (!std::strcmp(argv[i], "--warm")) warm = true;
+    if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc)
+      dir = argv[++i];
+    else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
+      repeat = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+      out = argv[++i];
+    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc)
+      only = argv[++i];
+    else if (!std::strcmp(argv[i], "--ours-only"))
+      ours_only = true;
+    else if (!std::strcmp(argv[i], "--warm"))
+      warm = true;
     else {
-      std::fprintf(stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--warm] [--ours-only]\n");
+      std::fprintf(
+          stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--warm] [--ours-only]\n");
       return 2;
     }
   }
@@ -156,9 +171,10 @@ int main(int argc, char** argv) {
       {"turbine x blade", "turbine.off", "blade.off", 10, {0, 0, 1}},
       {"fandisk x rotor", "fandisk_large.off", "rotor_small.off", 15, {1, 0, 0}},
   };
-  std::string table = "| case | gap (× diagonal) | caliber distance | FCL distance | relative difference | FCL's pair at our distance | "
-                      "caliber ms | FCL ms | caliber / FCL | node tests | leaf tests | FCL node tests | FCL leaf tests |\n"
-                      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::string table =
+      "| case | gap (× diagonal) | caliber distance | FCL distance | relative difference | FCL's pair at our distance | "
+      "caliber ms | FCL ms | caliber / FCL | node tests | leaf tests | FCL node tests | FCL leaf tests |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   BuildOptions bvh_only;
   bvh_only.adjacency = false;
   bvh_only.oriented_boxes = true;  // as the CLI and scenes build for distance queries
@@ -193,11 +209,11 @@ int main(int argc, char** argv) {
       const Row r = run(c, gap, *a, *b, fa, fb, repeat, warm);
       const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);
       char line[512];
-      std::snprintf(line, sizeof line, "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n",
-                    r.name.c_str(), r.gap, r.ours, r.fcl, rel, r.same_pair ? "yes" : "no", r.ours_ms, r.fcl_ms,
-                    r.ours_ms / r.fcl_ms, static_cast<unsigned long long>(r.node_tests),
-                    static_cast<unsigned long long>(r.leaf_tests), static_cast<unsigned long long>(r.fcl_node_tests),
-                    static_cast<unsigned long long>(r.fcl_leaf_tests));
+      std::snprintf(line, sizeof line,
+                    "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n", r.name.c_str(),
+                    r.gap, r.ours, r.fcl, rel, r.same_pair ? "yes" : "no", r.ours_ms, r.fcl_ms, r.ours_ms / r.fcl_ms,
+                    static_cast<unsigned long long>(r.node_tests), static_cast<unsigned long long>(r.leaf_tests),
+                    static_cast<unsigned long long>(r.fcl_node_tests), static_cast<unsigned long long>(r.fcl_leaf_tests));
       table += line;
       std::fputs(line, stdout);
       std::fflush(stdout);
@@ -209,7 +225,8 @@ int main(int argc, char** argv) {
   }
   if (!out.empty()) {
     std::ofstream f(out);
-    f << "# Distance query against FCL\n\n" << caliber::bench::machine_description() << "\n\n"
+    f << "# Distance query against FCL\n\n"
+      << caliber::bench::machine_description() << "\n\n"
       << "caliber::query (QueryKind::distance, unbounded) against fcl::distance (BVHModel<OBBRSS>, rel_err = abs_err = 0, "
          "nearest points on); B turned, then moved along +x to start `gap` × A's box diagonal beyond A's box. Times: median of "
       << repeat << " rounds, each timing one caliber query then one FCL query"

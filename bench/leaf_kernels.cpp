@@ -291,10 +291,11 @@ void census() {
     }
     const double n = static_cast<double>(std::max<std::size_t>(s.pairs.size(), 1));
     const double nb = static_cast<double>(std::max<std::size_t>(batches, 1));
-    std::printf("%-10s %7zu pairs: edge pairs beaten %5.1f %% (all 8 of a batch %4.1f %%), corners beaten %5.1f %% (all 8 %4.1f %%)\n",
-                scene.c_str(), s.pairs.size(), 100.0 * static_cast<double>(edges) / (9.0 * n),
-                100.0 * static_cast<double>(edges8) / (9.0 * nb), 100.0 * static_cast<double>(corners) / (6.0 * n),
-                100.0 * static_cast<double>(corners8) / (6.0 * nb));
+    std::printf(
+        "%-10s %7zu pairs: edge pairs beaten %5.1f %% (all 8 of a batch %4.1f %%), corners beaten %5.1f %% (all 8 %4.1f %%)\n",
+        scene.c_str(), s.pairs.size(), 100.0 * static_cast<double>(edges) / (9.0 * n),
+        100.0 * static_cast<double>(edges8) / (9.0 * nb), 100.0 * static_cast<double>(corners) / (6.0 * n),
+        100.0 * static_cast<double>(corners8) / (6.0 * nb));
   }
 }
 

@@ -73,10 +73,10 @@ int main() {
   caliber::EngineOptions sequential;
   sequential.method = caliber::Method::sequential;
   const caliber::StepResult reference = caliber::Engine(sequential).step(frame);
-  const bool ok = after == before && threads <= 2 && greedy_threads <= 2 && !step.contacts.empty() &&
-                  same(step, reference) && same(greedy_step, reference) &&
+  const bool ok = after == before && threads <= 2 && greedy_threads <= 2 && !step.contacts.empty() && same(step, reference) &&
+                  same(greedy_step, reference) &&
                   tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) == 2;
-  std::printf("%zu contacts on %d and %d threads; process threads %zu before, %zu after: %s\n", step.contacts.size(),
-              threads, greedy_threads, before, after, ok ? "ok" : "FAILED");
+  std::printf("%zu contacts on %d and %d threads; process threads %zu before, %zu after: %s\n", step.contacts.size(), threads,
+              greedy_threads, before, after, ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
 }

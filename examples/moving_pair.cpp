@@ -43,9 +43,8 @@ int main(int argc, char** argv) {
       // B slides along x through A, turning slowly about z.
       const double t = k / 99.0;
       const double angle = 0.5 * t;
-      frame.poses = {caliber::Pose{},
-                     caliber::Pose::from_values((2.0 * t - 1.0) * size, 0.05 * size, 0.0, std::cos(angle / 2), 0.0, 0.0,
-                                                std::sin(angle / 2))};
+      frame.poses = {caliber::Pose{}, caliber::Pose::from_values((2.0 * t - 1.0) * size, 0.05 * size, 0.0, std::cos(angle / 2),
+                                                                 0.0, 0.0, std::sin(angle / 2))};
       const caliber::StepResult step = engine.step(frame);
       const caliber::QueryResult want =
           caliber::query(*frame.models[0], frame.poses[0], *frame.models[1], frame.poses[1], frame.request);

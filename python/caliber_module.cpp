@@ -29,8 +29,10 @@ struct PyModel {
 };
 
 caliber::Mesh mesh_from_arrays(const Vertices& vertices, const Faces& faces) {
-  if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices", "must be an n x 3 array");
-  if (faces.ndim() != 2 || faces.shape(1) != 3) throw caliber::Error(caliber::ErrorCode::bad_argument, "faces", "must be an m x 3 array");
+  if (vertices.ndim() != 2 || vertices.shape(1) != 3)
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices", "must be an n x 3 array");
+  if (faces.ndim() != 2 || faces.shape(1) != 3)
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "faces", "must be an m x 3 array");
   caliber::Mesh mesh;
   mesh.source = "arrays";
   const auto v = vertices.unchecked<2>();
@@ -85,13 +87,13 @@ caliber::QueryRequest make_request(const std::string& kind, std::optional<double
 
 /// A query's or a step's answer as numpy arrays (one row per reported triangle pair).
 struct PyResult {
-  py::array_t<std::uint32_t> objects;  ///< k x 2 object ids (steps only)
-  py::array_t<std::uint32_t> pairs;    ///< k x 2 triangle ids
+  py::array_t<std::uint32_t> objects;               ///< k x 2 object ids (steps only)
+  py::array_t<std::uint32_t> pairs;                 ///< k x 2 triangle ids
   py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
-  py::array_t<double> distances;       ///< k
-  py::array_t<double> depths;          ///< k: Contact::depth (intersecting pairs' penetration estimate)
+  py::array_t<double> distances;                    ///< k
+  py::array_t<double> depths;                       ///< k: Contact::depth (intersecting pairs' penetration estimate)
   std::uint64_t node_tests = 0, leaf_tests = 0;
-  bool limit_reached = false;          ///< more than max_pairs were found: a partial answer
+  bool limit_reached = false;  ///< more than max_pairs were found: a partial answer
 };
 
 PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const caliber::QueryStats& stats) {
@@ -143,7 +145,8 @@ caliber::Pose pose_from_matrix(const py::array& m) {
   // float32 matrices are rotations only to float32's rounding: they get that tolerance.
   const bool single = m.dtype().is(py::dtype::of<float>());
   const py::array_t<double, py::array::c_style | py::array::forcecast> d(m);
-  if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
+  if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4)
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
   const auto a = d.unchecked<2>();
   Eigen::Matrix4d matrix;
   for (int i = 0; i < 4; ++i) {
@@ -161,7 +164,8 @@ std::array<double, 4> quaternion_wxyz(const std::array<double, 4>& q, const std:
 }
 
 caliber::Frame make_frame(const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
-                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const caliber::QueryRequest& request) {
+                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs,
+                          const caliber::QueryRequest& request) {
   caliber::Frame frame;
   for (const PyModel& m : models) frame.models.push_back(m.model);
   frame.poses = poses;
@@ -186,8 +190,9 @@ PYBIND11_MODULE(caliber, m) {
 
   py::class_<caliber::Mesh>(m, "Mesh", "Vertices (n x 3 float64) and triangles (m x 3 int); triangle ids are row numbers.")
       .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("faces"))
-      .def_static("load", [](const std::string& path) { return caliber::load_mesh(path); }, py::arg("path"),
-                  "Reads .off, .ply, .obj or .stl (the extension chooses the reader).")
+      .def_static(
+          "load", [](const std::string& path) { return caliber::load_mesh(path); }, py::arg("path"),
+          "Reads .off, .ply, .obj or .stl (the extension chooses the reader).")
       .def_property_readonly("vertices", &vertices_of)
       .def_property_readonly("faces", &faces_of)
       .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); });
@@ -202,26 +207,31 @@ PYBIND11_MODULE(caliber, m) {
            }),
            py::arg("mesh"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false,
            "adjacency: for contact queries; oriented_boxes: kept per node (120 bytes each), for faster distance queries")
-      .def_static("load", [](const std::string& path, bool adjacency, bool oriented_boxes) {
-             caliber::Mesh mesh = caliber::load_mesh(path);
-             caliber::BuildOptions options;
-             options.adjacency = adjacency;
-             options.oriented_boxes = oriented_boxes;
-             py::gil_scoped_release release;
-             return PyModel{caliber::build_model(std::move(mesh), options)};
-           }, py::arg("path"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false)
+      .def_static(
+          "load",
+          [](const std::string& path, bool adjacency, bool oriented_boxes) {
+            caliber::Mesh mesh = caliber::load_mesh(path);
+            caliber::BuildOptions options;
+            options.adjacency = adjacency;
+            options.oriented_boxes = oriented_boxes;
+            py::gil_scoped_release release;
+            return PyModel{caliber::build_model(std::move(mesh), options)};
+          },
+          py::arg("path"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false)
       .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh; })
       .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh.triangles.size(); })
       .def_property_readonly("height", [](const PyModel& p) { return p.model->height; })
-      .def_property_readonly("oriented_boxes", [](const PyModel& p) { return !p.model->oriented_boxes.empty(); },
-                             "whether each node's oriented box is kept (for faster distance queries)")
+      .def_property_readonly(
+          "oriented_boxes", [](const PyModel& p) { return !p.model->oriented_boxes.empty(); },
+          "whether each node's oriented box is kept (for faster distance queries)")
       .def(py::pickle(
           [](const PyModel& p) {
             return py::make_tuple(vertices_of(p.model->mesh), faces_of(p.model->mesh), p.model->has_adjacency(),
                                   !p.model->oriented_boxes.empty());
           },
           [](const py::tuple& t) {
-            if (t.size() != 3 && t.size() != 4) throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
+            if (t.size() != 3 && t.size() != 4)
+              throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
             caliber::BuildOptions options;
             options.adjacency = t[2].cast<bool>();
             options.oriented_boxes = t.size() == 4 && t[3].cast<bool>();
@@ -237,24 +247,35 @@ PYBIND11_MODULE(caliber, m) {
            py::kw_only(), py::arg("order") = "wxyz",
            "translation (x, y, z), quaternion normalized, in `order`: 'wxyz' (the default, Eigen's) or 'xyzw' (scipy's "
            "Rotation.as_quat() and ROS's)")
-      .def_static("from_quaternion", [](std::array<double, 4> q, const std::string& order, std::array<double, 3> t) {
-             q = quaternion_wxyz(q, order);
-             return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3], "quaternion");
-           },
-           py::arg("quaternion"), py::arg("order"), py::arg("translation") = std::array<double, 3>{0, 0, 0},
-           "from a quaternion in an explicit order, 'wxyz' or 'xyzw' (scipy's and ROS's), and a translation")
+      .def_static(
+          "from_quaternion",
+          [](std::array<double, 4> q, const std::string& order, std::array<double, 3> t) {
+            q = quaternion_wxyz(q, order);
+            return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3], "quaternion");
+          },
+          py::arg("quaternion"), py::arg("order"), py::arg("translation") = std::array<double, 3>{0, 0, 0},
+          "from a quaternion in an explicit order, 'wxyz' or 'xyzw' (scipy's and ROS's), and a translation")
       .def_static("from_matrix", &pose_from_matrix, py::arg("matrix"),
                   "from a 4 x 4 rigid transform; its rotation must be orthonormal within 1e-9 (float64) or 1e-6 (float32)")
-      .def_property_readonly("translation", [](const caliber::Pose& p) { return std::array<double, 3>{p.translation.x(), p.translation.y(), p.translation.z()}; })
-      .def_property_readonly("quaternion", [](const caliber::Pose& p) {
-        return std::array<double, 4>{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
-      }, "the unit quaternion (w, x, y, z)")
-      .def("as_quaternion", [](const caliber::Pose& p, const std::string& order) {
-        const std::array<double, 4> q{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
-        if (order == "wxyz") return q;
-        if (order == "xyzw") return std::array<double, 4>{q[1], q[2], q[3], q[0]};
-        throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
-      }, py::arg("order"), "the unit quaternion in `order`, 'wxyz' or 'xyzw'")
+      .def_property_readonly("translation",
+                             [](const caliber::Pose& p) {
+                               return std::array<double, 3>{p.translation.x(), p.translation.y(), p.translation.z()};
+                             })
+      .def_property_readonly(
+          "quaternion",
+          [](const caliber::Pose& p) {
+            return std::array<double, 4>{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
+          },
+          "the unit quaternion (w, x, y, z)")
+      .def(
+          "as_quaternion",
+          [](const caliber::Pose& p, const std::string& order) {
+            const std::array<double, 4> q{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
+            if (order == "wxyz") return q;
+            if (order == "xyzw") return std::array<double, 4>{q[1], q[2], q[3], q[0]};
+            throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
+          },
+          py::arg("order"), "the unit quaternion in `order`, 'wxyz' or 'xyzw'")
       .def("matrix", [](const caliber::Pose& p) {
         py::array_t<double> out({py::ssize_t{4}, py::ssize_t{4}});
         auto o = out.mutable_unchecked<2>();
@@ -265,7 +286,8 @@ PYBIND11_MODULE(caliber, m) {
         return out;
       });
 
-  py::class_<PyResult>(m, "Result", "Reported triangle pairs, sorted, with points, normals and distances (zero for interference).")
+  py::class_<PyResult>(m, "Result",
+                       "Reported triangle pairs, sorted, with points, normals and distances (zero for interference).")
       .def_readonly("objects", &PyResult::objects, "k x 2 object ids (steps; 0 and 1 for a query)")
       .def_readonly("pairs", &PyResult::pairs, "k x 2 triangle ids")
       .def_readonly("points_a", &PyResult::points_a)
@@ -290,13 +312,14 @@ PYBIND11_MODULE(caliber, m) {
         }
         return query_result(q);
       },
-      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
-      py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference",
+      py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
       "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
       "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
       "limit_reached (1: any pair).");
 
-  py::class_<caliber::Engine>(m, "Engine", "The parallel engine: a method on the threads the process allows; keeps temporal state.")
+  py::class_<caliber::Engine>(m, "Engine",
+                              "The parallel engine: a method on the threads the process allows; keeps temporal state.")
       .def(py::init([](const std::string& method, int threads) {
              caliber::EngineOptions options;
              options.method = caliber::parse_method(method);
@@ -323,8 +346,8 @@ PYBIND11_MODULE(caliber, m) {
             r.limit_reached = s.limit_reached;
             return r;
           },
-          py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
-          py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
+          py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference",
+          py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
           "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair past that many "
           "triangle pairs and sets limit_reached (1: does each pair touch at all?).");
 
@@ -336,11 +359,12 @@ PYBIND11_MODULE(caliber, m) {
            }),
            py::arg("path"))
       .def_property_readonly("steps", [](const caliber::World& w) { return w.scene().steps; })
-      .def_property_readonly("objects", [](const caliber::World& w) {
-        std::vector<std::string> names;
-        for (const caliber::SceneObject& o : w.scene().objects) names.push_back(o.name);
-        return names;
-      })
+      .def_property_readonly("objects",
+                             [](const caliber::World& w) {
+                               std::vector<std::string> names;
+                               for (const caliber::SceneObject& o : w.scene().objects) names.push_back(o.name);
+                               return names;
+                             })
       .def(
           "step",
           [](const caliber::World& world, caliber::Engine& engine, int k) {

@@ -17,7 +17,7 @@ namespace {
 
 /// The colour of object i (the viewer's hues): distinct for neighbouring ids.
 void object_colour(std::size_t i, int rgb[3]) {
-  static constexpr int kPalette[8][3] = {{230, 159, 0}, {86, 180, 233}, {0, 158, 115}, {240, 228, 66},
+  static constexpr int kPalette[8][3] = {{230, 159, 0}, {86, 180, 233}, {0, 158, 115},   {240, 228, 66},
                                          {0, 114, 178}, {213, 94, 0},   {204, 121, 167}, {120, 120, 120}};
   for (int k = 0; k < 3; ++k) rgb[k] = kPalette[i % 8][k];
 }
@@ -38,7 +38,8 @@ void write_objects(const World& world, const std::vector<Pose>& poses, int k, co
   }
   out << "ply\nformat ascii 1.0\ncomment caliber: scene " << world.scene().name << ", step " << k
       << ", every object's mesh posed in the world frame; face property 'object' is the object id\n";
-  for (std::size_t i = 0; i < world.object_count(); ++i) out << "comment object " << i << " " << world.scene().objects[i].name << "\n";
+  for (std::size_t i = 0; i < world.object_count(); ++i)
+    out << "comment object " << i << " " << world.scene().objects[i].name << "\n";
   out << "element vertex " << vertices << "\nproperty double x\nproperty double y\nproperty double z\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       << "element face " << faces << "\nproperty list uchar uint vertex_indices\nproperty uint object\nend_header\n";
@@ -52,7 +53,8 @@ void write_objects(const World& world, const std::vector<Pose>& poses, int k, co
   }
   std::size_t base = 0;
   for (std::size_t i = 0; i < world.object_count(); ++i) {
-    for (const auto& t : world.model(i).mesh.triangles) out << "3 " << base + t[0] << ' ' << base + t[1] << ' ' << base + t[2] << ' ' << i << '\n';
+    for (const auto& t : world.model(i).mesh.triangles)
+      out << "3 " << base + t[0] << ' ' << base + t[1] << ' ' << base + t[2] << ' ' << i << '\n';
     base += world.model(i).mesh.vertices.size();
   }
   file.commit();
@@ -86,7 +88,8 @@ void write_contacts(const World& world, const StepResult& step, const std::vecto
     put(out, c.point + length * c.normal);
     out << '\n';
   }
-  for (std::size_t k = 0; k < contacts.size(); ++k) out << 2 * k << ' ' << 2 * k + 1 << ' ' << contacts[k].object_a << ' ' << contacts[k].object_b << '\n';
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    out << 2 * k << ' ' << 2 * k + 1 << ' ' << contacts[k].object_a << ' ' << contacts[k].object_b << '\n';
   file.commit();
 }
 
@@ -98,7 +101,8 @@ void write_bvh(const World& world, const std::vector<Pose>& poses, int k, int de
   };
   std::vector<Box> boxes;
   for (std::size_t i = 0; i < world.object_count(); ++i) {
-    for (const auto& [node, d] : nodes_to_depth(world.model(i), depth)) boxes.push_back({node_box(world.model(i), node, poses[i]), i, d});
+    for (const auto& [node, d] : nodes_to_depth(world.model(i), depth))
+      boxes.push_back({node_box(world.model(i), node, poses[i]), i, d});
   }
   OutputFile file(path, "--export");
   std::ostream& out = file.stream();
@@ -114,7 +118,8 @@ void write_bvh(const World& world, const std::vector<Pose>& poses, int k, int de
     }
   }
   for (std::size_t n = 0; n < boxes.size(); ++n) {
-    for (const auto& e : kBoxEdges) out << 8 * n + e[0] << ' ' << 8 * n + e[1] << ' ' << boxes[n].object << ' ' << boxes[n].depth << '\n';
+    for (const auto& e : kBoxEdges)
+      out << 8 * n + e[0] << ' ' << 8 * n + e[1] << ' ' << boxes[n].object << ' ' << boxes[n].depth << '\n';
   }
   file.commit();
 }
@@ -138,9 +143,7 @@ Exporter::Exporter(ExportOptions options, int scene_steps) : mOptions(std::move(
   if (ec) throw Error(ErrorCode::bad_value, mOptions.dir, "--export: cannot create the folder (" + ec.message() + ")");
 }
 
-bool Exporter::wants(int k) const {
-  return std::find(mOptions.steps.begin(), mOptions.steps.end(), k) != mOptions.steps.end();
-}
+bool Exporter::wants(int k) const { return std::find(mOptions.steps.begin(), mOptions.steps.end(), k) != mOptions.steps.end(); }
 
 namespace {
 std::string stem(const ExportOptions& options, int k) {

@@ -12,9 +12,9 @@
 namespace caliber::cli {
 
 struct ExportOptions {
-  std::string dir;             ///< the folder (created if missing); empty: no export
-  std::vector<int> steps{0};   ///< the steps to write
-  int bvh_depth = -1;          ///< write BVH boxes down to this depth (-1: none)
+  std::string dir;            ///< the folder (created if missing); empty: no export
+  std::vector<int> steps{0};  ///< the steps to write
+  int bvh_depth = -1;         ///< write BVH boxes down to this depth (-1: none)
 };
 
 /// The files an export will write (to check them against the run's inputs and other outputs).

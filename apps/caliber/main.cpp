@@ -22,10 +22,8 @@ int main(int argc, char** argv) {
   CLI::App app{"caliber: exact collision detection between rigid triangle meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("caliber ") + caliber::kVersion);
-  const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app),
-                                                      caliber::cli::add_run_command(app),
-                                                      caliber::cli::add_refine_command(app),
-                                                      caliber::cli::add_bench_command(app),
+  const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app), caliber::cli::add_run_command(app),
+                                                      caliber::cli::add_refine_command(app), caliber::cli::add_bench_command(app),
                                                       caliber::cli::add_view_command(app)};
   try {
     app.parse(argc, argv);

@@ -85,7 +85,7 @@ int run_query(const QueryOptions& opt) {
   const caliber::Method method = caliber::parse_method(opt.method);
   const auto build_start = Clock::now();
   caliber::BuildOptions build;
-  build.adjacency = request.kind == caliber::QueryKind::contact;  // only the contact reduction reads it
+  build.adjacency = request.kind == caliber::QueryKind::contact;        // only the contact reduction reads it
   build.oriented_boxes = request.kind == caliber::QueryKind::distance;  // only the distance bound reads them
   const auto model_of = [&](const std::string& path) {
     try {
@@ -161,15 +161,13 @@ int run_query(const QueryOptions& opt) {
   const char* what = request.kind == caliber::QueryKind::interference ? "intersecting triangle pairs"
                      : request.kind == caliber::QueryKind::proximity  ? "triangle pairs within the tolerance"
                      : request.kind == caliber::QueryKind::distance   ? "closest triangle pair"
-                                                                       : "contacts (local minima)";
+                                                                      : "contacts (local minima)";
   std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.pairs.size(), what);
-  std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh.triangles.size(),
-              shown_a.height);
-  std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh.triangles.size(),
-              shown_b.height);
+  std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh.triangles.size(), shown_a.height);
+  std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh.triangles.size(), shown_b.height);
   std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms",
-              static_cast<unsigned long long>(result.stats.node_tests),
-              static_cast<unsigned long long>(result.stats.leaf_tests), build_ms, cold_ms);
+              static_cast<unsigned long long>(result.stats.node_tests), static_cast<unsigned long long>(result.stats.leaf_tests),
+              build_ms, cold_ms);
   if (opt.repeat > 1) std::printf(" (first; median of the other %d: %.3f ms)", opt.repeat - 1, warm_ms);
   std::printf("\n");
   const std::size_t shown = std::min<std::size_t>(result.pairs.size(), static_cast<std::size_t>(std::max(opt.show, 0)));
@@ -193,7 +191,6 @@ int run_query(const QueryOptions& opt) {
 
 }  // namespace
 
-
 Runner add_query_command(CLI::App& app) {
   auto opt = std::make_shared<QueryOptions>();
   CLI::App* cmd = app.add_subcommand("query", "Query two meshes: interference, proximity, contact or distance");
@@ -214,7 +211,9 @@ Runner add_query_command(CLI::App& app) {
                   "sequential (default: caliber::query) or an engine method: exploitation, stealing, aposteriori, "
                   "apriori, hybrid (same pairs; build time then counted in query_ms)")
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Engine threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads,
+                  "Engine threads (0: every hardware thread the process may use; 1: this thread alone)")
+      ->capture_default_str();
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
       ->check(at_least(0))

@@ -48,27 +48,31 @@ nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x
 nlohmann::json step_record(const StepResult& s) {
   nlohmann::json tasks = nlohmann::json::array();
   for (const TaskRecord& t : s.tasks) {
-    tasks.push_back({{"a", t.task.a}, {"b", t.task.b}, {"node_tests", t.stats.node_tests},
-                     {"leaf_tests", t.stats.leaf_tests}, {"pairs", t.pairs}, {"limit_reached", t.limit_reached}});
+    tasks.push_back({{"a", t.task.a},
+                     {"b", t.task.b},
+                     {"node_tests", t.stats.node_tests},
+                     {"leaf_tests", t.stats.leaf_tests},
+                     {"pairs", t.pairs},
+                     {"limit_reached", t.limit_reached}});
   }
   const ScheduleRecord& c = s.schedule;
   nlohmann::json schedule = {{"omega", c.omega},
-                                {"kept", c.kept},
-                                {"split", c.split},
-                                {"carted", c.carted},
-                                {"generated", c.generated},
-                                {"stage_node_tests", c.stage_node_tests},
-                                {"stage_task_node_tests", c.stage_task_node_tests},
-                                {"split_node_tests", c.split_node_tests},
-                                {"queue_peak", c.queue_peak},
-                                {"task_node_tests", c.task_node_tests},
-                                {"thread_node_tests", c.thread_node_tests},
-                                {"taboo", c.taboo},
-                                {"taboo_unreached_node_tests", c.taboo_unreached_node_tests},
-                                {"calibrate_ms", c.calibrate_ms},
-                                {"traverse_ms", c.traverse_ms},
-                                {"finalize_ms", c.finalize_ms},
-                                {"task_weights", c.task_weights}};
+                             {"kept", c.kept},
+                             {"split", c.split},
+                             {"carted", c.carted},
+                             {"generated", c.generated},
+                             {"stage_node_tests", c.stage_node_tests},
+                             {"stage_task_node_tests", c.stage_task_node_tests},
+                             {"split_node_tests", c.split_node_tests},
+                             {"queue_peak", c.queue_peak},
+                             {"task_node_tests", c.task_node_tests},
+                             {"thread_node_tests", c.thread_node_tests},
+                             {"taboo", c.taboo},
+                             {"taboo_unreached_node_tests", c.taboo_unreached_node_tests},
+                             {"calibrate_ms", c.calibrate_ms},
+                             {"traverse_ms", c.traverse_ms},
+                             {"finalize_ms", c.finalize_ms},
+                             {"task_weights", c.task_weights}};
   return {{"step", s.step},
           {"time", s.time},
           {"schedule", schedule},
@@ -87,8 +91,12 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
   nlohmann::json list = nlohmann::json::array();
   const bool points = world.request().kind != QueryKind::interference;
   for (const SceneContact& c : s.contacts) {
-    nlohmann::json j = {{"object_a", c.object_a}, {"object_b", c.object_b}, {"name_a", world.scene().objects[c.object_a].name},
-                        {"name_b", world.scene().objects[c.object_b].name}, {"tri_a", c.contact.tri_a}, {"tri_b", c.contact.tri_b}};
+    nlohmann::json j = {{"object_a", c.object_a},
+                        {"object_b", c.object_b},
+                        {"name_a", world.scene().objects[c.object_a].name},
+                        {"name_b", world.scene().objects[c.object_b].name},
+                        {"tri_a", c.contact.tri_a},
+                        {"tri_b", c.contact.tri_b}};
     if (points) {
       j["point_a"] = vec(c.contact.point_a);
       j["point_b"] = vec(c.contact.point_b);
@@ -186,7 +194,8 @@ int run_scene(const RunOptions& opt) {
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
   const bool interrupted = gInterrupted.load();
-  if (interrupted) std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
+  if (interrupted)
+    std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
   if (contacts_out) contacts_out->commit();
 
   if (limited_steps > 0) {
@@ -229,7 +238,8 @@ int run_scene(const RunOptions& opt) {
         {"scene", sc.name},
         {"objects", objects},
         {"file", sc.file.string()},
-        {"query", {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}}},
+        {"query",
+         {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}}},
         {"dt", sc.dt},
         {"method", std::string(to_string(engine.options().method))},
         {"threads", engine.threads()},
@@ -264,7 +274,8 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("SCENE", opt->scene, "Scene file (JSON, see docs/scenes.md)")->required();
   cmd->add_option("--steps", opt->steps, "Run this many steps instead of the scene's")
       ->check(at_least(1));  // -1, the default, stands for the scene's steps: not a value to give
-  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")->capture_default_str();
+  cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")
+      ->capture_default_str();
   cmd->add_option("--beta", opt->beta, "Calibration: overthreading factor (Omega = total weight / (beta * threads))")
       ->capture_default_str();
   cmd->add_option("--epsilon", opt->epsilon, "Calibration: tolerance on Omega, as a fraction of Omega")->capture_default_str();
@@ -273,7 +284,8 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--simulate-cores", opt->simulate, "Virtual core counts for the load-balance simulation")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")
+      ->capture_default_str();
   cmd->add_option("--stealing-depth", opt->stealing_depth, "Stealing: CD-tree depth below which a subtree runs serially")
       ->capture_default_str();
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");

@@ -32,7 +32,8 @@ double RunStats::mean_tasks() const { return steps() ? double(mTasks) / double(s
 std::vector<std::pair<std::uint64_t, Task>> RunStats::ranked() const {
   std::vector<std::pair<std::uint64_t, Task>> r;
   for (const auto& [task, work] : mPairWork) r.emplace_back(work, task);
-  std::sort(r.begin(), r.end(), [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
+  std::sort(r.begin(), r.end(),
+            [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
   return r;
 }
 

@@ -32,8 +32,8 @@ struct ShownContact {
 /// An oriented box: a BVH node's box in its object's frame, posed.
 struct ShownBox {
   Eigen::Vector3d center;
-  Eigen::Vector3d half;      ///< half-extents along the axes
-  Eigen::Matrix3d axes;      ///< columns: the box's axes in the world frame
+  Eigen::Vector3d half;  ///< half-extents along the axes
+  Eigen::Matrix3d axes;  ///< columns: the box's axes in the world frame
 };
 
 /// The box of node `node` of `model`, posed.

@@ -63,8 +63,18 @@ nlohmann::json mesh_record(const Mesh& mesh) {
 /// Row-major rotation, then translation.
 nlohmann::json pose_record(const Pose& pose) {
   const Eigen::Matrix3d r = pose.rotation_matrix();
-  return {r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2),
-          pose.translation.x(), pose.translation.y(), pose.translation.z()};
+  return {r(0, 0),
+          r(0, 1),
+          r(0, 2),
+          r(1, 0),
+          r(1, 1),
+          r(1, 2),
+          r(2, 0),
+          r(2, 1),
+          r(2, 2),
+          pose.translation.x(),
+          pose.translation.y(),
+          pose.translation.z()};
 }
 
 /// The run-time tasks with the thread that ran each, their node tests and their roots' boxes (A's
@@ -105,7 +115,9 @@ nlohmann::json step_view(const World& world, const StepResult& s, const std::vec
   nlohmann::json pair_list = nlohmann::json::array();
   for (const TaskRecord& t : s.tasks) {
     const auto it = per_pair.find({t.task.a, t.task.b});
-    pair_list.push_back({{"a", t.task.a}, {"b", t.task.b}, {"node_tests", t.stats.node_tests},
+    pair_list.push_back({{"a", t.task.a},
+                         {"b", t.task.b},
+                         {"node_tests", t.stats.node_tests},
                          {"contacts", it == per_pair.end() ? 0 : it->second}});
   }
   nlohmann::json timeline = nlohmann::json::array();
@@ -113,12 +125,9 @@ nlohmann::json step_view(const World& world, const StepResult& s, const std::vec
     timeline.push_back({span.thread, span.start_ms, span.end_ms, static_cast<int>(span.phase), span.unit});
   }
   int budget = max_boxes;
-  return {{"step", s.step},
-          {"step_ms", s.broad_ms + s.narrow_ms + s.reduce_ms},
-          {"poses", pose_list},
-          {"contacts", {{"points", points}, {"normals", normals}, {"pairs", pairs}}},
-          {"pairs", pair_list},
-          {"tasks", task_records(world, s, budget)},
+  return {{"step", s.step},      {"step_ms", s.broad_ms + s.narrow_ms + s.reduce_ms},
+          {"poses", pose_list},  {"contacts", {{"points", points}, {"normals", normals}, {"pairs", pairs}}},
+          {"pairs", pair_list},  {"tasks", task_records(world, s, budget)},
           {"timeline", timeline}};
 }
 
@@ -200,7 +209,8 @@ Runner add_view_command(CLI::App& app) {
       ->check(at_least(1));  // -1, the default, stands for the scene's steps: not a value to give
   cmd->add_option("--method", opt->method, "sequential | exploitation | stealing | aposteriori | apriori | hybrid")
       ->capture_default_str();
-  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")->capture_default_str();
+  cmd->add_option("--threads", opt->threads, "Threads (0: every hardware thread the process may use; 1: this thread alone)")
+      ->capture_default_str();
   cmd->add_option("--max-boxes", opt->max_boxes, "Most task-root boxes drawn per step")->capture_default_str();
   return [cmd, opt]() { return cmd->parsed() ? view_scene(*opt) : -1; };
 }

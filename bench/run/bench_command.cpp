@@ -60,9 +60,9 @@ struct BenchOptions {
   bool figures = true;
   bool fcl = true;
   bool ceiling = true;
-  double budget_s = 0.0;   // 0: no budget
-  std::string log;         // the JSON-lines log (default: OUT/runs.jsonl)
-  std::string from_log;    // rebuild the report from this log instead of measuring
+  double budget_s = 0.0;  // 0: no budget
+  std::string log;        // the JSON-lines log (default: OUT/runs.jsonl)
+  std::string from_log;   // rebuild the report from this log instead of measuring
 };
 
 /// A method name as the bench knows it: the six methods, and "hybrid+history" (node history on).
@@ -258,7 +258,8 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
     ++b.done;
     if (b.progress.terminal() || k + 1 == sc.steps) {  // plain output: one line per run
       char line[200];
-      std::snprintf(line, sizeof line, "%s: round %d/%d, %s x%d, step %d", sc.name.c_str(), round + 1, b.opt.repeat, v.name.c_str(), t, k);
+      std::snprintf(line, sizeof line, "%s: round %d/%d, %s x%d, step %d", sc.name.c_str(), round + 1, b.opt.repeat,
+                    v.name.c_str(), t, k);
       b.progress.update(b.done, line);
     }
   }
@@ -279,17 +280,17 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
   }
   const double steps = sc.steps;
   return Json{{"kind", "run"},
-          {"scene", sc.name},
-          {"method", v.name},
-          {"threads", t},
-          {"round", round},
-          {"total_ms", total},
-          {"phases",
-           {{"broad_ms", broad / steps},
-            {"calibrate_ms", calibrate / steps},
-            {"traverse_ms", traverse / steps},
-            {"finalize_ms", finalize / steps},
-            {"balance_speedup", simulated.speedup()}}}};
+              {"scene", sc.name},
+              {"method", v.name},
+              {"threads", t},
+              {"round", round},
+              {"total_ms", total},
+              {"phases",
+               {{"broad_ms", broad / steps},
+                {"calibrate_ms", calibrate / steps},
+                {"traverse_ms", traverse / steps},
+                {"finalize_ms", finalize / steps},
+                {"balance_speedup", simulated.speedup()}}}};
 }
 
 /// The machine's own ceiling at `copies` threads: that many independent sequential copies of the
@@ -358,7 +359,8 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
     if (v.method == Method::sequential) continue;
     bool correlated = false;
     for (const int p : b.opt.simulate) {
-      if (!b.fits(sequential_s * steps / sc.steps, sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores")) return;
+      if (!b.fits(sequential_s * steps / sc.steps, sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores"))
+        return;
       // The cut made for P threads, run on one thread with its timeline: each piece timed
       // undisturbed (this machine may have fewer cores than P), replayed on P virtual cores both
       // by node tests and by measured time.
@@ -385,14 +387,20 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
           b.progress.update(b.done, line);
         }
       }
-      Json record = {{"kind", "simulation"}, {"scene", sc.name}, {"method", v.name}, {"cores", p}, {"speedup", simulated.speedup()},
-                     {"predicted_step_ms", simulated.predicted_ms()}, {"sequential_step_ms", sequential_ms}};
+      Json record = {{"kind", "simulation"},
+                     {"scene", sc.name},
+                     {"method", v.name},
+                     {"cores", p},
+                     {"speedup", simulated.speedup()},
+                     {"predicted_step_ms", simulated.predicted_ms()},
+                     {"sequential_step_ms", sequential_ms}};
       if (!estimated.empty() && (p == 8 || !correlated)) {
         // Keep at most 4000 points for the figure (evenly spaced); r uses all of them.
         Json points = Json::array();
         const std::size_t stride = std::max<std::size_t>(1, estimated.size() / 4000);
         for (std::size_t i = 0; i < estimated.size(); i += stride) points.push_back({estimated[i], effective[i]});
-        record["correlation"] = {{"cores", p}, {"pearson", pearson(estimated, effective)}, {"tasks", estimated.size()}, {"points", points}};
+        record["correlation"] = {
+            {"cores", p}, {"pearson", pearson(estimated, effective)}, {"tasks", estimated.size()}, {"points", points}};
         correlated = true;
       }
       b.log.add(record);
@@ -409,14 +417,16 @@ void bench_scene(BenchRun& b, std::size_t si) {
   const Scene& sc = world.scene();
   std::vector<Config> configs;
   for (const Variant& v : b.variants) {
-    for (const int t : v.method == Method::sequential ? std::vector<int>{1} : b.opt.threads) configs.push_back(Config{&v, t, 0.0});
+    for (const int t : v.method == Method::sequential ? std::vector<int>{1} : b.opt.threads)
+      configs.push_back(Config{&v, t, 0.0});
   }
   std::vector<std::uint64_t> reference;
   for (int r = 0; r < b.opt.repeat; ++r) {
     for (Config& c : configs) {
       // A configuration not run yet is estimated at sequential's time (one thread, no calibration).
       const double estimate = c.last_ms > 0 ? c.last_ms : configs.front().last_ms;
-      if (!b.fits(estimate / 1000.0, sc.name + " round " + std::to_string(r + 1) + " " + c.variant->name + " x" + std::to_string(c.threads))) {
+      if (!b.fits(estimate / 1000.0,
+                  sc.name + " round " + std::to_string(r + 1) + " " + c.variant->name + " x" + std::to_string(c.threads))) {
         return;
       }
       const std::optional<Json> record = measure_run(b, world, *c.variant, c.threads, r, reference);
@@ -461,7 +471,9 @@ void record_gantt(BenchRun& b) {
     Json spans = Json::array();
     for (const TaskSpan& span : s.schedule.timeline) {
       spans.push_back({span.thread, span.start_ms, span.end_ms,
-                       span.phase == TaskSpan::Phase::stage ? "stage" : span.phase == TaskSpan::Phase::traverse ? "traverse" : "finalize"});
+                       span.phase == TaskSpan::Phase::stage      ? "stage"
+                       : span.phase == TaskSpan::Phase::traverse ? "traverse"
+                                                                 : "finalize"});
     }
     gantt["methods"][name] = {{"narrow_ms", s.narrow_ms}, {"spans", spans}};
   }
@@ -472,13 +484,14 @@ void record_gantt(BenchRun& b) {
 std::string fcl_report(const BenchOptions& opt) {
   const auto fcl_program = program_dir() / "bench_fcl_compare";
   if (!opt.fcl) return "Not run: --no-fcl.\n";
-  if (!std::filesystem::exists(fcl_program)) return "Not run: bench_fcl_compare was not built (install libfcl-dev and rebuild).\n";
+  if (!std::filesystem::exists(fcl_program))
+    return "Not run: bench_fcl_compare was not built (install libfcl-dev and rebuild).\n";
   std::string scenes;
   for (const std::string& s : opt.scenes) scenes += (scenes.empty() ? "" : ",") + s;
   const auto fcl_md = std::filesystem::path(opt.out) / "fcl_compare.md";
   std::fprintf(stderr, "peer comparison: %s\n", fcl_program.c_str());
-  const int rc = run_command(quote(fcl_program.string()) + " --repeat " + std::to_string(opt.fcl_repeat) + " --scenes " + quote(scenes) +
-                             " --steps 0,50,100 --out " + quote(fcl_md.string()) + " > /dev/null");
+  const int rc = run_command(quote(fcl_program.string()) + " --repeat " + std::to_string(opt.fcl_repeat) + " --scenes " +
+                             quote(scenes) + " --steps 0,50,100 --out " + quote(fcl_md.string()) + " > /dev/null");
   if (rc != 0 || !std::filesystem::exists(fcl_md)) return "bench_fcl_compare failed (exit " + std::to_string(rc) + ").\n";
   std::ifstream in(fcl_md);
   std::stringstream ss;
@@ -500,7 +513,8 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
   std::string figures_note;
   if (figures) {
     std::filesystem::path script;
-    for (const auto& candidate : {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
+    for (const auto& candidate :
+         {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
       if (std::filesystem::exists(candidate)) {
         script = candidate;
         break;
@@ -539,7 +553,8 @@ int run_bench(BenchOptions opt) {
   if (!opt.from_log.empty()) return report_from_log(opt);
   const Budget budget(opt.budget_s);  // counts from here: loading the scenes is part of the run
   if (opt.scenes.empty()) {
-    for (const char* name : {"two_large", "two_small", "funnel", "front_car"}) opt.scenes.push_back(std::string("scenes/") + name + ".json");
+    for (const char* name : {"two_large", "two_small", "funnel", "front_car"})
+      opt.scenes.push_back(std::string("scenes/") + name + ".json");
     for (const std::string& s : opt.scenes) {
       if (!std::filesystem::exists(s)) {
         throw Error(ErrorCode::file_not_found, s, "no such file (run from the repository root, or name the scenes)");
@@ -562,11 +577,13 @@ int run_bench(BenchOptions opt) {
   std::vector<Variant> variants;
   for (const std::string& m : opt.methods) {
     Variant v = parse_variant(m);
-    if (std::none_of(variants.begin(), variants.end(), [&](const Variant& u) { return u.name == v.name; })) variants.push_back(std::move(v));
+    if (std::none_of(variants.begin(), variants.end(), [&](const Variant& u) { return u.name == v.name; }))
+      variants.push_back(std::move(v));
   }
   // Sequential first, exactly once: the reference for every speed-up and every contact check.
-  variants.erase(std::remove_if(variants.begin(), variants.end(), [](const Variant& v) { return v.method == Method::sequential; }),
-                 variants.end());
+  variants.erase(
+      std::remove_if(variants.begin(), variants.end(), [](const Variant& v) { return v.method == Method::sequential; }),
+      variants.end());
   variants.insert(variants.begin(), parse_variant("sequential"));
   // Every scene file parsed (and its meshes checked to exist) before anything is created on disk.
   std::vector<Scene> scenes;
@@ -579,7 +596,8 @@ int run_bench(BenchOptions opt) {
     throw Error(ErrorCode::bad_value, "--out", "'" + opt.out + "' exists and is not a folder");
   }
   std::filesystem::create_directories(opt.out);
-  const std::filesystem::path log_path = opt.log.empty() ? std::filesystem::path(opt.out) / "runs.jsonl" : std::filesystem::path(opt.log);
+  const std::filesystem::path log_path =
+      opt.log.empty() ? std::filesystem::path(opt.out) / "runs.jsonl" : std::filesystem::path(opt.log);
   BenchLog log(log_path);  // opened before the long work: an unwritable log fails now
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 
@@ -597,13 +615,15 @@ int run_bench(BenchOptions opt) {
       const std::size_t configs = v.method == Method::sequential ? 1 : opt.threads.size();
       runs_planned += static_cast<std::size_t>(opt.repeat) * configs;
       units += static_cast<std::size_t>(opt.repeat) * configs * static_cast<std::size_t>(w->scene().steps);
-      if (v.method != Method::sequential) units += opt.simulate.size() * static_cast<std::size_t>(simulated_steps(opt, w->scene()));
+      if (v.method != Method::sequential)
+        units += opt.simulate.size() * static_cast<std::size_t>(simulated_steps(opt, w->scene()));
     }
   }
   std::printf("caliber bench on %s\n%zu scene(s), %zu method(s), threads {", bench::machine_description().c_str(), worlds.size(),
               variants.size());
   for (std::size_t i = 0; i < opt.threads.size(); ++i) std::printf("%s%d", i ? ", " : "", opt.threads[i]);
-  std::printf("}, %d repeat(s); results in %s, each run logged to %s as it ends\n", opt.repeat, opt.out.c_str(), log_path.c_str());
+  std::printf("}, %d repeat(s); results in %s, each run logged to %s as it ends\n", opt.repeat, opt.out.c_str(),
+              log_path.c_str());
   std::fflush(stdout);
 
   Json header = {{"kind", "header"},
@@ -653,8 +673,11 @@ Runner add_bench_command(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--repeat", opt->repeat, "Runs per configuration; the median is reported")->capture_default_str();
   cmd->add_option("--steps", opt->steps, "Steps per run (default: the scene's)");
-  cmd->add_option("--simulate", opt->simulate, "Virtual core counts for the load-balance simulation")->delimiter(',')->capture_default_str();
-  cmd->add_option("--simulate-steps", opt->simulate_steps, "Steps replayed per simulated core count (0: all)")->capture_default_str();
+  cmd->add_option("--simulate", opt->simulate, "Virtual core counts for the load-balance simulation")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--simulate-steps", opt->simulate_steps, "Steps replayed per simulated core count (0: all)")
+      ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output folder (default: bench/results/<machine>/engine)");
   cmd->add_option("--fcl-repeat", opt->fcl_repeat, "Runs per FCL comparison")->capture_default_str();
   cmd->add_flag("!--no-figures", opt->figures, "Do not run scripts/plot_bench.py");
@@ -665,7 +688,8 @@ Runner add_bench_command(CLI::App& app) {
                   "Time budget in seconds: a run starts only if its estimated time still fits, and the report covers what ran "
                   "(0: none)")
       ->capture_default_str();
-  cmd->add_option("--log", opt->log, "JSON-lines log, one record per finished run, written as measured (default: OUT/runs.jsonl)");
+  cmd->add_option("--log", opt->log,
+                  "JSON-lines log, one record per finished run, written as measured (default: OUT/runs.jsonl)");
   cmd->add_option("--from-log", opt->from_log,
                   "Measure nothing: rebuild results.json, the figures and report.md from a bench log (a run cut short "
                   "included), into --out or the log's folder");

@@ -38,29 +38,47 @@ std::string record_problem(const Json& r, const Json* header) {
   const std::string kind = r["kind"].get<std::string>();
   std::vector<std::pair<const char*, bool (Json::*)() const>> fields;
   if (kind == "header") {
-    fields = {{"machine", &Json::is_string}, {"cpu", &Json::is_string}, {"hardware_threads", &Json::is_number_integer},
-              {"compiler", &Json::is_string}, {"repeat", &Json::is_number_integer}, {"threads", &Json::is_array},
-              {"simulate", &Json::is_array}, {"simulate_steps", &Json::is_number_integer}, {"methods", &Json::is_array},
-              {"scenes", &Json::is_array}, {"runs_planned", &Json::is_number_integer}};
+    fields = {{"machine", &Json::is_string},
+              {"cpu", &Json::is_string},
+              {"hardware_threads", &Json::is_number_integer},
+              {"compiler", &Json::is_string},
+              {"repeat", &Json::is_number_integer},
+              {"threads", &Json::is_array},
+              {"simulate", &Json::is_array},
+              {"simulate_steps", &Json::is_number_integer},
+              {"methods", &Json::is_array},
+              {"scenes", &Json::is_array},
+              {"runs_planned", &Json::is_number_integer}};
   } else if (kind == "run") {
-    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"threads", &Json::is_number_integer},
+    fields = {{"scene", &Json::is_string},         {"method", &Json::is_string},   {"threads", &Json::is_number_integer},
               {"round", &Json::is_number_integer}, {"total_ms", &Json::is_number}, {"phases", &Json::is_object}};
   } else if (kind == "table1") {
-    fields = {{"scene", &Json::is_string}, {"objects", &Json::is_number}, {"triangles", &Json::is_number},
-              {"node_tests_per_step", &Json::is_number}, {"contacts_per_step", &Json::is_number},
-              {"pairs_per_step", &Json::is_number}, {"candidate_pairs", &Json::is_number},
-              {"heaviest_pair_share", &Json::is_number}, {"second_pair_share", &Json::is_number},
+    fields = {{"scene", &Json::is_string},
+              {"objects", &Json::is_number},
+              {"triangles", &Json::is_number},
+              {"node_tests_per_step", &Json::is_number},
+              {"contacts_per_step", &Json::is_number},
+              {"pairs_per_step", &Json::is_number},
+              {"candidate_pairs", &Json::is_number},
+              {"heaviest_pair_share", &Json::is_number},
+              {"second_pair_share", &Json::is_number},
               {"exploitation_bound", &Json::is_number}};
   } else if (kind == "ceiling") {
     fields = {{"scene", &Json::is_string}, {"copies", &Json::is_number_integer}, {"copy_step_ms", &Json::is_array}};
   } else if (kind == "simulation") {
-    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"cores", &Json::is_number_integer},
+    fields = {{"scene", &Json::is_string},
+              {"method", &Json::is_string},
+              {"cores", &Json::is_number_integer},
               {"speedup", &Json::is_number}};
   } else if (kind == "mismatch") {
-    fields = {{"scene", &Json::is_string}, {"method", &Json::is_string}, {"threads", &Json::is_number_integer},
+    fields = {{"scene", &Json::is_string},
+              {"method", &Json::is_string},
+              {"threads", &Json::is_number_integer},
               {"step", &Json::is_number_integer}};
   } else if (kind == "gantt") {
-    fields = {{"scene", &Json::is_string}, {"threads", &Json::is_number_integer}, {"step", &Json::is_number_integer},
+    fields = {{"scene", &Json::is_string},
+              {"threads", &Json::is_number_integer},
+              {"step", &Json::is_number_integer},
               {"methods", &Json::is_object}};
   } else if (kind == "fcl") {
     fields = {{"report", &Json::is_string}};
@@ -153,8 +171,9 @@ struct SceneRecords {
   Json info;  ///< name, file, steps (from the header)
   Json table1;
   std::map<std::pair<std::string, int>, std::vector<Json>> runs;  ///< (method, threads) -> run records
-  std::map<std::string, Json> simulated, predicted, correlation;   ///< method -> {cores: speedup}, {cores: {ms, speedup}}, correlation
-  std::map<int, std::vector<double>> ceiling;                      ///< copies -> each copy's ms/step
+  std::map<std::string, Json> simulated, predicted,
+      correlation;                             ///< method -> {cores: speedup}, {cores: {ms, speedup}}, correlation
+  std::map<int, std::vector<double>> ceiling;  ///< copies -> each copy's ms/step
 };
 
 /// A configuration's entry: median step time, its runs in round order, the phases of the median
@@ -165,7 +184,9 @@ Json configuration(const std::vector<Json>& runs, int steps) {
   std::vector<std::size_t> order(totals.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return totals[x] < totals[y]; });
-  return {{"step_ms", median_of(totals) / steps}, {"runs_ms", totals}, {"phases_per_step", runs[order[(order.size() - 1) / 2]]["phases"]}};
+  return {{"step_ms", median_of(totals) / steps},
+          {"runs_ms", totals},
+          {"phases_per_step", runs[order[(order.size() - 1) / 2]]["phases"]}};
 }
 
 Json scene_results(const SceneRecords& s, const std::vector<std::string>& methods) {
@@ -203,9 +224,14 @@ Json results_from_records(const std::vector<Json>& records) {
     throw Error(ErrorCode::unreadable, "bench log", "no header record");
   }
   const Json& h = records.front();
-  Json results = {{"machine", h["machine"]}, {"cpu", h["cpu"]},         {"hardware_threads", h["hardware_threads"]},
-                  {"compiler", h["compiler"]}, {"repeat", h["repeat"]}, {"threads", h["threads"]},
-                  {"simulate", h["simulate"]}, {"simulate_steps", h["simulate_steps"]}};
+  Json results = {{"machine", h["machine"]},
+                  {"cpu", h["cpu"]},
+                  {"hardware_threads", h["hardware_threads"]},
+                  {"compiler", h["compiler"]},
+                  {"repeat", h["repeat"]},
+                  {"threads", h["threads"]},
+                  {"simulate", h["simulate"]},
+                  {"simulate_steps", h["simulate_steps"]}};
   const auto methods = h["methods"].get<std::vector<std::string>>();
   std::vector<SceneRecords> scenes;
   std::map<std::string, std::size_t> index;
@@ -240,9 +266,9 @@ Json results_from_records(const std::vector<Json>& records) {
       if (r.contains("predicted_step_ms") && r["predicted_step_ms"].is_number() && r["predicted_step_ms"].get<double>() > 0 &&
           r.contains("sequential_step_ms") && r["sequential_step_ms"].is_number()) {
         const double predicted = r["predicted_step_ms"].get<double>();
-        s.predicted[m][std::to_string(r["cores"].get<int>())] = {
-            {"step_ms", predicted}, {"sequential_step_ms", r["sequential_step_ms"]},
-            {"speedup", r["sequential_step_ms"].get<double>() / predicted}};
+        s.predicted[m][std::to_string(r["cores"].get<int>())] = {{"step_ms", predicted},
+                                                                 {"sequential_step_ms", r["sequential_step_ms"]},
+                                                                 {"speedup", r["sequential_step_ms"].get<double>() / predicted}};
       }
       if (r.contains("correlation")) s.correlation[m] = r["correlation"];
     } else if (kind == "mismatch") {

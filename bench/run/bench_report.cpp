@@ -43,7 +43,8 @@ std::vector<std::string> method_names(const Json& scene) {
   std::vector<std::string> names;
   for (const auto& [name, value] : scene["methods"].items()) names.push_back(name);
   // Keep the paper's order: sequential, exploitation, stealing, aposteriori, apriori, hybrid(+history).
-  const std::vector<std::string> order = {"sequential", "exploitation", "stealing", "aposteriori", "apriori", "hybrid", "hybrid+history"};
+  const std::vector<std::string> order = {"sequential", "exploitation", "stealing",      "aposteriori",
+                                          "apriori",    "hybrid",       "hybrid+history"};
   std::vector<std::string> sorted;
   for (const std::string& o : order) {
     if (std::find(names.begin(), names.end(), o) != names.end()) sorted.push_back(o);
@@ -88,18 +89,21 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   for (std::size_t i = 0; i < simulate.size(); ++i) out << (i ? ", " : "") << simulate[i];
   out << " are the **load-balance simulation** (node tests of the run-time tasks, cut for P threads, list-scheduled on P "
          "virtual cores; "
-      << (r["simulate_steps"].get<int>() > 0 ? "first " + std::to_string(r["simulate_steps"].get<int>()) + " steps" : std::string("every step"))
+      << (r["simulate_steps"].get<int>() > 0 ? "first " + std::to_string(r["simulate_steps"].get<int>()) + " steps"
+                                             : std::string("every step"))
       << "), not measurements.\n\n";
 
   out << "## Table 1: scenes\n\n| scene | objects | triangles | node tests / step | contacts / step | pairs / step | "
-         "candidate pairs | heaviest pair | second | exploitation bound | sequential ms / step |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "candidate pairs | heaviest pair | second | exploitation bound | sequential ms / step "
+         "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Json& s : r["scenes"]) {
     const Json& t = s["table1"];
     out << "| " << s["name"].get<std::string>() << " | " << t["objects"] << " | " << t["triangles"] << " | "
-        << num(t["node_tests_per_step"].get<double>(), "%.0f") << " | " << num(t["contacts_per_step"].get<double>(), "%.1f") << " | "
-        << num(t["pairs_per_step"].get<double>(), "%.1f") << " | " << t["candidate_pairs"] << " | "
-        << num(100 * t["heaviest_pair_share"].get<double>(), "%.1f") << " % | " << num(100 * t["second_pair_share"].get<double>(), "%.1f")
-        << " % | " << num(t["exploitation_bound"].get<double>()) << "x | " << num(s["sequential_step_ms"].get<double>()) << " |\n";
+        << num(t["node_tests_per_step"].get<double>(), "%.0f") << " | " << num(t["contacts_per_step"].get<double>(), "%.1f")
+        << " | " << num(t["pairs_per_step"].get<double>(), "%.1f") << " | " << t["candidate_pairs"] << " | "
+        << num(100 * t["heaviest_pair_share"].get<double>(), "%.1f") << " % | "
+        << num(100 * t["second_pair_share"].get<double>(), "%.1f") << " % | " << num(t["exploitation_bound"].get<double>())
+        << "x | " << num(s["sequential_step_ms"].get<double>()) << " |\n";
   }
 
   out << "\n## Table 2: time per step (ms) and speed-up over sequential\n\n| scene | method |";
@@ -122,7 +126,8 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   out << "\n## The machine's ceiling\n\nP independent sequential copies of the scene run at once (each its own world and "
          "engine, nothing shared): the ceiling is P x (one copy alone) / (each copy among P), what memory, shared caches and "
          "clock boost leave of P x before any scheduling. Measured, not simulated. Each method's speed-up is also given as a "
-         "fraction of it.\n\n| scene | P | one copy alone (ms/step) | each of P copies (median ms/step) | ceiling | best method at P "
+         "fraction of it.\n\n| scene | P | one copy alone (ms/step) | each of P copies (median ms/step) | ceiling | best method "
+         "at P "
          "| its speed-up | of the ceiling |\n|---|---|---|---|---|---|---|---|\n";
   for (const Json& s : r["scenes"]) {
     if (!s.contains("ceiling")) continue;
@@ -213,14 +218,15 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   }
 
   out << "\n## Estimated vs effective node tests per run-time task\n\n(Pearson r between the weight the calibration gave "
-         "each run-time task and the node tests it took; tasks cut for P = 8 threads when simulated.)\n\n| scene | method | r | tasks |\n|---|---|---|---|\n";
+         "each run-time task and the node tests it took; tasks cut for P = 8 threads when simulated.)\n\n| scene | method | r | "
+         "tasks |\n|---|---|---|---|\n";
   for (const Json& s : r["scenes"]) {
     for (const std::string& m : method_names(s)) {
       if (!s["methods"][m].contains("correlation")) continue;
       const Json& c = s["methods"][m]["correlation"];
       if (m != "apriori" && m != "hybrid" && m != "hybrid+history" && m != "aposteriori") continue;
-      out << "| " << s["name"].get<std::string>() << " | " << m << " | " << num(c["pearson"].get<double>(), "%.3f") << " | " << c["tasks"]
-          << " |\n";
+      out << "| " << s["name"].get<std::string>() << " | " << m << " | " << num(c["pearson"].get<double>(), "%.3f") << " | "
+          << c["tasks"] << " |\n";
     }
   }
 
@@ -230,8 +236,8 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
     for (const int t : threads) {
       const double c = phase_ms(s, "hybrid", t, "calibrate_ms");
       if (std::isnan(c)) continue;
-      out << "| " << s["name"].get<std::string>() << " | " << t << " | " << num(c) << " | " << num(phase_ms(s, "hybrid", t, "traverse_ms"))
-          << " | " << num(phase_ms(s, "hybrid", t, "finalize_ms")) << " |\n";
+      out << "| " << s["name"].get<std::string>() << " | " << t << " | " << num(c) << " | "
+          << num(phase_ms(s, "hybrid", t, "traverse_ms")) << " | " << num(phase_ms(s, "hybrid", t, "finalize_ms")) << " |\n";
     }
   }
 
@@ -257,8 +263,8 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
       const double f1 = phase_ms(s, "hybrid", 1, "finalize_ms"), f2 = phase_ms(s, "hybrid", 2, "finalize_ms");
       if (!std::isnan(c1) && c2 > 0 && f2 > 0) {
         out << ": depth-first part " << num(c1 / c2) << "x, finalization " << num(f1 / f2) << "x, calibration "
-            << num(phase_ms(s, "hybrid", 2, "calibrate_ms")) << " ms/step, broad phase " << num(phase_ms(s, "hybrid", 2, "broad_ms"))
-            << " ms/step (serial)";
+            << num(phase_ms(s, "hybrid", 2, "calibrate_ms")) << " ms/step, broad phase "
+            << num(phase_ms(s, "hybrid", 2, "broad_ms")) << " ms/step (serial)";
         const Json& phases = s["methods"]["hybrid"]["threads"]["2"]["phases_per_step"];
         if (phases.contains("balance_speedup")) {
           // What the cut allows: the run's tasks list-scheduled by node tests on 2 virtual cores.
@@ -268,7 +274,8 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
               << "the depth-first part reaches " << num(100.0 * (c1 / c2) / b, "%.0f") << " % of that";
         }
       }
-      out << "; runs spread over sequential " << spread("sequential", 1) << ", hybrid x2 " << spread("hybrid", 2) << " per step |\n";
+      out << "; runs spread over sequential " << spread("sequential", 1) << ", hybrid x2 " << spread("hybrid", 2)
+          << " per step |\n";
     }
     if (threads.front() == 1) {
       for (const char* m : {"apriori", "hybrid"}) {
@@ -277,15 +284,15 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
         // At one thread the method tests the same node pairs as sequential (conservation, tested);
         // what it adds is its calibration, and the rest is how the runs spread.
         out << "| " << m << " 1-thread overhead over sequential | " << name << " | " << num(over, "%+.1f") << " %: calibration "
-            << num(phase_ms(s, m, 1, "calibrate_ms")) << " ms/step; runs spread over sequential " << spread("sequential", 1) << ", "
-            << m << " x1 " << spread(m, 1) << " per step |\n";
+            << num(phase_ms(s, m, 1, "calibrate_ms")) << " ms/step; runs spread over sequential " << spread("sequential", 1)
+            << ", " << m << " x1 " << spread(m, 1) << " per step |\n";
       }
     }
     const double bound = s["table1"]["exploitation_bound"].get<double>();
     const double expl = seq / step_ms(s, "exploitation", max_t);
     if (!std::isnan(expl)) {
-      out << "| exploitation at " << max_t << " threads (its bound: " << num(bound) << "x) | " << name << " | " << num(expl) << "x, "
-          << num(100.0 * expl / std::min<double>(bound, max_t), "%.0f") << " % of min(bound, threads) |\n";
+      out << "| exploitation at " << max_t << " threads (its bound: " << num(bound) << "x) | " << name << " | " << num(expl)
+          << "x, " << num(100.0 * expl / std::min<double>(bound, max_t), "%.0f") << " % of min(bound, threads) |\n";
     }
     // Hybrid against work stealing, where 8 or 16 threads were measured.
     for (const int t : {8, 16}) {
@@ -309,10 +316,11 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
         }
       }
       const double ceiling = s["ceiling"][std::to_string(max_t)]["ceiling_speedup"].get<double>();
-      const std::string measured =
-          std::isnan(best) ? std::string("not measured") : best_method + " " + num(best) + "x, " + num(100.0 * best / ceiling, "%.0f") + " % of it";
-      out << "| best method at " << max_t << " threads (the machine's ceiling: " << num(ceiling) << "x) | " << name << " | " << measured
-          << " |\n";
+      const std::string measured = std::isnan(best)
+                                       ? std::string("not measured")
+                                       : best_method + " " + num(best) + "x, " + num(100.0 * best / ceiling, "%.0f") + " % of it";
+      out << "| best method at " << max_t << " threads (the machine's ceiling: " << num(ceiling) << "x) | " << name << " | "
+          << measured << " |\n";
     }
     if (s["methods"].contains("hybrid") && s["methods"]["hybrid"].contains("simulated_speedup") &&
         s["methods"]["hybrid"]["simulated_speedup"].contains("8")) {
@@ -323,11 +331,12 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
         s["methods"]["apriori"].contains("correlation")) {
       const double h = s["methods"]["hybrid"]["correlation"]["pearson"].get<double>();
       const double a = s["methods"]["apriori"]["correlation"]["pearson"].get<double>();
-      out << "| estimate against effective node tests, Pearson r: hybrid vs apriori | " << name << " | r = " << num(h, "%.3f") << " vs "
-          << num(a, "%.3f");
+      out << "| estimate against effective node tests, Pearson r: hybrid vs apriori | " << name << " | r = " << num(h, "%.3f")
+          << " vs " << num(a, "%.3f");
       if (s["methods"].contains("hybrid+history") && s["methods"]["hybrid+history"].contains("correlation")) {
         // The variant that weighs nodes by last step's node tests (not in the paper), for comparison.
-        out << " (hybrid+history: r = " << num(s["methods"]["hybrid+history"]["correlation"]["pearson"].get<double>(), "%.3f") << ")";
+        out << " (hybrid+history: r = " << num(s["methods"]["hybrid+history"]["correlation"]["pearson"].get<double>(), "%.3f")
+            << ")";
       }
       out << " |\n";
     }

@@ -34,9 +34,9 @@ struct SceneContact {
 
 /// The work and result of one task in one step.
 struct TaskRecord {
-  Task task;              ///< the object pair
-  QueryStats stats;       ///< node and leaf tests
-  std::size_t pairs = 0;  ///< triangle pairs reported
+  Task task;                   ///< the object pair
+  QueryStats stats;            ///< node and leaf tests
+  std::size_t pairs = 0;       ///< triangle pairs reported
   bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `pairs` is partial
   /// Triangle pairs the traversals kept, before the contact reduction and max_pairs: what the
   /// pair's finalization worked on.
@@ -69,13 +69,13 @@ struct TaskRoot {
 /// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
 /// that do not calibrate; `task_node_tests` is filled by every engine method.
 struct ScheduleRecord {
-  double omega = 0.0;                          ///< the caliber Omega (in weight units)
-  std::size_t kept = 0;                        ///< initial tasks run as they are
-  std::size_t split = 0;                       ///< initial tasks split by the weight-driven stage
-  std::size_t carted = 0;                      ///< items merged in the cart (light tasks and light nodes)
-  std::size_t generated = 0;                   ///< run-time tasks
-  std::uint64_t stage_node_tests = 0;          ///< node tests made in the weight-driven stage
-  std::size_t queue_peak = 0;                  ///< widest level of the weight-driven stage (nodes waiting at once)
+  double omega = 0.0;                                ///< the caliber Omega (in weight units)
+  std::size_t kept = 0;                              ///< initial tasks run as they are
+  std::size_t split = 0;                             ///< initial tasks split by the weight-driven stage
+  std::size_t carted = 0;                            ///< items merged in the cart (light tasks and light nodes)
+  std::size_t generated = 0;                         ///< run-time tasks
+  std::uint64_t stage_node_tests = 0;                ///< node tests made in the weight-driven stage
+  std::size_t queue_peak = 0;                        ///< widest level of the weight-driven stage (nodes waiting at once)
   std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
   /// The weight-driven stage level by level: for each level of each split task (the split tasks in
   /// the order of stage_task_node_tests, each one's levels from the root down), the node tests of
@@ -89,9 +89,9 @@ struct ScheduleRecord {
   /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
   /// cut-off and the single node tests above it (stealing). The load-balance simulation replays them.
   std::vector<std::uint64_t> task_node_tests;
-  std::vector<double> task_weights;            ///< estimated weight of each run-time task (calibrated methods)
-  std::uint64_t split_node_tests = 0;          ///< stealing: node tests made above the cut-off, while splitting
-  std::size_t taboo = 0;                       ///< a posteriori: taboo nodes (sub-task roots) handed out
+  std::vector<double> task_weights;    ///< estimated weight of each run-time task (calibrated methods)
+  std::uint64_t split_node_tests = 0;  ///< stealing: node tests made above the cut-off, while splitting
+  std::size_t taboo = 0;               ///< a posteriori: taboo nodes (sub-task roots) handed out
   /// A posteriori: node tests of sub-tasks whose root the original task never reached (an ancestor
   /// was pruned at this step): work the sequential traversal does not do. The other node tests add
   /// up to sequential's exactly.
@@ -112,16 +112,16 @@ struct ScheduleRecord {
 
 /// Everything one step produced.
 struct StepResult {
-  int step = 0;                         ///< step index
-  double time = 0.0;                    ///< simulated time (step * dt)
-  double broad_ms = 0.0;                ///< broad-phase wall time
-  double narrow_ms = 0.0;               ///< narrow-phase wall time (all tasks)
-  double reduce_ms = 0.0;               ///< gathering and sorting the contacts
-  std::vector<TaskRecord> tasks;        ///< one per initial task, in task order
-  std::vector<SceneContact> contacts;   ///< sorted by (object a, object b, tri a, tri b)
-  QueryStats stats;                     ///< totals over the tasks
-  ScheduleRecord schedule;              ///< how the work was cut and scheduled
-  bool limit_reached = false;           ///< some pair reached QueryRequest::max_pairs (its contacts are partial)
+  int step = 0;                        ///< step index
+  double time = 0.0;                   ///< simulated time (step * dt)
+  double broad_ms = 0.0;               ///< broad-phase wall time
+  double narrow_ms = 0.0;              ///< narrow-phase wall time (all tasks)
+  double reduce_ms = 0.0;              ///< gathering and sorting the contacts
+  std::vector<TaskRecord> tasks;       ///< one per initial task, in task order
+  std::vector<SceneContact> contacts;  ///< sorted by (object a, object b, tri a, tri b)
+  QueryStats stats;                    ///< totals over the tasks
+  ScheduleRecord schedule;             ///< how the work was cut and scheduled
+  bool limit_reached = false;          ///< some pair reached QueryRequest::max_pairs (its contacts are partial)
 };
 
 /// One moment of a set of rigid objects, as the engine takes it: whatever produced it (a scene's
@@ -140,7 +140,6 @@ struct Frame {
   /// outlive the step.
   QueryRequest request;
 };
-
 
 /// How a step's narrow phase is cut and scheduled.
 enum class Method : std::uint8_t {

@@ -10,13 +10,13 @@ namespace caliber {
 
 /// What kind of bad input an Error reports.
 enum class ErrorCode {
-  file_not_found,   ///< the path does not exist or is not a regular file
-  unreadable,       ///< the file exists but could not be read or parsed
-  bad_value,        ///< a value is out of range or not finite (coordinate, pose, option)
-  bad_index,        ///< a face refers to a vertex that does not exist
-  empty_mesh,       ///< the input holds no triangle at all
-  bad_argument,     ///< an API argument is invalid (for example a null model)
-  out_of_memory,    ///< the input needs more memory than there is (the message says what was being done)
+  file_not_found,  ///< the path does not exist or is not a regular file
+  unreadable,      ///< the file exists but could not be read or parsed
+  bad_value,       ///< a value is out of range or not finite (coordinate, pose, option)
+  bad_index,       ///< a face refers to a vertex that does not exist
+  empty_mesh,      ///< the input holds no triangle at all
+  bad_argument,    ///< an API argument is invalid (for example a null model)
+  out_of_memory,   ///< the input needs more memory than there is (the message says what was being done)
 };
 
 /// Thrown for every bad input: missing or malformed files, non-finite values, bad options.
@@ -26,9 +26,7 @@ class CALIBER_EXPORT Error : public std::runtime_error {
  public:
   /// `source` names where the problem is (a file path, an option name); may be empty.
   Error(ErrorCode code, std::string source, const std::string& problem)
-      : std::runtime_error(source.empty() ? problem : source + ": " + problem),
-        mCode(code),
-        mSource(std::move(source)) {}
+      : std::runtime_error(source.empty() ? problem : source + ": " + problem), mCode(code), mSource(std::move(source)) {}
 
   /// The kind of problem.
   [[nodiscard]] ErrorCode code() const noexcept { return mCode; }

@@ -23,7 +23,7 @@ struct Pose {
   /// Throws caliber::Error (bad_value) if a value is not finite or the quaternion is (nearly) zero;
   /// otherwise the quaternion is normalized. `source` names the input in the message.
   CALIBER_EXPORT static Pose from_values(double tx, double ty, double tz, double qw, double qx, double qy, double qz,
-                          std::string_view source = "pose");
+                                         std::string_view source = "pose");
 
   /// Builds a pose from a 4 x 4 rigid transform [R t; 0 0 0 1]: R must be a rotation within
   /// `tolerance` (|R R^T - I| and |det R - 1| at most that; 1e-9 suits doubles, 1e-6 a matrix
@@ -54,7 +54,8 @@ struct Pose {
 /// ([1e200, 0, 0, 1e200] is [1, 0, 0, 1]). Throws caliber::Error (bad_value) naming `source` when a
 /// value is not finite or the quaternion is (nearly) zero: no component above 1e-9. The one
 /// normalization of the CLI and scene files.
-[[nodiscard]] CALIBER_EXPORT Eigen::Quaterniond unit_quaternion(double w, double x, double y, double z, std::string_view source = "quaternion");
+[[nodiscard]] CALIBER_EXPORT Eigen::Quaterniond unit_quaternion(double w, double x, double y, double z,
+                                                                std::string_view source = "quaternion");
 
 /// Parses "tx ty tz qw qx qy qz" (spaces or commas). Throws caliber::Error naming `source`
 /// when the text does not hold exactly seven finite numbers or the quaternion is zero.

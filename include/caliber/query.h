@@ -84,12 +84,12 @@ struct TrianglePair {
 
 /// One reported contact (proximity and contact queries), in world coordinates.
 struct Contact {
-  std::uint32_t tri_a = 0;             ///< triangle id in model A
-  std::uint32_t tri_b = 0;             ///< triangle id in model B
-  Eigen::Vector3d point_a;             ///< closest point on triangle A
-  Eigen::Vector3d point_b;             ///< closest point on triangle B
-  Eigen::Vector3d normal;              ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
-  double distance = 0.0;               ///< triangle distance; exactly 0 when the triangles intersect
+  std::uint32_t tri_a = 0;  ///< triangle id in model A
+  std::uint32_t tri_b = 0;  ///< triangle id in model B
+  Eigen::Vector3d point_a;  ///< closest point on triangle A
+  Eigen::Vector3d point_b;  ///< closest point on triangle B
+  Eigen::Vector3d normal;   ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
+  double distance = 0.0;    ///< triangle distance; exactly 0 when the triangles intersect
   /// Intersecting pairs (distance 0) with a normal: a penetration estimate, local to the pair: how
   /// far B's deepest vertex lies behind the plane through A's closest point, along the normal (the
   /// translation of B along the normal that takes that triangle's vertices out of A's half-space).
@@ -131,10 +131,10 @@ struct QueryResult {
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
 /// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.
 [[nodiscard]] CALIBER_EXPORT QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
-                                const QueryRequest& request);
+                                               const QueryRequest& request);
 
 /// The O(n*m) oracle: runs the leaf test on every triangle pair. For tests.
-[[nodiscard]] CALIBER_EXPORT QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b,
-                                            const Pose& pose_b, const QueryRequest& request);
+[[nodiscard]] CALIBER_EXPORT QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+                                                           const QueryRequest& request);
 
 }  // namespace caliber

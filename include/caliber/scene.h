@@ -19,8 +19,8 @@ namespace caliber {
 
 /// A pose at a given time, for keyframed motion.
 struct Keyframe {
-  double time = 0.0;                                               ///< seconds
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();              ///< translation at that time
+  double time = 0.0;                                                ///< seconds
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               ///< translation at that time
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< unit quaternion at that time
 };
 
@@ -51,14 +51,14 @@ struct GroupRange {
 
 /// One object of a scene.
 struct SceneObject {
-  std::string name;                 ///< unique name (defaults to "object<i>")
-  std::filesystem::path mesh;       ///< mesh file (made absolute relative to the scene file)
-  double scale = 1.0;               ///< uniform scale applied to the mesh
-  int refine = 0;                   ///< 1-to-4 subdivision levels applied after loading (0..6)
-  Pose pose;                        ///< pose at time 0
-  Motion motion;                    ///< how it moves
-  std::uint8_t group = 0;           ///< group of every triangle not in `groups`
-  std::vector<GroupRange> groups;   ///< triangle ranges in other groups
+  std::string name;                ///< unique name (defaults to "object<i>")
+  std::filesystem::path mesh;      ///< mesh file (made absolute relative to the scene file)
+  double scale = 1.0;              ///< uniform scale applied to the mesh
+  int refine = 0;                  ///< 1-to-4 subdivision levels applied after loading (0..6)
+  Pose pose;                       ///< pose at time 0
+  Motion motion;                   ///< how it moves
+  std::uint8_t group = 0;          ///< group of every triangle not in `groups`
+  std::vector<GroupRange> groups;  ///< triangle ranges in other groups
 };
 
 /// A whole scene: objects, the query every pair runs, and the time steps.
@@ -81,6 +81,6 @@ struct Scene {
 
 /// Parses scene JSON text; mesh paths are relative to `base_dir`. `source` names it in errors.
 [[nodiscard]] CALIBER_EXPORT Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir,
-                                const std::string& source);
+                                               const std::string& source);
 
 }  // namespace caliber

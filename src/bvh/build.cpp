@@ -22,14 +22,14 @@ namespace caliber {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using util::round_down;
-using util::round_up;
 using bvh::split_binned;
 using bvh::split_items;
 using bvh::split_turn;
 using bvh::triangle_turn;
 using bvh::turned_axes;
 using bvh::unturned_axes;
+using util::round_down;
+using util::round_up;
 
 /// Nodes with at most this many triangles get the exact covering radius (a pass over their vertices);
 /// larger ones bound it from their children's spheres.
@@ -37,27 +37,24 @@ constexpr std::uint32_t kExactRadiusCount = 256;
 /// Added to every cone half-angle: covers rounding in the angles and in the rotated normals.
 constexpr double kConeSlack = 1e-6;
 
-double angle_between(const Vec3& u, const Vec3& v) {
-  return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
-}
+double angle_between(const Vec3& u, const Vec3& v) { return std::acos(std::clamp(u.dot(v), -1.0, 1.0)); }
 
 Vec3 to_float_axis(const Vec3& axis) {
   Vec3 rounded(static_cast<float>(axis.x()), static_cast<float>(axis.y()), static_cast<float>(axis.z()));
   return rounded;
 }
 
-
 /// A node while it is built, in double precision; converted to BvhNode / BvhNodeFilter at the end.
 struct WorkNode {
   Vec3 center = Vec3::Zero();
   double radius = 0.0;
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  ///< box of the vertices below
-  Vec3 normal_sum = Vec3::Zero();             ///< sum of the unit normals below (cone axis direction)
-  Vec3 axis = Vec3::Zero();                   ///< cone axis, already rounded to float
-  double cone = -1.0;    ///< cone half-angle about `axis`, < 0 when no normal below
-  double slab_lo = 0.0, slab_hi = 0.0;  ///< range of axis . v over the vertices below (0, 0: no axis)
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();                      ///< box of the vertices below
+  Vec3 normal_sum = Vec3::Zero();                                 ///< sum of the unit normals below (cone axis direction)
+  Vec3 axis = Vec3::Zero();                                       ///< cone axis, already rounded to float
+  double cone = -1.0;                                             ///< cone half-angle about `axis`, < 0 when no normal below
+  double slab_lo = 0.0, slab_hi = 0.0;                            ///< range of axis . v over the vertices below (0, 0: no axis)
   double lateral_lo[2] = {0.0, 0.0}, lateral_hi[2] = {0.0, 0.0};  ///< ranges along the turned lateral axes
-  double turn[2] = {1.0, 0.0};                ///< the lateral axes' turn, the stored integers
+  double turn[2] = {1.0, 0.0};                                    ///< the lateral axes' turn, the stored integers
   std::uint64_t groups = 0;
   std::uint32_t index = 0;
   std::uint32_t count = 0;
@@ -210,8 +207,8 @@ class Builder {
       if (!candidates[i].allFinite()) continue;
       // The largest of the three norms: one square root of the largest square (sqrt is monotone
       // and correctly rounded, as norm() takes it).
-      const double r = std::sqrt(std::max({(a - candidates[i]).squaredNorm(), (b - candidates[i]).squaredNorm(),
-                                           (c - candidates[i]).squaredNorm()}));
+      const double r = std::sqrt(
+          std::max({(a - candidates[i]).squaredNorm(), (b - candidates[i]).squaredNorm(), (c - candidates[i]).squaredNorm()}));
       if (r < node.radius) {
         node.radius = r;
         node.center = candidates[i];
@@ -347,7 +344,7 @@ class Builder {
   const std::vector<Vec3>& mNormals;
   std::vector<std::uint32_t> mOrder;
   std::vector<bvh::SplitItem> mItems;  ///< what the split reads of triangle mOrder[i], in mItems[i]
-  std::unique_ptr<WorkSlot[]> mWork;  ///< node i in mWork[i].node, once made
+  std::unique_ptr<WorkSlot[]> mWork;   ///< node i in mWork[i].node, once made
   std::size_t mWorkCount = 0;
 };
 
@@ -366,7 +363,8 @@ std::shared_ptr<Model> build_on_this_thread(Mesh mesh, const BuildOptions& optio
     for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].squaredNorm());
   }
   model->extent = std::sqrt(extent);  // sqrt is monotone and correctly rounded: the largest norm
-  if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
+  if (options.adjacency)
+    bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);
   return model;
 }

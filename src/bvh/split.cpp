@@ -43,10 +43,18 @@ template <class Op>
 inline F4 each(F4 a, F4 b, Op op) {
   return {{op(a.v[0], b.v[0]), op(a.v[1], b.v[1]), op(a.v[2], b.v[2]), op(a.v[3], b.v[3])}};
 }
-inline F4 lane_min(F4 a, F4 b) { return each(a, b, [](float x, float y) { return x < y ? x : y; }); }
-inline F4 lane_max(F4 a, F4 b) { return each(a, b, [](float x, float y) { return x > y ? x : y; }); }
-inline F4 sub(F4 a, F4 b) { return each(a, b, [](float x, float y) { return x - y; }); }
-inline F4 mul(F4 a, F4 b) { return each(a, b, [](float x, float y) { return x * y; }); }
+inline F4 lane_min(F4 a, F4 b) {
+  return each(a, b, [](float x, float y) { return x < y ? x : y; });
+}
+inline F4 lane_max(F4 a, F4 b) {
+  return each(a, b, [](float x, float y) { return x > y ? x : y; });
+}
+inline F4 sub(F4 a, F4 b) {
+  return each(a, b, [](float x, float y) { return x - y; });
+}
+inline F4 mul(F4 a, F4 b) {
+  return each(a, b, [](float x, float y) { return x * y; });
+}
 inline void truncate(F4 a, std::int32_t out[4]) {
   for (int k = 0; k < 4; ++k) out[k] = static_cast<std::int32_t>(a.v[k]);
 }
@@ -137,8 +145,8 @@ std::uint32_t split_at_median(std::span<std::uint32_t> order, std::span<SplitIte
 /// partition: the same result for the same input) and returns how many, with the boxes of the
 /// two parts' centroids grown as the items are placed.
 template <class First>
-std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first,
-                             CentroidBounds& front, CentroidBounds& back) {
+std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first, CentroidBounds& front,
+                             CentroidBounds& back) {
   std::size_t lo = 0, hi = order.size();
   for (;;) {
     while (lo < hi && first(items[lo])) grow(front, items[lo++]);

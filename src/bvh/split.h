@@ -51,7 +51,7 @@ inline constexpr std::uint32_t kSplitBalance = 16;
 /// per axis that minimizes the surface-area cost (each side's box area times its count), of those
 /// that leave each side at least 1/kSplitBalance; where none does, the median along the
 /// centroids' longest axis (ties by id).
-[[nodiscard]] std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items,
-                                         const CentroidBounds& bounds, CentroidBounds& first, CentroidBounds& second);
+[[nodiscard]] std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items, const CentroidBounds& bounds,
+                                         CentroidBounds& first, CentroidBounds& second);
 
 }  // namespace caliber::bvh

@@ -21,14 +21,16 @@ using namespace lanes8;
 
 #define CALIBER_AVX512 __attribute__((target("avx512f")))
 
-CALIBER_AVX512 inline D abs(D u) { return _mm512_castsi512_pd(_mm512_andnot_si512(_mm512_set1_epi64(INT64_MIN), _mm512_castpd_si512(u))); }
+CALIBER_AVX512 inline D abs(D u) {
+  return _mm512_castsi512_pd(_mm512_andnot_si512(_mm512_set1_epi64(INT64_MIN), _mm512_castpd_si512(u)));
+}
 /// kernel::one_norm: (|x| + |y|) + |z|.
 CALIBER_AVX512 inline D one_norm(const P3& w) { return add(add(abs(w.x), abs(w.y)), abs(w.z)); }
 
 /// kernel::beyond_plane of q's corners against the plane of p, per lane.
 CALIBER_AVX512 M beyond_plane(const Triangle8& p, const Triangle8& q, D reach) {
   const D len = _mm512_sqrt_pd(p.normal2);
-  const D base = mul(mul(reach, len), all_lanes(1.0 + 1e-12));                 // plane_need
+  const D base = mul(mul(reach, len), all_lanes(1.0 + 1e-12));               // plane_need
   const D slack = mul(all_lanes(1e-13), _mm512_sqrt_pd(mul(p.ab2, p.ac2)));  // plane_slack
   M above = 0xFF, below = 0xFF;
   for (int i = 0; i < 3; ++i) {
@@ -61,7 +63,8 @@ CALIBER_AVX512 M edges_apart(const Triangle8& a, const Triangle8& b, D reach) {
       const M candidates = gt(len2, all_lanes(kernel::kAxisLength2Floor)) & gt(gap, zero) & le(gap, all_lanes(DBL_MAX));
       if (candidates == 0) continue;  // need >= 1e-300 > 0: no lane passes
       const D len = _mm512_sqrt_pd(len2);
-      const D need = add(mul(mul(reach, len), all_lanes(1.0 + 1e-12)), add(mul(mul(all_lanes(1e-13), len), scale), all_lanes(1e-300)));
+      const D need =
+          add(mul(mul(reach, len), all_lanes(1.0 + 1e-12)), add(mul(mul(all_lanes(1e-13), len), scale), all_lanes(1e-300)));
       apart |= candidates & gt(gap, need);
     }
   }

@@ -148,8 +148,7 @@ struct EdgeVectors {
 
 /// The last candidates of the triangle kernel, in its order. Intersecting triangles: an edge of one
 /// pierces the other; its crossing point is a candidate.
-void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb,
-                        Nearest& nearest) {
+void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
   Vec3 x;
   for (int i = 0; i < 3; ++i) {
     if (crossing_point(a[i], a[(i + 1) % 3], b[0], fb.normal, x)) nearest.consider(x, closest_point_on_frame(x, fb));
@@ -299,7 +298,9 @@ unsigned triangles_apart_batch(TriangleBatch& batch, double reach) {
   return chosen(batch, reach);
 }
 
-bool beyond_plane(const Vec3 p[3], const Vec3 q[3], double reach) { return kernel::beyond_plane(kernel::TriangleFrame(p), q, reach); }
+bool beyond_plane(const Vec3 p[3], const Vec3 q[3], double reach) {
+  return kernel::beyond_plane(kernel::TriangleFrame(p), q, reach);
+}
 
 /// The AVX2 kernel where the CPU has it, the portable one elsewhere: chosen at the first call.
 ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {

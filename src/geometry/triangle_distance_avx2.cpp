@@ -16,17 +16,14 @@ using kernel::Nearest;
 using kernel::TriangleFrame;
 using kernel::Vec3;
 
-// The same kernel, four candidates at a time in AVX2 registers (x86-64, chosen at run time where
-// the CPU has AVX2). Each lane computes exactly what the portable code computes for its candidate:
-// the same IEEE operations in the same order (no FMA: this file is built with -ffp-contract=off and
-// only "avx2" is enabled here, not "fma"), every region and case of the branches evaluated and the
-// one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on
-// NaN, as in C++), and clamp01 is max then min with the operands in the order of the scalar
-// maxsd/minsd of clamp01 (triangle_distance.cpp), so NaN falls to 0 in every lane as it does
-// there. The candidates are then taken by the same Nearest in the portable order, so the same pair
-// wins. Eigen computes a 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does dot()
-// (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389
-// kernel bit for bit).
+// The same kernel, four candidates at a time in AVX2 registers (x86-64, chosen at run time where the CPU has AVX2). Each lane
+// computes exactly what the portable code computes for its candidate: the same IEEE operations in the same order (no FMA: this
+// file is built with -ffp-contract=off and only "avx2" is enabled here, not "fma"), every region and case of the branches
+// evaluated and the one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on NaN, as in
+// C++), and clamp01 is max then min with the operands in the order of the scalar maxsd/minsd of clamp01
+// (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The candidates are then taken by the same Nearest
+// in the portable order, so the same pair wins. Eigen computes a 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does
+// dot() (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
 namespace {
 
 #define CALIBER_AVX2 __attribute__((target("avx2")))
@@ -81,8 +78,8 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero);
   // a > 0 and e > 0: the general case.
   const __m256d denom = _mm256_sub_pd(_mm256_mul_pd(a, e), _mm256_mul_pd(b, b));
-  const __m256d s_general = _mm256_and_pd(
-      gt(denom, zero), clamp01x4(_mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(b, f), _mm256_mul_pd(c, e)), denom)));
+  const __m256d s_general =
+      _mm256_and_pd(gt(denom, zero), clamp01x4(_mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(b, f), _mm256_mul_pd(c, e)), denom)));
   const __m256d t_general = _mm256_div_pd(_mm256_add_pd(_mm256_mul_pd(b, s_general), f), e);
   const __m256d s_at_0 = clamp01x4(_mm256_div_pd(negate(c), a));            // clamp01(-c / a)
   const __m256d s_at_1 = clamp01x4(_mm256_div_pd(_mm256_sub_pd(b, c), a));  // clamp01((b - c) / a)
@@ -136,8 +133,8 @@ CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
   const __m256d in_c = all(ge(d6, zero), le(d5, d6));
   const __m256d in_ac = all(le(vb, zero), ge(d2, zero), le(d6, zero), gt(d2_d6, zero));
   const __m256d in_bc = all(le(va, zero), ge(d4_d3, zero), ge(d5_d6, zero), gt(bc_sum, zero));
-  const __m256d in_face = all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero),
-                              le(_mm256_add_pd(v, w), one));
+  const __m256d in_face =
+      all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero), le(_mm256_add_pd(v, w), one));
   const __m256d settled = all(t.solid, any(in_a, in_b, in_ab, in_c, in_ac, in_bc, in_face));
 
   Pack3 y = x;  // every lane is overwritten below
@@ -166,13 +163,13 @@ CALIBER_AVX2 inline Pack3 broadcast(const Vec3& v) {
 
 /// One triangle's frame in all four lanes.
 CALIBER_AVX2 Frame4 broadcast(const TriangleFrame& f) {
-  return {broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2]), broadcast(f.ab), broadcast(f.ac),
-          _mm256_castsi256_pd(_mm256_set1_epi64x(f.solid ? -1 : 0))};
+  return {broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2]),
+          broadcast(f.ab),   broadcast(f.ac),   _mm256_castsi256_pd(_mm256_set1_epi64x(f.solid ? -1 : 0))};
 }
 
 CALIBER_AVX2 Frame4 pick(__m256d mask, const Frame4& u, const Frame4& v) {
-  return {pick(mask, u.a, v.a), pick(mask, u.b, v.b), pick(mask, u.c, v.c), pick(mask, u.ab, v.ab), pick(mask, u.ac, v.ac),
-          pick(mask, u.solid, v.solid)};
+  return {pick(mask, u.a, v.a),   pick(mask, u.b, v.b),   pick(mask, u.c, v.c),
+          pick(mask, u.ab, v.ab), pick(mask, u.ac, v.ac), pick(mask, u.solid, v.solid)};
 }
 
 /// The points the kernel projects onto the other triangle, in the portable order: a[0], b[0],
@@ -257,9 +254,10 @@ CALIBER_AVX2 inline int axes_apart_x4(const Pack3& e, const Pack3& f, const kern
   const __m256d bmin = _mm256_min_pd(_mm256_min_pd(pb0, pb1), pb2), bmax = _mm256_max_pd(_mm256_max_pd(pb0, pb1), pb2);
   const __m256d gap = _mm256_max_pd(_mm256_sub_pd(bmin, amax), _mm256_sub_pd(amin, bmax));
   const __m256d len2 = dot(n, n), len = _mm256_sqrt_pd(len2);
-  const __m256d need = _mm256_add_pd(
-      _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(reach), len), _mm256_set1_pd(1.0 + 1e-12)),
-      _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(1e-13), len), _mm256_set1_pd(pair.scale)), _mm256_set1_pd(1e-300)));
+  const __m256d need =
+      _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(reach), len), _mm256_set1_pd(1.0 + 1e-12)),
+                    _mm256_add_pd(_mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(1e-13), len), _mm256_set1_pd(pair.scale)),
+                                  _mm256_set1_pd(1e-300)));
   return _mm256_movemask_pd(
       all(gt(len2, _mm256_set1_pd(kernel::kAxisLength2Floor)), gt(gap, need), le(gap, _mm256_set1_pd(DBL_MAX))));
 }
@@ -276,10 +274,9 @@ CALIBER_AVX2 inline bool edges_apart_x4(const TriangleFrame& fa, const Vec3 b[3]
 
 /// The kernel's candidates once the frames, the corners' lanes and their signed distances along
 /// the other's normal (sa: A's corners against B's plane, sb: B's against A's) are known.
-CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(const Vec3 a[3], const Vec3 b[3],
-                                                                            const Triangle4& ta, const Triangle4& tb,
-                                                                            const TriangleFrame& fa, const TriangleFrame& fb,
-                                                                            __m256d sa, __m256d sb) {
+CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(const Vec3 a[3], const Vec3 b[3], const Triangle4& ta,
+                                                                            const Triangle4& tb, const TriangleFrame& fa,
+                                                                            const TriangleFrame& fb, __m256d sa, __m256d sb) {
   Nearest nearest(a[0], b[0]);
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
@@ -332,8 +329,14 @@ struct Pair4 {
   __m256d sa, sb;
 
   CALIBER_AVX2 Pair4(const Vec3 a[3], const Vec3 b[3])
-      : ta(load(a)), tb(load(b)), fa(a), fb(b), wa(ta.v - broadcast(b[0])), wb(tb.v - broadcast(a[0])),
-        sa(dot(broadcast(fb.normal), wa)), sb(dot(broadcast(fa.normal), wb)) {}
+      : ta(load(a)),
+        tb(load(b)),
+        fa(a),
+        fb(b),
+        wa(ta.v - broadcast(b[0])),
+        wb(tb.v - broadcast(a[0])),
+        sa(dot(broadcast(fb.normal), wa)),
+        sb(dot(broadcast(fa.normal), wb)) {}
 };
 
 #undef CALIBER_AVX2
@@ -357,7 +360,7 @@ __attribute__((target("avx2"), always_inline)) inline bool pair_apart(const Pair
 }
 
 __attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
-                                                                         ClosestPoints& out) {
+                                                                          ClosestPoints& out) {
   const Pair4 p(a, b);
   if (pair_apart(p, b, reach)) return false;
   out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);

@@ -148,8 +148,8 @@ CALIBER_AVX512 __attribute__((always_inline)) inline P3 closest_point_on_triangl
   const D q = div(pick(in_ab, d1, pick(in_ac, d2, pick(in_bc, d4_d3, one))),
                   pick(in_ab, d1_d3, pick(in_ac, d2_d6, pick(in_bc, bc_sum, vsum))));
   const D v = mul(vb, q), w = mul(vc, q);
-  const M in_face = ge(va, zero) & ge(vb, zero) & ge(vc, zero) & gt(vsum, zero) & ge(v, zero) & ge(w, zero) &
-                    le(add(v, w), one) & ~taken;
+  const M in_face =
+      ge(va, zero) & ge(vb, zero) & ge(vc, zero) & gt(vsum, zero) & ge(v, zero) & ge(w, zero) & le(add(v, w), one) & ~taken;
   const M settled = t.solid & (taken | in_face);
 
   // The region's point with the scalar's operations: a corner; a + q ab, a + q ac or b + q (c - b)
@@ -159,7 +159,8 @@ CALIBER_AVX512 __attribute__((always_inline)) inline P3 closest_point_on_triangl
   const P3 base = pick(in_b | in_bc, b, pick(in_c, c, a));
   const P3 along = pick(in_ac, t.ac, pick(in_bc, c - b, t.ab));
   const P3 step = pick(in_face, v, q) * along;
-  const P3 first{_mm512_mask_add_pd(base.x, on_edge | in_face, base.x, step.x), _mm512_mask_add_pd(base.y, on_edge | in_face, base.y, step.y),
+  const P3 first{_mm512_mask_add_pd(base.x, on_edge | in_face, base.x, step.x),
+                 _mm512_mask_add_pd(base.y, on_edge | in_face, base.y, step.y),
                  _mm512_mask_add_pd(base.z, on_edge | in_face, base.z, step.z)};
   const P3 rest = w * t.ac;
   const P3 y{_mm512_mask_add_pd(first.x, in_face, first.x, rest.x), _mm512_mask_add_pd(first.y, in_face, first.y, rest.y),

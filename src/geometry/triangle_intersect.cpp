@@ -173,8 +173,7 @@ bool planes_cross_meet(const Vec3 a[3], const Vec3 b[3], const int sa[3], const 
   const Vec3& p1 = *t1[0];
   const Vec3& q1 = d2[k] > 0 ? *t1[1] : *t1[2];
   const Vec3& r1 = d2[k] > 0 ? *t1[2] : *t1[1];
-  return orient3d(p1.data(), q1.data(), p2.data(), q2.data()) <= 0 &&
-         orient3d(p1.data(), r1.data(), r2.data(), p2.data()) <= 0;
+  return orient3d(p1.data(), q1.data(), p2.data(), q2.data()) <= 0 && orient3d(p1.data(), r1.data(), r2.data(), p2.data()) <= 0;
 }
 
 bool no_zero(const int s[3]) { return s[0] != 0 && s[1] != 0 && s[2] != 0; }
@@ -186,8 +185,7 @@ bool segment_intersects_triangle(const Vec3& p, const Vec3& q, const Vec3& a, co
                           orient3d(a.data(), b.data(), c.data(), q.data()));
 }
 
-bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
-                         const Vec3& b2) {
+bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1, const Vec3& b2) {
   const Vec3 a[3] = {a0, a1, a2};
   const Vec3 b[3] = {b0, b1, b2};
   // Most pairs that reach here are apart: one plane leaves the other triangle on one side.

@@ -19,16 +19,21 @@ using Vec3 = Eigen::Vector3d;
 /// A triangle with what the closest-point query on it needs of its own: computed once per triangle
 /// and reused for every point (the same expressions as a single query, so the same values).
 struct TriangleFrame {
-  const Vec3* v;   ///< the three corners
-  Vec3 ab, ac;     ///< v[1] - v[0], v[2] - v[0]
-  Vec3 normal;     ///< ab x ac
-  double normal2;  ///< |normal|^2
-  double ab2, ac2; ///< |ab|^2, |ac|^2
-  bool solid;      ///< far enough from degenerate for the region test (else: nearest edge point)
+  const Vec3* v;    ///< the three corners
+  Vec3 ab, ac;      ///< v[1] - v[0], v[2] - v[0]
+  Vec3 normal;      ///< ab x ac
+  double normal2;   ///< |normal|^2
+  double ab2, ac2;  ///< |ab|^2, |ac|^2
+  bool solid;       ///< far enough from degenerate for the region test (else: nearest edge point)
 
   explicit TriangleFrame(const Vec3 corners[3])
-      : v(corners), ab(corners[1] - corners[0]), ac(corners[2] - corners[0]), normal(ab.cross(ac)),
-        normal2(normal.squaredNorm()), ab2(ab.squaredNorm()), ac2(ac.squaredNorm()) {
+      : v(corners),
+        ab(corners[1] - corners[0]),
+        ac(corners[2] - corners[0]),
+        normal(ab.cross(ac)),
+        normal2(normal.squaredNorm()),
+        ab2(ab.squaredNorm()),
+        ac2(ac.squaredNorm()) {
     const double scale2 = std::max(ab2, ac2);
     solid = normal2 > 1e-24 * scale2 * scale2;
   }
@@ -94,7 +99,6 @@ Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t);
 
 /// Closest points c1 on p1 + s d1 and c2 on p2 + t d2 (s, t in [0, 1]), given a = |d1|^2 and
 /// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
-void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1,
-                          Vec3& c2);
+void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1, Vec3& c2);
 
 }  // namespace caliber::geometry::kernel

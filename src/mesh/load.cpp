@@ -84,17 +84,16 @@ Mesh convert(const aiScene& scene_ref, const std::filesystem::path& path) {
     for (unsigned v = 0; v < in->mNumVertices; ++v) {
       const aiVector3D& p = in->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        throw Error(ErrorCode::bad_value, path.string(),
-                    "vertex " + std::to_string(base + v) + " has a non-finite coordinate");
+        throw Error(ErrorCode::bad_value, path.string(), "vertex " + std::to_string(base + v) + " has a non-finite coordinate");
       }
       mesh.vertices.emplace_back(p.x, p.y, p.z);
     }
     for (unsigned f = 0; f < in->mNumFaces; ++f) {
       const aiFace& face = in->mFaces[f];
       if (face.mNumIndices < 3) {
-        throw Error(ErrorCode::bad_index, path.string(),
-                    "face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) +
-                        " corner(s); a face needs at least 3");
+        throw Error(
+            ErrorCode::bad_index, path.string(),
+            "face " + std::to_string(f) + " has " + std::to_string(face.mNumIndices) + " corner(s); a face needs at least 3");
       }
       for (unsigned k = 0; k < face.mNumIndices; ++k) {
         if (face.mIndices[k] >= in->mNumVertices) {
@@ -125,7 +124,8 @@ Mesh read_with_assimp(const std::filesystem::path& path, const char* format) {
 
   Assimp::Importer importer;
   Assimp::BaseImporter* reader = importer.GetImporter(format);
-  if (reader == nullptr) throw Error(ErrorCode::unreadable, path.string(), std::string("this assimp has no ") + format + " importer");
+  if (reader == nullptr)
+    throw Error(ErrorCode::unreadable, path.string(), std::string("this assimp has no ") + format + " importer");
   // No post-processing: triangulation, vertex joining or sorting by primitive type would change
   // triangle ids. Polygons are fanned below, in place.
   reader->SetupProperties(&importer);
@@ -160,7 +160,8 @@ Mesh load_mesh(const std::filesystem::path& path) {
     mesh = read_with_assimp(path, ext.c_str() + 1);
   } else {
     throw Error(ErrorCode::unreadable, path.string(),
-                (ext.empty() ? std::string("has no extension") : "extension '" + path.extension().string() + "' is not a mesh format caliber reads") +
+                (ext.empty() ? std::string("has no extension")
+                             : "extension '" + path.extension().string() + "' is not a mesh format caliber reads") +
                     " (caliber reads " + std::string(supported_mesh_formats()) + " files, chosen by extension)");
   }
   validate_mesh(mesh);

@@ -40,8 +40,8 @@ void validate_mesh(const Mesh& mesh) {
     for (const std::uint32_t index : mesh.triangles[t]) {
       if (index >= mesh.vertices.size()) {
         throw Error(ErrorCode::bad_index, src,
-                    "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(index) +
-                        " but there are only " + std::to_string(mesh.vertices.size()));
+                    "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(index) + " but there are only " +
+                        std::to_string(mesh.vertices.size()));
       }
     }
   }
@@ -52,8 +52,8 @@ void validate_mesh(const Mesh& mesh) {
     for (std::size_t t = 0; t < mesh.groups.size(); ++t) {
       if (mesh.groups[t] >= kMaxGroups) {
         throw Error(ErrorCode::bad_value, src,
-                    "triangle " + std::to_string(t) + " is in group " + std::to_string(mesh.groups[t]) +
-                        "; groups are 0.." + std::to_string(kMaxGroups - 1));
+                    "triangle " + std::to_string(t) + " is in group " + std::to_string(mesh.groups[t]) + "; groups are 0.." +
+                        std::to_string(kMaxGroups - 1));
       }
     }
   }

@@ -112,9 +112,13 @@ Mesh read_off(const std::filesystem::path& file) {
   std::size_t l = 0, k = 0;
   if (is_header(lines.token(0, 0))) {
     if (lines.count(0) > 1 && lines.token(0, 1) == "BINARY") fail("binary OFF is not supported");
-    if (lines.count(0) == 1) l = 1; else k = 1;  // counts may follow the header on its line
+    if (lines.count(0) == 1)
+      l = 1;
+    else
+      k = 1;  // counts may follow the header on its line
   } else if (lines.token(0, 0).find("OFF") != std::string_view::npos) {
-    fail("unsupported OFF variant " + quote_token(lines.token(0, 0)) + " (caliber reads OFF, COFF, NOFF, CNOFF, STOFF and the like, ascii)");
+    fail("unsupported OFF variant " + quote_token(lines.token(0, 0)) +
+         " (caliber reads OFF, COFF, NOFF, CNOFF, STOFF and the like, ascii)");
   }
   if (l >= lines.size()) fail("no vertex and face counts after the header (truncated file?)");
   if (lines.count(l) < k + 2) fail(where(l) + ": expected the vertex and face counts");
@@ -143,13 +147,15 @@ Mesh read_off(const std::filesystem::path& file) {
       throw Error(ErrorCode::bad_index, path,
                   "face " + std::to_string(f) + " has " + std::to_string(corners) + " corner(s); a face needs at least 3");
     }
-    if (lines.count(l) < corners + 1) fail(where(l) + ": face " + std::to_string(f) + " lists fewer than " + std::to_string(corners) + " corners");
+    if (lines.count(l) < corners + 1)
+      fail(where(l) + ": face " + std::to_string(f) + " lists fewer than " + std::to_string(corners) + " corners");
     idx.clear();
     for (std::uint64_t c = 0; c < corners; ++c) {
       const std::uint64_t i = count(l, static_cast<std::size_t>(c + 1), "a vertex index");
       if (i >= nv) {
-        throw Error(ErrorCode::bad_index, path, "face " + std::to_string(f) + " refers to vertex " + std::to_string(i) +
-                                                    " but there are only " + std::to_string(nv));
+        throw Error(
+            ErrorCode::bad_index, path,
+            "face " + std::to_string(f) + " refers to vertex " + std::to_string(i) + " but there are only " + std::to_string(nv));
       }
       idx.push_back(static_cast<std::uint32_t>(i));
     }

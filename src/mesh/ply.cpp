@@ -56,10 +56,18 @@ std::optional<Type> parse_type(const std::string& t) {
 
 std::size_t size_of(Type t) {
   switch (t) {
-    case Type::i8: case Type::u8: return 1;
-    case Type::i16: case Type::u16: return 2;
-    case Type::i32: case Type::u32: case Type::f32: return 4;
-    case Type::f64: return 8;
+    case Type::i8:
+    case Type::u8:
+      return 1;
+    case Type::i16:
+    case Type::u16:
+      return 2;
+    case Type::i32:
+    case Type::u32:
+    case Type::f32:
+      return 4;
+    case Type::f64:
+      return 8;
   }
   return 1;
 }
@@ -83,14 +91,43 @@ class Reader {
     const bool swap = (mFormat == Format::big) == (std::endian::native == std::endian::little);
     if (swap) std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(n));
     switch (type) {
-      case Type::i8: { std::int8_t v; std::memcpy(&v, b.data(), 1); return v; }
-      case Type::u8: return b[0];
-      case Type::i16: { std::int16_t v; std::memcpy(&v, b.data(), 2); return v; }
-      case Type::u16: { std::uint16_t v; std::memcpy(&v, b.data(), 2); return v; }
-      case Type::i32: { std::int32_t v; std::memcpy(&v, b.data(), 4); return v; }
-      case Type::u32: { std::uint32_t v; std::memcpy(&v, b.data(), 4); return v; }
-      case Type::f32: { float v; std::memcpy(&v, b.data(), 4); return v; }
-      case Type::f64: { double v; std::memcpy(&v, b.data(), 8); return v; }
+      case Type::i8: {
+        std::int8_t v;
+        std::memcpy(&v, b.data(), 1);
+        return v;
+      }
+      case Type::u8:
+        return b[0];
+      case Type::i16: {
+        std::int16_t v;
+        std::memcpy(&v, b.data(), 2);
+        return v;
+      }
+      case Type::u16: {
+        std::uint16_t v;
+        std::memcpy(&v, b.data(), 2);
+        return v;
+      }
+      case Type::i32: {
+        std::int32_t v;
+        std::memcpy(&v, b.data(), 4);
+        return v;
+      }
+      case Type::u32: {
+        std::uint32_t v;
+        std::memcpy(&v, b.data(), 4);
+        return v;
+      }
+      case Type::f32: {
+        float v;
+        std::memcpy(&v, b.data(), 4);
+        return v;
+      }
+      case Type::f64: {
+        double v;
+        std::memcpy(&v, b.data(), 8);
+        return v;
+      }
     }
     return 0.0;
   }
@@ -188,10 +225,14 @@ Header read_header(const std::string& data, const std::string& path) {
     if (keyword == "format") {
       std::string name, version;
       words >> name >> version;
-      if (name == "ascii") format = Format::ascii;
-      else if (name == "binary_little_endian") format = Format::little;
-      else if (name == "binary_big_endian") format = Format::big;
-      else fail(where + ": unknown format " + quote_token(name));
+      if (name == "ascii")
+        format = Format::ascii;
+      else if (name == "binary_little_endian")
+        format = Format::little;
+      else if (name == "binary_big_endian")
+        format = Format::big;
+      else
+        fail(where + ": unknown format " + quote_token(name));
       if (version != "1.0") fail(where + ": unsupported version " + quote_token(version));
     } else if (keyword == "element") {
       Element e;
@@ -199,7 +240,8 @@ Header read_header(const std::string& data, const std::string& path) {
       words >> e.name >> count;
       std::uint64_t n = 0;
       const auto [end, ec] = std::from_chars(count.data(), count.data() + count.size(), n);
-      if (e.name.empty() || ec != std::errc() || end != count.data() + count.size()) fail(where + ": expected 'element <name> <count>'");
+      if (e.name.empty() || ec != std::errc() || end != count.data() + count.size())
+        fail(where + ": expected 'element <name> <count>'");
       e.count = n;
       elements.push_back(std::move(e));
     } else if (keyword == "property") {
@@ -230,8 +272,9 @@ void read_indices(Reader& reader, const Property& p, Format format, const std::s
     const double index = reader.next(p.type, what);
     if (!keep) continue;
     if (index < 0 || index >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())) {
-      throw Error(ErrorCode::bad_index, path, "face " + std::to_string(face) + " refers to vertex " + std::to_string(static_cast<long long>(index)) +
-                                                 " but there are only " + std::to_string(mesh.vertices.size()));
+      throw Error(ErrorCode::bad_index, path,
+                  "face " + std::to_string(face) + " refers to vertex " + std::to_string(static_cast<long long>(index)) +
+                      " but there are only " + std::to_string(mesh.vertices.size()));
     }
     corners.push_back(static_cast<std::uint32_t>(index));
   }
@@ -245,8 +288,9 @@ void add_face(const std::vector<std::uint32_t>& corners, std::uint64_t i, const 
   }
   for (const std::uint32_t c : corners) {
     if (c >= mesh.vertices.size()) {
-      throw Error(ErrorCode::bad_index, path, "face " + std::to_string(i) + " refers to vertex " + std::to_string(c) +
-                                                 " but there are only " + std::to_string(mesh.vertices.size()));
+      throw Error(ErrorCode::bad_index, path,
+                  "face " + std::to_string(i) + " refers to vertex " + std::to_string(c) + " but there are only " +
+                      std::to_string(mesh.vertices.size()));
     }
   }
   for (std::size_t c = 1; c + 1 < corners.size(); ++c) mesh.triangles.push_back({corners[0], corners[c], corners[c + 1]});

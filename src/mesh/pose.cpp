@@ -20,8 +20,9 @@ void check_translation(const Eigen::Vector3d& t, std::string_view source) {
       throw Error(ErrorCode::bad_value, std::string(source), "translation beyond +-1e15 (caliber's limit on coordinates)");
     }
     if (x != 0.0 && x < kMinCoordinate) {
-      throw Error(ErrorCode::bad_value, std::string(source),
-                  "translation component below 2^-120 (about 7.5e-37), the smallest non-zero value caliber's exact predicates take");
+      throw Error(
+          ErrorCode::bad_value, std::string(source),
+          "translation component below 2^-120 (about 7.5e-37), the smallest non-zero value caliber's exact predicates take");
     }
   }
 }
@@ -42,8 +43,7 @@ Eigen::Quaterniond unit_quaternion(double w, double x, double y, double z, std::
   return Eigen::Quaterniond(w / norm, x / norm, y / norm, z / norm);
 }
 
-Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, double qy, double qz,
-                       std::string_view source) {
+Pose Pose::from_values(double tx, double ty, double tz, double qw, double qx, double qy, double qz, std::string_view source) {
   const double values[7] = {tx, ty, tz, qw, qx, qy, qz};
   for (const double v : values) {
     if (!std::isfinite(v)) throw Error(ErrorCode::bad_value, std::string(source), "pose has a non-finite value");
@@ -63,12 +63,12 @@ Pose Pose::from_matrix(const Eigen::Matrix4d& matrix, double tolerance, std::str
   const Eigen::Matrix3d r = matrix.topLeftCorner<3, 3>();
   const double off = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double det = r.determinant();
-  if (off > tolerance || std::abs(det - 1.0) > tolerance || matrix(3, 0) != 0.0 || matrix(3, 1) != 0.0 ||
-      matrix(3, 2) != 0.0 || matrix(3, 3) != 1.0) {
+  if (off > tolerance || std::abs(det - 1.0) > tolerance || matrix(3, 0) != 0.0 || matrix(3, 1) != 0.0 || matrix(3, 2) != 0.0 ||
+      matrix(3, 3) != 1.0) {
     char problem[200];
     std::snprintf(problem, sizeof problem,
-                  "is not a rigid transform within %g (|R R^T - I| = %.3g, det R = %.17g; last row must be 0 0 0 1)",
-                  tolerance, off, det);
+                  "is not a rigid transform within %g (|R R^T - I| = %.3g, det R = %.17g; last row must be 0 0 0 1)", tolerance,
+                  off, det);
     throw Error(ErrorCode::bad_value, std::string(source), problem);
   }
   const Eigen::Quaterniond q(r);

@@ -9,7 +9,6 @@
 namespace caliber {
 namespace {
 
-
 /// Triangles over a (rows+1) x (cols+1) vertex grid starting at `base`; the last column wraps
 /// to the first when `wrap` is set.
 void grid_triangles(Mesh& mesh, std::uint32_t base, int rows, int cols, bool wrap) {

@@ -57,9 +57,9 @@ Mesh refine_mesh(const Mesh& mesh, int levels) {
   const std::uint64_t available = util::available_memory();
   if (levels > 0 && needed > static_cast<double>(available)) {
     throw Error(ErrorCode::out_of_memory, mesh.source,
-                "refining this mesh " + std::to_string(levels) + " times makes " + std::to_string(triangles) + " triangles and needs about " +
-                    util::format_bytes(needed) + ", more than the " + util::format_bytes(static_cast<double>(available)) +
-                    " of memory available");
+                "refining this mesh " + std::to_string(levels) + " times makes " + std::to_string(triangles) +
+                    " triangles and needs about " + util::format_bytes(needed) + ", more than the " +
+                    util::format_bytes(static_cast<double>(available)) + " of memory available");
   }
   Mesh out = mesh;
   for (int i = 0; i < levels; ++i) out = refine_once(out);

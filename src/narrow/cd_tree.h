@@ -81,8 +81,7 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
 /// code that walks the CD tree its own way and must make the decisions narrow::visit makes (tests,
 /// benches).
 inline bool child_test(const PairContext& ctx, NodePair parent, NodePair child) {
-  return child.a != parent.a && child.b != parent.b ? ctx.node_test_2x2_lane(child.a, child.b)
-                                                    : ctx.node_test(child.a, child.b);
+  return child.a != parent.a && child.b != parent.b ? ctx.node_test_2x2_lane(child.a, child.b) : ctx.node_test(child.a, child.b);
 }
 
 }  // namespace caliber::narrow

@@ -42,10 +42,8 @@ namespace caliber::narrow {
   const double cross2 = x * x + y * y + z * z;
   const double b_at = m[0] * b.center[0] + m[1] * b.center[1] + m[2] * b.center[2];
   const double a_at = n[0] * a.center_from_b[0] + n[1] * a.center_from_b[1] + n[2] * a.center_from_b[2];
-  return disk_beyond_slab(b_at, b.disk_lo, b.disk_hi, along, b.radius, b.axis_len2, cross2, a.slab_lo, a.slab_hi,
-                          slab_reach) ||
-         disk_beyond_slab(a_at, a.disk_lo, a.disk_hi, along, a.radius, a.axis_len2, cross2, b.slab_lo, b.slab_hi,
-                          slab_reach);
+  return disk_beyond_slab(b_at, b.disk_lo, b.disk_hi, along, b.radius, b.axis_len2, cross2, a.slab_lo, a.slab_hi, slab_reach) ||
+         disk_beyond_slab(a_at, a.disk_lo, a.disk_hi, along, a.radius, a.axis_len2, cross2, b.slab_lo, b.slab_hi, slab_reach);
 }
 
 }  // namespace caliber::narrow

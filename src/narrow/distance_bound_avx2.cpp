@@ -69,7 +69,9 @@ CALIBER_AVX2 inline __m256d frames_apart(const BoundConstants& k, const __m256d 
 }
 
 /// Whether every lane of u is above `reach`.
-CALIBER_AVX2 inline bool all_beyond(__m256d u, __m256d reach) { return _mm256_movemask_pd(_mm256_cmp_pd(u, reach, _CMP_GT_OQ)) == 0xF; }
+CALIBER_AVX2 inline bool all_beyond(__m256d u, __m256d reach) {
+  return _mm256_movemask_pd(_mm256_cmp_pd(u, reach, _CMP_GT_OQ)) == 0xF;
+}
 
 CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
                            double reach_, double out[4]) {
@@ -78,11 +80,13 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
   __m256d boxes_a = _mm256_setzero_pd(), boxes_b = _mm256_setzero_pd();
   for (int i = 0; i < 3; ++i) {
     const __m256d along_a = magnitude(sub(lanes_b(b0.box_in_a[i], b1.box_in_a[i]), lanes_a(a0.box[i], a1.box[i])));
-    boxes_a = add(boxes_a, square_of_positive(sub(sub(along_a, lanes_a(a0.half[i], a1.half[i])),
-                                                  lanes_b(b0.reach_on_a[i], b1.reach_on_a[i]))));
+    boxes_a =
+        add(boxes_a,
+            square_of_positive(sub(sub(along_a, lanes_a(a0.half[i], a1.half[i])), lanes_b(b0.reach_on_a[i], b1.reach_on_a[i]))));
     const __m256d along_b = magnitude(sub(lanes_b(b0.box[i], b1.box[i]), lanes_a(a0.box_in_b[i], a1.box_in_b[i])));
-    boxes_b = add(boxes_b, square_of_positive(sub(sub(along_b, lanes_b(b0.half[i], b1.half[i])),
-                                                  lanes_a(a0.reach_on_b[i], a1.reach_on_b[i]))));
+    boxes_b =
+        add(boxes_b,
+            square_of_positive(sub(sub(along_b, lanes_b(b0.half[i], b1.half[i])), lanes_a(a0.reach_on_b[i], a1.reach_on_b[i]))));
   }
   const __m256d boxes = _mm256_sqrt_pd(_mm256_max_pd(boxes_a, boxes_b));
   // Every lane beyond the reach already (where the scalar stops too): the rest is not needed.

@@ -13,9 +13,7 @@ namespace caliber {
 namespace narrow {
 namespace {
 
-bool by_ids(const Candidate& x, const Candidate& y) {
-  return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b;
-}
+bool by_ids(const Candidate& x, const Candidate& y) { return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b; }
 
 /// Where each candidate of a list sits, by its triangle pair: an open-addressing hash table (linear
 /// probing, at most half full), so a neighbour lookup costs one or two probes whatever the list's
@@ -33,7 +31,7 @@ class PairIndex {
         for (std::size_t h = slot(key(candidates[i].tri_a, candidates[i].tri_b));; h = (h + 1) & mMask) {
           std::uint32_t expected = kEmpty;
           if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
-                                                                                 std::memory_order_relaxed)) {
+                                                                                std::memory_order_relaxed)) {
             break;
           }
         }
@@ -167,28 +165,28 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   const Eigen::Matrix3d ra = pose.rotation_matrix();
   result.contacts.resize(candidates.size());
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-  for (std::size_t i = lo; i != hi; ++i) {
-    const Candidate& c = candidates[i];
-    Contact contact;
-    contact.tri_a = c.tri_a;
-    contact.tri_b = c.tri_b;
-    contact.distance = c.distance;
-    contact.point_a = ra * c.point_a + pose.translation;
-    contact.point_b = ra * c.point_b + pose.translation;
-    const Eigen::Vector3d gap = c.point_b - c.point_a;
-    const double gap_norm = gap.norm();
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    if (c.distance > 0.0 && gap_norm > 0.0) {
-      normal = gap / gap_norm;
-    } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
-      normal = ctx.a().normals[c.tri_a];
-    } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
-      normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = candidates[i];
+      Contact contact;
+      contact.tri_a = c.tri_a;
+      contact.tri_b = c.tri_b;
+      contact.distance = c.distance;
+      contact.point_a = ra * c.point_a + pose.translation;
+      contact.point_b = ra * c.point_b + pose.translation;
+      const Eigen::Vector3d gap = c.point_b - c.point_a;
+      const double gap_norm = gap.norm();
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      if (c.distance > 0.0 && gap_norm > 0.0) {
+        normal = gap / gap_norm;
+      } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
+        normal = ctx.a().normals[c.tri_a];
+      } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
+        normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
+      }
+      contact.normal = ra * normal;
+      if (c.distance == 0.0 && normal.squaredNorm() > 0.0) contact.depth = depth_estimate(ctx, c, normal);
+      result.contacts[i] = contact;
     }
-    contact.normal = ra * normal;
-    if (c.distance == 0.0 && normal.squaredNorm() > 0.0) contact.depth = depth_estimate(ctx, c, normal);
-    result.contacts[i] = contact;
-  }
   });
   return result;
 }

@@ -20,7 +20,6 @@ inline constexpr std::size_t kFinalizeGrain = 128;
 /// object pair canonically (by triangle ids) and converts them to world coordinates. With
 /// `parallel`, a large candidate list is processed by several tasks of the current executor (same
 /// result).
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats,
-                     bool parallel = false);
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel = false);
 
 }  // namespace caliber::narrow

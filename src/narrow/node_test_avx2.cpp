@@ -78,8 +78,8 @@ CALIBER_AVX2 inline __m256d beyond_slab(const __m256d axis[3], const __m256d on[
 }
 
 /// narrow::disk_beyond_slab (disks.h) in four lanes.
-CALIBER_AVX2 inline __m256d disk_beyond_slab(__m256d at, __m256d disk_lo, __m256d disk_hi, __m256d along, __m256d r,
-                                             __m256d len2, __m256d cross2, __m256d lo, __m256d hi, __m256d slab_reach) {
+CALIBER_AVX2 inline __m256d disk_beyond_slab(__m256d at, __m256d disk_lo, __m256d disk_hi, __m256d along, __m256d r, __m256d len2,
+                                             __m256d cross2, __m256d lo, __m256d hi, __m256d slab_reach) {
   const __m256d s0 = mul(disk_lo, along), s1 = mul(disk_hi, along);
   const __m256d at2 = mul(at, len2);
   const __m256d low = add(at2, _mm256_min_pd(s0, s1)), high = add(at2, _mm256_max_pd(s0, s1));
@@ -155,15 +155,15 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   const __m256d y = sub(mul(a_axis[2], b_axis_in_a[0]), mul(a_axis[0], b_axis_in_a[2]));
   const __m256d z = sub(mul(a_axis[0], b_axis_in_a[1]), mul(a_axis[1], b_axis_in_a[0]));
   const __m256d cross2 = add(add(mul(x, x), mul(y, y)), mul(z, z));
-  apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), sub(b_lo, b_mid), sub(b_hi, b_mid), along,
-                                         bn[3], dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
-  apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), sub(a_lo, a_mid), sub(a_hi, a_mid), along,
-                                         an[3], dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
+  apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), sub(b_lo, b_mid), sub(b_hi, b_mid), along, bn[3],
+                                         dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
+  apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), sub(a_lo, a_mid), sub(a_hi, a_mid), along, an[3],
+                                         dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
   return ~_mm256_movemask_pd(apart) & 0xF;
 }
 
 CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                     std::uint32_t b1) {
+                                      std::uint32_t b1) {
   return node_within_2x2_lanes(f, a0, a1, b0, b1);
 }
 
@@ -171,8 +171,8 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, 
 /// with 16 registers a sixth of its instructions were spills). The same operations (no FMA: this
 /// file is built with -ffp-contract=off), so the same decisions.
 __attribute__((target("avx2,avx512f,avx512vl"))) int node_within_2x2_avx512vl(const NodeTestFrame& f, std::uint32_t a0,
-                                                                            std::uint32_t a1, std::uint32_t b0,
-                                                                            std::uint32_t b1) {
+                                                                              std::uint32_t a1, std::uint32_t b0,
+                                                                              std::uint32_t b1) {
   return node_within_2x2_lanes(f, a0, a1, b0, b1);
 }
 

@@ -25,8 +25,7 @@ struct NodeTestFrame {
 /// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes, slabs and disks:
 /// PairContext::node_within and !disks_beyond_slabs on prepare_a(ai) and prepare_b(bj) with their
 /// disks.
-using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                              std::uint32_t b1);
+using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1);
 
 /// The four-lane form compiled for AVX2 (`wide_registers` false) or for AVX-512VL (true: the same
 /// code and operations with 32 vector registers, so fewer spills), or nullptr where this build or

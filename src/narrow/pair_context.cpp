@@ -16,8 +16,7 @@ namespace {
 constexpr double kConeCosMargin = 1e-6;
 }  // namespace
 
-PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
-                         const QueryRequest& request)
+PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
     : mA(a), mB(b), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
   validate_request(request);
   validate_pose(pose_a, "pose of A");
@@ -31,8 +30,8 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
-  mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {},
-                kRotationHair, mReach, mSlabReach};
+  mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {}, kRotationHair,
+                mReach,          mSlabReach};
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       mNodeFrame.rot[i][j] = mRot(i, j);

@@ -65,8 +65,8 @@ class PairContext {
     const BvhNodeFilter& f = mA.filters[ia];
     for (int i = 0; i < 3; ++i) s.slab_axis[i] = f.cone_axis[i];
     for (int j = 0; j < 3; ++j) {
-      s.slab_on_b[j] = std::abs(mRot(0, j) * s.slab_axis[0] + mRot(1, j) * s.slab_axis[1] + mRot(2, j) * s.slab_axis[2]) +
-                       kRotationHair;
+      s.slab_on_b[j] =
+          std::abs(mRot(0, j) * s.slab_axis[0] + mRot(1, j) * s.slab_axis[1] + mRot(2, j) * s.slab_axis[2]) + kRotationHair;
     }
     s.slab_lo = f.slab_lo;
     s.slab_hi = f.slab_hi;
@@ -348,13 +348,13 @@ class PairContext {
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
   Eigen::Vector3d mTrans;
-  double mDescendAlone;  ///< descend_alone_ratio()
-  double mScale;       ///< extents of A and B plus their distance: what the safety margin is relative to
-  double mReach;       ///< tolerance + safety margin added to the sum of radii
-  double mSlabReach;   ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
-  double mTheta;       ///< contact angle, radians
-  double mCosTheta;    ///< cos(theta)
-  double mSinTheta;    ///< sin(theta)
+  double mDescendAlone;              ///< descend_alone_ratio()
+  double mScale;                     ///< extents of A and B plus their distance: what the safety margin is relative to
+  double mReach;                     ///< tolerance + safety margin added to the sum of radii
+  double mSlabReach;                 ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
+  double mTheta;                     ///< contact angle, radians
+  double mCosTheta;                  ///< cos(theta)
+  double mSinTheta;                  ///< sin(theta)
   detail::NodeTestFrame mNodeFrame;  ///< what node_tests_2x2's AVX2 form reads of the above
 };
 

@@ -16,10 +16,14 @@ namespace caliber {
 
 std::string_view to_string(QueryKind kind) {
   switch (kind) {
-    case QueryKind::interference: return "interference";
-    case QueryKind::proximity: return "proximity";
-    case QueryKind::contact: return "contact";
-    case QueryKind::distance: return "distance";
+    case QueryKind::interference:
+      return "interference";
+    case QueryKind::proximity:
+      return "proximity";
+    case QueryKind::contact:
+      return "contact";
+    case QueryKind::distance:
+      return "distance";
   }
   return "unknown";
 }
@@ -43,7 +47,8 @@ void validate_request(const QueryRequest& request) {
     throw Error(ErrorCode::bad_value, "tolerance", "must be at most 1e15 (caliber's limit on coordinates)");
   }
   if (request.tolerance > 0.0 && request.tolerance < kMinCoordinate) {
-    throw Error(ErrorCode::bad_value, "tolerance", "must be 0 or at least 2^-120 (about 7.5e-37; caliber's exact predicates need no smaller)");
+    throw Error(ErrorCode::bad_value, "tolerance",
+                "must be 0 or at least 2^-120 (about 7.5e-37; caliber's exact predicates need no smaller)");
   }
   if (!std::isfinite(request.angle_deg) || request.angle_deg < 0.0 || request.angle_deg > 180.0) {
     throw Error(ErrorCode::bad_value, "angle", "must be a number of degrees in [0, 180]");

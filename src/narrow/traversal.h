@@ -90,8 +90,8 @@ template <class Take>
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a stage, a
 /// leaf pair may wait there for its closest points (PairContext::leaf_test with a stage): the
 /// caller flushes it before reading `out`.
-[[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats, NodePair passed[4],
-                 TabooView taboo = {}, LeafStage* stage = nullptr) {
+[[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
+                                        NodePair passed[4], TabooView taboo = {}, LeafStage* stage = nullptr) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) {
@@ -149,7 +149,7 @@ struct TraversalScratch {
     NearA* a;
     NearB* b;
   };
-  util::GapBuckets<Reached> waiting;  ///< distance traversal: the nodes waiting, by gap
+  util::GapBuckets<Reached> waiting;        ///< distance traversal: the nodes waiting, by gap
   PreparedTree<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
   PreparedTree<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
 
@@ -163,9 +163,9 @@ struct TraversalScratch {
 /// when RootTest::done: it was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
 /// on passing leaf pairs, the kept pairs appended to `out`, every node and leaf test counted in
 /// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
-inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch,
-                                 std::vector<Candidate>& out, QueryStats& stats, RootTest root_test = RootTest::as_root,
-                                 TabooView taboo = {}, PairLimit* limit = nullptr) {
+inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
+                                 QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
+                                 PairLimit* limit = nullptr) {
   // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
   // more than 3 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
@@ -225,8 +225,8 @@ struct Nearest {
 /// after that; a side that does not split brings its own node.
 template <class Wait>
 [[gnu::always_inline]] inline void near_children(const PairContext& ctx, TraversalScratch& scratch, TraversalScratch::Reached r,
-                                                 const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats, TabooView taboo,
-                                                 Wait&& wait) {
+                                                 const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats,
+                                                 TabooView taboo, Wait&& wait) {
   using Reached = TraversalScratch::Reached;
   const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
   const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
@@ -239,8 +239,9 @@ template <class Wait>
     // as for_each_child takes them (a child on the taboo list marked reached, not counted).
     double gaps[4];
     ctx.gaps_2x2(ka[0], ka[1], kb[0], kb[1], reach, gaps);
-    for_each_child_2x2(a.index, b.index, stats, taboo,
-                       [&](std::uint32_t k, NodePair) { wait(gaps[k], Reached{&ka[k / 2], &kb[k % 2]}); });
+    for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair) {
+      wait(gaps[k], Reached{&ka[k / 2], &kb[k % 2]});
+    });
     return;
   }
   // One side splits: its two children against the other node twice in the four lanes (lanes
@@ -334,7 +335,8 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
 /// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first (stopping
 /// early at the pair's limit, if one is given).
 inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
-                     QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}, PairLimit* limit = nullptr) {
+                     QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
+                     PairLimit* limit = nullptr) {
   if (ctx.request().kind == QueryKind::distance) {
     Nearest nearest;
     traverse_nearest(ctx, root, scratch, nearest, stats, root_test, taboo);

@@ -254,12 +254,13 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
   // simple_partitioner: split down to the grain. The default (auto) partitioner stops splitting
   // early when nobody steals, so a thread would run ~16 consecutive items as one chunk. Even so the
   // halving hands out contiguous blocks: where the order matters, use for_each_in_order.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain),
-                    [&body, c = detail::t_concurrency](const tbb::blocked_range<std::size_t>& r) {
-                      const detail::ConcurrencyScope scope(c);
-                      body(r.begin(), r.end());
-                    },
-                    tbb::simple_partitioner());
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(begin, end, grain),
+      [&body, c = detail::t_concurrency](const tbb::blocked_range<std::size_t>& r) {
+        const detail::ConcurrencyScope scope(c);
+        body(r.begin(), r.end());
+      },
+      tbb::simple_partitioner());
 }
 
 #endif

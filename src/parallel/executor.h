@@ -123,7 +123,7 @@ class TaskGroup {
 
  private:
   Executor::Pool* mPool;
-  std::size_t mPending = 0;  ///< guarded by the pool's mutex
+  std::size_t mPending = 0;   ///< guarded by the pool's mutex
   std::exception_ptr mError;  ///< guarded by the pool's mutex
   friend struct Executor::Pool;
 #else

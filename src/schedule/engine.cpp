@@ -33,24 +33,30 @@ namespace caliber {
 
 std::string_view to_string(Method method) {
   switch (method) {
-    case Method::sequential: return "sequential";
-    case Method::exploitation: return "exploitation";
-    case Method::stealing: return "stealing";
-    case Method::aposteriori: return "aposteriori";
-    case Method::apriori: return "apriori";
-    case Method::hybrid: return "hybrid";
+    case Method::sequential:
+      return "sequential";
+    case Method::exploitation:
+      return "exploitation";
+    case Method::stealing:
+      return "stealing";
+    case Method::aposteriori:
+      return "aposteriori";
+    case Method::apriori:
+      return "apriori";
+    case Method::hybrid:
+      return "hybrid";
   }
   return "unknown";
 }
 
 Method parse_method(std::string_view name) {
-  for (const Method m : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori,
-                         Method::hybrid}) {
+  for (const Method m :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     if (name == to_string(m)) return m;
   }
-  throw Error(ErrorCode::bad_value, "method",
-              "unknown method '" + std::string(name) +
-                  "' (expected sequential, exploitation, stealing, aposteriori, apriori or hybrid)");
+  throw Error(
+      ErrorCode::bad_value, "method",
+      "unknown method '" + std::string(name) + "' (expected sequential, exploitation, stealing, aposteriori, apriori or hybrid)");
 }
 
 void validate_frame(const Frame& frame) {
@@ -107,7 +113,8 @@ class ContextStore {
     parallel::parallel_for(0, n, 64, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
         const Task& t = frame.pairs[i];
-        new (&base[i]) narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+        new (&base[i])
+            narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
       }
     });
     return {std::launder(base), n};
@@ -142,7 +149,8 @@ Engine::Engine(const EngineOptions& options) : mOptions(options) {
     throw Error(ErrorCode::bad_value, "plan threads", "must be between 1 and 1024 (0: the engine's threads)");
   }
   if (mOptions.stealing_depth < 0) throw Error(ErrorCode::bad_value, "stealing depth", "must be >= 0");
-  if (!(mOptions.beta > 0.0) || !std::isfinite(mOptions.beta)) throw Error(ErrorCode::bad_value, "beta", "must be a finite number > 0");
+  if (!(mOptions.beta > 0.0) || !std::isfinite(mOptions.beta))
+    throw Error(ErrorCode::bad_value, "beta", "must be a finite number > 0");
   if (!(mOptions.epsilon >= 0.0) || !std::isfinite(mOptions.epsilon)) {
     throw Error(ErrorCode::bad_value, "epsilon", "must be a finite number >= 0");
   }
@@ -160,8 +168,7 @@ namespace {
 
 /// After a step: what the temporal methods keep of each pair for the next one.
 void remember(const EngineOptions& options, const std::vector<Task>& pairs, const std::vector<QueryResult>& results,
-              const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests,
-              tasks::History& history) {
+              const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, tasks::History& history) {
   for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests[pairs[i]] = results[i].stats.node_tests;
   if (options.method == Method::aposteriori) {
     for (std::size_t i = 0; i < pairs.size(); ++i) history.reported[pairs[i]] = results[i].pairs;
@@ -207,9 +214,10 @@ StepResult Engine::step(const Frame& frame) {
     if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
       plan = tasks::plan_pairs(n);
     } else {
-      plan = tasks::plan_calibrated(options, frame.pairs, state.contexts, mImpl->history, [&](std::size_t pair, const std::function<void()>& stage) {
-        mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
-      });
+      plan = tasks::plan_calibrated(options, frame.pairs, state.contexts, mImpl->history,
+                                    [&](std::size_t pair, const std::function<void()>& stage) {
+                                      mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
+                                    });
     }
     record.calibrate_ms = util::ms_since(planning);
     stage_root_tests = schedule::run_plan(plan, state, record);

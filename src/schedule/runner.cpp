@@ -57,7 +57,8 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   if (state.timeline.on) {
     record.task_roots.resize(plan.run.size());
     for (std::size_t t = 0; t < plan.run.size(); ++t) {
-      for (const tasks::Root& root : plan.run[t].roots) record.task_roots[t].push_back(TaskRoot{root.pair, root.node.a, root.node.b});
+      for (const tasks::Root& root : plan.run[t].roots)
+        record.task_roots[t].push_back(TaskRoot{root.pair, root.node.a, root.node.b});
     }
   }
   std::vector<std::size_t> split_of(n, SIZE_MAX);
@@ -88,10 +89,10 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
       for (const tasks::Root& root : plan.run[t].roots) {
         QueryStats& stats = w.stats[root.pair];
         const std::uint64_t before = stats.node_tests;
-        const narrow::TabooView taboo = root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()}
-                                                        : narrow::TabooView{};
-        narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats, root.root_test(),
-                         taboo, state.limit(root.pair));
+        const narrow::TabooView taboo =
+            root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()} : narrow::TabooView{};
+        narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats, root.root_test(), taboo,
+                         state.limit(root.pair));
         tests += stats.node_tests - before;
         if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
         if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;
@@ -131,7 +132,8 @@ void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>&
     out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
-    for (std::size_t k = 0; k < r.pairs.size(); ++k) out.contacts.push_back(SceneContact{pairs[i].a, pairs[i].b, contact_at(r, k)});
+    for (std::size_t k = 0; k < r.pairs.size(); ++k)
+      out.contacts.push_back(SceneContact{pairs[i].a, pairs[i].b, contact_at(r, k)});
   }
 }
 

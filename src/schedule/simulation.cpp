@@ -66,8 +66,11 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
   if (total <= 0.0 || method == Method::sequential) return 1.0;
   double makespan = 0.0;
   switch (method) {
-    case Method::sequential: return 1.0;
-    case Method::exploitation: makespan = list_schedule_makespan(r.task_node_tests, cores); break;
+    case Method::sequential:
+      return 1.0;
+    case Method::exploitation:
+      makespan = list_schedule_makespan(r.task_node_tests, cores);
+      break;
     case Method::stealing:
       makespan = list_schedule_makespan(r.task_node_tests, cores) + static_cast<double>(r.split_node_tests) / cores;
       break;
@@ -94,7 +97,9 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
     spans += t.end_ms - t.start_ms;
     (t.phase == TaskSpan::Phase::stage ? stage : t.phase == TaskSpan::Phase::traverse ? traverse : finalize).push_back(&t);
   }
-  const auto by_unit = [](const TaskSpan* x, const TaskSpan* y) { return x->unit != y->unit ? x->unit < y->unit : x->start_ms < y->start_ms; };
+  const auto by_unit = [](const TaskSpan* x, const TaskSpan* y) {
+    return x->unit != y->unit ? x->unit < y->unit : x->start_ms < y->start_ms;
+  };
   const auto length = [](const TaskSpan* t) { return t->end_ms - t->start_ms; };
   // The stage: split tasks in pair order, as the stage spans' units (pairs) sort.
   std::sort(stage.begin(), stage.end(), by_unit);
@@ -132,7 +137,8 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
   std::vector<double> finals;
   for (const TaskSpan* t : finalize) {
     const std::size_t candidates = t->unit < step.tasks.size() ? step.tasks[t->unit].candidates : 0;
-    const std::size_t chunks = candidates >= narrow::kFinalizeGrain ? (candidates + narrow::kFinalizeGrain - 1) / narrow::kFinalizeGrain : 1;
+    const std::size_t chunks =
+        candidates >= narrow::kFinalizeGrain ? (candidates + narrow::kFinalizeGrain - 1) / narrow::kFinalizeGrain : 1;
     for (std::size_t c = 0; c < chunks; ++c) finals.push_back(length(t) / static_cast<double>(chunks));
   }
   const double serial = step.broad_ms + std::max(0.0, step.narrow_ms + step.reduce_ms - spans - split_ms);

@@ -147,8 +147,8 @@ void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& l
 /// tallies are added up in order here; each chunk then writes its outputs at its offsets in
 /// parallel (timed into `parallel_ms`), so the serial part is per chunk, not per node.
 std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const std::vector<StageOutcome>& outcome,
-                                    const std::vector<ChunkTally>& tally, std::uint32_t pair, std::size_t base,
-                                    SplitResult& out, double& parallel_ms) {
+                                    const std::vector<ChunkTally>& tally, std::uint32_t pair, std::size_t base, SplitResult& out,
+                                    double& parallel_ms) {
   const std::size_t chunks = tally.size();
   std::vector<std::uint64_t>& tests = out.levels.emplace_back(chunks, 0);
   std::vector<ChunkTally> at(chunks);  // where each chunk's outputs start
@@ -198,8 +198,8 @@ std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const s
 
 }  // namespace
 
-SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
-                       double omega, double eps, const NodeCounts* measured) {
+SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
+                       double eps, const NodeCounts* measured) {
   const auto weight_of = [&](narrow::NodePair n) {
     if (measured != nullptr) {
       const auto it = std::lower_bound(measured->begin(), measured->end(), n,
@@ -284,9 +284,8 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   const int count = narrow::cd_children(ctx, n, kids);
   TrianglePair* bounds[5] = {first};
   for (int k = 0; k < count; ++k) {
-    bounds[k + 1] = std::partition(bounds[k], last, [&](const TrianglePair& p) {
-      return a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b);
-    });
+    bounds[k + 1] = std::partition(
+        bounds[k], last, [&](const TrianglePair& p) { return a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b); });
   }
   const auto at = static_cast<std::uint32_t>(summary.size());
   std::uint32_t children = 0;
@@ -313,8 +312,8 @@ std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std
   return summary;
 }
 
-PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight,
-                                  double omega, double eps, std::size_t taboo_cap) {
+PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight, double omega,
+                                  double eps, std::size_t taboo_cap) {
   PosterioriSplit out;
   out.rest = weight;
   if (summary.empty() || summary[0].contacts == 0 || summary[0].children == 0) return out;

@@ -20,15 +20,15 @@ namespace caliber::tasks {
 /// A piece of work for one thread: a CD-tree node of one pair, and whether the weight-driven stage
 /// already tested it (then the depth-first traversal starts below it, so no node is tested twice).
 struct Root {
-  std::uint32_t pair;      ///< index of the initial task (object pair)
-  narrow::NodePair node;   ///< CD-tree node
-  bool tested;             ///< already tested (and passed) in the weight-driven stage
-  double weight;           ///< its estimated weight
-  std::int32_t taboo = -1;     ///< a posteriori: the taboo list this traversal skips (original tasks)
-  std::int32_t owner = -1;     ///< a posteriori: the taboo list this root is on (sub-tasks)
-  std::int32_t slot = -1;      ///< a posteriori: its place on that list
-  std::int32_t stage = -1;     ///< weight-driven stage: index of its record in SplitResult::stage
-  bool disks = false;          ///< untested, its CD parent splits both sides: tested with the disks
+  std::uint32_t pair;       ///< index of the initial task (object pair)
+  narrow::NodePair node;    ///< CD-tree node
+  bool tested;              ///< already tested (and passed) in the weight-driven stage
+  double weight;            ///< its estimated weight
+  std::int32_t taboo = -1;  ///< a posteriori: the taboo list this traversal skips (original tasks)
+  std::int32_t owner = -1;  ///< a posteriori: the taboo list this root is on (sub-tasks)
+  std::int32_t slot = -1;   ///< a posteriori: its place on that list
+  std::int32_t stage = -1;  ///< weight-driven stage: index of its record in SplitResult::stage
+  bool disks = false;       ///< untested, its CD parent splits both sides: tested with the disks
 
   /// How its traversal tests it (narrow::RootTest), as its parent's visit would.
   [[nodiscard]] narrow::RootTest root_test() const {
@@ -90,11 +90,11 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 /// so that its subtree's node tests can be added up after the step (the node-history variant of
 /// hybrid reuses them).
 struct StageRecord {
-  narrow::NodePair node;                 ///< the CD-tree node
-  std::uint8_t children = 0;             ///< expanded: how many children its visit tested
-  std::uint8_t passed = 0;               ///< expanded: bit k set when child k passed (and has a record)
-  narrow::NodePair child[4];             ///< expanded: the children tested
-  bool root = false;                     ///< became a sub-task root or a cart item (tested)
+  narrow::NodePair node;      ///< the CD-tree node
+  std::uint8_t children = 0;  ///< expanded: how many children its visit tested
+  std::uint8_t passed = 0;    ///< expanded: bit k set when child k passed (and has a record)
+  narrow::NodePair child[4];  ///< expanded: the children tested
+  bool root = false;          ///< became a sub-task root or a cart item (tested)
 };
 
 /// Measured node tests of CD subtrees at the previous step, per CD node, sorted by node.
@@ -125,8 +125,8 @@ struct SplitResult {
 /// a node does not depend on when, this runs the same cut level by level, each level's nodes in
 /// parallel on the current executor (one heavy pair's stage is no longer serial work), with the
 /// same result whatever the thread count.
-SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
-                       double omega, double eps, const NodeCounts* measured = nullptr);
+SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
+                       double eps, const NodeCounts* measured = nullptr);
 
 /// After a step: the node tests of every subtree the stage tested, from its records and the
 /// depth-first node tests of its roots (`root_tests[k]` for the root at record k). Sorted by node.
@@ -135,11 +135,11 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 /// The a posteriori summary tree of one pair: the CD-tree nodes above the triangle pairs reported at
 /// the previous step, each weighted by how many of them lie below it. Children are contiguous.
 struct SummaryNode {
-  narrow::NodePair node;        ///< the CD-tree node
-  std::uint32_t contacts = 0;   ///< reported pairs below it
-  std::uint32_t first = 0;      ///< index of its first child in the summary
-  std::uint32_t children = 0;   ///< how many children (only those with contacts below)
-  bool disks = false;           ///< its parent splits both sides (its node test has the disks)
+  narrow::NodePair node;       ///< the CD-tree node
+  std::uint32_t contacts = 0;  ///< reported pairs below it
+  std::uint32_t first = 0;     ///< index of its first child in the summary
+  std::uint32_t children = 0;  ///< how many children (only those with contacts below)
+  bool disks = false;          ///< its parent splits both sides (its node test has the disks)
 };
 
 /// Builds the summary tree of pair context ctx's CD tree from the previous step's reported pairs
@@ -150,12 +150,12 @@ std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std
 /// (a node's weight is the task's weight times its share of the contacts), the original task keeping
 /// the rest of the tree with those roots on its taboo list (at most `taboo_cap` of them).
 struct PosterioriSplit {
-  std::vector<Root> roots;         ///< sub-task roots meeting omega (untested)
-  std::vector<Root> cart;          ///< lighter sub-task roots (untested)
+  std::vector<Root> roots;              ///< sub-task roots meeting omega (untested)
+  std::vector<Root> cart;               ///< lighter sub-task roots (untested)
   std::vector<narrow::NodePair> taboo;  ///< every chosen root, sorted
-  double rest = 0.0;               ///< estimated weight left to the original task
+  double rest = 0.0;                    ///< estimated weight left to the original task
 };
-PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight,
-                                  double omega, double eps, std::size_t taboo_cap);
+PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight, double omega,
+                                  double eps, std::size_t taboo_cap);
 
 }  // namespace caliber::tasks

@@ -56,10 +56,9 @@ namespace {
 /// A posteriori: the sub-task roots of each heavy pair from last step's summary tree; nothing is
 /// tested here. A pair without reported pairs last step cannot be split (the metric's known blind
 /// spot) and runs whole. Its original task keeps the rest of the tree, the roots on its taboo list.
-void split_by_summary(const EngineOptions& options, const std::vector<Task>& pairs,
-                      narrow::PairContexts contexts, const History& history,
-                      const std::vector<std::size_t>& to_split, const std::vector<double>& weight, Plan& plan,
-                      std::vector<Root>& cart) {
+void split_by_summary(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+                      const History& history, const std::vector<std::size_t>& to_split, const std::vector<double>& weight,
+                      Plan& plan, std::vector<Root>& cart) {
   std::vector<PosterioriSplit> chosen(to_split.size());
   parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
     const std::size_t i = to_split[s];
@@ -135,9 +134,16 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pair
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Root whole{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, w.weight[i]};
     switch (classify(w.weight[i], plan.omega, eps)) {
-      case Verdict::keep: plan.run.push_back(RunTask{{whole}, w.weight[i]}); ++plan.kept; break;
-      case Verdict::cart: cart.push_back(whole); break;
-      case Verdict::split: to_split.push_back(i); break;
+      case Verdict::keep:
+        plan.run.push_back(RunTask{{whole}, w.weight[i]});
+        ++plan.kept;
+        break;
+      case Verdict::cart:
+        cart.push_back(whole);
+        break;
+      case Verdict::split:
+        to_split.push_back(i);
+        break;
     }
   }
   plan.split = to_split.size();
@@ -152,7 +158,8 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pair
   // (An order of indices, then each task moved once: tasks are too large to be moved around a sort.)
   std::vector<std::uint32_t> order(plan.run.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return plan.run[x].weight > plan.run[y].weight; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t x, std::uint32_t y) { return plan.run[x].weight > plan.run[y].weight; });
   std::vector<RunTask> sorted;
   sorted.reserve(order.size());
   for (const std::uint32_t t : order) sorted.push_back(std::move(plan.run[t]));

@@ -20,23 +20,23 @@ namespace caliber::tasks {
 /// What the engine remembers of each object pair from the last step it was tested (keyed by the
 /// pair's object indices, Frame::pairs). Changes only how work is cut, never the contacts.
 struct History {
-  std::map<Task, std::uint64_t> node_tests;             ///< node tests at its last step
-  std::map<Task, std::vector<TrianglePair>> reported;   ///< a posteriori: the triangle pairs it reported
-  std::map<Task, NodeCounts> node_counts;               ///< hybrid with node history: stage subtrees' node tests
+  std::map<Task, std::uint64_t> node_tests;            ///< node tests at its last step
+  std::map<Task, std::vector<TrianglePair>> reported;  ///< a posteriori: the triangle pairs it reported
+  std::map<Task, NodeCounts> node_counts;              ///< hybrid with node history: stage subtrees' node tests
 };
 
 /// A method's plan for one step.
 struct Plan {
-  std::vector<RunTask> run;                 ///< run-time tasks, in hand-out order
-  std::vector<SplitResult> splits;          ///< the weight-driven stage of each split pair
-  std::vector<std::uint32_t> split_pairs;   ///< the pair of each entry of `splits`
-  std::vector<narrow::Taboo> taboos;        ///< a posteriori taboo lists (Root::taboo and Root::owner index them)
-  bool weighted = false;                    ///< the tasks carry weight estimates (calibrated methods)
-  double omega = 0.0;                       ///< the caliber (0 for a plan of whole pairs)
-  std::size_t kept = 0;                     ///< initial tasks run as they are
-  std::size_t split = 0;                    ///< initial tasks split
-  std::size_t carted = 0;                   ///< items merged in the cart
-  std::size_t taboo_nodes = 0;              ///< a posteriori: sub-task roots handed out
+  std::vector<RunTask> run;                ///< run-time tasks, in hand-out order
+  std::vector<SplitResult> splits;         ///< the weight-driven stage of each split pair
+  std::vector<std::uint32_t> split_pairs;  ///< the pair of each entry of `splits`
+  std::vector<narrow::Taboo> taboos;       ///< a posteriori taboo lists (Root::taboo and Root::owner index them)
+  bool weighted = false;                   ///< the tasks carry weight estimates (calibrated methods)
+  double omega = 0.0;                      ///< the caliber (0 for a plan of whole pairs)
+  std::size_t kept = 0;                    ///< initial tasks run as they are
+  std::size_t split = 0;                   ///< initial tasks split
+  std::size_t carted = 0;                  ///< items merged in the cart
+  std::size_t taboo_nodes = 0;             ///< a posteriori: sub-task roots handed out
 };
 
 /// Sequential and exploitation: one run-time task per pair, whole, in pair order.
@@ -51,8 +51,8 @@ struct InitialWeights {
   std::vector<double> scale;   ///< per pair: what node weights are multiplied by
   double total = 0.0;
 };
-[[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<Task>& pairs,
-                                             narrow::PairContexts contexts, const History& history);
+[[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+                                             const History& history);
 
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
 /// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
@@ -60,8 +60,7 @@ struct InitialWeights {
 /// if set, is called with each split pair's index and its weight-driven stage, and must run it
 /// (the engine times it).
 using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;
-[[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs,
-                                   narrow::PairContexts contexts, const History& history,
-                                   const StageWrapper& around_stage = {});
+[[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+                                   const History& history, const StageWrapper& around_stage = {});
 
 }  // namespace caliber::tasks

@@ -28,14 +28,16 @@ double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n) {
   for (int i = 0; i < 3; ++i) dist2 += (a.center[i] - b.center[i]) * (a.center[i] - b.center[i]);
   const double d = reach(ctx.request());
   const double lens = std::max(0.0, a.radius + b.radius + d - std::sqrt(dist2));
-  double depth = lens;                                       // least penetration, spheres and six box axes
+  double depth = lens;  // least penetration, spheres and six box axes
   double axes_a = depth_share(lens, a.radius), axes_b = depth_share(lens, b.radius);  // least share per axis
   for (int i = 0; i < 3; ++i) {
     const double pen_a = a.half[i] + b.reach_on_a[i] + d - std::abs(b.box_in_a[i] - a.box[i]);  // A's axis i
     const double pen_b = b.half[i] + a.reach_on_b[i] + d - std::abs(b.box[i] - a.box_in_b[i]);  // B's axis i
     depth = std::min({depth, std::max(0.0, pen_a), std::max(0.0, pen_b)});
-    axes_a = std::min({axes_a, axis_share(pen_a, a.half[i], b.reach_on_a[i] + d), axis_share(pen_b, a.reach_on_b[i], b.half[i] + d)});
-    axes_b = std::min({axes_b, axis_share(pen_b, b.half[i], a.reach_on_b[i] + d), axis_share(pen_a, b.reach_on_a[i], a.half[i] + d)});
+    axes_a =
+        std::min({axes_a, axis_share(pen_a, a.half[i], b.reach_on_a[i] + d), axis_share(pen_b, a.reach_on_b[i], b.half[i] + d)});
+    axes_b =
+        std::min({axes_b, axis_share(pen_b, b.half[i], a.reach_on_b[i] + d), axis_share(pen_a, b.reach_on_a[i], a.half[i] + d)});
   }
   const double share_a = std::sqrt(depth_share(depth, a.radius) * axes_a);
   const double share_b = std::sqrt(depth_share(depth, b.radius) * axes_b);

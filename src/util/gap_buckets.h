@@ -141,12 +141,12 @@ class GapBuckets {
     mTop[b / 262144] &= ~(std::uint64_t{1} << ((b / 4096) % 64));
   }
 
-  std::vector<Node> mPool;            ///< every entry pushed since clear(), popped or not
+  std::vector<Node> mPool;  ///< every entry pushed since clear(), popped or not
   /// Per nonempty bucket: its last entry in mPool (never initialized: read only where the bucket's
   /// bit says it was written since it was last emptied).
   std::unique_ptr<std::uint32_t[]> mHeads;
-  std::vector<std::uint64_t> mBottom;  ///< bit b: bucket b is nonempty
-  std::vector<std::uint64_t> mMiddle;  ///< bit w: word w of mBottom is nonzero
+  std::vector<std::uint64_t> mBottom;          ///< bit b: bucket b is nonempty
+  std::vector<std::uint64_t> mMiddle;          ///< bit w: word w of mBottom is nonzero
   std::uint64_t mTop[kBuckets / 262144] = {};  ///< bit m: word m of mMiddle is nonzero
   std::uint32_t mCount = 0;                    ///< nonempty buckets
   std::uint32_t mMin = kBuckets;               ///< the lowest nonempty bucket; kBuckets when none

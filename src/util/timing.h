@@ -12,7 +12,9 @@ namespace caliber::util {
 using Clock = std::chrono::steady_clock;
 
 /// Milliseconds since `start`.
-inline double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
+inline double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
 
 /// Milliseconds from `origin` to `t`.
 inline double ms_between(Clock::time_point origin, Clock::time_point t) {

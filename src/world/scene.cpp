@@ -134,8 +134,8 @@ SceneObject read_object(const Reader& r, const Json& j, const std::string& where
   o.mesh = o.mesh.lexically_normal();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(o.mesh, ec)) {
-    r.fail(where + ".mesh", "no such mesh file: " + o.mesh.string() +
-                                (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
+    r.fail(where + ".mesh",
+           "no such mesh file: " + o.mesh.string() + (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
            ErrorCode::file_not_found);
   }
   o.scale = r.number(j, where, "scale", 1.0);
@@ -179,7 +179,8 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   }
   query.angle_deg = r.number(q, "query", "angle", query.angle_deg);
   if (query.angle_deg < 0.0 || query.angle_deg > 180.0) r.fail("query.angle", "must be in [0, 180] degrees");
-  if (q.contains("max_pairs")) query.max_pairs = static_cast<std::size_t>(r.integer(q.at("max_pairs"), "query.max_pairs", 0, 0x7fffffff));
+  if (q.contains("max_pairs"))
+    query.max_pairs = static_cast<std::size_t>(r.integer(q.at("max_pairs"), "query.max_pairs", 0, 0x7fffffff));
   return query;
 }
 
@@ -252,7 +253,8 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
 Scene load_scene(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw Error(ErrorCode::file_not_found, file.string(), "no such scene file");
-  if (std::filesystem::is_directory(file, ec)) throw Error(ErrorCode::unreadable, file.string(), "is a directory, not a scene file");
+  if (std::filesystem::is_directory(file, ec))
+    throw Error(ErrorCode::unreadable, file.string(), "is a directory, not a scene file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCode::unreadable, file.string(), "cannot be opened for reading");
   std::stringstream text;

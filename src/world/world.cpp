@@ -40,7 +40,8 @@ World::World(Scene scene) : mScene(std::move(scene)) {
   mRequest = mScene.query;
   mRequest.groups = mScene.use_groups ? &mScene.compatibility : nullptr;
   // One model per (file, scale, refinement, groups): objects that share all four share the BVH.
-  using Key = std::tuple<std::string, double, int, std::uint8_t, std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint8_t>>>;
+  using Key =
+      std::tuple<std::string, double, int, std::uint8_t, std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint8_t>>>;
   std::map<Key, std::shared_ptr<const Model>> cache;
   std::map<std::string, Mesh> loaded;
   for (const SceneObject& o : mScene.objects) {
@@ -49,28 +50,29 @@ World::World(Scene scene) : mScene(std::move(scene)) {
     const Key key{o.mesh.string(), o.scale, o.refine, o.group, ranges};
     auto it = cache.find(key);
     if (it == cache.end()) try {
-      auto file = loaded.find(o.mesh.string());
-      if (file == loaded.end()) file = loaded.emplace(o.mesh.string(), load_mesh(o.mesh)).first;
-      Mesh mesh = refine_mesh(file->second, o.refine);
-      if (o.scale != 1.0) scale_mesh(mesh, o.scale);
-      if (o.group != 0 || !o.groups.empty()) {
-        mesh.groups.assign(mesh.triangles.size(), o.group);
-        for (const GroupRange& g : o.groups) {
-          if (std::uint64_t{g.first} + g.count > mesh.triangles.size()) {
-            throw Error(ErrorCode::bad_value, mScene.file.string(),
-                        "object '" + o.name + "': group range beyond its " + std::to_string(mesh.triangles.size()) + " triangles");
+        auto file = loaded.find(o.mesh.string());
+        if (file == loaded.end()) file = loaded.emplace(o.mesh.string(), load_mesh(o.mesh)).first;
+        Mesh mesh = refine_mesh(file->second, o.refine);
+        if (o.scale != 1.0) scale_mesh(mesh, o.scale);
+        if (o.group != 0 || !o.groups.empty()) {
+          mesh.groups.assign(mesh.triangles.size(), o.group);
+          for (const GroupRange& g : o.groups) {
+            if (std::uint64_t{g.first} + g.count > mesh.triangles.size()) {
+              throw Error(
+                  ErrorCode::bad_value, mScene.file.string(),
+                  "object '" + o.name + "': group range beyond its " + std::to_string(mesh.triangles.size()) + " triangles");
+            }
+            std::fill_n(mesh.groups.begin() + g.first, g.count, g.group);
           }
-          std::fill_n(mesh.groups.begin() + g.first, g.count, g.group);
         }
+        BuildOptions build;
+        build.adjacency = mRequest.kind == QueryKind::contact;        // only the contact reduction reads it
+        build.oriented_boxes = mRequest.kind == QueryKind::distance;  // only the distance bound reads them
+        it = cache.emplace(key, build_model(std::move(mesh), build)).first;
+      } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::out_of_memory, o.mesh.string(),
+                    "out of memory while loading and building the model of object '" + o.name + "'");
       }
-      BuildOptions build;
-      build.adjacency = mRequest.kind == QueryKind::contact;  // only the contact reduction reads it
-      build.oriented_boxes = mRequest.kind == QueryKind::distance;  // only the distance bound reads them
-      it = cache.emplace(key, build_model(std::move(mesh), build)).first;
-    } catch (const std::bad_alloc&) {
-      throw Error(ErrorCode::out_of_memory, o.mesh.string(),
-                  "out of memory while loading and building the model of object '" + o.name + "'");
-    }
     mModels.push_back(it->second);
     mStatic.push_back(o.motion.type == Motion::Type::fixed);
   }
@@ -97,8 +99,7 @@ std::vector<Pose> World::poses_at(int step) const {
     poses.push_back(pose_at(o.pose, o.motion, t));
     if (!poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
       throw Error(ErrorCode::bad_value, "scene " + mScene.name,
-                  "object '" + o.name + "' moves beyond +-1e15 (caliber's limit on coordinates) by step " +
-                      std::to_string(step));
+                  "object '" + o.name + "' moves beyond +-1e15 (caliber's limit on coordinates) by step " + std::to_string(step));
     }
   }
   return poses;
@@ -130,7 +131,8 @@ std::vector<Task> World::broad_phase(const std::vector<Pose>& poses) const {
       const std::uint32_t a = std::min(order[i], order[j]);
       const std::uint32_t b = std::max(order[i], order[j]);
       if (mStatic[a] && mStatic[b]) continue;
-      if (std::find(mScene.ignore.begin(), mScene.ignore.end(), std::pair<int, int>(int(a), int(b))) != mScene.ignore.end()) continue;
+      if (std::find(mScene.ignore.begin(), mScene.ignore.end(), std::pair<int, int>(int(a), int(b))) != mScene.ignore.end())
+        continue;
       tasks.push_back(Task{a, b});
     }
   }

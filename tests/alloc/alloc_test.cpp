@@ -54,9 +54,9 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 namespace {
 
 struct Counts {
-  long first = 0;       // allocations over the first window after warm-up
-  long last = 0;        // over the last window
-  long most = 0;        // the most in one step
+  long first = 0;                // allocations over the first window after warm-up
+  long last = 0;                 // over the last window
+  long most = 0;                 // the most in one step
   std::uint64_t node_tests = 0;  // the most in one step
 };
 

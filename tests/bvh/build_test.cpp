@@ -60,10 +60,14 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
       EXPECT_LE((p - c).norm(), node.radius) << "node " << index << " sphere must cover its vertices";
       EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
       const double along = stored_axis.dot(p);
-      EXPECT_TRUE(filter.slab_lo <= along && along <= filter.slab_hi) << "node " << index << " slab must cover its vertices: " << filter.slab_lo << " <= " << along << " <= " << filter.slab_hi << " (triangle " << t << ")";
+      EXPECT_TRUE(filter.slab_lo <= along && along <= filter.slab_hi)
+          << "node " << index << " slab must cover its vertices: " << filter.slab_lo << " <= " << along
+          << " <= " << filter.slab_hi << " (triangle " << t << ")";
       for (int k = 0; k < 2; ++k) {
         const double at = lateral[k][0] * p.x() + lateral[k][1] * p.y() + lateral[k][2] * p.z();
-        EXPECT_TRUE(lateral_range.lateral_lo[k] <= at && at <= lateral_range.lateral_hi[k]) << "node " << index << " lateral range " << k << " must cover its vertices: " << lateral_range.lateral_lo[k] << " <= " << at << " <= " << lateral_range.lateral_hi[k] << " (triangle " << t << ")";
+        EXPECT_TRUE(lateral_range.lateral_lo[k] <= at && at <= lateral_range.lateral_hi[k])
+            << "node " << index << " lateral range " << k << " must cover its vertices: " << lateral_range.lateral_lo[k]
+            << " <= " << at << " <= " << lateral_range.lateral_hi[k] << " (triangle " << t << ")";
       }
     }
     if (m.normals[t].squaredNorm() > 0.0) {
@@ -93,7 +97,9 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   EXPECT_EQ(any_normal, filter.cone_angle >= 0.0f) << "node " << index;
   if (!any_normal) {
     EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
-    for (int k = 0; k < 2; ++k) EXPECT_TRUE(lateral_range.lateral_lo[k] == 0.0f && lateral_range.lateral_hi[k] == 0.0f) << "node " << index << ": no axis, no lateral range";
+    for (int k = 0; k < 2; ++k)
+      EXPECT_TRUE(lateral_range.lateral_lo[k] == 0.0f && lateral_range.lateral_hi[k] == 0.0f)
+          << "node " << index << ": no axis, no lateral range";
   } else {
     // The frame is orthonormal: the lateral axes unit, orthogonal to each other and to the axis.
     const Eigen::Vector3d u(lateral[0][0], lateral[0][1], lateral[0][2]), w(lateral[1][0], lateral[1][1], lateral[1][2]);

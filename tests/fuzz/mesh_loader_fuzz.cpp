@@ -35,7 +35,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   // The four formats, the same in capitals, and names caliber must refuse whatever they hold (no
   // extension, formats assimp knows but caliber does not read).
-  static const char* const kExtensions[] = {".off", ".obj", ".ply", ".stl", "", ".ase", ".dae", ".OFF", ".PLY", ".nff", ".raw", ".smd"};
+  static const char* const kExtensions[] = {".off", ".obj", ".ply", ".stl", "",     ".ase",
+                                            ".dae", ".OFF", ".PLY", ".nff", ".raw", ".smd"};
   const std::filesystem::path path = scratch_dir() / (std::string("input") + kExtensions[data[0] % 12]);
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -35,8 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::optional<caliber::Pose> parsed;
   try {
     parsed = caliber::parse_pose(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz");
-  } catch (const caliber::Error&) {
-  }
+  } catch (const caliber::Error&) {}
   if (parsed) check(*parsed);
   if (size >= 7 * sizeof(double)) {
     double v[9] = {};
@@ -44,14 +43,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::optional<caliber::Pose> built;
     try {
       built = caliber::Pose::from_values(v[0], v[1], v[2], v[3], v[4], v[5], v[6], "fuzz");
-    } catch (const caliber::Error&) {
-    }
+    } catch (const caliber::Error&) {}
     if (built) check(*built);
     try {
       caliber::validate_request(caliber::QueryRequest{caliber::QueryKind::contact, v[7], v[8], nullptr});
       if (!(v[7] >= 0 && v[7] <= caliber::kMaxCoordinate && v[8] >= 0 && v[8] <= 180)) std::abort();
-    } catch (const caliber::Error&) {
-    }
+    } catch (const caliber::Error&) {}
   }
   return 0;
 }

@@ -139,5 +139,4 @@ ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
   return best;
 }
 
-
 }  // namespace caliber::geometry::reference

@@ -155,8 +155,9 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
   int differing = 0;
   // Every form this build and this CPU have: the one the library calls, the portable one, AVX2.
   std::vector<std::pair<const char*, detail::TriangleKernel>> kernels{{"dispatched", &closest_points_triangles},
-                                                                     {"portable", &detail::closest_points_triangles_portable}};
-  if (const detail::TriangleKernel avx2 = detail::closest_points_triangles_avx2_if_supported()) kernels.emplace_back("avx2", avx2);
+                                                                      {"portable", &detail::closest_points_triangles_portable}};
+  if (const detail::TriangleKernel avx2 = detail::closest_points_triangles_avx2_if_supported())
+    kernels.emplace_back("avx2", avx2);
   for (int iter = 0; iter < 200000; ++iter) {
     Vec3 a[3], b[3];
     double scale = 1.0;
@@ -174,7 +175,8 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
     // The public single queries too (the leaf test does not call them, the build does not either).
     if (iter % 16 == 0) {
       const Vec3 x = random_point() * scale;
-      EXPECT_TRUE(same_bits(closest_point_on_triangle(x, b[0], b[1], b[2]), reference::closest_point_on_triangle(x, b[0], b[1], b[2])));
+      EXPECT_TRUE(
+          same_bits(closest_point_on_triangle(x, b[0], b[1], b[2]), reference::closest_point_on_triangle(x, b[0], b[1], b[2])));
     }
   }
   EXPECT_EQ(differing, 0);
@@ -185,8 +187,8 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
 /// must not depend on the padding), each pair's kind in different lanes from batch to batch.
 TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
   std::mt19937_64 rng(20261123);
-  std::vector<std::pair<const char*, detail::BatchKernel>> kernels{
-      {"dispatched", nullptr}, {"by pair", &detail::closest_points_triangles_batch_by_pair}};
+  std::vector<std::pair<const char*, detail::BatchKernel>> kernels{{"dispatched", nullptr},
+                                                                   {"by pair", &detail::closest_points_triangles_batch_by_pair}};
   if (const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported()) {
     kernels.emplace_back("avx512", avx512);
   }

@@ -159,7 +159,6 @@ TEST(TriangleIntersect, RandomAgreesWithDistanceWherePlain) {
   EXPECT_GT(no, 1000);
 }
 
-
 /// Whether the pair takes the planes-crossing test: every corner strictly off the other's plane, and
 /// each plane with corners of the other triangle on both sides.
 bool planes_cross(const Vec3 a[3], const Vec3 b[3]) {
@@ -269,8 +268,10 @@ TEST(CertainlySeparated, NeverForTouchingTriangles) {
   std::uniform_real_distribution<double> u(0.1, 1.0);
   for (int iter = 0; iter < 2000; ++iter) {
     const Vec3 shared(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
-    const Vec3 a[3] = {shared, shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5), shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5)};
-    const Vec3 b[3] = {shared, shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5), shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5)};
+    const Vec3 a[3] = {shared, shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5),
+                       shared + Vec3(-u(rng), u(rng) - 0.5, u(rng) - 0.5)};
+    const Vec3 b[3] = {shared, shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5),
+                       shared + Vec3(u(rng), u(rng) - 0.5, u(rng) - 0.5)};
     ASSERT_TRUE(tri_tri(a, b));
     const ClosestPoints c = closest_points_triangles(a, b);
     EXPECT_FALSE(certainly_separated(c.on_b - c.on_a, a, b)) << "iteration " << iter;

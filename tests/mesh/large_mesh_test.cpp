@@ -35,8 +35,8 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
   const double build_s = seconds_since(t);
   const auto probe = build_model(make_box(0.01, 0.01, 0.01, 2));
   const Pose at_surface = Pose::from_values(0.6, 0.0, 0.8, 0.97, 0.1, 0.2, 0.05);
-  std::printf("2M-triangle mesh: %zu triangles, write %.1f s, load %.1f s, BVH build %.1f s, %zu nodes\n",
-              big.triangles.size(), write_s, load_s, build_s, model->nodes.size());
+  std::printf("2M-triangle mesh: %zu triangles, write %.1f s, load %.1f s, BVH build %.1f s, %zu nodes\n", big.triangles.size(),
+              write_s, load_s, build_s, model->nodes.size());
 
   // Independent check: the big mesh's triangles whose box meets the probe's world box (grown by the
   // tolerance) form a small mesh; brute force on it must give exactly the pairs the BVH query gave.
@@ -76,8 +76,8 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
     std::sort(want.begin(), want.end());
     EXPECT_EQ(fast.pairs, want) << to_string(kind);
     std::printf("  %s: %zu pairs, %llu node tests (brute force over %zu nearby triangles)\n",
-                std::string(to_string(kind)).c_str(), fast.pairs.size(),
-                static_cast<unsigned long long>(fast.stats.node_tests), near.triangles.size());
+                std::string(to_string(kind)).c_str(), fast.pairs.size(), static_cast<unsigned long long>(fast.stats.node_tests),
+                near.triangles.size());
   }
 }
 

@@ -99,8 +99,9 @@ TEST(LoadOff, VariantsCommentsColoursAndDoubles) {
     return path;
   };
   // Counts on the header line, comments, a colour after each face, CRLF, doubles kept as doubles.
-  const Mesh m = load_mesh(write("coff", "COFF 4 2 0 # counts here\r\n0.1 0 0 255 0 0 255\r\n1 0 0 0 255 0 255\r\n"
-                                         "1 1 0 0 0 255 255\r\n# comment line\r\n0 1 0 9 9 9 9\r\n3 0 1 2 1 0 0\r\n3 0 2 3\r\n"));
+  const Mesh m = load_mesh(write("coff",
+                                 "COFF 4 2 0 # counts here\r\n0.1 0 0 255 0 0 255\r\n1 0 0 0 255 0 255\r\n"
+                                 "1 1 0 0 0 255 255\r\n# comment line\r\n0 1 0 9 9 9 9\r\n3 0 1 2 1 0 0\r\n3 0 2 3\r\n"));
   ASSERT_EQ(m.triangles.size(), 2u);
   EXPECT_EQ(m.vertices[0].x(), 0.1) << "a double, not a float";
   EXPECT_EQ(m.triangles[1], (std::array<std::uint32_t, 3>{0, 2, 3}));
@@ -111,12 +112,14 @@ TEST(LoadOff, VariantsCommentsColoursAndDoubles) {
   expect_error(write("huge", "OFF\n4000000000 1 0\n0 0 0\n"), ErrorCode::unreadable, "truncated");
   expect_error(write("short_face", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"), ErrorCode::unreadable,
                "line 6: face 0 lists fewer than 3 corners");
-  expect_error(write("word", "OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"), ErrorCode::unreadable, "line 4: 'x' is not a coordinate");
+  expect_error(write("word", "OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"), ErrorCode::unreadable,
+               "line 4: 'x' is not a coordinate");
   expect_error(write("negative", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n"), ErrorCode::unreadable,
                "'-1' is not a vertex index");
   expect_error(write("vertex", "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"), ErrorCode::unreadable, "vertex 1 needs x y z");
   // The input that made assimp's OFF importer crash (tests/fuzz/regressions/mesh_loader/).
-  expect_error(write("fuzz", "OFF\n# a pentagon\n3  2 0\n0 0 0\n2 0 0\n3 1 0\n1 3 0\nOFF\n"), ErrorCode::bad_index, "face 0 has 1 corner(s)");
+  expect_error(write("fuzz", "OFF\n# a pentagon\n3  2 0\n0 0 0\n2 0 0\n3 1 0\n1 3 0\nOFF\n"), ErrorCode::bad_index,
+               "face 0 has 1 corner(s)");
 }
 
 TEST(ValidateMesh, ReportsProblemsOfHandBuiltMeshes) {
@@ -143,7 +146,6 @@ TEST(LoadMesh, CgalMeshesLoad) {
   const Mesh mesh = load_mesh(dir / "armadillo.off");
   EXPECT_EQ(mesh.triangles.size(), 52000u);
 }
-
 
 namespace ply {
 
@@ -182,8 +184,9 @@ TEST(LoadPly, BinaryBothByteOrdersDoublesAndExtraProperties) {
   expect_tetra(load_mesh(ply::write("le", ply::binary_tetra(false))));
   expect_tetra(load_mesh(ply::write("be", ply::binary_tetra(true))));
   // A binary body whose first byte is '\n' (assimp skips it and shifts everything).
-  std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\n"
-                  "property uchar z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string s =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\n"
+      "property uchar z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
   s += std::string("\n\0\0", 3) + std::string("\0\n\0", 3) + std::string("\0\0\n", 3);
   s += ply::raw<std::uint8_t>(3, false) + ply::raw<std::int32_t>(0, false) + ply::raw<std::int32_t>(1, false) +
        ply::raw<std::int32_t>(2, false);
@@ -194,10 +197,11 @@ TEST(LoadPly, BinaryBothByteOrdersDoublesAndExtraProperties) {
 }
 
 TEST(LoadPly, AsciiWithCrLfQuadsAndPlusSigns) {
-  const Mesh m = load_mesh(ply::write("quad", "ply\r\nformat ascii 1.0\r\nelement vertex 4\r\nproperty float x\r\n"
-                                              "property float y\r\nproperty float z\r\nelement face 1\r\n"
-                                              "property list uchar int vertex_index\r\nend_header\r\n"
-                                              "0 0 0\r\n+1 0 0\r\n1 1 0\r\n0 1 0.5e0\r\n4 0 1 2 3\r\n"));
+  const Mesh m = load_mesh(ply::write("quad",
+                                      "ply\r\nformat ascii 1.0\r\nelement vertex 4\r\nproperty float x\r\n"
+                                      "property float y\r\nproperty float z\r\nelement face 1\r\n"
+                                      "property list uchar int vertex_index\r\nend_header\r\n"
+                                      "0 0 0\r\n+1 0 0\r\n1 1 0\r\n0 1 0.5e0\r\n4 0 1 2 3\r\n"));
   ASSERT_EQ(m.triangles.size(), 2u);
   EXPECT_EQ(m.triangles[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
   EXPECT_EQ(m.triangles[1], (std::array<std::uint32_t, 3>{0, 2, 3}));
@@ -205,15 +209,17 @@ TEST(LoadPly, AsciiWithCrLfQuadsAndPlusSigns) {
 }
 
 TEST(LoadPly, BadFilesFailClearly) {
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                           "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\n";
   const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   EXPECT_EQ(load_mesh(ply::write("ok", head + "end_header\n" + body)).triangles.size(), 1u);
   // assimp hangs on this one (found by the fuzzer; also in tests/fuzz/regressions/mesh_loader/).
   expect_error(ply::write("no_end", head), ErrorCode::unreadable, "no 'end_header'");
   expect_error(ply::write("no_end_body", head + body), ErrorCode::unreadable, "header line 9: unknown header keyword '0'");
-  expect_error(ply::write("huge_count", "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\n"
-                                        "property float z\nend_header\n0 0 0\n"),
+  expect_error(ply::write("huge_count",
+                          "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 0\n"),
                ErrorCode::unreadable, "more than the file holds");
   expect_error(ply::write("no_props", "ply\nformat ascii 1.0\nelement junk 1000000000000000000\nend_header\n"),
                ErrorCode::unreadable, "no properties");
@@ -230,11 +236,13 @@ TEST(LoadPly, BadFilesFailClearly) {
                "unknown format");
   expect_error(ply::write("keyword", "ply\nformat ascii 1.0\nelemnt vertex 3\nend_header\n"), ErrorCode::unreadable,
                "unknown header keyword 'elemnt'");
-  expect_error(ply::write("points", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                                    "property float z\nend_header\n0 0 0\n"),
+  expect_error(ply::write("points",
+                          "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 0\n"),
                ErrorCode::empty_mesh, "no triangles");
-  std::string list = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\n"
-                     "property uchar z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
+  std::string list =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\n"
+      "property uchar z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
   list += std::string(9, '\0') + ply::raw<std::uint32_t>(4000000000u, false) + ply::raw<std::int32_t>(0, false);
   expect_error(ply::write("long_list", list), ErrorCode::unreadable, "list longer than the rest of the file");
 }

@@ -79,8 +79,8 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
   for (const StepResult& r : reference) contacts += r.contacts.size();
   ASSERT_GT(contacts, 0u);
 
-  const Method methods[] = {Method::sequential, Method::exploitation, Method::stealing,
-                            Method::aposteriori, Method::apriori,     Method::hybrid};
+  const Method methods[] = {Method::sequential,  Method::exploitation, Method::stealing,
+                            Method::aposteriori, Method::apriori,      Method::hybrid};
   constexpr int kMethods = 6;
   std::vector<std::vector<StepResult>> got(kMethods + 1);
   std::vector<std::thread> threads;

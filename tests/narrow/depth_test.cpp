@@ -17,7 +17,7 @@ namespace {
 TEST(Depth, ABoxPushedIntoABoxByAFifth) {
   const auto box = build_model(make_box(0.5, 0.5, 0.5, 1));
   QueryRequest request;
-  request.kind = QueryKind::proximity;  // every intersecting pair, whatever its normals
+  request.kind = QueryKind::proximity;                            // every intersecting pair, whatever its normals
   const Pose up = Pose::from_values(0.1, 0.05, 0.8, 1, 0, 0, 0);  // B's bottom 0.2 below A's top
   const QueryResult r = query(*box, Pose{}, *box, up, request);
   int top = 0;

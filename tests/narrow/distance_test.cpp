@@ -193,8 +193,8 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
     for (const Contact& c : r.contacts) want.push_back(SceneContact{t.a, t.b, c});
   }
   ASSERT_GE(want.size(), 3u) << "most pairs must be within the tolerance for this to test anything";
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
-                              Method::apriori, Method::hybrid}) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     for (const int threads : {1, 2, 3}) {
       EngineOptions options;
       options.method = method;
@@ -209,11 +209,12 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
         for (std::size_t i = 0; i < want.size(); ++i) {
           EXPECT_EQ(got.contacts[i].object_a, want[i].object_a) << what;
           EXPECT_EQ(got.contacts[i].object_b, want[i].object_b) << what;
-          test::expect_identical(QueryResult{QueryKind::distance, {{got.contacts[i].contact.tri_a, got.contacts[i].contact.tri_b}},
-                                             {got.contacts[i].contact}, {}},
-                                 QueryResult{QueryKind::distance, {{want[i].contact.tri_a, want[i].contact.tri_b}},
-                                             {want[i].contact}, {}},
-                                 what);
+          test::expect_identical(
+              QueryResult{QueryKind::distance,
+                          {{got.contacts[i].contact.tri_a, got.contacts[i].contact.tri_b}},
+                          {got.contacts[i].contact},
+                          {}},
+              QueryResult{QueryKind::distance, {{want[i].contact.tri_a, want[i].contact.tri_b}}, {want[i].contact}, {}}, what);
         }
       }
     }

@@ -25,7 +25,8 @@ double apart_of(const Frame& a, const Frame& b, const double d[3]) {
 Frame random_frame(std::mt19937_64& rng, double spread) {
   std::normal_distribution<double> normal;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const Eigen::Matrix3d r = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
+  const Eigen::Matrix3d r =
+      Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
   Frame f{};
   for (int k = 0; k < 3; ++k) {
     for (int i = 0; i < 3; ++i) f.axis[k][i] = r(i, k);

@@ -60,7 +60,8 @@ TEST(Gaps2x2, SameBoundsAsGap) {
         // Descend into the pairs within twice the reach, where the bounds are close to it.
         if (want <= 2.0 * reach) work.emplace_back(na.index + k / 2, nb.index + k % 2);
         if (!ok && ++differing <= 5) {
-          ADD_FAILURE() << "pose " << p << " pair " << k << ": gap " << want << ", four at once " << gaps[k] << ", reach " << reach;
+          ADD_FAILURE() << "pose " << p << " pair " << k << ": gap " << want << ", four at once " << gaps[k] << ", reach "
+                        << reach;
         }
       }
     }

@@ -103,8 +103,8 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
     ASSERT_GT(f.pairs.size(), 30u) << t.a << "-" << t.b;
   }
   frame.request.max_pairs = 25;
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
-                              Method::apriori, Method::hybrid}) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     for (const int threads : {1, 3}) {
       EngineOptions options;
       options.method = method;

@@ -37,9 +37,8 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
         if (na.is_leaf() || nb.is_leaf()) continue;
         // Both sides split, then only A's, then only B's (the other side's node given twice).
         const std::uint32_t wa = work[w].first, wb = work[w].second;
-        const std::uint32_t cases[3][4] = {{na.index, na.index + 1, nb.index, nb.index + 1},
-                                           {na.index, na.index + 1, wb, wb},
-                                           {wa, wa, nb.index, nb.index + 1}};
+        const std::uint32_t cases[3][4] = {
+            {na.index, na.index + 1, nb.index, nb.index + 1}, {na.index, na.index + 1, wb, wb}, {wa, wa, nb.index, nb.index + 1}};
         for (int c = 0; c < 3; ++c) {
           const auto& [a0, a1, b0, b1] = cases[c];
           PairContext::SideA sa[2] = {ctx.prepare_a(a0), ctx.prepare_a(a1)};
@@ -70,8 +69,8 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
             (want ? passed : failed) += 1;
             if (want && c == 0) work.emplace_back(na.index + k / 2, nb.index + k % 2);
             if (want != (((mask >> k) & 1) != 0) && ++differing <= 5) {
-              ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << " pair " << k
-                            << ": scalar " << want;
+              ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << " pair " << k << ": scalar "
+                            << want;
             }
           }
         }

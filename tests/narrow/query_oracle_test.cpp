@@ -89,8 +89,8 @@ TEST(QueryOracle, AxisAlignedBoxesTouchingAndCoplanar) {
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<int> step(-9, 9);
   const double half = 0.70710678118654752440;
-  const Eigen::Quaterniond turns[6] = {Eigen::Quaterniond(1, 0, 0, 0), Eigen::Quaterniond(0, 1, 0, 0),
-                                       Eigen::Quaterniond(0, 0, 1, 0), Eigen::Quaterniond(0, 0, 0, 1),
+  const Eigen::Quaterniond turns[6] = {Eigen::Quaterniond(1, 0, 0, 0),       Eigen::Quaterniond(0, 1, 0, 0),
+                                       Eigen::Quaterniond(0, 0, 1, 0),       Eigen::Quaterniond(0, 0, 0, 1),
                                        Eigen::Quaterniond(half, half, 0, 0), Eigen::Quaterniond(half, 0, 0, half)};
   std::array<int, 3> non_empty{0, 0, 0};
   const int poses = 300;

@@ -99,8 +99,8 @@ TEST(NodeSlab, GapsAroundTheToleranceGiveTheOracleAnswer) {
         request.tolerance = tolerance;
         request.angle_deg = 180.0;  // parallel patches face the same way: let the cone test pass
         const Pose pb = pose_at_gap(common, own, gap);
-        const std::string what = "pose " + std::to_string(pose) + " gap " + std::to_string(gap) + " kind " +
-                                 std::to_string(static_cast<int>(kind));
+        const std::string what =
+            "pose " + std::to_string(pose) + " gap " + std::to_string(gap) + " kind " + std::to_string(static_cast<int>(kind));
         const QueryResult fast = query(*a, common, b, pb, request);
         test::expect_identical(fast, query_brute_force(*a, common, b, pb, request), what);
         if (::testing::Test::HasFatalFailure()) return;
@@ -165,8 +165,8 @@ TEST(NodeSlab, DisksRefuseOnlyWhatLiesBeyondASlab) {
   const auto box = build_model(make_box(0.6, 0.4, 0.3, 12));
   const auto flat_a = build_model(patch(12, 0.0, kNormal));
   const auto flat_b = build_model(patch(12, 0.37, kNormal));
-  const std::pair<const Model*, const Model*> pairs[] = {{torus.get(), box.get()}, {torus.get(), torus.get()},
-                                                         {flat_a.get(), flat_b.get()}};
+  const std::pair<const Model*, const Model*> pairs[] = {
+      {torus.get(), box.get()}, {torus.get(), torus.get()}, {flat_a.get(), flat_b.get()}};
   std::mt19937_64 rng(20261125);
   long refused = 0;
   for (const auto& [a, b] : pairs) {
@@ -204,8 +204,10 @@ TEST(NodeSlab, DisksRefuseOnlyWhatLiesBeyondASlab) {
             ++refused;
             // B's vertices in A's frame against A's slab; A's in B's frame against B's slab.
             std::vector<Eigen::Vector3d> below_b = vertices_below(*b, ib), below_a = vertices_below(*a, ia);
-            for (Eigen::Vector3d& v : below_b) v = to_a * (pose_b.rotation_matrix() * v + pose_b.translation - pose_a.translation);
-            for (Eigen::Vector3d& v : below_a) v = to_b * (pose_a.rotation_matrix() * v + pose_a.translation - pose_b.translation);
+            for (Eigen::Vector3d& v : below_b)
+              v = to_a * (pose_b.rotation_matrix() * v + pose_b.translation - pose_a.translation);
+            for (Eigen::Vector3d& v : below_a)
+              v = to_b * (pose_a.rotation_matrix() * v + pose_a.translation - pose_b.translation);
             const BvhNodeFilter& fa = a->filters[ia];
             const BvhNodeFilter& fb = b->filters[ib];
             EXPECT_TRUE(all_beyond(below_b, fa.cone_axis, fa.slab_lo, fa.slab_hi, tolerance) ||

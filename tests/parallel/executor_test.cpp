@@ -25,8 +25,7 @@ struct Occupancy {
   void enter() {
     const int n = ++now;
     int p = peak.load();
-    while (n > p && !peak.compare_exchange_weak(p, n)) {
-    }
+    while (n > p && !peak.compare_exchange_weak(p, n)) {}
   }
   void leave() { --now; }
 };
@@ -152,7 +151,8 @@ TEST(Executor, ZeroRunsInTheArenaItIsCalledFrom) {
   const std::size_t before = os_threads();
   Executor executor(0);
   host.execute([&] {
-    EXPECT_EQ(executor.threads(), std::min(2, static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+    EXPECT_EQ(executor.threads(),
+              std::min(2, static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
     executor.execute([&] {
       std::atomic<int> outside{0};
       parallel_for(0, 256, 1, [&](std::size_t, std::size_t) {
@@ -188,16 +188,19 @@ TEST(Executor, ExceptionsReachTheWaiter) {
   Executor executor(3);
   EXPECT_THROW(executor.execute([] {
     TaskGroup group;
-    for (int i = 0; i < 20; ++i) group.run([i] {
-      if (i == 7) throw std::runtime_error("task 7");
-    });
+    for (int i = 0; i < 20; ++i)
+      group.run([i] {
+        if (i == 7) throw std::runtime_error("task 7");
+      });
     group.wait();
-  }), std::runtime_error);
+  }),
+               std::runtime_error);
   EXPECT_THROW(executor.execute([] {
     parallel_for(0, 100, 1, [](std::size_t lo, std::size_t) {
       if (lo == 42) throw std::runtime_error("chunk 42");
     });
-  }), std::runtime_error);
+  }),
+               std::runtime_error);
   // The executor is still usable afterwards.
   std::atomic<int> sum{0};
   executor.execute([&] { parallel_for_each(0, 100, [&](std::size_t i) { sum += static_cast<int>(i); }); });
@@ -228,7 +231,8 @@ TEST(Executor, ForEachInOrderRunsEveryItemOnceAndRethrows) {
       for_each_in_order(100, [](std::size_t i) {
         if (i == 42) throw std::runtime_error("item 42");
       });
-    }), std::runtime_error);
+    }),
+                 std::runtime_error);
   }
   std::vector<std::size_t> order;  // on one thread: in order
   Executor(1).execute([&] { for_each_in_order(5, [&](std::size_t i) { order.push_back(i); }); });

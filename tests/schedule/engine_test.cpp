@@ -55,10 +55,9 @@ void expect_all_methods_identical(const World& world, int steps) {
   std::size_t contacts = 0;
   for (const auto& r : reference) contacts += r.contacts.size();
   EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
-  const std::pair<Method, bool> configs[] = {{Method::sequential, false}, {Method::exploitation, false},
-                                             {Method::stealing, false},   {Method::aposteriori, false},
-                                             {Method::apriori, false},    {Method::hybrid, false},
-                                             {Method::hybrid, true}};
+  const std::pair<Method, bool> configs[] = {
+      {Method::sequential, false}, {Method::exploitation, false}, {Method::stealing, false}, {Method::aposteriori, false},
+      {Method::apriori, false},    {Method::hybrid, false},       {Method::hybrid, true}};
   for (const auto& [method, node_history] : configs) {
     for (const int threads : {1, 2, 3, 4, 8}) {
       EngineOptions options;
@@ -337,8 +336,8 @@ TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
       {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}},
       {"name": "c", "mesh": "cube.off", "position": [-0.6, 0.5, 0], "motion": {"type": "velocity"}}]})",
                                 dir, "predicted.json"));
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori,
-                              Method::hybrid}) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
     options.method = method;
     options.threads = 1;
@@ -442,8 +441,8 @@ Frame memory_frame(double t) {
 TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
   const Frame base = memory_frame(0.0);
   std::size_t contacts = 0;
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
-                              Method::apriori, Method::hybrid}) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
     options.method = method;
     options.threads = 3;
@@ -479,8 +478,8 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
 
 TEST(EngineFrames, EveryMethodRecordsItsTraversalAndFinalization) {
   const Frame frame = memory_frame(0.8);
-  for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori,
-                              Method::apriori, Method::hybrid}) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
     options.method = method;
     options.threads = 2;

@@ -65,11 +65,16 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw caliber::Error(caliber::ErrorCode::bad_argument, arg, "needs a value");
         return argv[++i];
       };
-      if (arg == "--steps") steps = std::stoi(value());
-      else if (arg == "--threads") threads = std::stoi(value());
-      else if (arg == "--method") options.method = caliber::parse_method(value());
-      else if (arg == "--node-history") options.node_history = true;
-      else throw caliber::Error(caliber::ErrorCode::bad_argument, arg, "unknown argument");
+      if (arg == "--steps")
+        steps = std::stoi(value());
+      else if (arg == "--threads")
+        threads = std::stoi(value());
+      else if (arg == "--method")
+        options.method = caliber::parse_method(value());
+      else if (arg == "--node-history")
+        options.node_history = true;
+      else
+        throw caliber::Error(caliber::ErrorCode::bad_argument, arg, "unknown argument");
     }
     if (steps < 1000) throw caliber::Error(caliber::ErrorCode::bad_value, "--steps", "must be >= 1000");
   } catch (const std::exception& e) {
@@ -95,8 +100,8 @@ int main(int argc, char** argv) {
       const bool ok = same(got, caliber::step(world, fresh, k)) && same(got, caliber::step(world, sequential, k));
       ++samples;
       if (!ok) ++mismatches;
-      std::printf("step %5d: %zu contacts, VmRSS %ld KiB, VmHWM %ld KiB%s\n", k + 1, got.contacts.size(),
-                  status_kib("VmRSS"), status_kib("VmHWM"), ok ? "" : "  MISMATCH with a fresh run");
+      std::printf("step %5d: %zu contacts, VmRSS %ld KiB, VmHWM %ld KiB%s\n", k + 1, got.contacts.size(), status_kib("VmRSS"),
+                  status_kib("VmHWM"), ok ? "" : "  MISMATCH with a fresh run");
       std::fflush(stdout);
     }
     if (k == 999) hwm_1000 = status_kib("VmHWM");
@@ -118,8 +123,8 @@ int main(int argc, char** argv) {
   if (kSanitized) {
     std::printf("memory: VmHWM %ld -> %ld KiB (not checked under a sanitizer)\n", hwm_1000, hwm_end);
   } else if (hwm_1000 < 0 || hwm_end > allowed) {
-    std::printf("FAIL: peak memory grew: VmHWM %ld KiB after step 1000, %ld KiB after step %d (allowed %ld)\n",
-                hwm_1000, hwm_end, steps, allowed);
+    std::printf("FAIL: peak memory grew: VmHWM %ld KiB after step 1000, %ld KiB after step %d (allowed %ld)\n", hwm_1000, hwm_end,
+                steps, allowed);
     failed = true;
   } else {
     std::printf("memory flat: VmHWM %ld KiB after step 1000, %ld KiB after step %d\n", hwm_1000, hwm_end, steps);

@@ -37,8 +37,8 @@ TEST(Calibration, ClassifyAtTheEpsilonBoundaries) {
 TEST(Calibration, CartMergesHeaviestWithLightestUntilOmega) {
   // Omega 10: 9 takes 1 (=10); 8 takes 1, 2 (=11); 7 takes 3 (=10); 6 alone is left with nothing? No:
   // 6 takes 4 (=10); 5 is last and alone.
-  std::vector<Root> cart = {item(0, 5), item(1, 1), item(2, 9), item(3, 2), item(4, 8), item(5, 1),
-                            item(6, 7), item(7, 3), item(8, 6), item(9, 4)};
+  std::vector<Root> cart = {item(0, 5), item(1, 1), item(2, 9), item(3, 2), item(4, 8),
+                            item(5, 1), item(6, 7), item(7, 3), item(8, 6), item(9, 4)};
   const std::vector<RunTask> tasks = merge_cart(cart, 10.0);
   ASSERT_EQ(tasks.size(), 5u);
   const std::vector<std::vector<double>> want = {{9, 1}, {8, 1, 2}, {7, 3}, {6, 4}, {5}};
@@ -149,7 +149,6 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
     }
   }
 }
-
 
 /// The paper's alternate traversal as written (and as split_task ran it until it went level by
 /// level): a max-heap of untested nodes keyed by weight; pop the heaviest, test it, leaf-test a leaf

@@ -22,7 +22,8 @@ struct Pairs {
   std::shared_ptr<const Model> sphere = build_model(make_sphere(1.0, 24, 32));
   std::shared_ptr<const Model> box = build_model(make_box(0.2, 0.2, 0.2, 2));
   std::vector<Task> pairs{Task{0, 1}, Task{0, 2}};
-  std::vector<Pose> poses{Pose{}, Pose::from_values(0.2, 0.1, 0.3, 0.9, 0.3, 0.1, 0.2), Pose::from_values(1.0, 0.0, 0.0, 1, 0, 0, 0)};
+  std::vector<Pose> poses{Pose{}, Pose::from_values(0.2, 0.1, 0.3, 0.9, 0.3, 0.1, 0.2),
+                          Pose::from_values(1.0, 0.0, 0.0, 1, 0, 0, 0)};
   QueryRequest request;
   std::vector<narrow::PairContext> contexts;
   Pairs() {
@@ -48,7 +49,8 @@ std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(co
     EXPECT_FALSE(t.roots.empty());
     for (const Root& r : t.roots) {
       std::vector<char> reached(r.taboo >= 0 ? plan.taboos[r.taboo].nodes.size() : 0);
-      const narrow::TabooView taboo = r.taboo >= 0 ? narrow::TabooView{&plan.taboos[r.taboo], reached.data()} : narrow::TabooView{};
+      const narrow::TabooView taboo =
+          r.taboo >= 0 ? narrow::TabooView{&plan.taboos[r.taboo], reached.data()} : narrow::TabooView{};
       narrow::traverse_depth_first(p.contexts[r.pair], r.node, scratch, found[r.pair], stats[r.pair], r.root_test(), taboo);
     }
   }
@@ -56,7 +58,8 @@ std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(co
   for (std::size_t i = 0; i < p.pairs.size(); ++i) {
     std::vector<TrianglePair> pairs;
     for (const narrow::Candidate& c : found[i]) pairs.push_back({c.tri_a, c.tri_b});
-    std::sort(pairs.begin(), pairs.end(), [](auto x, auto y) { return std::pair(x.tri_a, x.tri_b) < std::pair(y.tri_a, y.tri_b); });
+    std::sort(pairs.begin(), pairs.end(),
+              [](auto x, auto y) { return std::pair(x.tri_a, x.tri_b) < std::pair(y.tri_a, y.tri_b); });
     out.emplace_back(pairs, stats[i].node_tests);
   }
   return out;
@@ -100,8 +103,9 @@ TEST(Plans, APrioriSplitsTheHeavyPairAndCoversItOnce) {
   EXPECT_EQ(plan.split_pairs.front(), 0u) << "the torus-sphere pair is heavy";
   EXPECT_EQ(plan.splits.size(), plan.split);
   EXPECT_GT(plan.run.size(), 8u);
-  EXPECT_TRUE(std::is_sorted(plan.run.begin(), plan.run.end(), [](const RunTask& x, const RunTask& y) { return x.weight > y.weight; }))
-      << "handed out heaviest first";
+  EXPECT_TRUE(std::is_sorted(plan.run.begin(), plan.run.end(), [](const RunTask& x, const RunTask& y) {
+    return x.weight > y.weight;
+  })) << "handed out heaviest first";
   expect_covers_like_query(plan, p, "apriori");
 }
 

@@ -53,7 +53,8 @@ TEST(SceneFile, ReadsEveryKey) {
       {"name": "b", "mesh": "tetra.ply", "motion": {"type": "velocity", "linear": [1, 0, 0], "angular": [0, 0, 1]}},
       {"name": "c", "mesh": "tetra.obj", "motion": {"type": "keyframes", "keys": [
         {"time": 0, "position": [0, 0, 0]}, {"time": 1, "position": [2, 0, 0], "orientation": [0, 0, 0, 1]}]}}
-    ]})", kData, "full.json");
+    ]})",
+                              kData, "full.json");
   EXPECT_EQ(s.name, "full");
   EXPECT_EQ(s.steps, 3);
   EXPECT_EQ(s.query.kind, QueryKind::contact);
@@ -87,13 +88,15 @@ TEST(SceneFile, ErrorsNameTheKey) {
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "scale": -1}]})", "'objects[0].scale': must be > 0");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "scale": "big"}]})", "'objects[0].scale': must be a number");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "refine": 9}]})", "'objects[0].refine': must be in [0, 6]");
-  expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "position": [1, 2]}]})", "'objects[0].position': must be an array of 3");
+  expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "position": [1, 2]}]})",
+                     "'objects[0].position': must be an array of 3");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "orientation": [0, 0, 0, 0]}]})", "quaternion is (nearly) zero");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "teleport"}}]})", "unknown motion 'teleport'");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "keyframes", "keys": []}}]})",
                      "'objects[0].motion.keys': must be a non-empty array");
-  expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "keyframes", "keys": [{"time": 1}, {"time": 1}]}}]})",
-                     "key times must increase");
+  expect_scene_error(
+      R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "keyframes", "keys": [{"time": 1}, {"time": 1}]}}]})",
+      "key times must increase");
   expect_scene_error(R"({"objects": [{"mesh": "tetra.off", "motion": {"type": "static", "linear": [1, 0, 0]}}]})",
                      "'objects[0].motion.linear': unknown key");
   expect_scene_error(R"({"query": {"kind": "collide"}, "objects": [)" + kObject + "]}", "unknown query kind");
@@ -101,7 +104,8 @@ TEST(SceneFile, ErrorsNameTheKey) {
   expect_scene_error(R"({"query": {"angle": 270}, "objects": [)" + kObject + "]}", "'query.angle': must be in [0, 180]");
   expect_scene_error(R"({"steps": 0, "objects": [)" + kObject + "]}", "'steps': must be in [1,");
   expect_scene_error(R"({"dt": 0, "objects": [)" + kObject + "]}", "'dt': must be > 0");
-  expect_scene_error(R"({"objects": [{"name": "x", "mesh": "tetra.off"}, {"name": "x", "mesh": "tetra.off"}]})", "duplicate name 'x'");
+  expect_scene_error(R"({"objects": [{"name": "x", "mesh": "tetra.off"}, {"name": "x", "mesh": "tetra.off"}]})",
+                     "duplicate name 'x'");
   expect_scene_error(R"({"ignore": [["a", "b"]], "objects": [)" + kObject + "]}", "no object named 'a'");
   expect_scene_error(R"({"groups": {"compatible": [[0, 64]]}, "objects": [)" + kObject + "]}", "must be in [0, 63]");
 }

@@ -124,10 +124,11 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
       const Pose p = test::random_pose(rng, 2.0);
       const bool fixed = i % 4 == 0;
       char buf[512];
-      std::snprintf(buf, sizeof buf,
-                    R"(%s{"name": "o%d", "mesh": "%s", "position": [%.17g, %.17g, %.17g], "orientation": [%.17g, %.17g, %.17g, %.17g]%s})",
-                    i ? "," : "", i, meshes[i % 3], p.translation.x(), p.translation.y(), p.translation.z(), p.rotation.w(),
-                    p.rotation.x(), p.rotation.y(), p.rotation.z(), fixed ? "" : R"(, "motion": {"type": "velocity", "linear": [0, 0, 1]})");
+      std::snprintf(
+          buf, sizeof buf,
+          R"(%s{"name": "o%d", "mesh": "%s", "position": [%.17g, %.17g, %.17g], "orientation": [%.17g, %.17g, %.17g, %.17g]%s})",
+          i ? "," : "", i, meshes[i % 3], p.translation.x(), p.translation.y(), p.translation.z(), p.rotation.w(), p.rotation.x(),
+          p.rotation.y(), p.rotation.z(), fixed ? "" : R"(, "motion": {"type": "velocity", "linear": [0, 0, 1]})");
       json += buf;
     }
     json += "]}";
@@ -143,7 +144,8 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
         const bool both_fixed = a % 4 == 0 && b % 4 == 0;
         const bool ignored = a == 0 && b == 1;
         if (overlap && !both_fixed && !ignored) want.push_back(Task{a, b});
-        if (!both_fixed && !ignored && !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).pairs.empty()) {
+        if (!both_fixed && !ignored &&
+            !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).pairs.empty()) {
           EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), Task{a, b}) != tasks.end()) << "touching pair dropped";
         }
       }
