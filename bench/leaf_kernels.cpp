@@ -114,7 +114,7 @@ const Sample& sample(const std::string& scene) {
   s.world = std::make_unique<caliber::World>(caliber::load_scene(std::filesystem::path(g_scenes) / (scene + ".json")));
   const std::vector<caliber::Pose> poses = s.world->poses_at(kStep);
   std::vector<TrianglePair> all;
-  for (const caliber::Task& t : s.world->broad_phase(poses)) {
+  for (const caliber::ObjectPair& t : s.world->broad_phase(poses)) {
     s.contexts.push_back(std::make_unique<caliber::narrow::PairContext>(s.world->model(t.a), poses[t.a], s.world->model(t.b),
                                                                         poses[t.b], s.world->request()));
     collect_leaf_pairs(*s.contexts.back(), static_cast<std::uint32_t>(s.contexts.size() - 1), all);

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
       std::vector<Node> nodes;
       for (int k = 0; k < steps * 10; k += 10) {
         const caliber::Frame frame = world.frame(k);
-        for (const caliber::Task& t : frame.pairs) {
+        for (const caliber::ObjectPair& t : frame.pairs) {
           const caliber::narrow::PairContext ctx(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b],
                                                  frame.request);
           if (ctx.node_test(0, 0)) below(ctx, caliber::narrow::NodePair{0, 0}, nodes);

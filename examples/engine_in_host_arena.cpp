@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <caliber/caliber.h>
+#include <caliber/procedural.h>
 
 static std::size_t os_threads() {
   std::size_t n = 0;

@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
     // Models are built once and shared by every frame; only the poses change.
     caliber::Frame frame;
     frame.models = {caliber::build_model(caliber::load_mesh(argv[1])), caliber::build_model(caliber::load_mesh(argv[2]))};
-    frame.pairs = {caliber::Task{0, 1}};  // object indices: the pair's identity from frame to frame
+    frame.pairs = {caliber::ObjectPair{0, 1}};  // object indices: the pair's identity from frame to frame
     frame.request.kind = caliber::QueryKind::contact;
     const double size = frame.models[0]->extent + frame.models[1]->extent;
     frame.request.tolerance = 0.01 * size;
@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
       total += step.contacts.size();
       frames_in_contact += step.contacts.empty() ? 0 : 1;
       if (k % 10 == 0) {
-        std::printf("frame %3d: %6zu contacts, %8llu node tests, %5zu run-time tasks, %.3f ms\n", k, step.contacts.size(),
-                    static_cast<unsigned long long>(step.stats.node_tests), step.schedule.generated, step.narrow_ms);
+        std::printf("frame %3d: %6zu contacts, %8llu node tests, %.3f ms\n", k, step.contacts.size(),
+                    static_cast<unsigned long long>(step.stats.node_tests), step.narrow_ms);
       }
     }
     std::printf("100 frames, hybrid on %d threads: %zu contacts in all, %zu frames in contact, every frame as caliber::query\n",

@@ -17,6 +17,7 @@
 #include <omp.h>
 
 #include <caliber/caliber.h>
+#include <caliber/procedural.h>
 
 namespace {
 

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "caliber/caliber.h"
+#include "caliber/scene.h"
+#include "caliber/world.h"
 
 namespace py = pybind11;
 
@@ -33,26 +35,10 @@ caliber::Mesh mesh_from_arrays(const Vertices& vertices, const Faces& faces) {
     throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices", "must be an n x 3 array");
   if (faces.ndim() != 2 || faces.shape(1) != 3)
     throw caliber::Error(caliber::ErrorCode::bad_argument, "faces", "must be an m x 3 array");
-  caliber::Mesh mesh;
-  mesh.source = "arrays";
-  const auto v = vertices.unchecked<2>();
-  for (py::ssize_t i = 0; i < v.shape(0); ++i) mesh.vertices.emplace_back(v(i, 0), v(i, 1), v(i, 2));
-  const auto f = faces.unchecked<2>();
-  for (py::ssize_t i = 0; i < f.shape(0); ++i) {
-    std::array<std::uint32_t, 3> t{};
-    for (int k = 0; k < 3; ++k) {
-      const std::int64_t index = f(i, k);
-      if (index < 0 || index >= static_cast<std::int64_t>(mesh.vertices.size())) {
-        throw caliber::Error(caliber::ErrorCode::bad_index, "faces",
-                             "face " + std::to_string(i) + " refers to vertex " + std::to_string(index) + " but there are only " +
-                                 std::to_string(mesh.vertices.size()));
-      }
-      t[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(index);
-    }
-    mesh.triangles.push_back(t);
-  }
-  caliber::validate_mesh(mesh);
-  return mesh;
+  // Both arrays are C-contiguous (the casters' c_style): the library's checks do the rest.
+  const std::span<const double> xyz(vertices.data(), static_cast<std::size_t>(vertices.size()));
+  const std::span<const std::int64_t> indices(faces.data(), static_cast<std::size_t>(faces.size()));
+  return caliber::mesh_from_buffers(xyz, indices, "arrays");
 }
 
 py::array_t<double> vertices_of(const caliber::Mesh& mesh) {
@@ -169,7 +155,7 @@ caliber::Frame make_frame(const std::vector<PyModel>& models, const std::vector<
   caliber::Frame frame;
   for (const PyModel& m : models) frame.models.push_back(m.model);
   frame.poses = poses;
-  for (const auto& [a, b] : pairs) frame.pairs.push_back(caliber::Task{a, b});
+  for (const auto& [a, b] : pairs) frame.pairs.push_back(caliber::ObjectPair{a, b});
   frame.request = request;
   return frame;
 }
@@ -350,6 +336,29 @@ PYBIND11_MODULE(caliber, m) {
           py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
           "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair past that many "
           "triangle pairs and sets limit_reached (1: does each pair touch at all?).");
+
+  m.def(
+      "broad_phase",
+      [](const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses, double reach, std::vector<bool> fixed,
+         const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+        std::vector<std::shared_ptr<const caliber::Model>> shared;
+        for (const PyModel& m : models) shared.push_back(m.model);
+        std::vector<caliber::ObjectPair> skip;
+        for (const auto& [a, b] : ignored) skip.push_back(caliber::ObjectPair{a, b});
+        std::vector<caliber::ObjectPair> pairs;
+        {
+          py::gil_scoped_release release;
+          pairs = caliber::broad_phase(shared, poses, reach, fixed, skip);
+        }
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+        out.reserve(pairs.size());
+        for (const caliber::ObjectPair& p : pairs) out.emplace_back(p.a, p.b);
+        return out;
+      },
+      py::arg("models"), py::arg("poses"), py::arg("reach") = 0.0, py::arg("fixed") = std::vector<bool>{},
+      py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
+      "The object pairs (a < b, sorted) whose world boxes, grown by reach / 2, overlap: what Engine.step takes. fixed: "
+      "one flag per object (pairs of two fixed objects are skipped); ignored: pairs never tested.");
 
   py::class_<caliber::World>(m, "World", "A scene file's objects, poses and broad phase.")
       .def(py::init([](const std::string& path) {

@@ -106,7 +106,7 @@ int run_query(const QueryOptions& opt) {
     engine = std::make_unique<caliber::Engine>(options);
     frame.models = {model_a, model_b};
     frame.poses = {pose_a, pose_b};
-    frame.pairs = {caliber::Task{0, 1}};
+    frame.pairs = {caliber::ObjectPair{0, 1}};
     frame.request = request;
   }
   caliber::QueryResult result;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
@@ -47,15 +48,15 @@ nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x
 
 nlohmann::json step_record(const StepResult& s) {
   nlohmann::json tasks = nlohmann::json::array();
-  for (const TaskRecord& t : s.tasks) {
-    tasks.push_back({{"a", t.task.a},
-                     {"b", t.task.b},
+  for (const PairRecord& t : s.pair_records) {
+    tasks.push_back({{"a", t.pair.a},
+                     {"b", t.pair.b},
                      {"node_tests", t.stats.node_tests},
                      {"leaf_tests", t.stats.leaf_tests},
                      {"pairs", t.pairs},
                      {"limit_reached", t.limit_reached}});
   }
-  const ScheduleRecord& c = s.schedule;
+  const ScheduleRecord& c = *s.schedule;
   nlohmann::json schedule = {{"omega", c.omega},
                              {"kept", c.kept},
                              {"split", c.split},
@@ -109,7 +110,7 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
   return {{"schema_version", kSchemaVersion}, {"step", s.step}, {"limit_reached", s.limit_reached}, {"contacts", list}};
 }
 
-std::string pair_name(const World& world, const Task& t) {
+std::string pair_name(const World& world, const ObjectPair& t) {
   return world.scene().objects[t.a].name + " / " + world.scene().objects[t.b].name;
 }
 
@@ -138,6 +139,7 @@ int run_scene(const RunOptions& opt) {
   }
   EngineOptions engine_options;
   engine_options.method = parse_method(opt.method);
+  engine_options.profile = true;  // the summary and the JSON report how the work was cut
   engine_options.threads = opt.threads;
   engine_options.stealing_depth = opt.stealing_depth;
   engine_options.beta = opt.beta;
@@ -189,7 +191,7 @@ int run_scene(const RunOptions& opt) {
     if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
     if (exporter && exporter->wants(k)) exporter->write(world, s);
     char line[256];
-    std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.tasks.size(),
+    std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.pair_records.size(),
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }

@@ -12,9 +12,9 @@ void RunStats::add(const StepResult& step) {
   mStepMs.push_back(step.broad_ms + step.narrow_ms + step.reduce_ms);
   mNodeTests += step.stats.node_tests;
   mContacts += step.contacts.size();
-  mTasks += step.tasks.size();
+  mTasks += step.pair_records.size();
   if (!step.contacts.empty()) ++mStepsWithContacts;
-  for (const TaskRecord& t : step.tasks) mPairWork[t.task] += t.stats.node_tests;
+  for (const PairRecord& t : step.pair_records) mPairWork[t.pair] += t.stats.node_tests;
 }
 
 double RunStats::median_step_ms() const { return median_of(mStepMs); }
@@ -29,23 +29,23 @@ double RunStats::mean_node_tests() const { return steps() ? double(mNodeTests) /
 double RunStats::mean_contacts() const { return steps() ? double(mContacts) / double(steps()) : 0.0; }
 double RunStats::mean_tasks() const { return steps() ? double(mTasks) / double(steps()) : 0.0; }
 
-std::vector<std::pair<std::uint64_t, Task>> RunStats::ranked() const {
-  std::vector<std::pair<std::uint64_t, Task>> r;
+std::vector<std::pair<std::uint64_t, ObjectPair>> RunStats::ranked() const {
+  std::vector<std::pair<std::uint64_t, ObjectPair>> r;
   for (const auto& [task, work] : mPairWork) r.emplace_back(work, task);
   std::sort(r.begin(), r.end(),
             [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
   return r;
 }
 
-std::pair<Task, double> RunStats::heaviest_pair() const {
+std::pair<ObjectPair, double> RunStats::heaviest_pair() const {
   const auto r = ranked();
-  if (r.empty() || mNodeTests == 0) return {Task{0, 0}, 0.0};
+  if (r.empty() || mNodeTests == 0) return {ObjectPair{0, 0}, 0.0};
   return {r[0].second, double(r[0].first) / double(mNodeTests)};
 }
 
-std::pair<Task, double> RunStats::second_heaviest_pair() const {
+std::pair<ObjectPair, double> RunStats::second_heaviest_pair() const {
   const auto r = ranked();
-  if (r.size() < 2 || mNodeTests == 0) return {Task{0, 0}, 0.0};
+  if (r.size() < 2 || mNodeTests == 0) return {ObjectPair{0, 0}, 0.0};
   return {r[1].second, double(r[1].first) / double(mNodeTests)};
 }
 

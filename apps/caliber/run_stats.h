@@ -34,19 +34,19 @@ class RunStats {
   /// Distinct object pairs the broad phase kept over the run.
   [[nodiscard]] std::size_t candidate_pairs() const { return mPairWork.size(); }
   /// The object pair with the most node tests over the run, and its share of all node tests (0..1).
-  [[nodiscard]] std::pair<Task, double> heaviest_pair() const;
+  [[nodiscard]] std::pair<ObjectPair, double> heaviest_pair() const;
   /// The pair with the second most node tests over the run, and its share.
-  [[nodiscard]] std::pair<Task, double> second_heaviest_pair() const;
+  [[nodiscard]] std::pair<ObjectPair, double> second_heaviest_pair() const;
 
  private:
-  [[nodiscard]] std::vector<std::pair<std::uint64_t, Task>> ranked() const;
+  [[nodiscard]] std::vector<std::pair<std::uint64_t, ObjectPair>> ranked() const;
 
   std::vector<double> mStepMs;
   std::uint64_t mNodeTests = 0;
   std::uint64_t mContacts = 0;
   std::uint64_t mTasks = 0;
   std::size_t mStepsWithContacts = 0;
-  std::map<Task, std::uint64_t> mPairWork;
+  std::map<ObjectPair, std::uint64_t> mPairWork;
 };
 
 }  // namespace caliber::cli

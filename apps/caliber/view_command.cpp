@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
@@ -80,7 +81,7 @@ nlohmann::json pose_record(const Pose& pose) {
 /// The run-time tasks with the thread that ran each, their node tests and their roots' boxes (A's
 /// node, object frame); at most `budget` boxes over the step, the heaviest tasks first in the list.
 nlohmann::json task_records(const World& world, const StepResult& s, int& budget) {
-  const ScheduleRecord& r = s.schedule;
+  const ScheduleRecord& r = *s.schedule;
   std::vector<int> thread(r.task_roots.size(), 0);
   for (const TaskSpan& span : r.timeline) {
     if (span.phase == TaskSpan::Phase::traverse && span.unit < thread.size()) thread[span.unit] = span.thread;
@@ -91,7 +92,7 @@ nlohmann::json task_records(const World& world, const StepResult& s, int& budget
     for (const TaskRoot& root : r.task_roots[t]) {
       if (budget <= 0) break;
       --budget;
-      const std::uint32_t object = s.tasks[root.pair].task.a;
+      const std::uint32_t object = s.pair_records[root.pair].pair.a;
       const BvhNode& n = world.model(object).nodes[root.node_a];
       roots.push_back({object, n.box_center[0], n.box_center[1], n.box_center[2], n.box_half[0], n.box_half[1], n.box_half[2]});
     }
@@ -113,15 +114,15 @@ nlohmann::json step_view(const World& world, const StepResult& s, const std::vec
     ++per_pair[{c.object_a, c.object_b}];
   }
   nlohmann::json pair_list = nlohmann::json::array();
-  for (const TaskRecord& t : s.tasks) {
-    const auto it = per_pair.find({t.task.a, t.task.b});
-    pair_list.push_back({{"a", t.task.a},
-                         {"b", t.task.b},
+  for (const PairRecord& t : s.pair_records) {
+    const auto it = per_pair.find({t.pair.a, t.pair.b});
+    pair_list.push_back({{"a", t.pair.a},
+                         {"b", t.pair.b},
                          {"node_tests", t.stats.node_tests},
                          {"contacts", it == per_pair.end() ? 0 : it->second}});
   }
   nlohmann::json timeline = nlohmann::json::array();
-  for (const TaskSpan& span : s.schedule.timeline) {
+  for (const TaskSpan& span : s.schedule->timeline) {
     timeline.push_back({span.thread, span.start_ms, span.end_ms, static_cast<int>(span.phase), span.unit});
   }
   int budget = max_boxes;
@@ -179,7 +180,7 @@ int view_scene(const ViewOptions& opt) {
     const StepResult s = step(world, engine, k);
     steps.push_back(step_view(world, s, world.poses_at(k), opt.max_boxes));
     progress.update(static_cast<std::size_t>(k + 1), "step " + std::to_string(k) + ": " + std::to_string(s.contacts.size()) +
-                                                         " contacts, " + std::to_string(s.schedule.task_node_tests.size()) +
+                                                         " contacts, " + std::to_string(s.schedule->task_node_tests.size()) +
                                                          " run-time tasks");
   }
   const nlohmann::json data = {{"schema_version", kSchemaVersion},

@@ -30,6 +30,7 @@
 #include <nlohmann/json.hpp>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
@@ -145,6 +146,7 @@ int simulated_steps(const BenchOptions& opt, const Scene& scene) {
 
 EngineOptions engine_options(const Variant& v, int threads) {
   EngineOptions o;
+  o.profile = true;  // the bench reports every step's schedule
   o.method = v.method;
   o.node_history = v.node_history;
   o.threads = threads;
@@ -242,9 +244,9 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
     const StepResult s = step(world, engine, k);
     total += s.broad_ms + s.narrow_ms + s.reduce_ms;
     broad += s.broad_ms;
-    calibrate += s.schedule.calibrate_ms;
-    traverse += s.schedule.traverse_ms;
-    finalize += s.schedule.finalize_ms;
+    calibrate += s.schedule->calibrate_ms;
+    traverse += s.schedule->traverse_ms;
+    finalize += s.schedule->finalize_ms;
     simulated.add(s);
     const std::uint64_t h = contacts_hash(s);
     if (is_reference) {
@@ -374,7 +376,7 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
         const StepResult s = step(world, engine, k);
         simulated.add(s);
         if (p == 8 || p == b.opt.simulate.front()) {
-          const auto& r = s.schedule;
+          const auto& r = *s.schedule;
           for (std::size_t i = 0; i < r.task_weights.size() && i < r.task_node_tests.size(); ++i) {
             estimated.push_back(r.task_weights[i]);
             effective.push_back(static_cast<double>(r.task_node_tests[i]));
@@ -469,7 +471,7 @@ void record_gantt(BenchRun& b) {
     StepResult s;
     for (int k = 0; k <= step; ++k) s = caliber::step(world, engine, k);  // hybrid needs the previous steps' history
     Json spans = Json::array();
-    for (const TaskSpan& span : s.schedule.timeline) {
+    for (const TaskSpan& span : s.schedule->timeline) {
       spans.push_back({span.thread, span.start_ms, span.end_ms,
                        span.phase == TaskSpan::Phase::stage      ? "stage"
                        : span.phase == TaskSpan::Phase::traverse ? "traverse"

@@ -1,16 +1,17 @@
 #pragma once
 /// \file
-/// Everything of caliber's public API: one pair (mesh, model, pose, query), frames and the parallel
-/// engine, scene files and the world that makes frames from them, and the version.
+/// caliber's API for a program that runs queries and steps: meshes and models, poses, the query
+/// between two models, frames, the broad phase and the parallel engine, errors and the version. Opt-in beside it:
+/// caliber/profile.h (how the engine cut and scheduled a step, and the load-balance simulation),
+/// caliber/scene.h and caliber/world.h (scene files and the world that makes frames from them),
+/// caliber/procedural.h (small generated meshes). docs/api.md lists every public type.
 
+#include "caliber/broad_phase.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
 #include "caliber/export.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
-#include "caliber/procedural.h"
 #include "caliber/query.h"
-#include "caliber/scene.h"
 #include "caliber/version.h"
-#include "caliber/world.h"

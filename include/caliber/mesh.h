@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <ostream>
+#include <span>
 #include <string_view>
 #include <string>
 #include <vector>
@@ -57,6 +58,25 @@ inline constexpr double kMinCoordinate = 0x1p-120;
 /// Throws caliber::Error naming the file on a missing file, a parse error, a non-finite coordinate,
 /// an index out of range, a face with fewer than 3 corners, or a mesh without triangles.
 [[nodiscard]] CALIBER_EXPORT Mesh load_mesh(const std::filesystem::path& path);
+
+/// A mesh from a program's own buffers: `xyz` holds the vertices as x, y, z triples (3n values),
+/// `indices` the triangles as three vertex indices each (3m values). The same checks as the file
+/// readers: a length that is not a multiple of 3, a negative index or one past the vertices, more
+/// vertices than 32-bit ids reach, or what validate_mesh refuses, throws caliber::Error naming
+/// `source` and the problem (for example "face 7 refers to vertex 12 but there are only 10").
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::int64_t> indices,
+                                                    std::string source = "buffers");
+/// See above: float vertices, 32-bit indices, and the mixes.
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::int32_t> indices,
+                                                    std::string source = "buffers");
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::int64_t> indices,
+                                                    std::string source = "buffers");
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::int32_t> indices,
+                                                    std::string source = "buffers");
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::uint32_t> indices,
+                                                    std::string source = "buffers");
+[[nodiscard]] CALIBER_EXPORT Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::uint32_t> indices,
+                                                    std::string source = "buffers");
 
 /// Checks the invariants every routine relies on: at least one triangle, finite coordinates of
 /// magnitude 0 or in [kMinCoordinate, kMaxCoordinate], indices in range, groups (if any) one per triangle and below kMaxGroups.

@@ -39,9 +39,9 @@ class CALIBER_EXPORT World {
   /// World-space box of object i at `pose` (its root box moved by the pose, grown by `grow` and a
   /// rounding margin), as the broad phase uses it: low corner, high corner.
   [[nodiscard]] std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds(std::size_t i, const Pose& pose, double grow) const;
-  /// The broad phase: object pairs whose world boxes, grown by the tolerance, overlap; pairs of two
-  /// static objects and ignored pairs are skipped. Sorted. Sweep and prune along x.
-  [[nodiscard]] std::vector<Task> broad_phase(const std::vector<Pose>& poses) const;
+  /// The broad phase (caliber::broad_phase): object pairs whose world boxes, grown by the tolerance,
+  /// overlap; pairs of two static objects and ignored pairs are skipped. Sorted.
+  [[nodiscard]] std::vector<ObjectPair> broad_phase(const std::vector<Pose>& poses) const;
   /// Step k as a frame: every object's model and pose, the broad phase's pairs, the request.
   /// The frame points to this world's group table: it must not outlive the world.
   [[nodiscard]] Frame frame(int step) const;
@@ -53,6 +53,7 @@ class CALIBER_EXPORT World {
   QueryRequest mRequest;
   std::vector<std::shared_ptr<const Model>> mModels;
   std::vector<bool> mStatic;
+  std::vector<ObjectPair> mIgnored;
 };
 
 /// Step k of a world on an engine: its frame (poses and broad phase, timed as broad_ms), then

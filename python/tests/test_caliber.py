@@ -55,7 +55,7 @@ def test_meshes_from_arrays_equal_meshes_from_files():
     a = caliber.query(caliber.Model(m), caliber.Pose(), caliber.Model.load(TETRA), pose(POSE), kind="proximity", tolerance=0.3)
     b = caliber.query(caliber.Model(again), caliber.Pose(), caliber.Model.load(TETRA), pose(POSE), kind="proximity", tolerance=0.3)
     assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.points_a, b.points_a)
-    with pytest.raises(caliber.Error, match="faces: face 0 refers to vertex 9"):
+    with pytest.raises(caliber.Error, match="arrays: face 0 refers to vertex 9"):
         caliber.Mesh(m.vertices, np.array([[0, 1, 9]]))
     with pytest.raises(ValueError, match="n x 3"):
         caliber.Mesh(np.zeros((3, 2)), m.faces)
@@ -95,6 +95,20 @@ def test_engine_step_max_pairs_bounds_each_pair():
     one = engine.step(models, poses, [(0, 1)], kind="proximity", tolerance=0.3, max_pairs=1)
     assert len(full) > 1 and not full.limit_reached
     assert len(one) == 1 and one.limit_reached
+
+
+def test_broad_phase_gives_the_pairs_a_step_takes():
+    models = [caliber.Model.load(TETRA), caliber.Model.load(FAN), caliber.Model.load(TETRA)]
+    poses = [caliber.Pose(), pose(POSE), caliber.Pose((50.0, 0.0, 0.0))]
+    pairs = caliber.broad_phase(models, poses, reach=0.3)
+    assert pairs == [(0, 1)]
+    assert caliber.broad_phase(models, poses, 0.3, fixed=[True, True, False]) == []
+    assert caliber.broad_phase(models, poses, 0.3, ignored=[(0, 1)]) == []
+    got = caliber.Engine().step(models, poses, pairs, kind="proximity", tolerance=0.3)
+    want = caliber.query(models[0], poses[0], models[1], poses[1], kind="proximity", tolerance=0.3)
+    assert got.pairs.tolist() == want.pairs.tolist() and len(got) > 0
+    with pytest.raises(caliber.Error, match="broad phase: 3 models but 2 poses"):
+        caliber.broad_phase(models, poses[:2])
 
 
 def test_pickled_models_answer_the_same():

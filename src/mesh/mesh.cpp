@@ -1,6 +1,10 @@
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
+#include <utility>
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
@@ -17,7 +21,67 @@ std::string tiny_coordinate(std::size_t v, double x) {
          "scale the mesh up (coordinates 0 or between 7.5e-37 and 1e15 are accepted)";
 }
 
+template <class Real, class Index>
+Mesh from_buffers(std::span<const Real> xyz, std::span<const Index> indices, std::string source) {
+  if (xyz.size() % 3 != 0) {
+    throw Error(ErrorCode::bad_argument, source,
+                "the vertex buffer holds " + std::to_string(xyz.size()) + " values, not x, y, z triples (a multiple of 3)");
+  }
+  if (indices.size() % 3 != 0) {
+    throw Error(ErrorCode::bad_argument, source,
+                "the index buffer holds " + std::to_string(indices.size()) + " values, not three per triangle (a multiple of 3)");
+  }
+  const std::size_t n = xyz.size() / 3;
+  if (n > std::size_t{UINT32_MAX}) {
+    throw Error(ErrorCode::bad_value, source, std::to_string(n) + " vertices: more than 32-bit vertex ids reach");
+  }
+  Mesh mesh;
+  mesh.source = std::move(source);
+  mesh.vertices.reserve(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    mesh.vertices.emplace_back(static_cast<double>(xyz[3 * v]), static_cast<double>(xyz[3 * v + 1]),
+                               static_cast<double>(xyz[3 * v + 2]));
+  }
+  mesh.triangles.reserve(indices.size() / 3);
+  for (std::size_t t = 0; t < indices.size() / 3; ++t) {
+    std::array<std::uint32_t, 3> tri{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Index index = indices[3 * t + k];
+      // Compared as signed 64-bit values: a negative index, or one past the vertices, is refused.
+      const auto wide = static_cast<long long>(index);
+      if (wide < 0 || static_cast<unsigned long long>(wide) >= n) {
+        throw Error(ErrorCode::bad_index, mesh.source,
+                    "face " + std::to_string(t) + " refers to vertex " + std::to_string(wide) + " but there are only " +
+                        std::to_string(n));
+      }
+      tri[k] = static_cast<std::uint32_t>(wide);
+    }
+    mesh.triangles.push_back(tri);
+  }
+  validate_mesh(mesh);
+  return mesh;
+}
+
 }  // namespace
+
+Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::int64_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
+Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::int32_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
+Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::int64_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
+Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::int32_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
+Mesh mesh_from_buffers(std::span<const float> xyz, std::span<const std::uint32_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
+Mesh mesh_from_buffers(std::span<const double> xyz, std::span<const std::uint32_t> indices, std::string source) {
+  return from_buffers(xyz, indices, std::move(source));
+}
 
 void validate_mesh(const Mesh& mesh) {
   const std::string& src = mesh.source.empty() ? std::string("mesh") : mesh.source;

@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "caliber/error.h"
+#include "caliber/profile.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"
 #include "schedule/runner.h"
@@ -75,7 +76,7 @@ void validate_frame(const Frame& frame) {
     }
   }
   for (std::size_t k = 0; k < frame.pairs.size(); ++k) {
-    const Task& p = frame.pairs[k];
+    const ObjectPair& p = frame.pairs[k];
     if (p.a >= p.b || p.b >= n) {
       throw Error(ErrorCode::bad_argument, "frame",
                   "pair " + std::to_string(k) + " (" + std::to_string(p.a) + ", " + std::to_string(p.b) +
@@ -112,7 +113,7 @@ class ContextStore {
     // keep a small frame on this thread and spread a large one.
     parallel::parallel_for(0, n, 64, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
-        const Task& t = frame.pairs[i];
+        const ObjectPair& t = frame.pairs[i];
         new (&base[i])
             narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
       }
@@ -139,6 +140,8 @@ struct Engine::Impl {
   /// Who ran what when, this step (EngineOptions::timeline).
   schedule::Timeline timeline;
   ContextStore contexts;
+  /// This step's schedule record when nobody asked for it.
+  ScheduleRecord record;
 };
 
 Engine::Engine(const EngineOptions& options) : mOptions(options) {
@@ -166,8 +169,27 @@ void Engine::forget() { mImpl->history = tasks::History{}; }
 
 namespace {
 
+/// Empties a record, its vectors keeping their storage (no allocation once they have grown).
+void reset_keeping_storage(ScheduleRecord& r) {
+  ScheduleRecord fresh;
+  const auto keep = [](auto& from, auto& to) {
+    from.clear();
+    to = std::move(from);
+  };
+  keep(r.stage_task_node_tests, fresh.stage_task_node_tests);
+  keep(r.stage_levels, fresh.stage_levels);
+  keep(r.stage_level_task, fresh.stage_level_task);
+  keep(r.stage_serial_ms, fresh.stage_serial_ms);
+  keep(r.task_node_tests, fresh.task_node_tests);
+  keep(r.task_weights, fresh.task_weights);
+  keep(r.thread_node_tests, fresh.thread_node_tests);
+  keep(r.timeline, fresh.timeline);
+  keep(r.task_roots, fresh.task_roots);
+  r = std::move(fresh);
+}
+
 /// After a step: what the temporal methods keep of each pair for the next one.
-void remember(const EngineOptions& options, const std::vector<Task>& pairs, const std::vector<QueryResult>& results,
+void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
               const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, tasks::History& history) {
   for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests[pairs[i]] = results[i].stats.node_tests;
   if (options.method == Method::aposteriori) {
@@ -201,7 +223,12 @@ StepResult Engine::step(const Frame& frame) {
     for (std::size_t i = 0; i < n; ++i) limits[i].max = frame.request.max_pairs;
     state.limits = limits.get();
   }
-  ScheduleRecord& record = out.schedule;
+  // The runners always keep their record (the engine's own bookkeeping, in storage reused from step
+  // to step); it is handed out only when asked for.
+  const bool profile = mOptions.profile || mOptions.timeline;
+  std::shared_ptr<ScheduleRecord> handed = profile ? std::make_shared<ScheduleRecord>() : nullptr;
+  if (!profile) reset_keeping_storage(mImpl->record);
+  ScheduleRecord& record = profile ? *handed : mImpl->record;
   tasks::Plan plan;
   std::vector<std::vector<std::uint64_t>> stage_root_tests;
   mImpl->executor.execute([&] {
@@ -237,7 +264,7 @@ StepResult Engine::step(const Frame& frame) {
 
   const auto reduce = util::Clock::now();
   schedule::gather_step(frame.pairs, results, out);
-  for (std::size_t i = 0; i < n && i < state.candidates.size(); ++i) out.tasks[i].candidates = state.candidates[i];
+  for (std::size_t i = 0; i < n && i < state.candidates.size(); ++i) out.pair_records[i].candidates = state.candidates[i];
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
                                 [](const SceneContact& x, const SceneContact& y) {
                                   return std::tie(x.object_a, x.object_b, x.contact.tri_a, x.contact.tri_b) <
@@ -249,6 +276,7 @@ StepResult Engine::step(const Frame& frame) {
                      out.stats.node_tests,
                  "node tests are conserved: the units the schedule ran add up to the pairs' totals");
   out.reduce_ms = util::ms_since(reduce);
+  out.schedule = std::move(handed);
   return out;
 }
 

@@ -118,8 +118,8 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   return stage_root_tests;
 }
 
-void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>& results, StepResult& out) {
-  out.tasks.clear();
+void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results, StepResult& out) {
+  out.pair_records.clear();
   out.contacts.clear();
   out.limit_reached = false;
   out.stats = QueryStats{};
@@ -128,7 +128,7 @@ void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>&
   out.contacts.reserve(total);
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const QueryResult& r = results[i];
-    out.tasks.push_back(TaskRecord{pairs[i], r.stats, r.pairs.size(), r.limit_reached});
+    out.pair_records.push_back(PairRecord{pairs[i], r.stats, r.pairs.size(), r.limit_reached});
     out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "schedule/workers.h"
 #include "tasks/plan.h"
 

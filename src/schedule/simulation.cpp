@@ -8,11 +8,21 @@
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "caliber/profile.h"
 #include "narrow/finalize.h"
 
 namespace caliber {
 
 namespace {
+
+/// The step's schedule; an Error when the step was run without EngineOptions::profile.
+const ScheduleRecord& schedule_of(const StepResult& step) {
+  if (!step.schedule) {
+    throw Error(ErrorCode::bad_argument, "load-balance simulation",
+                "the step has no schedule (run it with EngineOptions::profile on)");
+  }
+  return *step.schedule;
+}
 
 /// Greedy list scheduling of `costs` in order on `cores` cores: the makespan.
 template <class Cost>
@@ -61,7 +71,7 @@ double stage_makespan(const ScheduleRecord& r, const std::vector<double>& unit, 
 }  // namespace
 
 double simulated_speedup(const StepResult& step, Method method, int cores) {
-  const ScheduleRecord& r = step.schedule;
+  const ScheduleRecord& r = schedule_of(step);
   const double total = static_cast<double>(step.stats.node_tests);
   if (total <= 0.0 || method == Method::sequential) return 1.0;
   double makespan = 0.0;
@@ -87,7 +97,7 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
 
 double predicted_step_ms(const StepResult& step, Method method, int cores) {
   if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
-  const ScheduleRecord& r = step.schedule;
+  const ScheduleRecord& r = schedule_of(step);
   if (r.timeline.empty()) {
     throw Error(ErrorCode::bad_argument, "predicted_step_ms", "the step has no timeline (EngineOptions::timeline)");
   }
@@ -136,7 +146,7 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
   std::sort(finalize.begin(), finalize.end(), [](const TaskSpan* x, const TaskSpan* y) { return x->start_ms < y->start_ms; });
   std::vector<double> finals;
   for (const TaskSpan* t : finalize) {
-    const std::size_t candidates = t->unit < step.tasks.size() ? step.tasks[t->unit].candidates : 0;
+    const std::size_t candidates = t->unit < step.pair_records.size() ? step.pair_records[t->unit].candidates : 0;
     const std::size_t chunks =
         candidates >= narrow::kFinalizeGrain ? (candidates + narrow::kFinalizeGrain - 1) / narrow::kFinalizeGrain : 1;
     for (std::size_t c = 0; c < chunks; ++c) finals.push_back(length(t) / static_cast<double>(chunks));
@@ -146,7 +156,7 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
 }
 
 void SimulatedRun::add(const StepResult& step) {
-  if (!step.schedule.timeline.empty()) {
+  if (step.schedule && !step.schedule->timeline.empty()) {
     mPredictedMs += predicted_step_ms(step, mMethod, mCores);
     ++mTimed;
   }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 #include "parallel/executor.h"
@@ -110,8 +111,8 @@ void finalize_pairs(StepState& state,
                     const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start);
 
 /// The reduction of a step: per-pair records and the contacts of every pair, in pair order (pairs
-/// are sorted and each result is sorted, so the concatenation is canonical). Fills out.tasks,
+/// are sorted and each result is sorted, so the concatenation is canonical). Fills out.pair_records,
 /// out.contacts and out.stats.
-void gather_step(const std::vector<Task>& pairs, const std::vector<QueryResult>& results, StepResult& out);
+void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results, StepResult& out);
 
 }  // namespace caliber::schedule

@@ -21,7 +21,7 @@ Plan plan_pairs(std::size_t pairs) {
   return plan;
 }
 
-InitialWeights initial_weights(Method method, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                                const History& history) {
   const std::size_t n = pairs.size();
   std::vector<double> root(n);
@@ -56,7 +56,7 @@ namespace {
 /// A posteriori: the sub-task roots of each heavy pair from last step's summary tree; nothing is
 /// tested here. A pair without reported pairs last step cannot be split (the metric's known blind
 /// spot) and runs whole. Its original task keeps the rest of the tree, the roots on its taboo list.
-void split_by_summary(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+void split_by_summary(const EngineOptions& options, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                       const History& history, const std::vector<std::size_t>& to_split, const std::vector<double>& weight,
                       Plan& plan, std::vector<Root>& cart) {
   std::vector<PosterioriSplit> chosen(to_split.size());
@@ -91,7 +91,7 @@ void split_by_summary(const EngineOptions& options, const std::vector<Task>& pai
 
 /// A priori and hybrid: the weight-driven stage of each heavy pair, the pairs in parallel (and each
 /// pair's levels in parallel inside).
-void split_by_stage(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+void split_by_stage(const EngineOptions& options, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                     const History& history, const std::vector<std::size_t>& to_split, const InitialWeights& w,
                     const StageWrapper& around_stage, Plan& plan, std::vector<Root>& cart) {
   const bool node_history = options.method == Method::hybrid && options.node_history;
@@ -122,7 +122,7 @@ void split_by_stage(const EngineOptions& options, const std::vector<Task>& pairs
 
 }  // namespace
 
-Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                      const History& history, const StageWrapper& around_stage) {
   const InitialWeights w = initial_weights(options.method, pairs, contexts, history);
   Plan plan;

@@ -20,9 +20,9 @@ namespace caliber::tasks {
 /// What the engine remembers of each object pair from the last step it was tested (keyed by the
 /// pair's object indices, Frame::pairs). Changes only how work is cut, never the contacts.
 struct History {
-  std::map<Task, std::uint64_t> node_tests;            ///< node tests at its last step
-  std::map<Task, std::vector<TrianglePair>> reported;  ///< a posteriori: the triangle pairs it reported
-  std::map<Task, NodeCounts> node_counts;              ///< hybrid with node history: stage subtrees' node tests
+  std::map<ObjectPair, std::uint64_t> node_tests;            ///< node tests at its last step
+  std::map<ObjectPair, std::vector<TrianglePair>> reported;  ///< a posteriori: the triangle pairs it reported
+  std::map<ObjectPair, NodeCounts> node_counts;              ///< hybrid with node history: stage subtrees' node tests
 };
 
 /// A method's plan for one step.
@@ -51,7 +51,7 @@ struct InitialWeights {
   std::vector<double> scale;   ///< per pair: what node weights are multiplied by
   double total = 0.0;
 };
-[[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<Task>& pairs, narrow::PairContexts contexts,
+[[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                                              const History& history);
 
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
@@ -60,7 +60,7 @@ struct InitialWeights {
 /// if set, is called with each split pair's index and its weight-driven stage, and must run it
 /// (the engine times it).
 using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;
-[[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<Task>& pairs, narrow::PairContexts contexts,
-                                   const History& history, const StageWrapper& around_stage = {});
+[[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>& pairs,
+                                   narrow::PairContexts contexts, const History& history, const StageWrapper& around_stage = {});
 
 }  // namespace caliber::tasks

@@ -7,31 +7,19 @@
 #include <new>
 #include <tuple>
 
+#include "caliber/broad_phase.h"
 #include "caliber/error.h"
 #include "util/timing.h"
+#include "world/world_box.h"
 
 namespace caliber {
 namespace {
 
+using world::world_box;
+using world::WorldBox;
+
 using util::Clock;
 using util::ms_since;
-
-/// A world-space box of an object: its root box moved by its pose (conservative: |R| h).
-struct WorldBox {
-  Eigen::Vector3d lo, hi;
-};
-
-WorldBox world_box(const Model& m, const Pose& pose, double grow) {
-  const BvhNode& root = m.nodes[0];
-  const Eigen::Vector3d c(root.box_center[0], root.box_center[1], root.box_center[2]);
-  const Eigen::Vector3d h(root.box_half[0], root.box_half[1], root.box_half[2]);
-  const Eigen::Matrix3d r = pose.rotation_matrix();
-  const Eigen::Vector3d center = r * c + pose.translation;
-  const Eigen::Vector3d half = r.cwiseAbs() * h;
-  // The same kind of safety margin as the narrow phase: rounding never drops a pair.
-  const double margin = grow + 1e-9 * (m.extent + pose.translation.norm() + grow);
-  return {center - half - Eigen::Vector3d::Constant(margin), center + half + Eigen::Vector3d::Constant(margin)};
-}
 
 }  // namespace
 
@@ -76,6 +64,13 @@ World::World(Scene scene) : mScene(std::move(scene)) {
     mModels.push_back(it->second);
     mStatic.push_back(o.motion.type == Motion::Type::fixed);
   }
+  for (const auto& [a, b] : mScene.ignore) {
+    if (a < 0 || a >= b || static_cast<std::size_t>(b) >= mScene.objects.size()) {
+      throw Error(ErrorCode::bad_value, "scene " + mScene.name,
+                  "ignored pair (" + std::to_string(a) + ", " + std::to_string(b) + ") must name two objects a < b");
+    }
+    mIgnored.push_back(ObjectPair{static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b)});
+  }
 }
 
 std::size_t World::distinct_models() const {
@@ -110,34 +105,8 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> World::bounds(std::size_t i, const P
   return {b.lo, b.hi};
 }
 
-std::vector<Task> World::broad_phase(const std::vector<Pose>& poses) const {
-  const std::size_t n = mScene.objects.size();
-  const double grow = 0.5 * reach(mRequest);
-  std::vector<WorldBox> boxes;
-  boxes.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) boxes.push_back(world_box(*mModels[i], poses[i], grow));
-  // Sweep and prune along x: sort by the boxes' low x, sweep, test y and z for the overlapping ones.
-  std::vector<std::uint32_t> order(n);
-  for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return boxes[a].lo.x() < boxes[b].lo.x() || (boxes[a].lo.x() == boxes[b].lo.x() && a < b);
-  });
-  std::vector<Task> tasks;
-  for (std::size_t i = 0; i < n; ++i) {
-    const WorldBox& bi = boxes[order[i]];
-    for (std::size_t j = i + 1; j < n && boxes[order[j]].lo.x() <= bi.hi.x(); ++j) {
-      const WorldBox& bj = boxes[order[j]];
-      if (bj.lo.y() > bi.hi.y() || bi.lo.y() > bj.hi.y() || bj.lo.z() > bi.hi.z() || bi.lo.z() > bj.hi.z()) continue;
-      const std::uint32_t a = std::min(order[i], order[j]);
-      const std::uint32_t b = std::max(order[i], order[j]);
-      if (mStatic[a] && mStatic[b]) continue;
-      if (std::find(mScene.ignore.begin(), mScene.ignore.end(), std::pair<int, int>(int(a), int(b))) != mScene.ignore.end())
-        continue;
-      tasks.push_back(Task{a, b});
-    }
-  }
-  std::sort(tasks.begin(), tasks.end());
-  return tasks;
+std::vector<ObjectPair> World::broad_phase(const std::vector<Pose>& poses) const {
+  return caliber::broad_phase(mModels, poses, reach(mRequest), mStatic, mIgnored);
 }
 
 Frame World::frame(int step) const {

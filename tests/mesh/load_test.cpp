@@ -3,8 +3,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "support/error_message.h"
 
 #include "caliber/error.h"
 #include "caliber/mesh.h"
@@ -49,6 +55,73 @@ TEST(LoadMesh, ObjFansQuadsInPlace) {
   EXPECT_EQ(mesh.vertices[mesh.triangles[1][1]], Eigen::Vector3d(1, 1, 0));
   EXPECT_EQ(mesh.vertices[mesh.triangles[1][2]], Eigen::Vector3d(1, 0, 0));
   EXPECT_EQ(mesh.vertices[mesh.triangles[2][2]], Eigen::Vector3d(0, 0, 1));
+}
+
+TEST(MeshFromBuffers, EveryTypeGivesTheFilesMesh) {
+  const Mesh file = load_mesh(kData / "tetra.off");
+  std::vector<double> xyz;
+  std::vector<float> xyz_f;
+  for (const Eigen::Vector3d& v : file.vertices) {
+    for (int k = 0; k < 3; ++k) {
+      xyz.push_back(v[k]);
+      xyz_f.push_back(static_cast<float>(v[k]));
+    }
+  }
+  std::vector<std::int64_t> i64;
+  std::vector<std::int32_t> i32;
+  std::vector<std::uint32_t> u32;
+  for (const auto& t : file.triangles) {
+    for (const std::uint32_t v : t) {
+      i64.push_back(v);
+      i32.push_back(static_cast<std::int32_t>(v));
+      u32.push_back(v);
+    }
+  }
+  for (const Mesh& m : {mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int64_t>(i64)),
+                        mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int32_t>(i32)),
+                        mesh_from_buffers(std::span<const double>(xyz), std::span<const std::uint32_t>(u32))}) {
+    EXPECT_EQ(m.vertices, file.vertices);
+    EXPECT_EQ(m.triangles, file.triangles);
+  }
+  const Mesh f = mesh_from_buffers(std::span<const float>(xyz_f), std::span<const std::int32_t>(i32), "robot link");
+  EXPECT_EQ(f.triangles, file.triangles);
+  EXPECT_EQ(f.source, "robot link");
+  for (std::size_t v = 0; v < f.vertices.size(); ++v) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(f.vertices[v][k], static_cast<double>(xyz_f[3 * v + static_cast<std::size_t>(k)]));
+  }
+  EXPECT_EQ(mesh_from_buffers(std::span<const float>(xyz_f), std::span<const std::int64_t>(i64)).triangles, file.triangles);
+  EXPECT_EQ(mesh_from_buffers(std::span<const float>(xyz_f), std::span<const std::uint32_t>(u32)).triangles, file.triangles);
+}
+
+TEST(MeshFromBuffers, BadBuffersAreErrorsNamingTheSource) {
+  const std::vector<double> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const auto message = [](auto&& call) { return test::error_message(call); };
+  const std::vector<std::int64_t> past = {0, 1, 3};
+  EXPECT_EQ(message([&] { return mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int64_t>(past), "link"); }),
+            "link: face 0 refers to vertex 3 but there are only 3");
+  const std::vector<std::int32_t> negative = {0, -1, 2};
+  EXPECT_EQ(
+      message([&] { return mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int32_t>(negative), "link"); }),
+      "link: face 0 refers to vertex -1 but there are only 3");
+  const std::vector<std::int64_t> two = {0, 1};
+  EXPECT_NE(message([&] {
+              return mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int64_t>(two), "link");
+            }).find("link: the index buffer holds 2 values"),
+            std::string::npos);
+  const std::vector<double> ragged = {0, 0, 0, 1};
+  const std::vector<std::int64_t> tri = {0, 1, 2};
+  EXPECT_NE(message([&] {
+              return mesh_from_buffers(std::span<const double>(ragged), std::span<const std::int64_t>(tri), "link");
+            }).find("the vertex buffer holds 4 values"),
+            std::string::npos);
+  const std::vector<float> nan = {0, 0, 0, 1, 0, 0, 0, std::numeric_limits<float>::quiet_NaN(), 0};
+  EXPECT_NE(message([&] {
+              return mesh_from_buffers(std::span<const float>(nan), std::span<const std::int64_t>(tri), "link");
+            }).find("link: "),
+            std::string::npos)
+      << "validate_mesh's checks hold: a NaN is refused";
+  EXPECT_THROW((void)mesh_from_buffers(std::span<const float>(nan), std::span<const std::int64_t>(tri)), Error);
+  EXPECT_THROW((void)mesh_from_buffers(std::span<const double>(xyz), std::span<const std::int64_t>()), Error) << "no triangle";
 }
 
 TEST(LoadMesh, DegenerateTrianglesAreKept) {

@@ -184,11 +184,11 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
   frame.models = {shapes().torus, shapes().sphere, shapes().box, shapes().torus};
   for (int i = 0; i < 4; ++i) frame.poses.push_back(test::random_pose(rng, 1.5));
   for (std::uint32_t a = 0; a < 4; ++a) {
-    for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(Task{a, b});
+    for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(ObjectPair{a, b});
   }
   frame.request = distance_request(1.5);
   std::vector<SceneContact> want;
-  for (const Task& t : frame.pairs) {
+  for (const ObjectPair& t : frame.pairs) {
     const QueryResult r = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
     for (const Contact& c : r.contacts) want.push_back(SceneContact{t.a, t.b, c});
   }

@@ -93,11 +93,11 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
   Frame frame;
   frame.models = {shapes().torus, shapes().sphere, shapes().torus};
   frame.poses = {Pose{}, Pose::from_values(0.9, 0.1, 0.05, 1, 0.2, 0.1, 0), Pose::from_values(0.2, 0.3, 0.1, 1, 0, 0.3, 0.1)};
-  frame.pairs = {Task{0, 1}, Task{0, 2}, Task{1, 2}};
+  frame.pairs = {ObjectPair{0, 1}, ObjectPair{0, 2}, ObjectPair{1, 2}};
   frame.request.kind = QueryKind::proximity;
   frame.request.tolerance = 0.02;
   std::map<std::pair<std::uint32_t, std::uint32_t>, QueryResult> full;
-  for (const Task& t : frame.pairs) {
+  for (const ObjectPair& t : frame.pairs) {
     const QueryResult& f = full[{t.a, t.b}] =
         query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
     ASSERT_GT(f.pairs.size(), 30u) << t.a << "-" << t.b;
@@ -113,7 +113,7 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
       const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
       const StepResult step = engine.step(frame);
       EXPECT_TRUE(step.limit_reached) << what;
-      for (const TaskRecord& t : step.tasks) {
+      for (const PairRecord& t : step.pair_records) {
         EXPECT_TRUE(t.limit_reached) << what;
         EXPECT_EQ(t.pairs, 25u) << what;
       }

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "caliber/engine.h"
+#include "caliber/profile.h"
 #include "caliber/error.h"
 #include "caliber/procedural.h"
 #include "caliber/world.h"
@@ -21,14 +22,14 @@ namespace {
 /// `exact_work`: the method tests exactly the nodes sequential tests (all but a posteriori, whose
 /// sub-tasks may test below a node that the original task pruned; see ScheduleRecord).
 void expect_same_step(const StepResult& got, const StepResult& want, const std::string& what, bool exact_work = true) {
-  ASSERT_EQ(got.tasks.size(), want.tasks.size()) << what;
-  for (std::size_t i = 0; i < want.tasks.size(); ++i) {
-    ASSERT_EQ(got.tasks[i].task, want.tasks[i].task) << what;
+  ASSERT_EQ(got.pair_records.size(), want.pair_records.size()) << what;
+  for (std::size_t i = 0; i < want.pair_records.size(); ++i) {
+    ASSERT_EQ(got.pair_records[i].pair, want.pair_records[i].pair) << what;
     if (exact_work) {
-      EXPECT_EQ(got.tasks[i].stats.node_tests, want.tasks[i].stats.node_tests) << what << " task " << i;
-      EXPECT_EQ(got.tasks[i].stats.leaf_tests, want.tasks[i].stats.leaf_tests) << what << " task " << i;
+      EXPECT_EQ(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " task " << i;
+      EXPECT_EQ(got.pair_records[i].stats.leaf_tests, want.pair_records[i].stats.leaf_tests) << what << " task " << i;
     } else {
-      EXPECT_GE(got.tasks[i].stats.node_tests, want.tasks[i].stats.node_tests) << what << " task " << i;
+      EXPECT_GE(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " task " << i;
     }
   }
   ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
@@ -61,6 +62,7 @@ void expect_all_methods_identical(const World& world, int steps) {
   for (const auto& [method, node_history] : configs) {
     for (const int threads : {1, 2, 3, 4, 8}) {
       EngineOptions options;
+      options.profile = true;  // the tests read the schedule
       options.method = method;
       options.node_history = node_history;
       options.threads = threads;
@@ -72,28 +74,29 @@ void expect_all_methods_identical(const World& world, int steps) {
                                  std::to_string(threads) + " step " + std::to_string(k);
         expect_same_step(got, reference[k], what, method != Method::aposteriori);
         if (::testing::Test::HasFatalFailure()) return;
-        std::uint64_t units = got.schedule.split_node_tests;
-        for (const std::uint64_t t : got.schedule.task_node_tests) units += t;
-        for (const std::uint64_t t : got.schedule.stage_task_node_tests) units += t;
+        std::uint64_t units = got.schedule->split_node_tests;
+        for (const std::uint64_t t : got.schedule->task_node_tests) units += t;
+        for (const std::uint64_t t : got.schedule->stage_task_node_tests) units += t;
         EXPECT_EQ(units, got.stats.node_tests) << what << ": the recorded work units must add up";
         // Conservation: every node sequential tests is tested once; a posteriori may add the work of
         // sub-tasks whose root the original task never reached, and says how much.
-        EXPECT_EQ(got.stats.node_tests - got.schedule.taboo_unreached_node_tests, reference[k].stats.node_tests) << what;
-        for (const TaskRecord& t : got.tasks) EXPECT_GE(t.candidates, t.pairs) << what << ": reported pairs are candidates";
+        EXPECT_EQ(got.stats.node_tests - got.schedule->taboo_unreached_node_tests, reference[k].stats.node_tests) << what;
+        for (const PairRecord& t : got.pair_records)
+          EXPECT_GE(t.candidates, t.pairs) << what << ": reported pairs are candidates";
         if (method == Method::apriori || method == Method::hybrid) {
           // The stage's levels hold its node tests (all but each split task's root test).
-          std::uint64_t levels = got.schedule.stage_task_node_tests.size();
-          for (const std::vector<std::uint64_t>& level : got.schedule.stage_levels) {
+          std::uint64_t levels = got.schedule->stage_task_node_tests.size();
+          for (const std::vector<std::uint64_t>& level : got.schedule->stage_levels) {
             for (const std::uint64_t chunk : level) levels += chunk;
           }
-          EXPECT_EQ(levels, got.schedule.stage_node_tests) << what;
-          EXPECT_EQ(got.schedule.stage_levels.size(), got.schedule.stage_level_task.size()) << what;
+          EXPECT_EQ(levels, got.schedule->stage_node_tests) << what;
+          EXPECT_EQ(got.schedule->stage_levels.size(), got.schedule->stage_level_task.size()) << what;
           // Conservation: the weight-driven stage and the run-time tasks test every node once.
-          std::uint64_t cut = got.schedule.stage_node_tests;
-          for (const std::uint64_t t : got.schedule.task_node_tests) cut += t;
+          std::uint64_t cut = got.schedule->stage_node_tests;
+          for (const std::uint64_t t : got.schedule->task_node_tests) cut += t;
           EXPECT_EQ(cut, reference[k].stats.node_tests) << what;
-          for (const std::uint64_t t : got.schedule.task_node_tests) EXPECT_GT(t, 0u) << what << ": an empty run-time task";
-          EXPECT_EQ(got.schedule.generated, got.schedule.task_node_tests.size()) << what;
+          for (const std::uint64_t t : got.schedule->task_node_tests) EXPECT_GT(t, 0u) << what << ": an empty run-time task";
+          EXPECT_EQ(got.schedule->generated, got.schedule->task_node_tests.size()) << what;
         }
       }
     }
@@ -156,21 +159,22 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
   expect_all_methods_identical(single, 2);
   // One heavy pair on two threads is split: more than one run-time task.
   EngineOptions options;
+  options.profile = true;  // the tests read the schedule
   options.method = Method::apriori;
   options.threads = 2;
   Engine engine(options);
   const StepResult s = step(single, engine, 0);
-  EXPECT_EQ(s.schedule.split, 1u);
-  EXPECT_GT(s.schedule.generated, 1u);
+  EXPECT_EQ(s.schedule->split, 1u);
+  EXPECT_GT(s.schedule->generated, 1u);
   // A posteriori has nothing to go on at the first step; from the second, last step's contacts
   // give sub-task roots and the taboo list.
   options.method = Method::aposteriori;
   Engine temporal(options);
   const StepResult first = step(single, temporal, 0);
-  EXPECT_EQ(first.schedule.taboo, 0u);
+  EXPECT_EQ(first.schedule->taboo, 0u);
   const StepResult second = step(single, temporal, 1);
-  EXPECT_GT(second.schedule.taboo, 0u);
-  EXPECT_GT(second.schedule.generated, 1u);
+  EXPECT_GT(second.schedule->taboo, 0u);
+  EXPECT_GT(second.schedule->generated, 1u);
 }
 
 TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
@@ -180,21 +184,24 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_EQ(list_schedule_makespan({9, 1, 1, 1}, 2), 9.0);
   EXPECT_THROW((void)list_schedule_makespan({1}, 0), Error);
   StepResult step;
+  EXPECT_THROW((void)simulated_speedup(step, Method::exploitation, 8), Error) << "a step run without a schedule";
+  auto record = std::make_shared<ScheduleRecord>();
+  step.schedule = record;
   step.stats.node_tests = 100;
-  step.schedule.task_node_tests = {60, 30, 10};
+  record->task_node_tests = {60, 30, 10};
   EXPECT_NEAR(simulated_speedup(step, Method::exploitation, 8), 100.0 / 60.0, 1e-12) << "bound by the heaviest pair";
   EXPECT_EQ(simulated_speedup(step, Method::sequential, 8), 1.0);
-  step.schedule.task_node_tests = {20, 20, 20, 20};
+  record->task_node_tests = {20, 20, 20, 20};
   // One split task: its root's test, then levels of 4 and 15 node tests (chunks 8 and 7: one core
   // each at most), 20 in all: a span of 1 + 4 + 8 = 13 on 4 cores, above 20 / 4.
-  step.schedule.stage_task_node_tests = {20};
-  step.schedule.stage_levels = {{4}, {8, 7}};
-  step.schedule.stage_level_task = {0, 0};
+  record->stage_task_node_tests = {20};
+  record->stage_levels = {{4}, {8, 7}};
+  record->stage_level_task = {0, 0};
   EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / (13.0 + 20.0), 1e-12) << "stage, barrier, then the tasks";
   // Wide levels: the stage's tests spread evenly bound it (two split tasks sharing the cores).
-  step.schedule.stage_task_node_tests = {35, 35};
-  step.schedule.stage_levels = {{2}, {4, 4, 4, 4, 4, 4, 4, 4}, {2}, {4, 4, 4, 4, 4, 4, 4, 4}};
-  step.schedule.stage_level_task = {0, 0, 1, 1};
+  record->stage_task_node_tests = {35, 35};
+  record->stage_levels = {{2}, {4, 4, 4, 4, 4, 4, 4, 4}, {2}, {4, 4, 4, 4, 4, 4, 4, 4}};
+  record->stage_level_task = {0, 0, 1, 1};
   step.stats.node_tests = 150;
   EXPECT_NEAR(simulated_speedup(step, Method::apriori, 4), 150.0 / (70.0 / 4 + 20.0), 1e-12) << "each span 1 + 2 + 8";
 }
@@ -211,6 +218,7 @@ TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
   for (const Method method : {Method::stealing, Method::hybrid}) {
     for (const int threads : {2, 8}) {
       EngineOptions options;
+      options.profile = true;  // the tests read the schedule
       options.method = method;
       options.threads = threads;
       Engine engine(options);
@@ -227,6 +235,7 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
   const StepResult reference = test::reference_step(world, 0);
   for (const Method method : {Method::sequential, Method::exploitation, Method::stealing, Method::apriori, Method::hybrid}) {
     EngineOptions options;
+    options.profile = true;  // the tests read the schedule
     options.method = method;
     options.threads = 3;
     options.timeline = true;
@@ -234,9 +243,9 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
     const StepResult got = step(world, engine, 0);
     const std::string what(to_string(method));
     expect_same_step(got, reference, what);
-    const ScheduleRecord& r = got.schedule;
+    const ScheduleRecord& r = *got.schedule;
     std::size_t stage = 0, traverse = 0, finalize = 0;
-    const std::size_t pairs = got.tasks.size();
+    const std::size_t pairs = got.pair_records.size();
     std::vector<int> finalized(pairs, 0), traversed(r.task_node_tests.size(), 0);
     for (const TaskSpan& s : r.timeline) {
       if (s.phase == TaskSpan::Phase::finalize) {
@@ -267,7 +276,7 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
         ASSERT_FALSE(roots.empty()) << what;
         for (const TaskRoot& root : roots) {
           ASSERT_LT(root.pair, pairs) << what;
-          const Task& pair = got.tasks[root.pair].task;
+          const ObjectPair& pair = got.pair_records[root.pair].pair;
           EXPECT_LT(root.node_a, world.model(pair.a).nodes.size()) << what;
           EXPECT_LT(root.node_b, world.model(pair.b).nodes.size()) << what;
         }
@@ -287,12 +296,13 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
     }
   }
   EngineOptions off;
+  off.profile = true;  // the tests read the schedule
   off.method = Method::hybrid;
   off.threads = 2;
   Engine quiet(off);
   const StepResult plain = step(world, quiet, 0);
-  EXPECT_TRUE(plain.schedule.timeline.empty()) << "off by default";
-  EXPECT_TRUE(plain.schedule.task_roots.empty()) << "off by default";
+  EXPECT_TRUE(plain.schedule->timeline.empty()) << "off by default";
+  EXPECT_TRUE(plain.schedule->task_roots.empty()) << "off by default";
 }
 
 TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
@@ -303,6 +313,7 @@ TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
                                 dir, "plan_threads.json"));
   for (const Method method : {Method::apriori, Method::hybrid}) {
     EngineOptions wide;
+    wide.profile = true;  // the tests read the schedule
     wide.method = method;
     wide.threads = 4;
     wide.plan_threads = 4;  // what 4 threads get (this machine may have fewer)
@@ -316,15 +327,16 @@ TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
       const StepResult a = step(world, four, k), b = step(world, one, k);
       const std::string what = std::string(to_string(method)) + " step " + std::to_string(k);
       expect_same_step(b, a, what);
-      EXPECT_EQ(b.schedule.omega, a.schedule.omega) << what;
-      EXPECT_EQ(b.schedule.task_node_tests, a.schedule.task_node_tests) << what << ": the same tasks, in the same order";
-      EXPECT_EQ(b.schedule.stage_task_node_tests, a.schedule.stage_task_node_tests) << what;
-      EXPECT_EQ(b.schedule.stage_levels, a.schedule.stage_levels) << what;
-      split = split || a.schedule.split > 0;
+      EXPECT_EQ(b.schedule->omega, a.schedule->omega) << what;
+      EXPECT_EQ(b.schedule->task_node_tests, a.schedule->task_node_tests) << what << ": the same tasks, in the same order";
+      EXPECT_EQ(b.schedule->stage_task_node_tests, a.schedule->stage_task_node_tests) << what;
+      EXPECT_EQ(b.schedule->stage_levels, a.schedule->stage_levels) << what;
+      split = split || a.schedule->split > 0;
     }
     EXPECT_TRUE(split) << to_string(method) << ": a cut with a weight-driven stage, or the test shows little";
   }
   EngineOptions bad;
+  bad.profile = true;  // the tests read the schedule
   bad.plan_threads = -1;
   EXPECT_THROW(Engine{bad}, Error);
   bad.plan_threads = 2000;
@@ -339,6 +351,7 @@ TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
   for (const Method method :
        {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
+    options.profile = true;  // the tests read the schedule
     options.method = method;
     options.threads = 1;
     options.plan_threads = 8;
@@ -352,7 +365,7 @@ TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
     EXPECT_NEAR(predicted_step_ms(s, method, 1), measured, 1e-9 * measured) << what;
     // More cores never take longer; the serial rest and the longest piece bound it from below.
     double longest = 0.0;
-    for (const TaskSpan& t : s.schedule.timeline) {
+    for (const TaskSpan& t : s.schedule->timeline) {
       if (t.phase == TaskSpan::Phase::traverse) longest = std::max(longest, t.end_ms - t.start_ms);
     }
     const double four = predicted_step_ms(s, method, 4);
@@ -362,6 +375,7 @@ TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
   }
   // Without a timeline there is nothing to replay.
   EngineOptions quiet;
+  quiet.profile = true;  // the tests read the schedule
   quiet.method = Method::hybrid;
   quiet.threads = 1;
   Engine engine(quiet);
@@ -373,10 +387,12 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   // levels of 4 and 15 tests), four run-time tasks of 1 ms, the pair's finalization 0.4 ms over
   // 256 candidates (two chunks), and 0.45 ms outside every piece (broad phase 0.1, the rest 0.35).
   StepResult step;
-  step.tasks.resize(2);
-  step.tasks[0].candidates = 256;
+  step.pair_records.resize(2);
+  step.pair_records[0].candidates = 256;
   step.stats.node_tests = 100;
-  ScheduleRecord& r = step.schedule;
+  auto record = std::make_shared<ScheduleRecord>();
+  ScheduleRecord& r = *record;
+  step.schedule = record;
   r.stage_task_node_tests = {20};
   r.stage_levels = {{4}, {8, 7}};
   r.stage_level_task = {0, 0};
@@ -407,6 +423,7 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
 
 TEST(EngineOptionsValidation, RejectsBadValues) {
   EngineOptions options;
+  options.profile = true;  // the tests read the schedule
   options.threads = -1;
   EXPECT_THROW(Engine{options}, Error);
   options.threads = 5000;
@@ -432,7 +449,7 @@ Frame memory_frame(double t) {
   frame.models = {build_model(make_torus(0.8, 0.25, 24, 12)), build_model(make_sphere(0.5, 12, 16)),
                   build_model(make_box(0.3, 0.3, 0.3, 2))};
   frame.poses = {Pose{}, Pose::from_values(-1.2 + t, 0.1, 0.0, 1, 0, 0, 0), Pose::from_values(1.0, 0.9, 0.0, 1, 0, 0, 0)};
-  frame.pairs = {Task{0, 1}, Task{0, 2}, Task{1, 2}};
+  frame.pairs = {ObjectPair{0, 1}, ObjectPair{0, 2}, ObjectPair{1, 2}};
   frame.request.kind = QueryKind::contact;
   frame.request.tolerance = 0.05;
   return frame;
@@ -444,6 +461,7 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
   for (const Method method :
        {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
+    options.profile = true;  // the tests read the schedule
     options.method = method;
     options.threads = 3;
     options.stealing_depth = 2;
@@ -452,12 +470,12 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
       Frame frame = base;  // the same models every frame; only the sphere's pose changes
       frame.poses[1] = Pose::from_values(-1.2 + 0.4 * k, 0.1, 0.0, 1, 0, 0, 0);
       const StepResult got = engine.step(frame);
-      ASSERT_EQ(got.tasks.size(), frame.pairs.size());
+      ASSERT_EQ(got.pair_records.size(), frame.pairs.size());
       std::size_t at = 0;
       for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
-        const Task t = frame.pairs[i];
+        const ObjectPair t = frame.pairs[i];
         const QueryResult want = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-        ASSERT_EQ(got.tasks[i].pairs, want.pairs.size()) << to_string(method) << " frame " << k << " pair " << i;
+        ASSERT_EQ(got.pair_records[i].pairs, want.pairs.size()) << to_string(method) << " frame " << k << " pair " << i;
         for (const Contact& c : want.contacts) {
           const SceneContact& g = got.contacts[at++];
           ASSERT_EQ(g.object_a, t.a);
@@ -481,12 +499,13 @@ TEST(EngineFrames, EveryMethodRecordsItsTraversalAndFinalization) {
   for (const Method method :
        {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
     EngineOptions options;
+    options.profile = true;  // the tests read the schedule
     options.method = method;
     options.threads = 2;
     Engine engine(options);
     for (int k = 0; k < 2; ++k) {  // the second step: a posteriori and hybrid have history
       const StepResult got = engine.step(frame);
-      const ScheduleRecord& r = got.schedule;
+      const ScheduleRecord& r = *got.schedule;
       ASSERT_GT(got.stats.node_tests, 0u);
       EXPECT_GT(r.traverse_ms, 0.0) << to_string(method);
       EXPECT_GT(r.finalize_ms, 0.0) << to_string(method);
@@ -513,13 +532,13 @@ TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
     frame.poses.push_back(Pose::from_values(0.45 * (i % 4), 0.5 * (i / 4), 0.05 * i, std::cos(angle), 0, std::sin(angle), 0));
   }
   for (std::uint32_t a = 0; a < 17; ++a) {
-    for (std::uint32_t b = a + 1; b < 17; ++b) frame.pairs.push_back(Task{a, b});
+    for (std::uint32_t b = a + 1; b < 17; ++b) frame.pairs.push_back(ObjectPair{a, b});
   }
   frame.request.kind = QueryKind::proximity;
   frame.request.tolerance = 0.02;
   std::vector<std::size_t> want;
   std::size_t total = 0;
-  for (const Task& t : frame.pairs) {
+  for (const ObjectPair& t : frame.pairs) {
     want.push_back(query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request).pairs.size());
     total += want.back();
   }
@@ -527,14 +546,15 @@ TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
   ASSERT_GT(std::count(want.begin(), want.end(), std::size_t{0}), 0) << "and some are not";
   for (const Method method : {Method::exploitation, Method::stealing, Method::hybrid}) {
     EngineOptions options;
+    options.profile = true;  // the tests read the schedule
     options.method = method;
     options.threads = 3;
     Engine engine(options);
     for (int repeat = 0; repeat < 2; ++repeat) {  // the second step reuses the contexts' storage
       const StepResult got = engine.step(frame);
-      ASSERT_EQ(got.tasks.size(), frame.pairs.size());
+      ASSERT_EQ(got.pair_records.size(), frame.pairs.size());
       for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
-        EXPECT_EQ(got.tasks[i].pairs, want[i]) << to_string(method) << " pair " << i;
+        EXPECT_EQ(got.pair_records[i].pairs, want[i]) << to_string(method) << " pair " << i;
       }
     }
   }
@@ -542,16 +562,17 @@ TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
 
 TEST(EngineFrames, ForgetDropsTheTemporalState) {
   EngineOptions options;
+  options.profile = true;  // the tests read the schedule
   options.method = Method::aposteriori;
   options.threads = 2;
   options.beta = 8;
   Engine engine(options);
   Frame frame = memory_frame(0.9);
-  frame.pairs = {Task{0, 1}};
-  EXPECT_EQ(engine.step(frame).schedule.taboo, 0u) << "nothing to go on at the first step";
-  EXPECT_GT(engine.step(frame).schedule.taboo, 0u) << "last step's contacts give sub-task roots";
+  frame.pairs = {ObjectPair{0, 1}};
+  EXPECT_EQ(engine.step(frame).schedule->taboo, 0u) << "nothing to go on at the first step";
+  EXPECT_GT(engine.step(frame).schedule->taboo, 0u) << "last step's contacts give sub-task roots";
   engine.forget();
-  EXPECT_EQ(engine.step(frame).schedule.taboo, 0u) << "forgotten";
+  EXPECT_EQ(engine.step(frame).schedule->taboo, 0u) << "forgotten";
 }
 
 TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {
@@ -578,13 +599,13 @@ TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {
   f.poses[2].rotation.coeffs() *= 2.0;
   EXPECT_NE(message(f).find("pose of object 2: quaternion is not unit length"), std::string::npos) << message(f);
   f = memory_frame(0.0);
-  f.pairs = {Task{0, 3}};
+  f.pairs = {ObjectPair{0, 3}};
   EXPECT_NE(message(f).find("a < b < 3"), std::string::npos) << message(f);
-  f.pairs = {Task{1, 1}};
+  f.pairs = {ObjectPair{1, 1}};
   EXPECT_NE(message(f).find("a < b < 3"), std::string::npos) << message(f);
-  f.pairs = {Task{1, 2}, Task{0, 1}};
+  f.pairs = {ObjectPair{1, 2}, ObjectPair{0, 1}};
   EXPECT_NE(message(f).find("sorted and distinct"), std::string::npos) << message(f);
-  f.pairs = {Task{0, 1}, Task{0, 1}};
+  f.pairs = {ObjectPair{0, 1}, ObjectPair{0, 1}};
   EXPECT_NE(message(f).find("sorted and distinct"), std::string::npos) << message(f);
   f = memory_frame(0.0);
   f.request.tolerance = -1;

@@ -29,9 +29,9 @@ long status_kib(const std::string& field) {
 }
 
 bool same(const caliber::StepResult& a, const caliber::StepResult& b) {
-  if (a.contacts.size() != b.contacts.size() || a.tasks.size() != b.tasks.size()) return false;
-  for (std::size_t i = 0; i < a.tasks.size(); ++i) {
-    if (!(a.tasks[i].task == b.tasks[i].task)) return false;
+  if (a.contacts.size() != b.contacts.size() || a.pair_records.size() != b.pair_records.size()) return false;
+  for (std::size_t i = 0; i < a.pair_records.size(); ++i) {
+    if (!(a.pair_records[i].pair == b.pair_records[i].pair)) return false;
   }
   for (std::size_t i = 0; i < a.contacts.size(); ++i) {
     const auto& x = a.contacts[i];

@@ -15,7 +15,7 @@ inline StepResult reference_step(const World& world, int k) {
   const Frame frame = world.frame(k);
   std::vector<QueryResult> results;
   results.reserve(frame.pairs.size());
-  for (const Task& t : frame.pairs) {
+  for (const ObjectPair& t : frame.pairs) {
     results.push_back(query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request));
   }
   StepResult out;

@@ -21,7 +21,7 @@ struct Pairs {
   std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.3, 40, 24));
   std::shared_ptr<const Model> sphere = build_model(make_sphere(1.0, 24, 32));
   std::shared_ptr<const Model> box = build_model(make_box(0.2, 0.2, 0.2, 2));
-  std::vector<Task> pairs{Task{0, 1}, Task{0, 2}};
+  std::vector<ObjectPair> pairs{ObjectPair{0, 1}, ObjectPair{0, 2}};
   std::vector<Pose> poses{Pose{}, Pose::from_values(0.2, 0.1, 0.3, 0.9, 0.3, 0.1, 0.2),
                           Pose::from_values(1.0, 0.0, 0.0, 1, 0, 0, 0)};
   QueryRequest request;
@@ -68,7 +68,7 @@ std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(co
 void expect_covers_like_query(const Plan& plan, const Pairs& p, const std::string& what) {
   const auto got = run_serially(plan, p);
   for (std::size_t i = 0; i < p.pairs.size(); ++i) {
-    const Task t = p.pairs[i];
+    const ObjectPair t = p.pairs[i];
     const Model& b = t.b == 1 ? *p.sphere : *p.box;
     const QueryResult want = query(*p.torus, p.poses[t.a], b, p.poses[t.b], p.request);
     ASSERT_EQ(got[i].first.size(), want.pairs.size()) << what << " pair " << i;

@@ -134,8 +134,8 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
     json += "]}";
     const World world(scene(json));
     const std::vector<Pose> poses = world.poses_at(0);
-    const std::vector<Task> tasks = world.broad_phase(poses);
-    std::vector<Task> want;
+    const std::vector<ObjectPair> tasks = world.broad_phase(poses);
+    std::vector<ObjectPair> want;
     for (std::uint32_t a = 0; a < n; ++a) {
       for (std::uint32_t b = a + 1; b < n; ++b) {
         const auto [alo, ahi] = world.bounds(a, poses[a], 0.05);
@@ -143,10 +143,10 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
         const bool overlap = (alo.array() <= bhi.array()).all() && (blo.array() <= ahi.array()).all();
         const bool both_fixed = a % 4 == 0 && b % 4 == 0;
         const bool ignored = a == 0 && b == 1;
-        if (overlap && !both_fixed && !ignored) want.push_back(Task{a, b});
+        if (overlap && !both_fixed && !ignored) want.push_back(ObjectPair{a, b});
         if (!both_fixed && !ignored &&
             !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).pairs.empty()) {
-          EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), Task{a, b}) != tasks.end()) << "touching pair dropped";
+          EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), ObjectPair{a, b}) != tasks.end()) << "touching pair dropped";
         }
       }
     }
