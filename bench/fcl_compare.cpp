@@ -29,6 +29,7 @@
 #include "caliber/mesh.h"
 #include "geometry/triangle_distance.h"
 #include "geometry/triangle_intersect.h"
+#include "narrow/candidate.h"
 #include "caliber/model.h"
 #include "caliber/query.h"
 #include "caliber/scene.h"
@@ -107,7 +108,7 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
     fcl::collide(&obj_a, &obj_b, one_request, one_result);
   });
   row.first_agrees =
-      row.first_agrees && one.pairs.empty() == ours.pairs.empty() && one_result.isCollision() == fcl_result.isCollision();
+      row.first_agrees && one.contacts.empty() == ours.contacts.empty() && one_result.isCollision() == fcl_result.isCollision();
 
   std::vector<caliber::TrianglePair> theirs;
   for (std::size_t i = 0; i < fcl_result.numContacts(); ++i) {
@@ -115,9 +116,10 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
     theirs.push_back({static_cast<std::uint32_t>(contact.b1), static_cast<std::uint32_t>(contact.b2)});
   }
   std::sort(theirs.begin(), theirs.end());
-  std::vector<caliber::TrianglePair> only_ours, only_fcl;
-  std::set_difference(ours.pairs.begin(), ours.pairs.end(), theirs.begin(), theirs.end(), std::back_inserter(only_ours));
-  std::set_difference(theirs.begin(), theirs.end(), ours.pairs.begin(), ours.pairs.end(), std::back_inserter(only_fcl));
+  std::vector<caliber::TrianglePair> mine, only_ours, only_fcl;
+  for (const caliber::Contact& c : ours.contacts) mine.push_back({c.tri_a, c.tri_b});
+  std::set_difference(mine.begin(), mine.end(), theirs.begin(), theirs.end(), std::back_inserter(only_ours));
+  std::set_difference(theirs.begin(), theirs.end(), mine.begin(), mine.end(), std::back_inserter(only_fcl));
   for (const caliber::TrianglePair& p : only_fcl) {
     Eigen::Vector3d ta[3], tb[3];
     for (int k = 0; k < 3; ++k) {
@@ -127,7 +129,7 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
     if (caliber::geometry::triangles_intersect(ta[0], ta[1], ta[2], tb[0], tb[1], tb[2])) ++row.only_fcl_exact_hits;
     row.only_fcl_max_distance = std::max(row.only_fcl_max_distance, caliber::geometry::closest_points_triangles(ta, tb).distance);
   }
-  row.pairs_ours += ours.pairs.size();
+  row.pairs_ours += ours.contacts.size();
   row.pairs_fcl += theirs.size();
   row.only_ours += only_ours.size();
   row.only_fcl += only_fcl.size();

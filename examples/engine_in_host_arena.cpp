@@ -41,9 +41,9 @@ static caliber::Frame make_frame() {
 static bool same(const caliber::StepResult& x, const caliber::StepResult& y) {
   if (x.contacts.size() != y.contacts.size()) return false;
   for (std::size_t i = 0; i < x.contacts.size(); ++i) {
-    const caliber::Contact &p = x.contacts[i].contact, &q = y.contacts[i].contact;
-    if (x.contacts[i].object_a != y.contacts[i].object_a || x.contacts[i].object_b != y.contacts[i].object_b ||
-        p.tri_a != q.tri_a || p.tri_b != q.tri_b || p.point_a != q.point_a || p.point_b != q.point_b)
+    const caliber::Contact &p = x.contacts[i], &q = y.contacts[i];
+    if (p.object_a != q.object_a || p.object_b != q.object_b || p.tri_a != q.tri_a || p.tri_b != q.tri_b ||
+        p.point_a != q.point_a || p.point_b != q.point_b)
       return false;
   }
   return true;

@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
         return 1;
       }
       for (std::size_t i = 0; i < want.contacts.size(); ++i) {
-        const caliber::Contact& got = step.contacts[i].contact;
+        const caliber::Contact& got = step.contacts[i];
         if (got.tri_a != want.contacts[i].tri_a || got.tri_b != want.contacts[i].tri_b ||
             got.distance != want.contacts[i].distance || got.point_a != want.contacts[i].point_a) {
           std::fprintf(stderr, "frame %d: contact %zu differs from caliber::query's\n", k, i);

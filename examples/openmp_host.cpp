@@ -72,7 +72,7 @@ int main() {
       contacts += mine.contacts.size();
       bool same = step.contacts.size() == mine.contacts.size();
       for (std::size_t i = 0; same && i < mine.contacts.size(); ++i) {
-        const caliber::Contact &p = step.contacts[i].contact, &q = mine.contacts[i];
+        const caliber::Contact &p = step.contacts[i], &q = mine.contacts[i];
         same = p.tri_a == q.tri_a && p.tri_b == q.tri_b && p.point_a == q.point_a && p.point_b == q.point_b &&
                p.distance == q.distance;
       }

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
     request.tolerance = std::atof(argv[4]);
     const caliber::QueryResult contacts = caliber::query(*a, caliber::Pose{}, *b, pose_b, request);
     std::printf("caliber %s\n", caliber::kVersion);
-    std::printf("interference: %zu pairs\n", hits.pairs.size());
-    std::printf("contact: %zu contacts\n", contacts.pairs.size());
+    std::printf("interference: %zu pairs\n", hits.contacts.size());
+    std::printf("contact: %zu contacts\n", contacts.contacts.size());
     return 0;
   } catch (const caliber::Error& e) {
     std::fprintf(stderr, "consumer: %s\n", e.what());

@@ -82,7 +82,7 @@ struct PyResult {
   bool limit_reached = false;  ///< more than max_pairs were found: a partial answer
 };
 
-PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const caliber::QueryStats& stats) {
+PyResult to_result(const std::vector<caliber::Contact>& contacts, const caliber::QueryStats& stats) {
   const auto k = static_cast<py::ssize_t>(contacts.size());
   PyResult r;
   r.objects = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
@@ -100,18 +100,18 @@ PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const cal
   auto dd = r.distances.mutable_unchecked<1>();
   auto dp = r.depths.mutable_unchecked<1>();
   for (py::ssize_t i = 0; i < k; ++i) {
-    const caliber::SceneContact& c = contacts[static_cast<std::size_t>(i)];
+    const caliber::Contact& c = contacts[static_cast<std::size_t>(i)];
     obj(i, 0) = c.object_a;
     obj(i, 1) = c.object_b;
-    tri(i, 0) = c.contact.tri_a;
-    tri(i, 1) = c.contact.tri_b;
+    tri(i, 0) = c.tri_a;
+    tri(i, 1) = c.tri_b;
     for (int d = 0; d < 3; ++d) {
-      pa(i, d) = c.contact.point_a[d];
-      pb(i, d) = c.contact.point_b[d];
-      nn(i, d) = c.contact.normal[d];
+      pa(i, d) = c.point_a[d];
+      pb(i, d) = c.point_b[d];
+      nn(i, d) = c.normal[d];
     }
-    dd(i) = c.contact.distance;
-    dp(i) = c.contact.depth;
+    dd(i) = c.distance;
+    dp(i) = c.depth;
   }
   r.node_tests = stats.node_tests;
   r.leaf_tests = stats.leaf_tests;
@@ -119,10 +119,7 @@ PyResult to_result(const std::vector<caliber::SceneContact>& contacts, const cal
 }
 
 PyResult query_result(const caliber::QueryResult& q) {
-  std::vector<caliber::SceneContact> contacts;
-  contacts.reserve(q.pairs.size());
-  for (std::size_t i = 0; i < q.pairs.size(); ++i) contacts.push_back(caliber::SceneContact{0, 1, caliber::contact_at(q, i)});
-  PyResult r = to_result(contacts, q.stats);
+  PyResult r = to_result(q.contacts, q.stats);
   r.limit_reached = q.limit_reached;
   return r;
 }

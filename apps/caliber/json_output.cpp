@@ -9,9 +9,10 @@ nlohmann::json to_json(const QueryResult& result) {
   nlohmann::json out;
   out["kind"] = std::string(to_string(result.kind));
   auto& pairs = out["pairs"] = nlohmann::json::array();
-  for (const TrianglePair& p : result.pairs) pairs.push_back({p.tri_a, p.tri_b});
+  for (const Contact& c : result.contacts) pairs.push_back({c.tri_a, c.tri_b});
   auto& contacts = out["contacts"] = nlohmann::json::array();
-  for (const Contact& c : result.contacts) {
+  // Interference reports triangle ids only: its pairs say it all.
+  for (const Contact& c : result.kind == QueryKind::interference ? std::vector<Contact>{} : result.contacts) {
     contacts.push_back({{"tri_a", c.tri_a},
                         {"tri_b", c.tri_b},
                         {"point_a", vec(c.point_a)},

@@ -41,15 +41,12 @@ struct QueryOptions {
 };
 
 bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
-  if (x.pairs.size() != y.pairs.size() || x.contacts.size() != y.contacts.size()) return false;
-  for (std::size_t i = 0; i < x.pairs.size(); ++i) {
-    if (x.pairs[i].tri_a != y.pairs[i].tri_a || x.pairs[i].tri_b != y.pairs[i].tri_b) return false;
-  }
+  if (x.contacts.size() != y.contacts.size()) return false;
   for (std::size_t i = 0; i < x.contacts.size(); ++i) {
     const auto& a = x.contacts[i];
     const auto& b = y.contacts[i];
-    if (a.distance != b.distance || a.point_a != b.point_a || a.point_b != b.point_b || a.normal != b.normal ||
-        a.depth != b.depth) {
+    if (a.tri_a != b.tri_a || a.tri_b != b.tri_b || a.distance != b.distance || a.point_a != b.point_a ||
+        a.point_b != b.point_b || a.normal != b.normal || a.depth != b.depth) {
       return false;
     }
   }
@@ -64,10 +61,7 @@ caliber::QueryResult query_with_engine(caliber::Engine& engine, const caliber::F
   result.kind = frame.request.kind;
   result.stats = step.stats;
   result.limit_reached = step.limit_reached;
-  for (const caliber::SceneContact& c : step.contacts) {
-    result.pairs.push_back({c.contact.tri_a, c.contact.tri_b});
-    if (frame.request.kind != caliber::QueryKind::interference) result.contacts.push_back(c.contact);
-  }
+  result.contacts = step.contacts;  // one shape: the frame's objects are 0 and 1, as caliber::query's
   return result;
 }
 
@@ -162,7 +156,7 @@ int run_query(const QueryOptions& opt) {
                      : request.kind == caliber::QueryKind::proximity  ? "triangle pairs within the tolerance"
                      : request.kind == caliber::QueryKind::distance   ? "closest triangle pair"
                                                                       : "contacts (local minima)";
-  std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.pairs.size(), what);
+  std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.contacts.size(), what);
   std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh.triangles.size(), shown_a.height);
   std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh.triangles.size(), shown_b.height);
   std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms",
@@ -170,20 +164,20 @@ int run_query(const QueryOptions& opt) {
               build_ms, cold_ms);
   if (opt.repeat > 1) std::printf(" (first; median of the other %d: %.3f ms)", opt.repeat - 1, warm_ms);
   std::printf("\n");
-  const std::size_t shown = std::min<std::size_t>(result.pairs.size(), static_cast<std::size_t>(std::max(opt.show, 0)));
+  const std::size_t shown = std::min<std::size_t>(result.contacts.size(), static_cast<std::size_t>(std::max(opt.show, 0)));
   for (std::size_t i = 0; i < shown; ++i) {
-    if (result.contacts.empty()) {
-      std::printf("  pair %u %u\n", result.pairs[i].tri_a, result.pairs[i].tri_b);
+    if (result.kind == caliber::QueryKind::interference) {
+      std::printf("  pair %u %u\n", result.contacts[i].tri_a, result.contacts[i].tri_b);
     } else {
       const auto& c = result.contacts[i];
       std::printf("  pair %u %u  distance %.6g  normal (%.4f %.4f %.4f)\n", c.tri_a, c.tri_b, c.distance, c.normal.x(),
                   c.normal.y(), c.normal.z());
     }
   }
-  if (shown < result.pairs.size()) std::printf("  ... %zu more (use --json for all)\n", result.pairs.size() - shown);
+  if (shown < result.contacts.size()) std::printf("  ... %zu more (use --json for all)\n", result.contacts.size() - shown);
   if (result.limit_reached) {
     std::printf("  limit reached: more than %zu pairs; the query stopped early and reports %zu of them\n", request.max_pairs,
-                result.pairs.size());
+                result.contacts.size());
   }
   check_stdout();
   return 0;

@@ -53,7 +53,7 @@ nlohmann::json step_record(const StepResult& s) {
                      {"b", t.pair.b},
                      {"node_tests", t.stats.node_tests},
                      {"leaf_tests", t.stats.leaf_tests},
-                     {"pairs", t.pairs},
+                     {"pairs", t.contacts},
                      {"limit_reached", t.limit_reached}});
   }
   const ScheduleRecord& c = *s.schedule;
@@ -91,19 +91,19 @@ nlohmann::json step_record(const StepResult& s) {
 nlohmann::json contacts_line(const World& world, const StepResult& s) {
   nlohmann::json list = nlohmann::json::array();
   const bool points = world.request().kind != QueryKind::interference;
-  for (const SceneContact& c : s.contacts) {
+  for (const Contact& c : s.contacts) {
     nlohmann::json j = {{"object_a", c.object_a},
                         {"object_b", c.object_b},
                         {"name_a", world.scene().objects[c.object_a].name},
                         {"name_b", world.scene().objects[c.object_b].name},
-                        {"tri_a", c.contact.tri_a},
-                        {"tri_b", c.contact.tri_b}};
+                        {"tri_a", c.tri_a},
+                        {"tri_b", c.tri_b}};
     if (points) {
-      j["point_a"] = vec(c.contact.point_a);
-      j["point_b"] = vec(c.contact.point_b);
-      j["normal"] = vec(c.contact.normal);
-      j["distance"] = c.contact.distance;
-      j["depth"] = c.contact.depth;
+      j["point_a"] = vec(c.point_a);
+      j["point_b"] = vec(c.point_b);
+      j["normal"] = vec(c.normal);
+      j["distance"] = c.distance;
+      j["depth"] = c.depth;
     }
     list.push_back(std::move(j));
   }

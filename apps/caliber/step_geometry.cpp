@@ -10,15 +10,15 @@ std::vector<ShownContact> shown_contacts(const World& world, const StepResult& s
   std::vector<ShownContact> out;
   out.reserve(step.contacts.size());
   const bool points = world.request().kind != QueryKind::interference;
-  for (const SceneContact& c : step.contacts) {
-    ShownContact s{c.object_a, c.object_b, c.contact.point_a, c.contact.normal};
+  for (const Contact& c : step.contacts) {
+    ShownContact s{c.object_a, c.object_b, c.point_a, c.normal};
     if (!points) {
       const Model& model = world.model(c.object_a);
       const Pose& pose = poses[c.object_a];
-      const auto& t = model.mesh.triangles[c.contact.tri_a];
+      const auto& t = model.mesh.triangles[c.tri_a];
       const auto& v = model.mesh.vertices;
       s.point = pose.apply((v[t[0]] + v[t[1]] + v[t[2]]) / 3.0);
-      s.normal = pose.rotation * model.normals[c.contact.tri_a];
+      s.normal = pose.rotation * model.normals[c.tri_a];
     }
     out.push_back(s);
   }

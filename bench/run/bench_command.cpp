@@ -113,15 +113,15 @@ std::uint64_t contacts_hash(const StepResult& s) {
     const auto* b = static_cast<const unsigned char*>(data);
     for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
   };
-  for (const SceneContact& c : s.contacts) {
+  for (const Contact& c : s.contacts) {
     mix(&c.object_a, sizeof c.object_a);
     mix(&c.object_b, sizeof c.object_b);
-    mix(&c.contact.tri_a, sizeof c.contact.tri_a);
-    mix(&c.contact.tri_b, sizeof c.contact.tri_b);
-    mix(&c.contact.distance, sizeof c.contact.distance);
-    mix(c.contact.point_a.data(), 3 * sizeof(double));
-    mix(c.contact.point_b.data(), 3 * sizeof(double));
-    mix(c.contact.normal.data(), 3 * sizeof(double));
+    mix(&c.tri_a, sizeof c.tri_a);
+    mix(&c.tri_b, sizeof c.tri_b);
+    mix(&c.distance, sizeof c.distance);
+    mix(c.point_a.data(), 3 * sizeof(double));
+    mix(c.point_b.data(), 3 * sizeof(double));
+    mix(c.normal.data(), 3 * sizeof(double));
   }
   return h;
 }

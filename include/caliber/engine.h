@@ -27,19 +27,12 @@ struct ObjectPair {
   friend auto operator<=>(const ObjectPair&, const ObjectPair&) = default;
 };
 
-/// A contact between two objects of a scene, in world coordinates.
-struct SceneContact {
-  std::uint32_t object_a;  ///< object id (lower)
-  std::uint32_t object_b;  ///< object id (higher)
-  Contact contact;         ///< triangle ids, points, normal, distance (points unset for interference)
-};
-
 /// The work and result of one object pair in one step.
 struct PairRecord {
   ObjectPair pair;             ///< the object pair
   QueryStats stats;            ///< node and leaf tests
-  std::size_t pairs = 0;       ///< triangle pairs reported
-  bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `pairs` is partial
+  std::size_t contacts = 0;    ///< triangle pairs reported
+  bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `contacts` is partial
   /// Triangle pairs the traversals kept, before the contact reduction and max_pairs: what the
   /// pair's finalization worked on.
   std::size_t candidates = 0;
@@ -53,7 +46,7 @@ struct StepResult {
   double narrow_ms = 0.0;                ///< narrow-phase wall time (all tasks)
   double reduce_ms = 0.0;                ///< gathering and sorting the contacts
   std::vector<PairRecord> pair_records;  ///< one per object pair of the frame, in its order
-  std::vector<SceneContact> contacts;    ///< sorted by (object a, object b, tri a, tri b)
+  std::vector<Contact> contacts;         ///< every pair's contacts, sorted by (object_a, object_b, tri_a, tri_b)
   QueryStats stats;                      ///< totals over the tasks
   /// How the work was cut and scheduled (caliber/profile.h): null unless EngineOptions::profile
   /// (or timeline) is on.

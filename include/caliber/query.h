@@ -74,22 +74,17 @@ CALIBER_EXPORT void validate_request(const QueryRequest& request);
   return request.kind == QueryKind::interference ? 0.0 : request.tolerance;
 }
 
-/// A triangle pair: triangle of A, triangle of B.
-struct TrianglePair {
-  std::uint32_t tri_a;  ///< triangle id in model A
-  std::uint32_t tri_b;  ///< triangle id in model B
-  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
-  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
-};
-
-/// One reported contact (proximity and contact queries), in world coordinates.
+/// One reported triangle pair, in world coordinates: the one result shape of caliber::query and
+/// Engine::step. Interference reports the triangle ids only (points and normal zero, distance 0).
 struct Contact {
-  std::uint32_t tri_a = 0;  ///< triangle id in model A
-  std::uint32_t tri_b = 0;  ///< triangle id in model B
-  Eigen::Vector3d point_a;  ///< closest point on triangle A
-  Eigen::Vector3d point_b;  ///< closest point on triangle B
-  Eigen::Vector3d normal;   ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
-  double distance = 0.0;    ///< triangle distance; exactly 0 when the triangles intersect
+  std::uint32_t object_a = 0;  ///< object id of A: its index in the frame (caliber::query: 0)
+  std::uint32_t object_b = 0;  ///< object id of B, > object_a (caliber::query: 1)
+  std::uint32_t tri_a = 0;     ///< triangle id in model A
+  std::uint32_t tri_b = 0;     ///< triangle id in model B
+  Eigen::Vector3d point_a;     ///< closest point on triangle A
+  Eigen::Vector3d point_b;     ///< closest point on triangle B
+  Eigen::Vector3d normal;      ///< unit normal from A to B (zero only if undefined: both degenerate and touching)
+  double distance = 0.0;       ///< triangle distance; exactly 0 when the triangles intersect
   /// Intersecting pairs (distance 0) with a normal: a penetration estimate, local to the pair: how
   /// far B's deepest vertex lies behind the plane through A's closest point, along the normal (the
   /// translation of B along the normal that takes that triangle's vertices out of A's half-space).
@@ -103,30 +98,17 @@ struct QueryStats {
   std::uint64_t leaf_tests = 0;  ///< triangle-pair tests
 };
 
-/// The result of a query. `pairs` is sorted and holds every reported triangle pair; `contacts`
-/// (proximity, contact and distance; empty for interference) holds one entry per pair, same order.
-/// A distance query reports one pair, the closest (ties: the lowest triangle ids), or none when
+/// The result of a query: its contacts, one per reported triangle pair, sorted by (tri_a, tri_b).
+/// A distance query reports one, the closest pair (ties: the lowest triangle ids), or none when
 /// the meshes are farther apart than the tolerance.
 struct QueryResult {
   QueryKind kind = QueryKind::interference;  ///< the kind that produced it
-  std::vector<TrianglePair> pairs;           ///< sorted by (tri_a, tri_b)
-  std::vector<Contact> contacts;             ///< sorted like pairs
+  std::vector<Contact> contacts;             ///< sorted by (tri_a, tri_b)
   QueryStats stats;                          ///< work done
-  /// More than QueryRequest::max_pairs pairs were found: the query stopped early and `pairs` is a
-  /// part of the answer (max_pairs of the pairs found), not all of it.
+  /// More than QueryRequest::max_pairs pairs were found: the query stopped early and `contacts`
+  /// is a part of the answer (max_pairs of the pairs found), not all of it.
   bool limit_reached = false;
 };
-
-/// Reported pair k of a result as a Contact: the result's contact for proximity and contact
-/// queries; for interference, the triangle ids with zero points, normal and distance.
-[[nodiscard]] inline Contact contact_at(const QueryResult& result, std::size_t k) {
-  if (!result.contacts.empty()) return result.contacts[k];
-  Contact c;
-  c.tri_a = result.pairs[k].tri_a;
-  c.tri_b = result.pairs[k].tri_b;
-  c.point_a = c.point_b = c.normal = Eigen::Vector3d::Zero();
-  return c;
-}
 
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
 /// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.

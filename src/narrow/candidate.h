@@ -6,6 +6,18 @@
 
 #include <Eigen/Core>
 
+namespace caliber {
+
+/// A triangle pair: triangle of A, triangle of B (what the a posteriori weights keep of a step).
+struct TrianglePair {
+  std::uint32_t tri_a;  ///< triangle id in model A
+  std::uint32_t tri_b;  ///< triangle id in model B
+  friend bool operator==(const TrianglePair&, const TrianglePair&) = default;
+  friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
+};
+
+}  // namespace caliber
+
 namespace caliber::narrow {
 
 /// A triangle pair kept by the leaf test, in model A's frame.

@@ -122,7 +122,8 @@ double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::V
 
 }  // namespace
 
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel) {
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
+                     bool parallel) {
   // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
   const std::size_t grain = parallel ? kFinalizeGrain : std::max<std::size_t>(candidates.size(), 1);
   QueryResult result;
@@ -157,9 +158,18 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   CALIBER_ASSERT(std::adjacent_find(candidates.begin(), candidates.end(),
                                     [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end(),
                  "a pair's candidates are sorted by triangle ids, each pair once");
-  result.pairs.reserve(candidates.size());
-  for (const Candidate& c : candidates) result.pairs.push_back(TrianglePair{c.tri_a, c.tri_b});
-  if (result.kind == QueryKind::interference) return result;
+  if (result.kind == QueryKind::interference) {  // the triangles meet: ids only, no points
+    result.contacts.resize(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      Contact& contact = result.contacts[i];
+      contact.object_a = objects.a;
+      contact.object_b = objects.b;
+      contact.tri_a = candidates[i].tri_a;
+      contact.tri_b = candidates[i].tri_b;
+      contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
+    }
+    return result;
+  }
 
   const Pose& pose = ctx.pose_a();
   const Eigen::Matrix3d ra = pose.rotation_matrix();
@@ -168,6 +178,8 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     for (std::size_t i = lo; i != hi; ++i) {
       const Candidate& c = candidates[i];
       Contact contact;
+      contact.object_a = objects.a;
+      contact.object_b = objects.b;
       contact.tri_a = c.tri_a;
       contact.tri_b = c.tri_b;
       contact.distance = c.distance;

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "caliber/engine.h"
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 
@@ -17,9 +18,11 @@ namespace caliber::narrow {
 inline constexpr std::size_t kFinalizeGrain = 128;
 
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
-/// object pair canonically (by triangle ids) and converts them to world coordinates. With
+/// object pair canonically (by triangle ids) and converts them to world coordinates, as contacts
+/// between `objects` (their ids in the frame; 0 and 1 for caliber::query). With
 /// `parallel`, a large candidate list is processed by several tasks of the current executor (same
 /// result).
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, bool parallel = false);
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
+                     bool parallel = false);
 
 }  // namespace caliber::narrow

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "caliber/error.h"
+#include "caliber/engine.h"
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 #include "narrow/finalize.h"
@@ -72,7 +73,7 @@ QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose
   // A large query's scratch is let go: the thread would hold it, and every later query would
   // clear its tables. (Such a query takes far longer than making them again.)
   if (scratch.footprint() > kKeptScratchBytes) scratch = narrow::TraversalScratch{};
-  return narrow::finalize(ctx, candidates, stats);
+  return narrow::finalize(ctx, candidates, stats, ObjectPair{0, 1});
 }
 
 QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
@@ -97,7 +98,7 @@ QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b
     }
   }
   if (best) candidates.push_back(*best);
-  return narrow::finalize(ctx, candidates, stats);
+  return narrow::finalize(ctx, candidates, stats, ObjectPair{0, 1});
 }
 
 }  // namespace caliber

@@ -193,7 +193,11 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
               const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, tasks::History& history) {
   for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests[pairs[i]] = results[i].stats.node_tests;
   if (options.method == Method::aposteriori) {
-    for (std::size_t i = 0; i < pairs.size(); ++i) history.reported[pairs[i]] = results[i].pairs;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      std::vector<TrianglePair>& reported = history.reported[pairs[i]];
+      reported.clear();
+      for (const Contact& c : results[i].contacts) reported.push_back(TrianglePair{c.tri_a, c.tri_b});
+    }
   }
   if (options.method == Method::hybrid && options.node_history) {
     for (std::size_t s = 0; s < plan.splits.size(); ++s) {
@@ -216,7 +220,7 @@ StepResult Engine::step(const Frame& frame) {
   // The work is cut for the threads this step really has (the host's arena and limit decide).
   EngineOptions options = mOptions;
   options.threads = mImpl->executor.threads();
-  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, options.threads > 1, nullptr, {}};
+  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, options.threads > 1, nullptr, {}, frame.pairs.data()};
   std::unique_ptr<narrow::PairLimit[]> limits;
   if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);
@@ -266,9 +270,9 @@ StepResult Engine::step(const Frame& frame) {
   schedule::gather_step(frame.pairs, results, out);
   for (std::size_t i = 0; i < n && i < state.candidates.size(); ++i) out.pair_records[i].candidates = state.candidates[i];
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
-                                [](const SceneContact& x, const SceneContact& y) {
-                                  return std::tie(x.object_a, x.object_b, x.contact.tri_a, x.contact.tri_b) <
-                                         std::tie(y.object_a, y.object_b, y.contact.tri_a, y.contact.tri_b);
+                                [](const Contact& x, const Contact& y) {
+                                  return std::tie(x.object_a, x.object_b, x.tri_a, x.tri_b) <
+                                         std::tie(y.object_a, y.object_b, y.tri_a, y.tri_b);
                                 }),
                  "a step's contacts are sorted by objects, then triangles");
   CALIBER_ASSERT(std::accumulate(record.task_node_tests.begin(), record.task_node_tests.end(), std::uint64_t{0}) +

@@ -38,7 +38,7 @@ void finalize_pairs(StepState& state,
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
       state.candidates[i] = all.size();
-      state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.parallel_finalize);
+      state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.pairs[i], state.parallel_finalize);
     });
   });
 }
@@ -124,16 +124,19 @@ void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryRe
   out.limit_reached = false;
   out.stats = QueryStats{};
   std::size_t total = 0;
-  for (const QueryResult& r : results) total += r.pairs.size();
+  for (const QueryResult& r : results) total += r.contacts.size();
   out.contacts.reserve(total);
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const QueryResult& r = results[i];
-    out.pair_records.push_back(PairRecord{pairs[i], r.stats, r.pairs.size(), r.limit_reached});
+    out.pair_records.push_back(PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached});
     out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
-    for (std::size_t k = 0; k < r.pairs.size(); ++k)
-      out.contacts.push_back(SceneContact{pairs[i].a, pairs[i].b, contact_at(r, k)});
+    for (Contact c : r.contacts) {  // the pair's object ids (a result of caliber::query has 0 and 1)
+      c.object_a = pairs[i].a;
+      c.object_b = pairs[i].b;
+      out.contacts.push_back(c);
+    }
   }
 }
 

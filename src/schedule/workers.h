@@ -100,6 +100,8 @@ struct StepState {
   narrow::PairLimit* limits = nullptr;
   /// Per pair: the candidates its finalization took in (filled by finalize_pairs).
   std::vector<std::size_t> candidates;
+  /// The frame's object pairs (the ids each pair's contacts carry).
+  const ObjectPair* pairs = nullptr;
   /// The pair's limit for a traversal, or null.
   [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
 };

@@ -5,13 +5,14 @@
 //      no more than steps 0-19 (2 % + 100 of slack for a worker thread that first joins late and
 //      sets up its scratch);
 //  (2) it does not grow with the traversal's work: the same scene with every mesh 4x finer (about
-//      7x the node tests, 19x the leaf tests, same pairs) allocates at most twice as much a step,
-//      so nothing allocates per node test, leaf test or summary node;
-//  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does.
+//      7x the node tests, 19x the leaf tests, same pairs) allocates at most twice as much in the median
+//      step, so nothing allocates per node test, leaf test or summary node;
+//  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does (medians).
 // Prints the counts. Exit 0: all hold; 1: a check failed; 77: skipped (sanitizer build, whose
 // allocator hooks would count their own allocations).
 
 #include <algorithm>
+#include <vector>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -57,6 +58,7 @@ struct Counts {
   long first = 0;                // allocations over the first window after warm-up
   long last = 0;                 // over the last window
   long most = 0;                 // the most in one step
+  long median = 0;               // the median step's, after warm-up
   std::uint64_t node_tests = 0;  // the most in one step
 };
 
@@ -70,6 +72,7 @@ Counts count(const caliber::World& world, caliber::Method method, int threads, b
   caliber::Engine engine(options);
   const caliber::Frame fixed = world.frame(7);
   Counts c;
+  std::vector<long> per_step;
   for (int k = 0; k < kWarmup + 2 * kWindow + kGap; ++k) {
     const caliber::Frame frame = moving ? world.frame(k) : fixed;
     gAllocations = 0;
@@ -82,8 +85,11 @@ Counts count(const caliber::World& world, caliber::Method method, int threads, b
     if (at < kWindow) c.first += n;
     if (at >= kWindow + kGap) c.last += n;
     c.most = std::max(c.most, n);
+    per_step.push_back(n);
     c.node_tests = std::max(c.node_tests, result.stats.node_tests);
   }
+  std::nth_element(per_step.begin(), per_step.begin() + static_cast<std::ptrdiff_t>(per_step.size() / 2), per_step.end());
+  c.median = per_step[per_step.size() / 2];
   return c;
 }
 
@@ -103,7 +109,8 @@ int main() {
       ++failures;
     }
   };
-  std::puts("method        threads  allocations a step (most): fixed, 4x finer, moving;  node tests fixed / finer");
+  std::puts(
+      "method        threads  allocations a step, median: fixed, 4x finer, moving;  most: the same;  node tests fixed / finer");
   for (const caliber::Method method : {caliber::Method::sequential, caliber::Method::exploitation, caliber::Method::stealing,
                                        caliber::Method::aposteriori, caliber::Method::apriori, caliber::Method::hybrid}) {
     for (const int threads : {1, 2}) {
@@ -111,16 +118,20 @@ int main() {
       const Counts base = count(*coarse, method, threads, false);
       const Counts finer = count(*fine, method, threads, false);
       const Counts moving = count(*coarse, method, threads, true);
-      std::printf("%-13s %7d  %8ld %9ld %7ld;  %llu / %llu\n", std::string(caliber::to_string(method)).c_str(), threads,
-                  base.most, finer.most, moving.most, static_cast<unsigned long long>(base.node_tests),
-                  static_cast<unsigned long long>(finer.node_tests));
+      std::printf("%-13s %7d  %8ld %9ld %7ld;  %8ld %9ld %7ld;  %llu / %llu\n", std::string(caliber::to_string(method)).c_str(),
+                  threads, base.median, finer.median, moving.median, base.most, finer.most, moving.most,
+                  static_cast<unsigned long long>(base.node_tests), static_cast<unsigned long long>(finer.node_tests));
       check(finer.node_tests >= 5 * base.node_tests, "the finer scene does at least 5x the node tests");
       for (const Counts* c : {&base, &finer}) {
         check(static_cast<double>(c->last) <= 1.02 * static_cast<double>(c->first) + 100.0,
               "a fixed frame's allocations do not grow with the steps");
       }
-      check(finer.most <= 2 * base.most, "4x finer meshes allocate at most twice as much a step");
-      check(moving.most <= 2 * base.most, "moving frames allocate at most twice what a fixed one does");
+      // Medians: anything allocated per node test, leaf test or summary node shows in every step,
+      // while the most in one step also counts a worker that joins late and sets up its scratch
+      // then (seen under a loaded run: stealing on 2 threads 88 in one step against a median of 45).
+      check(finer.median <= 2 * base.median, "4x finer meshes allocate at most twice as much a step");
+      check(moving.median <= 2 * base.median, "moving frames allocate at most twice what a fixed one does");
+      check(finer.most <= 4 * base.most + 100, "no step of the finer meshes allocates far beyond the coarse ones' worst");
     }
   }
   std::printf("%s\n", failures == 0 ? "bounded and flat" : "FAILED");

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -45,7 +46,7 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
     request.kind = kind;
     request.tolerance = kind == QueryKind::proximity ? 0.004 : 0.0;
     const QueryResult fast = query(*model, Pose{}, *probe, at_surface, request);
-    ASSERT_FALSE(fast.pairs.empty()) << "the probe must touch the sphere";
+    ASSERT_FALSE(fast.contacts.empty()) << "the probe must touch the sphere";
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300);
     for (const auto& v : probe->mesh.vertices) {
       const Eigen::Vector3d w = at_surface.apply(v);
@@ -72,12 +73,12 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
     ASSERT_FALSE(near.triangles.empty());
     const QueryResult slow = query_brute_force(*build_model(near), Pose{}, *probe, at_surface, request);
     std::vector<TrianglePair> want;
-    for (const TrianglePair& p : slow.pairs) want.push_back({original[p.tri_a], p.tri_b});
+    for (const Contact& p : slow.contacts) want.push_back({original[p.tri_a], p.tri_b});
     std::sort(want.begin(), want.end());
-    EXPECT_EQ(fast.pairs, want) << to_string(kind);
+    EXPECT_EQ(test::pairs_of(fast), want) << to_string(kind);
     std::printf("  %s: %zu pairs, %llu node tests (brute force over %zu nearby triangles)\n",
-                std::string(to_string(kind)).c_str(), fast.pairs.size(), static_cast<unsigned long long>(fast.stats.node_tests),
-                near.triangles.size());
+                std::string(to_string(kind)).c_str(), fast.contacts.size(),
+                static_cast<unsigned long long>(fast.stats.node_tests), near.triangles.size());
   }
 }
 

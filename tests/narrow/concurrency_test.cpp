@@ -37,7 +37,7 @@ TEST(Concurrency, ManyThreadsQueryTheSameModels) {
     }
   }
   std::size_t nonempty = 0;
-  for (const QueryResult& r : reference) nonempty += r.pairs.empty() ? 0 : 1;
+  for (const QueryResult& r : reference) nonempty += r.contacts.empty() ? 0 : 1;
   ASSERT_GT(nonempty, reference.size() / 4) << "too few touching poses to test anything";
 
   constexpr int kThreads = 8;
@@ -107,12 +107,12 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
       for (std::size_t i = 0; i < w.size(); ++i) {
         ASSERT_EQ(g[i].object_a, w[i].object_a);
         ASSERT_EQ(g[i].object_b, w[i].object_b);
-        ASSERT_EQ(g[i].contact.tri_a, w[i].contact.tri_a);
-        ASSERT_EQ(g[i].contact.tri_b, w[i].contact.tri_b);
-        ASSERT_EQ(g[i].contact.distance, w[i].contact.distance);
-        ASSERT_EQ(g[i].contact.point_a, w[i].contact.point_a);
-        ASSERT_EQ(g[i].contact.point_b, w[i].contact.point_b);
-        ASSERT_EQ(g[i].contact.normal, w[i].contact.normal);
+        ASSERT_EQ(g[i].tri_a, w[i].tri_a);
+        ASSERT_EQ(g[i].tri_b, w[i].tri_b);
+        ASSERT_EQ(g[i].distance, w[i].distance);
+        ASSERT_EQ(g[i].point_a, w[i].point_a);
+        ASSERT_EQ(g[i].point_b, w[i].point_b);
+        ASSERT_EQ(g[i].normal, w[i].normal);
       }
     }
   }

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
@@ -66,7 +67,7 @@ TEST(Distance, EqualsTheBruteForceMinimumAtEveryScaleOfGap) {
       const QueryResult fast = query(a, pa, b, pb, distance_request());
       const QueryResult slow = query_brute_force(a, pa, b, pb, distance_request());
       test::expect_identical(fast, slow, what);
-      ASSERT_EQ(fast.pairs.size(), 1u) << what;
+      ASSERT_EQ(fast.contacts.size(), 1u) << what;
       const Contact& c = fast.contacts.front();
       EXPECT_GE(c.distance, gap * (1 - 1e-9)) << what << ": the spheres' gap is a lower bound";
       EXPECT_NEAR((c.point_b - c.point_a).norm(), c.distance, 1e-12 * (1 + c.distance)) << what;
@@ -115,7 +116,7 @@ TEST(Distance, RandomPosesAgreeWithTheOracleIncludingOverlaps) {
     const Pose pb = test::random_pose(rng, 1.2);
     const QueryResult fast = query(a, pa, b, pb, distance_request());
     test::expect_identical(fast, query_brute_force(a, pa, b, pb, distance_request()), "pose " + std::to_string(i));
-    ASSERT_EQ(fast.pairs.size(), 1u);
+    ASSERT_EQ(fast.contacts.size(), 1u);
     (fast.contacts.front().distance == 0.0 ? overlapping : apart)++;
   }
   EXPECT_GT(overlapping, 10) << "overlapping poses must be tested: their ties at 0 go to the lowest ids";
@@ -139,7 +140,7 @@ TEST(Distance, FacingPlatesTieAndTheLowestIdsWin) {
       const std::string what = "gap " + std::to_string(gap) + " case " + std::to_string(k);
       const QueryResult fast = query(*plate, Pose{}, *plate, pb, distance_request());
       test::expect_identical(fast, query_brute_force(*plate, Pose{}, *plate, pb, distance_request()), what);
-      ASSERT_EQ(fast.pairs.size(), 1u) << what;
+      ASSERT_EQ(fast.contacts.size(), 1u) << what;
       ++cases;
     }
   }
@@ -157,11 +158,11 @@ TEST(Distance, TheToleranceBoundsTheAnswer) {
   const QueryResult within = query(a, Pose{}, b, pb, distance_request(d));
   test::expect_identical(within, any, "tolerance exactly the distance");
   const QueryResult beyond = query(a, Pose{}, b, pb, distance_request(std::nextafter(d, 0.0)));
-  EXPECT_TRUE(beyond.pairs.empty() && beyond.contacts.empty()) << "nothing within a tolerance below the distance";
+  EXPECT_TRUE(beyond.contacts.empty() && beyond.contacts.empty()) << "nothing within a tolerance below the distance";
   test::expect_identical(beyond, query_brute_force(a, Pose{}, b, pb, distance_request(std::nextafter(d, 0.0))), "oracle");
   EXPECT_LE(beyond.stats.node_tests, any.stats.node_tests) << "a tolerance never costs more";
   const QueryResult far_below = query(a, Pose{}, b, pb, distance_request(0.5 * d));
-  EXPECT_TRUE(far_below.pairs.empty());
+  EXPECT_TRUE(far_below.contacts.empty());
   EXPECT_LT(far_below.stats.node_tests, any.stats.node_tests) << "a tolerance well below the distance answers early";
 }
 
@@ -187,10 +188,10 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
     for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(ObjectPair{a, b});
   }
   frame.request = distance_request(1.5);
-  std::vector<SceneContact> want;
+  std::vector<Contact> want;
   for (const ObjectPair& t : frame.pairs) {
     const QueryResult r = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-    for (const Contact& c : r.contacts) want.push_back(SceneContact{t.a, t.b, c});
+    for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
   }
   ASSERT_GE(want.size(), 3u) << "most pairs must be within the tolerance for this to test anything";
   for (const Method method :
@@ -209,12 +210,8 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
         for (std::size_t i = 0; i < want.size(); ++i) {
           EXPECT_EQ(got.contacts[i].object_a, want[i].object_a) << what;
           EXPECT_EQ(got.contacts[i].object_b, want[i].object_b) << what;
-          test::expect_identical(
-              QueryResult{QueryKind::distance,
-                          {{got.contacts[i].contact.tri_a, got.contacts[i].contact.tri_b}},
-                          {got.contacts[i].contact},
-                          {}},
-              QueryResult{QueryKind::distance, {{want[i].contact.tri_a, want[i].contact.tri_b}}, {want[i].contact}, {}}, what);
+          test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
+                                 QueryResult{QueryKind::distance, {want[i]}, {}}, what);
         }
       }
     }

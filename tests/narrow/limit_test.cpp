@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/engine.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -29,12 +30,13 @@ const Shapes& shapes() {
 
 /// Every reported pair of `part` is in `full`, with the same contact to the last bit.
 void expect_part_of(const QueryResult& part, const QueryResult& full, const std::string& what) {
-  for (std::size_t k = 0; k < part.pairs.size(); ++k) {
-    const auto it = std::lower_bound(full.pairs.begin(), full.pairs.end(), part.pairs[k]);
-    ASSERT_TRUE(it != full.pairs.end() && *it == part.pairs[k]) << what << ": a pair the full answer lacks";
+  const std::vector<TrianglePair> full_pairs = test::pairs_of(full), part_pairs = test::pairs_of(part);
+  for (std::size_t k = 0; k < part.contacts.size(); ++k) {
+    const auto it = std::lower_bound(full_pairs.begin(), full_pairs.end(), part_pairs[k]);
+    ASSERT_TRUE(it != full_pairs.end() && *it == part_pairs[k]) << what << ": a pair the full answer lacks";
     if (!full.contacts.empty()) {
       const Contact& a = part.contacts[k];
-      const Contact& b = full.contacts[static_cast<std::size_t>(it - full.pairs.begin())];
+      const Contact& b = full.contacts[static_cast<std::size_t>(it - full_pairs.begin())];
       EXPECT_EQ(a.distance, b.distance) << what;
       EXPECT_EQ(a.point_a, b.point_a) << what;
       EXPECT_EQ(a.point_b, b.point_b) << what;
@@ -49,18 +51,18 @@ TEST(MaxPairs, StopsEarlyFlagsAndReportsOnlyTrueAnswers) {
     request.kind = kind;
     request.tolerance = 0.02;
     const QueryResult full = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
-    ASSERT_GT(full.pairs.size(), 20u) << "the test pose must give many pairs";
+    ASSERT_GT(full.contacts.size(), 20u) << "the test pose must give many pairs";
     EXPECT_FALSE(full.limit_reached);
-    for (const std::size_t limit : {std::size_t{1}, std::size_t{7}, full.pairs.size() - 1}) {
+    for (const std::size_t limit : {std::size_t{1}, std::size_t{7}, full.contacts.size() - 1}) {
       request.max_pairs = limit;
       const std::string what = std::string(to_string(kind)) + " limit " + std::to_string(limit);
       const QueryResult part = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
       EXPECT_TRUE(part.limit_reached) << what;
-      EXPECT_EQ(part.pairs.size(), limit) << what;
+      EXPECT_EQ(part.contacts.size(), limit) << what;
       expect_part_of(part, full, what);
       if (limit < 10) EXPECT_LT(part.stats.leaf_tests, full.stats.leaf_tests) << what << ": it stopped early";
     }
-    for (const std::size_t limit : {full.pairs.size(), full.pairs.size() + 1}) {
+    for (const std::size_t limit : {full.contacts.size(), full.contacts.size() + 1}) {
       request.max_pairs = limit;
       const QueryResult same = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
       EXPECT_FALSE(same.limit_reached) << "a limit the answer does not exceed changes nothing";
@@ -80,10 +82,10 @@ TEST(MaxPairs, FirstAnswersWhetherTheyTouch) {
     const Pose pb = test::random_pose(rng, 1.0);
     const QueryResult full = query(*shapes().torus, pa, *shapes().sphere, pb, QueryRequest{});
     const QueryResult first = query(*shapes().torus, pa, *shapes().sphere, pb, any);
-    ASSERT_EQ(first.pairs.empty(), full.pairs.empty()) << "pose " << i;
-    EXPECT_EQ(first.limit_reached, full.pairs.size() > 1) << "pose " << i;
+    ASSERT_EQ(first.contacts.empty(), full.contacts.empty()) << "pose " << i;
+    EXPECT_EQ(first.limit_reached, full.contacts.size() > 1) << "pose " << i;
     expect_part_of(first, full, "pose " + std::to_string(i));
-    touching += full.pairs.empty() ? 0 : 1;
+    touching += full.contacts.empty() ? 0 : 1;
   }
   EXPECT_GT(touching, 10);
   EXPECT_LT(touching, 55);
@@ -100,7 +102,7 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
   for (const ObjectPair& t : frame.pairs) {
     const QueryResult& f = full[{t.a, t.b}] =
         query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-    ASSERT_GT(f.pairs.size(), 30u) << t.a << "-" << t.b;
+    ASSERT_GT(f.contacts.size(), 30u) << t.a << "-" << t.b;
   }
   frame.request.max_pairs = 25;
   for (const Method method :
@@ -115,13 +117,14 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
       EXPECT_TRUE(step.limit_reached) << what;
       for (const PairRecord& t : step.pair_records) {
         EXPECT_TRUE(t.limit_reached) << what;
-        EXPECT_EQ(t.pairs, 25u) << what;
+        EXPECT_EQ(t.contacts, 25u) << what;
       }
-      for (const SceneContact& c : step.contacts) {
+      for (const Contact& c : step.contacts) {
         const QueryResult& f = full[{c.object_a, c.object_b}];
-        const auto it = std::lower_bound(f.pairs.begin(), f.pairs.end(), TrianglePair{c.contact.tri_a, c.contact.tri_b});
-        ASSERT_TRUE(it != f.pairs.end() && *it == (TrianglePair{c.contact.tri_a, c.contact.tri_b})) << what;
-        EXPECT_EQ(c.contact.point_a, f.contacts[static_cast<std::size_t>(it - f.pairs.begin())].point_a) << what;
+        const std::vector<TrianglePair> f_pairs = test::pairs_of(f);
+        const auto it = std::lower_bound(f_pairs.begin(), f_pairs.end(), TrianglePair{c.tri_a, c.tri_b});
+        ASSERT_TRUE(it != f_pairs.end() && *it == (TrianglePair{c.tri_a, c.tri_b})) << what;
+        EXPECT_EQ(c.point_a, f.contacts[static_cast<std::size_t>(it - f_pairs.begin())].point_a) << what;
       }
     }
   }

@@ -53,7 +53,7 @@ int compare_with_oracle(const Model& a, const Model& b, int poses, double spread
     const QueryResult fast = query(a, pa, b, pb, request);
     test::expect_identical(fast, query_brute_force(a, pa, b, pb, request), name + " pose " + std::to_string(i));
     if (::testing::Test::HasFatalFailure()) return non_empty;
-    non_empty += fast.pairs.empty() ? 0 : 1;
+    non_empty += fast.contacts.empty() ? 0 : 1;
   }
   return non_empty;
 }
@@ -74,7 +74,7 @@ TEST(OddMeshes, DuplicateVerticesGiveTheSameAnswerAsSharedOnes) {
     // Vertices are welded by exact position for adjacency, so even the contact reduction agrees.
     test::expect_identical(query(*soup, Pose{}, *sphere, p, request), want, "soup pose " + std::to_string(i));
     if (HasFatalFailure()) return;
-    non_empty += want.pairs.empty() ? 0 : 1;
+    non_empty += want.contacts.empty() ? 0 : 1;
   }
   EXPECT_GT(non_empty, 30);
   EXPECT_GT(compare_with_oracle(*soup, *sphere, 60, 0.7, 8, "soup-sphere"), 10);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -29,7 +30,7 @@ class Cubes : public ::testing::Test {
 
 TEST_F(Cubes, SeparatedCubesDoNotInterfere) {
   const QueryResult r = query(*cube, at(0), *cube, at(1.25), QueryRequest{});
-  EXPECT_TRUE(r.pairs.empty());
+  EXPECT_TRUE(r.contacts.empty());
   EXPECT_TRUE(r.contacts.empty());
   EXPECT_GE(r.stats.node_tests, 1u);
 }
@@ -38,17 +39,18 @@ TEST_F(Cubes, ProximityRespectsTheTolerance) {
   QueryRequest request;
   request.kind = QueryKind::proximity;
   request.tolerance = 0.2;
-  EXPECT_TRUE(query(*cube, at(0), *cube, at(1.25), request).pairs.empty());
+  EXPECT_TRUE(query(*cube, at(0), *cube, at(1.25), request).contacts.empty());
   request.tolerance = 0.25;  // exactly the gap: included (distance <= d)
   const QueryResult r = query(*cube, at(0), *cube, at(1.25), request);
-  ASSERT_FALSE(r.pairs.empty());
+  ASSERT_FALSE(r.contacts.empty());
   for (const Contact& c : r.contacts) {
     EXPECT_EQ(c.distance, 0.25);
     EXPECT_EQ(c.point_a.x(), 0.5);
     EXPECT_EQ(c.point_b.x(), 0.75);
   }
-  EXPECT_EQ(r.pairs.size(), r.contacts.size());
-  EXPECT_TRUE(std::is_sorted(r.pairs.begin(), r.pairs.end()));
+  EXPECT_EQ(r.contacts.size(), r.contacts.size());
+  const std::vector<TrianglePair> sorted = test::pairs_of(r);
+  EXPECT_TRUE(std::is_sorted(sorted.begin(), sorted.end()));
 }
 
 TEST_F(Cubes, ContactReducesFacingFacesToOneLocalMinimum) {
@@ -97,21 +99,21 @@ TEST_F(Cubes, ResultsAreInWorldCoordinates) {
 
 TEST_F(Cubes, OverlappingCubesInterfereAndHaveZeroDistance) {
   const QueryResult inter = query(*cube, at(0), *cube, at(0.75, 0.1, 0.2), QueryRequest{});
-  ASSERT_FALSE(inter.pairs.empty());
+  ASSERT_FALSE(inter.contacts.empty());
   QueryRequest request;
   request.kind = QueryKind::proximity;
   request.tolerance = 0.0;
   const QueryResult prox = query(*cube, at(0), *cube, at(0.75, 0.1, 0.2), request);
-  EXPECT_EQ(prox.pairs, inter.pairs) << "with d = 0, proximity reports exactly the intersecting pairs";
+  EXPECT_EQ(test::pairs_of(prox), test::pairs_of(inter)) << "with d = 0, proximity reports exactly the intersecting pairs";
   for (const Contact& c : prox.contacts) EXPECT_EQ(c.distance, 0.0);
 }
 
 TEST_F(Cubes, FaceToFaceTouchingIsAnIntersection) {
   // B's -x face lies in A's +x face plane: touching counts as intersecting (closed triangles).
   const QueryResult r = query(*cube, at(0), *cube, at(1.0, 0.25, 0), QueryRequest{});
-  EXPECT_FALSE(r.pairs.empty());
+  EXPECT_FALSE(r.contacts.empty());
   const QueryResult apart = query(*cube, at(0), *cube, at(1.0 + 1e-12, 0.25, 0), QueryRequest{});
-  EXPECT_TRUE(apart.pairs.empty());
+  EXPECT_TRUE(apart.contacts.empty());
 }
 
 TEST(QueryGroups, IncompatibleGroupsNeverTouch) {
@@ -133,12 +135,12 @@ TEST(QueryGroups, IncompatibleGroupsNeverTouch) {
     request.angle_deg = 60;
     request.groups = &groups;
     const QueryResult r = query(*ma, at(0), *mb, at(0.9, 0.2, 0.1), request);
-    for (const TrianglePair& p : r.pairs) EXPECT_EQ(b.groups[p.tri_b], 2) << "kind " << to_string(kind);
+    for (const Contact& p : r.contacts) EXPECT_EQ(b.groups[p.tri_b], 2) << "kind " << to_string(kind);
     test::expect_identical(r, query_brute_force(*ma, at(0), *mb, at(0.9, 0.2, 0.1), request), "groups");
     if (kind != QueryKind::contact) {  // (fewer candidates can leave more local minima)
       QueryRequest all = request;
       all.groups = nullptr;
-      EXPECT_GT(query(*ma, at(0), *mb, at(0.9, 0.2, 0.1), all).pairs.size(), r.pairs.size());
+      EXPECT_GT(query(*ma, at(0), *mb, at(0.9, 0.2, 0.1), all).contacts.size(), r.contacts.size());
     }
   }
 }
@@ -179,7 +181,7 @@ TEST(QueryStats, CountsWork) {
   EXPECT_GT(r.stats.node_tests, 1u);
   EXPECT_GT(r.stats.leaf_tests, 0u);
   EXPECT_LE(r.stats.leaf_tests, r.stats.node_tests);
-  EXPECT_FALSE(r.pairs.empty());
+  EXPECT_FALSE(r.contacts.empty());
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ std::array<int, 3> compare_with_oracle(const Model& a, const Model& b, int poses
     test::expect_identical(fast, slow, name + " pose " + std::to_string(i) + " kind " + std::string(to_string(kind)));
     if (::testing::Test::HasFatalFailure()) return non_empty;
     EXPECT_LE(fast.stats.leaf_tests, slow.stats.leaf_tests);
-    if (!fast.pairs.empty()) ++non_empty[i % 3];
+    if (!fast.contacts.empty()) ++non_empty[i % 3];
   }
   return non_empty;
 }
@@ -114,7 +114,7 @@ TEST(QueryOracle, AxisAlignedBoxesTouchingAndCoplanar) {
     const QueryResult slow = query_brute_force(box, pa, box, pb, request);
     test::expect_identical(fast, slow, "aligned boxes pose " + std::to_string(i));
     if (HasFatalFailure()) return;
-    if (!fast.pairs.empty()) ++non_empty[i % 3];
+    if (!fast.contacts.empty()) ++non_empty[i % 3];
   }
   expect_mostly_non_empty(non_empty, poses);
 }

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
@@ -45,7 +46,7 @@ TEST(Scale, EveryAcceptedPowerOfTwoGivesTheScaleOneAnswer) {
     request.tolerance = 0.0078125;  // 2^-7
     const auto one = build_model(mesh);
     const QueryResult want = query(*one, Pose{}, *one, pose_b, request);
-    ASSERT_FALSE(want.pairs.empty()) << to_string(kind);
+    ASSERT_FALSE(want.contacts.empty()) << to_string(kind);
     int compared = 0;
     for (int e = -100; e <= 40; e += 10) {
       if (e == 0) continue;
@@ -54,7 +55,7 @@ TEST(Scale, EveryAcceptedPowerOfTwoGivesTheScaleOneAnswer) {
       r.tolerance = std::ldexp(request.tolerance, e);
       const QueryResult got = query(*model, Pose{}, *model, scaled(pose_b, e), r);
       const std::string what = std::string(to_string(kind)) + " at 2^" + std::to_string(e);
-      ASSERT_EQ(got.pairs, want.pairs) << what;
+      ASSERT_EQ(test::pairs_of(got), test::pairs_of(want)) << what;
       EXPECT_EQ(got.stats.node_tests, want.stats.node_tests) << what << ": the same prunes";
       ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
       for (std::size_t i = 0; i < want.contacts.size(); ++i) {
@@ -102,7 +103,7 @@ TEST(Scale, CoordinatesBelowTheRangeAreRefusedNotAnsweredWrongly) {
       continue;
     }
     const QueryResult r = query(*build_model(a), Pose{}, *build_model(b), Pose{}, QueryRequest{});
-    EXPECT_TRUE(r.pairs.empty()) << "2^" << e;
+    EXPECT_TRUE(r.contacts.empty()) << "2^" << e;
   }
 }
 

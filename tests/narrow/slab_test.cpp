@@ -67,7 +67,7 @@ TEST(NodeSlab, ParallelPatchesApartAreCutBeforeTheLeaves) {
   QueryRequest interference;
   interference.kind = QueryKind::interference;
   const QueryResult apart = query(*a, identity, *b, pose_at_gap(identity, z_onto_normal(), 0.01), interference);
-  EXPECT_TRUE(apart.pairs.empty());
+  EXPECT_TRUE(apart.contacts.empty());
   // Without the slab every box of the tilted patch overlaps B's down to the leaves (thousands of
   // leaf tests: 3,988 with the slab test switched off); with it, the tests stop near the roots.
   EXPECT_EQ(apart.stats.leaf_tests, 0u);
@@ -77,7 +77,7 @@ TEST(NodeSlab, ParallelPatchesApartAreCutBeforeTheLeaves) {
   proximity.kind = QueryKind::proximity;
   proximity.tolerance = 0.02;
   const QueryResult near = query(*a, identity, *b, pose_at_gap(identity, z_onto_normal(), 0.01), proximity);
-  EXPECT_FALSE(near.pairs.empty()) << "0.01 apart is within a tolerance of 0.02";
+  EXPECT_FALSE(near.contacts.empty()) << "0.01 apart is within a tolerance of 0.02";
 }
 
 TEST(NodeSlab, GapsAroundTheToleranceGiveTheOracleAnswer) {
@@ -104,7 +104,7 @@ TEST(NodeSlab, GapsAroundTheToleranceGiveTheOracleAnswer) {
         const QueryResult fast = query(*a, common, b, pb, request);
         test::expect_identical(fast, query_brute_force(*a, common, b, pb, request), what);
         if (::testing::Test::HasFatalFailure()) return;
-        (fast.pairs.empty() ? empty : non_empty) += 1;
+        (fast.contacts.empty() ? empty : non_empty) += 1;
       }
     }
   }
@@ -120,7 +120,7 @@ TEST(NodeSlab, BothTiltedParallelPatchesApartAreCutByTheDisks) {
   QueryRequest interference;
   interference.kind = QueryKind::interference;
   const QueryResult apart = query(*a, identity, *b, pose_at_gap(identity, Eigen::Quaterniond::Identity(), 0.01), interference);
-  EXPECT_TRUE(apart.pairs.empty());
+  EXPECT_TRUE(apart.contacts.empty());
   // Both patches' boxes are thick, so the boxes and the slab-against-box tests let every pair down
   // to the leaves (12.5k node tests and 2.9k leaf tests before the disks); a disk is as thin along
   // the other's slab axis as its own slab.

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/engine.h"
 #include "caliber/profile.h"
 #include "caliber/error.h"
@@ -34,17 +35,17 @@ void expect_same_step(const StepResult& got, const StepResult& want, const std::
   }
   ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
   for (std::size_t i = 0; i < want.contacts.size(); ++i) {
-    const SceneContact& g = got.contacts[i];
-    const SceneContact& w = want.contacts[i];
+    const Contact& g = got.contacts[i];
+    const Contact& w = want.contacts[i];
     ASSERT_EQ(g.object_a, w.object_a) << what;
     ASSERT_EQ(g.object_b, w.object_b) << what;
-    ASSERT_EQ(g.contact.tri_a, w.contact.tri_a) << what;
-    ASSERT_EQ(g.contact.tri_b, w.contact.tri_b) << what;
-    ASSERT_EQ(g.contact.distance, w.contact.distance) << what;
-    ASSERT_EQ(g.contact.point_a, w.contact.point_a) << what;
-    ASSERT_EQ(g.contact.point_b, w.contact.point_b) << what;
-    ASSERT_EQ(g.contact.normal, w.contact.normal) << what;
-    ASSERT_EQ(g.contact.depth, w.contact.depth) << what;
+    ASSERT_EQ(g.tri_a, w.tri_a) << what;
+    ASSERT_EQ(g.tri_b, w.tri_b) << what;
+    ASSERT_EQ(g.distance, w.distance) << what;
+    ASSERT_EQ(g.point_a, w.point_a) << what;
+    ASSERT_EQ(g.point_b, w.point_b) << what;
+    ASSERT_EQ(g.normal, w.normal) << what;
+    ASSERT_EQ(g.depth, w.depth) << what;
   }
 }
 
@@ -82,7 +83,7 @@ void expect_all_methods_identical(const World& world, int steps) {
         // sub-tasks whose root the original task never reached, and says how much.
         EXPECT_EQ(got.stats.node_tests - got.schedule->taboo_unreached_node_tests, reference[k].stats.node_tests) << what;
         for (const PairRecord& t : got.pair_records)
-          EXPECT_GE(t.candidates, t.pairs) << what << ": reported pairs are candidates";
+          EXPECT_GE(t.candidates, t.contacts) << what << ": reported pairs are candidates";
         if (method == Method::apriori || method == Method::hybrid) {
           // The stage's levels hold its node tests (all but each split task's root test).
           std::uint64_t levels = got.schedule->stage_task_node_tests.size();
@@ -475,16 +476,16 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
       for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
         const ObjectPair t = frame.pairs[i];
         const QueryResult want = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-        ASSERT_EQ(got.pair_records[i].pairs, want.pairs.size()) << to_string(method) << " frame " << k << " pair " << i;
+        ASSERT_EQ(got.pair_records[i].contacts, want.contacts.size()) << to_string(method) << " frame " << k << " pair " << i;
         for (const Contact& c : want.contacts) {
-          const SceneContact& g = got.contacts[at++];
+          const Contact& g = got.contacts[at++];
           ASSERT_EQ(g.object_a, t.a);
           ASSERT_EQ(g.object_b, t.b);
-          ASSERT_EQ(g.contact.tri_a, c.tri_a);
-          ASSERT_EQ(g.contact.tri_b, c.tri_b);
-          ASSERT_EQ(g.contact.point_a, c.point_a);
-          ASSERT_EQ(g.contact.normal, c.normal);
-          ASSERT_EQ(g.contact.distance, c.distance);
+          ASSERT_EQ(g.tri_a, c.tri_a);
+          ASSERT_EQ(g.tri_b, c.tri_b);
+          ASSERT_EQ(g.point_a, c.point_a);
+          ASSERT_EQ(g.normal, c.normal);
+          ASSERT_EQ(g.distance, c.distance);
         }
       }
       ASSERT_EQ(at, got.contacts.size());
@@ -539,7 +540,8 @@ TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
   std::vector<std::size_t> want;
   std::size_t total = 0;
   for (const ObjectPair& t : frame.pairs) {
-    want.push_back(query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request).pairs.size());
+    want.push_back(
+        query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request).contacts.size());
     total += want.back();
   }
   ASSERT_GT(total, 0u) << "some pairs are within the tolerance";
@@ -554,7 +556,7 @@ TEST(EngineFrames, AFrameOfManyPairsGivesEachPairItsOwnAnswer) {
       const StepResult got = engine.step(frame);
       ASSERT_EQ(got.pair_records.size(), frame.pairs.size());
       for (std::size_t i = 0; i < frame.pairs.size(); ++i) {
-        EXPECT_EQ(got.pair_records[i].pairs, want[i]) << to_string(method) << " pair " << i;
+        EXPECT_EQ(got.pair_records[i].contacts, want[i]) << to_string(method) << " pair " << i;
       }
     }
   }

@@ -36,10 +36,8 @@ bool same(const caliber::StepResult& a, const caliber::StepResult& b) {
   for (std::size_t i = 0; i < a.contacts.size(); ++i) {
     const auto& x = a.contacts[i];
     const auto& y = b.contacts[i];
-    if (x.object_a != y.object_a || x.object_b != y.object_b || x.contact.tri_a != y.contact.tri_a ||
-        x.contact.tri_b != y.contact.tri_b || x.contact.distance != y.contact.distance ||
-        x.contact.point_a != y.contact.point_a || x.contact.point_b != y.contact.point_b ||
-        x.contact.normal != y.contact.normal) {
+    if (x.object_a != y.object_a || x.object_b != y.object_b || x.tri_a != y.tri_a || x.tri_b != y.tri_b ||
+        x.distance != y.distance || x.point_a != y.point_a || x.point_b != y.point_b || x.normal != y.normal) {
       return false;
     }
   }

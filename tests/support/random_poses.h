@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
 
@@ -22,7 +23,7 @@ inline Pose random_pose(std::mt19937_64& rng, double spread) {
 /// Bitwise equality of two results: same kind, same pairs, same contacts (every double equal).
 inline void expect_identical(const QueryResult& got, const QueryResult& want, const std::string& what) {
   ASSERT_EQ(got.kind, want.kind) << what;
-  ASSERT_EQ(got.pairs, want.pairs) << what;
+  ASSERT_EQ(test::pairs_of(got), test::pairs_of(want)) << what;
   ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
   for (std::size_t i = 0; i < got.contacts.size(); ++i) {
     const Contact& g = got.contacts[i];

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/results.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
@@ -71,10 +72,10 @@ void expect_covers_like_query(const Plan& plan, const Pairs& p, const std::strin
     const ObjectPair t = p.pairs[i];
     const Model& b = t.b == 1 ? *p.sphere : *p.box;
     const QueryResult want = query(*p.torus, p.poses[t.a], b, p.poses[t.b], p.request);
-    ASSERT_EQ(got[i].first.size(), want.pairs.size()) << what << " pair " << i;
-    for (std::size_t k = 0; k < want.pairs.size(); ++k) {
-      EXPECT_EQ(got[i].first[k].tri_a, want.pairs[k].tri_a) << what;
-      EXPECT_EQ(got[i].first[k].tri_b, want.pairs[k].tri_b) << what;
+    ASSERT_EQ(got[i].first.size(), want.contacts.size()) << what << " pair " << i;
+    for (std::size_t k = 0; k < want.contacts.size(); ++k) {
+      EXPECT_EQ(got[i].first[k].tri_a, want.contacts[k].tri_a) << what;
+      EXPECT_EQ(got[i].first[k].tri_b, want.contacts[k].tri_b) << what;
     }
     EXPECT_EQ(got[i].second, want.stats.node_tests) << what << " pair " << i << ": each CD node tested once";
   }
@@ -129,8 +130,8 @@ TEST(Plans, APosterioriSplitsOnLastStepsContactsWithTabooLists) {
   options.threads = 8;
   History history;
   const QueryResult last = query(*p.torus, p.poses[0], *p.sphere, p.poses[1], p.request);
-  ASSERT_GT(last.pairs.size(), 10u);
-  history.reported[p.pairs[0]] = last.pairs;
+  ASSERT_GT(last.contacts.size(), 10u);
+  history.reported[p.pairs[0]] = test::pairs_of(last);
   history.node_tests[p.pairs[0]] = last.stats.node_tests;
   const Plan plan = plan_calibrated(options, p.pairs, p.contexts, history);
   ASSERT_EQ(plan.taboos.size(), 1u);
@@ -139,7 +140,7 @@ TEST(Plans, APosterioriSplitsOnLastStepsContactsWithTabooLists) {
   // The sub-tasks may test below a node the original task prunes: the contacts are the same, the
   // node tests at least query's.
   const auto got = run_serially(plan, p);
-  EXPECT_EQ(got[0].first.size(), last.pairs.size());
+  EXPECT_EQ(got[0].first.size(), last.contacts.size());
   EXPECT_GE(got[0].second, last.stats.node_tests);
 }
 

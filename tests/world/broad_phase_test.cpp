@@ -49,7 +49,7 @@ TEST(BroadPhase, KeepsEveryPairWithinReachAndSkipsFixedAndIgnoredOnes) {
           const bool skipped = (fixed[a] && fixed[b]) || p == ignored[0] || p == ignored[1];
           if (skipped) EXPECT_FALSE(kept) << a << ", " << b;
           if (!skipped) EXPECT_EQ(kept, std::binary_search(all.begin(), all.end(), p)) << "only fixed and ignored pairs differ";
-          if (!query_brute_force(*models[a], poses[a], *models[b], poses[b], request).pairs.empty()) {
+          if (!query_brute_force(*models[a], poses[a], *models[b], poses[b], request).contacts.empty()) {
             EXPECT_TRUE(std::binary_search(all.begin(), all.end(), p)) << "a pair within reach was dropped: " << a << ", " << b;
           }
         }

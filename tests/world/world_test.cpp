@@ -12,6 +12,7 @@
 #include "support/random_poses.h"
 #include "support/temp_dir.h"
 #include "support/reference_step.h"
+#include "support/results.h"
 
 namespace caliber {
 namespace {
@@ -37,7 +38,7 @@ void expect_steps_match_oracle(const World& world, int steps) {
   for (int k = 0; k < steps; ++k) {
     const StepResult s = test::reference_step(world, k);
     const std::vector<Pose> poses = world.poses_at(k);
-    std::vector<SceneContact> want;
+    std::vector<Contact> want;
     for (std::uint32_t a = 0; a < world.object_count(); ++a) {
       for (std::uint32_t b = a + 1; b < world.object_count(); ++b) {
         if (world.scene().objects[a].motion.type == Motion::Type::fixed &&
@@ -45,18 +46,18 @@ void expect_steps_match_oracle(const World& world, int steps) {
           continue;
         }
         const QueryResult r = query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request());
-        for (std::size_t i = 0; i < r.pairs.size(); ++i) want.push_back(SceneContact{a, b, contact_at(r, i)});
+        for (const Contact& c : test::between(r, a, b)) want.push_back(c);
       }
     }
     ASSERT_EQ(s.contacts.size(), want.size()) << "step " << k;
     for (std::size_t i = 0; i < want.size(); ++i) {
       ASSERT_EQ(s.contacts[i].object_a, want[i].object_a) << "step " << k;
       ASSERT_EQ(s.contacts[i].object_b, want[i].object_b) << "step " << k;
-      ASSERT_EQ(s.contacts[i].contact.tri_a, want[i].contact.tri_a) << "step " << k;
-      ASSERT_EQ(s.contacts[i].contact.tri_b, want[i].contact.tri_b) << "step " << k;
-      ASSERT_EQ(s.contacts[i].contact.distance, want[i].contact.distance) << "step " << k;
-      ASSERT_EQ(s.contacts[i].contact.point_a, want[i].contact.point_a) << "step " << k;
-      ASSERT_EQ(s.contacts[i].contact.normal, want[i].contact.normal) << "step " << k;
+      ASSERT_EQ(s.contacts[i].tri_a, want[i].tri_a) << "step " << k;
+      ASSERT_EQ(s.contacts[i].tri_b, want[i].tri_b) << "step " << k;
+      ASSERT_EQ(s.contacts[i].distance, want[i].distance) << "step " << k;
+      ASSERT_EQ(s.contacts[i].point_a, want[i].point_a) << "step " << k;
+      ASSERT_EQ(s.contacts[i].normal, want[i].normal) << "step " << k;
     }
   }
 }
@@ -106,8 +107,8 @@ TEST_F(WorldFiles, SharedModelsGiveTheSameContactsAsSeparateOnes) {
     const StepResult x = test::reference_step(one, k), y = test::reference_step(two, k);
     ASSERT_EQ(x.contacts.size(), y.contacts.size());
     for (std::size_t i = 0; i < x.contacts.size(); ++i) {
-      EXPECT_EQ(x.contacts[i].contact.tri_a, y.contacts[i].contact.tri_a);
-      EXPECT_EQ(x.contacts[i].contact.point_b, y.contacts[i].contact.point_b);
+      EXPECT_EQ(x.contacts[i].tri_a, y.contacts[i].tri_a);
+      EXPECT_EQ(x.contacts[i].point_b, y.contacts[i].point_b);
     }
     total += static_cast<int>(x.contacts.size());
   }
@@ -145,7 +146,7 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
         const bool ignored = a == 0 && b == 1;
         if (overlap && !both_fixed && !ignored) want.push_back(ObjectPair{a, b});
         if (!both_fixed && !ignored &&
-            !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).pairs.empty()) {
+            !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).contacts.empty()) {
           EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), ObjectPair{a, b}) != tasks.end()) << "touching pair dropped";
         }
       }
