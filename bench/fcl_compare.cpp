@@ -123,8 +123,8 @@ void compare_pair(const caliber::Model& ours_a, const caliber::Pose& pose_a, con
   for (const caliber::TrianglePair& p : only_fcl) {
     Eigen::Vector3d ta[3], tb[3];
     for (int k = 0; k < 3; ++k) {
-      ta[k] = pose_a.apply(ours_a.mesh.vertices[ours_a.mesh.triangles[p.tri_a][k]]);
-      tb[k] = pose_b.apply(ours_b.mesh.vertices[ours_b.mesh.triangles[p.tri_b][k]]);
+      ta[k] = pose_a.apply(ours_a.mesh().vertices[ours_a.mesh().triangles[p.tri_a][k]]);
+      tb[k] = pose_b.apply(ours_b.mesh().vertices[ours_b.mesh().triangles[p.tri_b][k]]);
     }
     if (caliber::geometry::triangles_intersect(ta[0], ta[1], ta[2], tb[0], tb[1], tb[2])) ++row.only_fcl_exact_hits;
     row.only_fcl_max_distance = std::max(row.only_fcl_max_distance, caliber::geometry::closest_points_triangles(ta, tb).distance);
@@ -179,9 +179,9 @@ std::vector<Row> run_scene(const std::filesystem::path& file, const std::vector<
   for (std::size_t i = 0; i < world.object_count(); ++i) {
     const caliber::Model* key = &world.model(i);
     if (ours.count(key)) continue;
-    build_ours_ms += median_ms(repeat, [&] { ours[key] = caliber::build_model(key->mesh, bvh_only); });
-    build_fcl_ms += median_ms(repeat, [&] { theirs[key] = build_fcl(key->mesh); });
-    triangles += key->mesh.triangles.size();
+    build_ours_ms += median_ms(repeat, [&] { ours[key] = caliber::build_model(key->mesh(), bvh_only); });
+    build_fcl_ms += median_ms(repeat, [&] { theirs[key] = build_fcl(key->mesh()); });
+    triangles += key->mesh().triangles.size();
   }
   std::vector<Row> rows;
   for (const int k : steps) {

@@ -91,7 +91,7 @@ void fcl_counts(const FclModel& fa, const FclModel& fb, const Pose& pose_b, cons
 
 Row run(const Case& c, double gap, const Model& a, const Model& b, const std::shared_ptr<FclModel>& fa,
         const std::shared_ptr<FclModel>& fb, int repeat, bool warm) {
-  const Pose pose_b = place(c, a.mesh, b.mesh, gap);
+  const Pose pose_b = place(c, a.mesh(), b.mesh(), gap);
   const QueryRequest request = distance_request();
   fcl::CollisionObjectd oa(fa, bench::to_fcl(Pose{}));
   fcl::CollisionObjectd ob(fb, bench::to_fcl(pose_b));
@@ -126,13 +126,13 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
           ours.stats.leaf_tests};
   // FCL keeps the first of several pairs at the same distance (a shared vertex closest, say), we the
   // lowest ids: FCL's pair agrees when our kernel gives it our distance.
-  const auto& ta = a.mesh.triangles[static_cast<std::size_t>(fres.b1)];
-  const auto& tb = b.mesh.triangles[static_cast<std::size_t>(fres.b2)];
+  const auto& ta = a.mesh().triangles[static_cast<std::size_t>(fres.b1)];
+  const auto& tb = b.mesh().triangles[static_cast<std::size_t>(fres.b2)];
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
-  const Eigen::Vector3d va[3] = {a.mesh.vertices[ta[0]], a.mesh.vertices[ta[1]], a.mesh.vertices[ta[2]]};
-  const Eigen::Vector3d vb[3] = {rb * b.mesh.vertices[tb[0]] + pose_b.translation,
-                                 rb * b.mesh.vertices[tb[1]] + pose_b.translation,
-                                 rb * b.mesh.vertices[tb[2]] + pose_b.translation};
+  const Eigen::Vector3d va[3] = {a.mesh().vertices[ta[0]], a.mesh().vertices[ta[1]], a.mesh().vertices[ta[2]]};
+  const Eigen::Vector3d vb[3] = {rb * b.mesh().vertices[tb[0]] + pose_b.translation,
+                                 rb * b.mesh().vertices[tb[1]] + pose_b.translation,
+                                 rb * b.mesh().vertices[tb[2]] + pose_b.translation};
   row.same_pair = geometry::closest_points_triangles(va, vb).distance == row.ours;
   fcl_counts(*fa, *fb, pose_b, freq, row);
   return row;
@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
     const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(dir / c.mesh_b), bvh_only);
     if (ours_only) {
       for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
-        const Pose pose_b = place(c, a->mesh, b->mesh, gap);
+        const Pose pose_b = place(c, a->mesh(), b->mesh(), gap);
         const QueryRequest request = distance_request();
         QueryResult ours;
         const double ms = bench::median_ms(repeat, [&] { ours = query(*a, Pose{}, *b, pose_b, request); });
@@ -203,8 +203,8 @@ int main(int argc, char** argv) {
       }
       continue;
     }
-    const auto fa = bench::build_fcl(a->mesh);
-    const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh);
+    const auto fa = bench::build_fcl(a->mesh());
+    const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh());
     for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
       const Row r = run(c, gap, *a, *b, fa, fb, repeat, warm);
       const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);

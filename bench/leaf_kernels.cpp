@@ -118,7 +118,7 @@ const Sample& sample(const std::string& scene) {
     s.contexts.push_back(std::make_unique<caliber::narrow::PairContext>(s.world->model(t.a), poses[t.a], s.world->model(t.b),
                                                                         poses[t.b], s.world->request()));
     collect_leaf_pairs(*s.contexts.back(), static_cast<std::uint32_t>(s.contexts.size() - 1), all);
-    s.size = std::max({s.size, s.world->model(t.a).extent, s.world->model(t.b).extent});
+    s.size = std::max({s.size, s.world->model(t.a).extent(), s.world->model(t.b).extent()});
   }
   const std::size_t stride = all.size() > kMaxPairs ? (all.size() + kMaxPairs - 1) / kMaxPairs : 1;
   for (std::size_t i = 0; i < all.size(); i += stride) s.pairs.push_back(all[i]);

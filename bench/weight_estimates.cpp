@@ -25,8 +25,8 @@ struct Node {
 
 /// Node tests below CD node n (whose test passed), recording n and every passing node below it.
 double below(const caliber::narrow::PairContext& ctx, caliber::narrow::NodePair n, std::vector<Node>& out) {
-  const caliber::Model& a = ctx.a();
-  const caliber::Model& b = ctx.b();
+  const caliber::ModelData& a = ctx.a();
+  const caliber::ModelData& b = ctx.b();
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return 0.0;
   caliber::narrow::NodePair kids[4];
   const int count = caliber::narrow::cd_children(ctx, n, kids);

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     frame.models = {caliber::build_model(caliber::load_mesh(argv[1])), caliber::build_model(caliber::load_mesh(argv[2]))};
     frame.pairs = {caliber::ObjectPair{0, 1}};  // object indices: the pair's identity from frame to frame
     frame.request.kind = caliber::QueryKind::contact;
-    const double size = frame.models[0]->extent + frame.models[1]->extent;
+    const double size = frame.models[0]->extent() + frame.models[1]->extent();
     frame.request.tolerance = 0.01 * size;
 
     caliber::EngineOptions options;

@@ -201,16 +201,16 @@ PYBIND11_MODULE(caliber, m) {
             return PyModel{caliber::build_model(std::move(mesh), options)};
           },
           py::arg("path"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false)
-      .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh; })
-      .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh.triangles.size(); })
-      .def_property_readonly("height", [](const PyModel& p) { return p.model->height; })
+      .def_property_readonly("mesh", [](const PyModel& p) { return p.model->mesh(); })
+      .def_property_readonly("triangles", [](const PyModel& p) { return p.model->mesh().triangles.size(); })
+      .def_property_readonly("height", [](const PyModel& p) { return p.model->height(); })
       .def_property_readonly(
-          "oriented_boxes", [](const PyModel& p) { return !p.model->oriented_boxes.empty(); },
+          "oriented_boxes", [](const PyModel& p) { return p.model->has_oriented_boxes(); },
           "whether each node's oriented box is kept (for faster distance queries)")
       .def(py::pickle(
           [](const PyModel& p) {
-            return py::make_tuple(vertices_of(p.model->mesh), faces_of(p.model->mesh), p.model->has_adjacency(),
-                                  !p.model->oriented_boxes.empty());
+            return py::make_tuple(vertices_of(p.model->mesh()), faces_of(p.model->mesh()), p.model->has_adjacency(),
+                                  p.model->has_oriented_boxes());
           },
           [](const py::tuple& t) {
             if (t.size() != 3 && t.size() != 4)

@@ -33,8 +33,8 @@ void write_objects(const World& world, const std::vector<Pose>& poses, int k, co
   std::ostream& out = file.stream();
   std::size_t vertices = 0, faces = 0;
   for (std::size_t i = 0; i < world.object_count(); ++i) {
-    vertices += world.model(i).mesh.vertices.size();
-    faces += world.model(i).mesh.triangles.size();
+    vertices += world.model(i).mesh().vertices.size();
+    faces += world.model(i).mesh().triangles.size();
   }
   out << "ply\nformat ascii 1.0\ncomment caliber: scene " << world.scene().name << ", step " << k
       << ", every object's mesh posed in the world frame; face property 'object' is the object id\n";
@@ -46,16 +46,16 @@ void write_objects(const World& world, const std::vector<Pose>& poses, int k, co
   for (std::size_t i = 0; i < world.object_count(); ++i) {
     int rgb[3];
     object_colour(i, rgb);
-    for (const Eigen::Vector3d& v : world.model(i).mesh.vertices) {
+    for (const Eigen::Vector3d& v : world.model(i).mesh().vertices) {
       put(out, poses[i].apply(v));
       out << ' ' << rgb[0] << ' ' << rgb[1] << ' ' << rgb[2] << '\n';
     }
   }
   std::size_t base = 0;
   for (std::size_t i = 0; i < world.object_count(); ++i) {
-    for (const auto& t : world.model(i).mesh.triangles)
+    for (const auto& t : world.model(i).mesh().triangles)
       out << "3 " << base + t[0] << ' ' << base + t[1] << ' ' << base + t[2] << ' ' << i << '\n';
-    base += world.model(i).mesh.vertices.size();
+    base += world.model(i).mesh().vertices.size();
   }
   file.commit();
 }

@@ -157,8 +157,8 @@ int run_query(const QueryOptions& opt) {
                      : request.kind == caliber::QueryKind::distance   ? "closest triangle pair"
                                                                       : "contacts (local minima)";
   std::printf("%s: %zu %s\n", std::string(caliber::to_string(result.kind)).c_str(), result.contacts.size(), what);
-  std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh.triangles.size(), shown_a.height);
-  std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh.triangles.size(), shown_b.height);
+  std::printf("  A: %s (%zu triangles, BVH height %d)\n", opt.mesh_a.c_str(), shown_a.mesh().triangles.size(), shown_a.height());
+  std::printf("  B: %s (%zu triangles, BVH height %d)\n", opt.mesh_b.c_str(), shown_b.mesh().triangles.size(), shown_b.height());
   std::printf("  node tests %llu, leaf tests %llu; build %.2f ms, query %.3f ms",
               static_cast<unsigned long long>(result.stats.node_tests), static_cast<unsigned long long>(result.stats.leaf_tests),
               build_ms, cold_ms);

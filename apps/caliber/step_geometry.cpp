@@ -2,6 +2,8 @@
 
 #include "step_geometry.h"
 
+#include "bvh/model_data.h"
+
 #include <Eigen/Geometry>
 
 namespace caliber::cli {
@@ -15,10 +17,10 @@ std::vector<ShownContact> shown_contacts(const World& world, const StepResult& s
     if (!points) {
       const Model& model = world.model(c.object_a);
       const Pose& pose = poses[c.object_a];
-      const auto& t = model.mesh.triangles[c.tri_a];
-      const auto& v = model.mesh.vertices;
+      const auto& t = model.mesh().triangles[c.tri_a];
+      const auto& v = model.mesh().vertices;
       s.point = pose.apply((v[t[0]] + v[t[1]] + v[t[2]]) / 3.0);
-      s.normal = pose.rotation * model.normals[c.tri_a];
+      s.normal = pose.rotation * model.normals()[c.tri_a];
     }
     out.push_back(s);
   }
@@ -26,22 +28,23 @@ std::vector<ShownContact> shown_contacts(const World& world, const StepResult& s
 }
 
 ShownBox node_box(const Model& model, std::uint32_t node, const Pose& pose) {
-  const BvhNode& n = model.nodes[node];
+  const BvhNode& n = data(model).nodes[node];
   const Eigen::Vector3d center(n.box_center[0], n.box_center[1], n.box_center[2]);
   return ShownBox{pose.apply(center), Eigen::Vector3d(n.box_half[0], n.box_half[1], n.box_half[2]), pose.rotation_matrix()};
 }
 
 std::vector<std::pair<std::uint32_t, int>> nodes_to_depth(const Model& model, int depth) {
   std::vector<std::pair<std::uint32_t, int>> out;
-  if (model.nodes.empty() || depth < 0) return out;
+  const std::vector<BvhNode>& nodes = data(model).nodes;
+  if (nodes.empty() || depth < 0) return out;
   std::vector<std::uint32_t> level{0};
   for (int d = 0; d <= depth && !level.empty(); ++d) {
     std::vector<std::uint32_t> next;
     for (const std::uint32_t i : level) {
       out.emplace_back(i, d);
-      if (!model.nodes[i].is_leaf()) {
-        next.push_back(model.nodes[i].index);
-        next.push_back(model.nodes[i].index + 1);
+      if (!nodes[i].is_leaf()) {
+        next.push_back(nodes[i].index);
+        next.push_back(nodes[i].index + 1);
       }
     }
     level = std::move(next);

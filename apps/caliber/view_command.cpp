@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bvh/model_data.h"
 #include "caliber/engine.h"
 #include "caliber/profile.h"
 #include "caliber/error.h"
@@ -93,7 +94,7 @@ nlohmann::json task_records(const World& world, const StepResult& s, int& budget
       if (budget <= 0) break;
       --budget;
       const std::uint32_t object = s.pair_records[root.pair].pair.a;
-      const BvhNode& n = world.model(object).nodes[root.node_a];
+      const BvhNode& n = data(world.model(object)).nodes[root.node_a];
       roots.push_back({object, n.box_center[0], n.box_center[1], n.box_center[2], n.box_half[0], n.box_half[1], n.box_half[2]});
     }
     tasks.push_back({{"thread", thread[t]}, {"node_tests", r.task_node_tests[t]}, {"roots", roots}});
@@ -171,7 +172,7 @@ int view_scene(const ViewOptions& opt) {
   for (std::size_t i = 0; i < world.object_count(); ++i) {
     const Model* model = &world.model(i);
     const auto [it, added] = mesh_index.emplace(model, mesh_index.size());
-    if (added) meshes.push_back(mesh_record(model->mesh));
+    if (added) meshes.push_back(mesh_record(model->mesh()));
     objects.push_back({{"name", sc.objects[i].name}, {"mesh", it->second}});
   }
   nlohmann::json steps = nlohmann::json::array();

@@ -5,8 +5,7 @@
 /// to share between threads and between objects that use the same mesh.
 
 #include "caliber/export.h"
-#include <cmath>
-#include <cstdint>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -15,167 +14,6 @@
 #include "caliber/mesh.h"
 
 namespace caliber {
-
-/// One node of the BVH, as the node-node test reads it: 48 bytes. Two bounding volumes per node:
-/// the paper's sphere, tested first, and the node's axis-aligned box in the mesh's own frame, which
-/// sharpens what the sphere lets through (thin and elongated parts, where spheres are loose). All
-/// boxes of one mesh share that frame, so the rotation between two meshes' boxes is one matrix per
-/// query and the box test is a separating-axis test on six face axes.
-///
-/// Values are stored as floats, rounded outward at build time (the radius and half-extents cover
-/// the rounding of the centers), so every vertex below lies inside both volumes exactly as stored.
-/// The children of an internal node are adjacent: `index` and `index + 1`.
-struct BvhNode {
-  /// Bounding-sphere center (object space).
-  float center[3];
-  /// Bounding-sphere radius.
-  float radius;
-  /// Box center (object space).
-  float box_center[3];
-  /// Box half-extents along the object axes.
-  float box_half[3];
-  /// Internal node: index of the first child (the second is index + 1). Leaf: the triangle id.
-  std::uint32_t index;
-  /// Number of triangles below (the paper's P); 1 for a leaf.
-  std::uint32_t count;
-
-  /// True for a leaf (one triangle).
-  [[nodiscard]] bool is_leaf() const { return count == 1; }
-};
-static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
-
-/// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
-/// tests have passed; the cone only by contact queries) and its group mask (read only with groups).
-/// Kept apart from BvhNode so that the first two tests touch 48 bytes.
-struct BvhNodeFilter {
-  /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
-  float cone_axis[3];
-  /// Normal-cone half-angle in radians, rounded up; negative when every triangle below is
-  /// degenerate (no normal, so no contact can come from this node).
-  float cone_angle;
-  /// cos(cone_angle) and sin(cone_angle), so the cone test needs no trigonometric call.
-  float cone_cos, cone_sin;
-  /// Slab along cone_axis (as stored, not renormalized): every vertex v below has
-  /// slab_lo <= cone_axis . v <= slab_hi, the bounds rounded outward. Thin where the triangles
-  /// below are nearly coplanar, whatever their tilt against the box's axes; both 0 when the axis
-  /// is 0 (no normal below), which prunes nothing.
-  float slab_lo, slab_hi;
-  /// Bit g set when some triangle below is in primitive group g.
-  std::uint64_t groups;
-};
-
-/// What only the distance query reads of a node: the ranges along the two lateral axes of its cone
-/// axis (lateral_axes), every vertex v below having lateral_lo[k] <= axis_k . v <= lateral_hi[k],
-/// rounded outward. With the slab, a box around the triangles below in the frame of the cone axis,
-/// tight where they are nearly coplanar. The lateral axes are turned about the cone axis to follow
-/// the patch (a leaf: its triangle's principal direction in the slab's plane; a parent: the line
-/// between its children, across which the build split it), so that an elongated patch gets a
-/// narrow box whatever its direction. All 0 when the cone axis is 0.
-struct BvhNodeLateral {
-  float lateral_lo[2], lateral_hi[2];
-  /// (cos, sin) of the turn, up to scale, as integers of at most 32767 in magnitude (normalized
-  /// in double where used).
-  std::int16_t turn[2];
-};
-
-/// The two axes that complete a unit axis (nx, ny, nz) to an orthonormal frame (Duff et al. 2017's
-/// branchless basis), up to double rounding.
-inline void lateral_axes_of_unit(double nx, double ny, double nz, double u[3], double v[3]) {
-  const double sign = std::copysign(1.0, nz);
-  const double a = -1.0 / (sign + nz);
-  const double b = nx * ny * a;
-  u[0] = 1.0 + sign * nx * nx * a;
-  u[1] = sign * b;
-  u[2] = -sign * nx;
-  v[0] = b;
-  v[1] = sign + ny * ny * a;
-  v[2] = -ny;
-}
-
-/// Turns the orthonormal pair (u, v) about their normal by the angle whose (cos, sin) is `turn` up
-/// to scale (normalized here in double, so the pair stays orthonormal up to double rounding; a zero
-/// turn leaves it as it is).
-inline void turn_lateral_axes(const std::int16_t turn[2], double u[3], double v[3]) {
-  double c = turn[0], s = turn[1];
-  const double r = std::sqrt(c * c + s * s);
-  if (!(r > 0.0)) return;
-  c /= r;
-  s /= r;
-  for (int k = 0; k < 3; ++k) {
-    const double uk = u[k], vk = v[k];
-    u[k] = c * uk + s * vk;
-    v[k] = c * vk - s * uk;
-  }
-}
-
-/// The lateral axes of a stored float cone axis before their turn: those of the normalized axis
-/// (lateral_axes_of_unit). Both 0 when the axis is 0.
-inline void unturned_lateral_axes(const float axis[3], double u[3], double v[3]) {
-  const double x = axis[0], y = axis[1], z = axis[2];
-  const double len = std::sqrt(x * x + y * y + z * z);
-  if (!(len > 0.0)) {
-    for (int k = 0; k < 3; ++k) u[k] = v[k] = 0.0;
-    return;
-  }
-  lateral_axes_of_unit(x / len, y / len, z / len, u, v);
-}
-
-/// The two axes that complete a node's cone axis to a frame: those of the normalized stored float
-/// axis, turned by the stored turn, by the same formulas at build and at query time. Both 0 when
-/// the axis is 0.
-inline void lateral_axes(const float axis[3], const std::int16_t turn[2], double u[3], double v[3]) {
-  unturned_lateral_axes(axis, u, v);
-  turn_lateral_axes(turn, u, v);
-}
-
-/// A box around the triangles below a node along axes of its own, in double precision: what the
-/// distance query's bound reads of a node (Model::oriented_boxes). Where the node has a slab, the
-/// box of its slab and lateral ranges: axis[0] the normalized cone axis, axis[1] and axis[2] its
-/// lateral axes (lateral_axes); else its BvhNode box along the model's axes. Computed from the
-/// stored BvhNode, BvhNodeFilter and BvhNodeLateral by one function, at build time or by the query.
-struct BvhNodeOrientedBox {
-  /// Unit axes (orthonormal up to double rounding), in object space.
-  double axis[3][3];
-  /// Center, in object space.
-  double center[3];
-  /// Half-extents along axis[0], axis[1], axis[2].
-  double half[3];
-};
-
-/// The oriented box of a node from its stored parts: the box of its slab (along the normalized
-/// cone axis, as lateral_axes normalizes it) and lateral ranges where it has a slab, else its
-/// BvhNode box. Where it has a slab, each half-extent grows by a relative 1e-12 for the rounding
-/// of the division by the axis's length.
-inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const BvhNodeLateral& l, BvhNodeOrientedBox& out) {
-  const double x = f.cone_axis[0], y = f.cone_axis[1], z = f.cone_axis[2];
-  const double len = std::sqrt(x * x + y * y + z * z);
-  if (len > 0.0) {
-    const double axis[3] = {x / len, y / len, z / len};  // as lateral_axes computes them
-    double u[3], v[3];
-    lateral_axes_of_unit(axis[0], axis[1], axis[2], u, v);
-    turn_lateral_axes(l.turn, u, v);
-    const double lo[3] = {f.slab_lo / len, l.lateral_lo[0], l.lateral_lo[1]};
-    const double hi[3] = {f.slab_hi / len, l.lateral_hi[0], l.lateral_hi[1]};
-    double mid[3], half[3];
-    for (int k = 0; k < 3; ++k) {
-      mid[k] = 0.5 * (lo[k] + hi[k]);
-      half[k] = 0.5 * (hi[k] - lo[k]) * (1.0 + 1e-12);  // the division by len rounds
-    }
-    for (int i = 0; i < 3; ++i) {
-      out.axis[0][i] = axis[i];
-      out.axis[1][i] = u[i];
-      out.axis[2][i] = v[i];
-      out.center[i] = mid[0] * axis[i] + mid[1] * u[i] + mid[2] * v[i];
-    }
-    for (int k = 0; k < 3; ++k) out.half[k] = half[k];
-    return;
-  }
-  for (int k = 0; k < 3; ++k) {
-    for (int i = 0; i < 3; ++i) out.axis[k][i] = k == i ? 1.0 : 0.0;
-    out.center[k] = n.box_center[k];
-    out.half[k] = n.box_half[k];
-  }
-}
 
 /// Options of the BVH build.
 struct BuildOptions {
@@ -192,68 +30,34 @@ struct BuildOptions {
   int threads = 0;
 };
 
-/// A mesh with its BVH, normals and adjacency. Create with build_model; never modified afterwards.
-struct Model {
-  /// The mesh, as loaded (triangle ids unchanged).
-  Mesh mesh;
-  /// BVH nodes, root first; siblings adjacent.
-  std::vector<BvhNode> nodes;
-  /// filters[i]: normal cone, slab and group mask of nodes[i].
-  std::vector<BvhNodeFilter> filters;
-  /// laterals[i]: the lateral ranges of nodes[i] (distance queries).
-  std::vector<BvhNodeLateral> laterals;
-  /// oriented_boxes[i]: the oriented box of nodes[i], as node_oriented_box computes it from the
-  /// three above; empty unless built with BuildOptions::oriented_boxes.
-  std::vector<BvhNodeOrientedBox> oriented_boxes;
-  /// The triangles below node i are those whose leaf_position lies in
-  /// [first_leaf[i], first_leaf[i] + nodes[i].count): every subtree is a run of the leaf order.
-  std::vector<std::uint32_t> first_leaf;
-  /// Position of each triangle in the leaf order (see first_leaf).
-  std::vector<std::uint32_t> leaf_position;
+/// A mesh with its BVH, normals and adjacency: what caliber::query and the engine traverse. Made
+/// by build_model; immutable (read-only accessors), so any number of threads and objects may
+/// share one. Its BVH's layout is private to caliber.
+class CALIBER_EXPORT Model {
+ public:
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
 
-  /// Whether triangle t lies below node i.
-  [[nodiscard]] bool holds(std::uint32_t node, std::uint32_t triangle) const {
-    const std::uint32_t p = leaf_position[triangle];
-    return p >= first_leaf[node] && p < first_leaf[node] + nodes[node].count;
-  }
+  /// The mesh, as given to build_model (triangle ids unchanged).
+  [[nodiscard]] const Mesh& mesh() const;
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
-  std::vector<Eigen::Vector3d> normals;
-  /// Vertex adjacency (BuildOptions::adjacency), linear in the corners whatever a vertex's degree:
-  /// the welded vertex of each corner (corner t*3 + k of triangle t; vertices are welded by exact
-  /// position, so files that repeat vertices per face still get their topology) ...
-  std::vector<std::uint32_t> corner_vertex;
-  /// ... and the triangles around each welded vertex w, ascending:
-  /// vertex_triangles[vertex_offsets[w] .. vertex_offsets[w + 1]).
-  std::vector<std::uint64_t> vertex_offsets;
-  /// See vertex_offsets.
-  std::vector<std::uint32_t> vertex_triangles;
-  /// Whether the vertex adjacency was built.
-  [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }
-  /// Calls f(u) for every triangle u that shares a vertex position with triangle t (u != t; a
-  /// triangle sharing two or three positions with t comes two or three times).
-  template <class F>
-  void for_each_neighbour(std::uint32_t t, F&& f) const {
-    for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint32_t w = corner_vertex[std::size_t{t} * 3 + k];
-      for (std::uint64_t i = vertex_offsets[w]; i < vertex_offsets[w + 1]; ++i) {
-        if (vertex_triangles[i] != t) f(vertex_triangles[i]);
-      }
-    }
-  }
-  /// Whether u is among the triangles for_each_neighbour(t, ...) gives: distinct from t, sharing
-  /// a vertex position with it.
-  [[nodiscard]] bool are_neighbours(std::uint32_t t, std::uint32_t u) const {
-    if (t == u) return false;
-    const std::uint32_t* vt = &corner_vertex[std::size_t{t} * 3];
-    const std::uint32_t* vu = &corner_vertex[std::size_t{u} * 3];
-    bool shared = false;
-    for (int k = 0; k < 3; ++k) shared |= (vt[k] == vu[0]) | (vt[k] == vu[1]) | (vt[k] == vu[2]);
-    return shared;
-  }
-  /// Largest distance of a vertex from the object-space origin (used to bound rounding error).
-  double extent = 0.0;
-  /// Height of the BVH (a root-only tree has height 1).
-  int height = 0;
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& normals() const;
+  /// Number of triangles.
+  [[nodiscard]] std::size_t triangle_count() const;
+  /// Number of BVH nodes (2 x triangles - 1).
+  [[nodiscard]] std::size_t node_count() const;
+  /// Height of the BVH (a one-triangle model has height 1).
+  [[nodiscard]] int height() const;
+  /// Largest distance of a vertex from the object-space origin.
+  [[nodiscard]] double extent() const;
+  /// Whether the triangle adjacency was built (BuildOptions::adjacency: contact queries need it).
+  [[nodiscard]] bool has_adjacency() const;
+  /// Whether the distance query's oriented boxes were kept (BuildOptions::oriented_boxes).
+  [[nodiscard]] bool has_oriented_boxes() const;
+
+ protected:
+  Model() = default;
+  ~Model() = default;
 };
 
 /// Validates the mesh and builds its model in O(n log n). Throws caliber::Error on a bad mesh.

@@ -11,7 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "caliber/error.h"
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
 #include "bvh/split.h"
@@ -88,7 +88,7 @@ class Builder {
   }
 
   /// The tree into model, with each node's oriented box where `oriented_boxes` asks for them.
-  void build(Model& model, bool oriented_boxes) {
+  void build(ModelData& model, bool oriented_boxes) {
     model.height = build_range(0, 1, 0, static_cast<std::uint32_t>(mOrder.size()), bvh::centroid_bounds(mItems));
     model.nodes.resize(mWorkCount);
     model.filters.resize(mWorkCount);
@@ -353,8 +353,8 @@ class Builder {
 namespace {
 
 /// The build, its parallel parts on the executor the caller runs in.
-std::shared_ptr<Model> build_on_this_thread(Mesh mesh, const BuildOptions& options) {
-  auto model = std::make_shared<Model>();
+std::shared_ptr<ModelData> build_on_this_thread(Mesh mesh, const BuildOptions& options) {
+  auto model = std::make_shared<ModelData>();
   model->normals = bvh::face_normals(mesh, kBuildGrain);
   Builder builder(mesh, model->normals);
   builder.build(*model, options.oriented_boxes);
@@ -376,7 +376,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
     throw Error(ErrorCode::bad_value, "threads", "must be between 0 and 1024 (0: the arena caliber is called from)");
   }
   validate_mesh(mesh);
-  std::shared_ptr<Model> out;
+  std::shared_ptr<ModelData> out;
   // Inside an executor already (a step, a World being built on the host's arena), its threads
   // are this build's too; otherwise the build runs where BuildOptions::threads says.
   if (parallel::current_thread_index() >= 0 && options.threads == 0) {

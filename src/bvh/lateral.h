@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 
 namespace caliber::bvh {
 

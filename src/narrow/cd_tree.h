@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 #include "narrow/pair_context.h"
 
 namespace caliber::narrow {

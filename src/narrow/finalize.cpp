@@ -74,8 +74,8 @@ constexpr std::size_t kNearby = 8;
 /// kept ones are returned in the input's order.
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
   const PairIndex index(candidates, grain);
-  const Model& ma = ctx.a();
-  const Model& mb = ctx.b();
+  const ModelData& ma = ctx.a();
+  const ModelData& mb = ctx.b();
   std::vector<char> keep(candidates.size(), 0);
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i != hi; ++i) {

@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 
 namespace caliber::narrow::detail {
 

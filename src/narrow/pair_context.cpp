@@ -17,7 +17,7 @@ constexpr double kConeCosMargin = 1e-6;
 }  // namespace
 
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
-    : mA(a), mB(b), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
+    : mA(data(a)), mB(data(b)), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
   validate_request(request);
   validate_pose(pose_a, "pose of A");
   validate_pose(pose_b, "pose of B");
@@ -26,7 +26,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
-  mScale = a.extent + b.extent + mTrans.norm();
+  mScale = mA.extent + mB.extent + mTrans.norm();
   mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);

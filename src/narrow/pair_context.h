@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
@@ -221,9 +222,9 @@ class PairContext {
   bool leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const;
 
   /// Model A.
-  [[nodiscard]] const Model& a() const { return mA; }
+  [[nodiscard]] const ModelData& a() const { return mA; }
   /// Model B.
-  [[nodiscard]] const Model& b() const { return mB; }
+  [[nodiscard]] const ModelData& b() const { return mB; }
   /// The query.
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
   /// Pose of A (to bring results to world coordinates).
@@ -324,7 +325,7 @@ class PairContext {
   }
   /// A node's Frame in its own model's frame: the model's oriented box where it keeps them, else
   /// computed by the same function.
-  static const Frame& own_frame(const Model& m, std::uint32_t i, Frame& computed) {
+  static const Frame& own_frame(const ModelData& m, std::uint32_t i, Frame& computed) {
     if (!m.oriented_boxes.empty()) return m.oriented_boxes[i];
     node_oriented_box(m.nodes[i], m.filters[i], m.laterals[i], computed);
     return computed;
@@ -339,8 +340,8 @@ class PairContext {
     return at - reach > hi + slab_reach || at + reach < lo - slab_reach;
   }
 
-  const Model& mA;
-  const Model& mB;
+  const ModelData& mA;
+  const ModelData& mB;
   Pose mPoseA;
   QueryRequest mRequest;
   QueryKind mKind;

@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 
 namespace caliber::narrow {
 

@@ -81,8 +81,8 @@ QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b
   const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
   std::vector<narrow::Candidate> candidates;
   QueryStats stats;
-  const auto na = static_cast<std::uint32_t>(a.mesh.triangles.size());
-  const auto nb = static_cast<std::uint32_t>(b.mesh.triangles.size());
+  const auto na = static_cast<std::uint32_t>(a.triangle_count());
+  const auto nb = static_cast<std::uint32_t>(b.triangle_count());
   // Distance: every pair against the tolerance (no bound from the pairs before it); the closest
   // kept, ties to the lowest ids, by a comparison of its own (the oracle shares no rule with the
   // traversal's Nearest).

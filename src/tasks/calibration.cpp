@@ -5,7 +5,7 @@
 #include <map>
 #include <queue>
 
-#include "caliber/model.h"
+#include "bvh/model_data.h"
 #include "parallel/executor.h"
 #include "util/assert.h"
 #include "util/timing.h"
@@ -274,8 +274,8 @@ namespace {
 /// triangles, as a traversal would meet it), so the tree costs no allocation per node.
 void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, bool disks, TrianglePair* first,
                   TrianglePair* last, std::vector<SummaryNode>& summary) {
-  const Model& a = ctx.a();
-  const Model& b = ctx.b();
+  const ModelData& a = ctx.a();
+  const ModelData& b = ctx.b();
   summary[slot].node = n;
   summary[slot].disks = disks;
   summary[slot].contacts = static_cast<std::uint32_t>(last - first);

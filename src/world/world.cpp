@@ -82,7 +82,7 @@ std::size_t World::distinct_models() const {
 
 std::size_t World::triangle_count() const {
   std::size_t n = 0;
-  for (const auto& m : mModels) n += m->mesh.triangles.size();
+  for (const auto& m : mModels) n += m->triangle_count();
   return n;
 }
 

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 
@@ -15,7 +16,8 @@ struct WorldBox {
 
 /// The box of model m at `pose`, grown by `grow` and by a margin for the rounding of the move, so
 /// that rounding never drops a pair (the same kind of safety margin as the narrow phase's).
-inline WorldBox world_box(const Model& m, const Pose& pose, double grow) {
+inline WorldBox world_box(const Model& model, const Pose& pose, double grow) {
+  const ModelData& m = data(model);
   const BvhNode& root = m.nodes[0];
   const Eigen::Vector3d c(root.box_center[0], root.box_center[1], root.box_center[2]);
   const Eigen::Vector3d h(root.box_half[0], root.box_half[1], root.box_half[2]);

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh/model_data.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -30,9 +31,9 @@ int height_bound(std::uint32_t n) {
 
 /// Checks every invariant of the BVH; returns the triangles below `index`.
 std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
-  const BvhNode& node = m.nodes[index];
-  const BvhNodeFilter& filter = m.filters[index];
-  const BvhNodeLateral& lateral_range = m.laterals[index];
+  const BvhNode& node = data(m).nodes[index];
+  const BvhNodeFilter& filter = data(m).filters[index];
+  const BvhNodeLateral& lateral_range = data(m).laterals[index];
   std::vector<std::uint32_t> below;
   if (node.is_leaf()) {
     below.push_back(node.index);
@@ -40,8 +41,8 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
     EXPECT_GT(node.index, index) << "children after their parent";
     auto left = check_subtree(m, node.index);
     auto right = check_subtree(m, node.index + 1);
-    EXPECT_EQ(m.nodes[node.index].count + m.nodes[node.index + 1].count, node.count);
-    EXPECT_EQ(m.filters[node.index].groups | m.filters[node.index + 1].groups, filter.groups);
+    EXPECT_EQ(data(m).nodes[node.index].count + data(m).nodes[node.index + 1].count, node.count);
+    EXPECT_EQ(data(m).filters[node.index].groups | data(m).filters[node.index + 1].groups, filter.groups);
     below = std::move(left);
     below.insert(below.end(), right.begin(), right.end());
   }
@@ -55,8 +56,8 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   lateral_axes(filter.cone_axis, lateral_range.turn, lateral[0], lateral[1]);
   bool any_normal = false;
   for (const std::uint32_t t : below) {
-    for (const std::uint32_t v : m.mesh.triangles[t]) {
-      const Eigen::Vector3d& p = m.mesh.vertices[v];
+    for (const std::uint32_t v : m.mesh().triangles[t]) {
+      const Eigen::Vector3d& p = m.mesh().vertices[v];
       EXPECT_LE((p - c).norm(), node.radius) << "node " << index << " sphere must cover its vertices";
       EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
       const double along = stored_axis.dot(p);
@@ -70,22 +71,22 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
             << " <= " << at << " <= " << lateral_range.lateral_hi[k] << " (triangle " << t << ")";
       }
     }
-    if (m.normals[t].squaredNorm() > 0.0) {
+    if (m.normals()[t].squaredNorm() > 0.0) {
       any_normal = true;
-      const double angle = std::acos(std::clamp(axis.dot(m.normals[t]), -1.0, 1.0));
+      const double angle = std::acos(std::clamp(axis.dot(m.normals()[t]), -1.0, 1.0));
       EXPECT_LE(angle, filter.cone_angle) << "node " << index << " cone must hold the normal of triangle " << t;
     }
   }
-  if (!m.oriented_boxes.empty()) {
+  if (!data(m).oriented_boxes.empty()) {
     // The kept oriented box is the one the query would compute, and it covers the vertices.
     BvhNodeOrientedBox computed;
     node_oriented_box(node, filter, lateral_range, computed);
-    const BvhNodeOrientedBox& kept = m.oriented_boxes[index];
+    const BvhNodeOrientedBox& kept = data(m).oriented_boxes[index];
     EXPECT_EQ(std::memcmp(&kept, &computed, sizeof kept), 0) << "node " << index << " oriented box as computed";
     const Eigen::Vector3d center(kept.center[0], kept.center[1], kept.center[2]);
     for (const std::uint32_t t : below) {
-      for (const std::uint32_t v : m.mesh.triangles[t]) {
-        const Eigen::Vector3d& p = m.mesh.vertices[v];
+      for (const std::uint32_t v : m.mesh().triangles[t]) {
+        const Eigen::Vector3d& p = m.mesh().vertices[v];
         for (int k = 0; k < 3; ++k) {
           const Eigen::Vector3d axis_k(kept.axis[k][0], kept.axis[k][1], kept.axis[k][2]);
           EXPECT_LE(std::abs(axis_k.dot(p - center)), kept.half[k] + 1e-12 * (1.0 + p.norm() + center.norm()))
@@ -113,7 +114,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
 }
 
 void check_model(const Model& m) {
-  ASSERT_EQ(m.nodes.size(), 2 * m.mesh.triangles.size() - 1);
+  ASSERT_EQ(data(m).nodes.size(), 2 * m.mesh().triangles.size() - 1);
   auto all = check_subtree(m, 0);
   std::sort(all.begin(), all.end());
   for (std::uint32_t t = 0; t < all.size(); ++t) ASSERT_EQ(all[t], t) << "each triangle in exactly one leaf";
@@ -127,12 +128,12 @@ TEST(BuildModel, InvariantsOnProceduralMeshes) {
 }
 
 TEST(BuildModel, OrientedBoxesOnlyWhenAskedAndCoveringTheirTriangles) {
-  EXPECT_TRUE(build_model(make_sphere(1.0, 12, 16))->oriented_boxes.empty()) << "off by default";
+  EXPECT_TRUE(data(*build_model(make_sphere(1.0, 12, 16))).oriented_boxes.empty()) << "off by default";
   BuildOptions options;
   options.oriented_boxes = true;
   for (const Mesh& mesh : {make_sphere(1.0, 12, 16), make_torus(2.0, 0.5, 16, 10), make_plate(1.0, 0.02, 5)}) {
     const auto model = build_model(mesh, options);
-    ASSERT_EQ(model->oriented_boxes.size(), model->nodes.size());
+    ASSERT_EQ(data(*model).oriented_boxes.size(), data(*model).nodes.size());
     check_model(*model);
   }
   // Far from the origin, and a node with no normal below (its box is the node's own).
@@ -161,8 +162,8 @@ TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
   }
   const auto model = build_model(mesh);
   check_model(*model);
-  EXPECT_EQ(model->filters[0].groups, 0b11111u);
-  EXPECT_LE(model->height, height_bound(500));
+  EXPECT_EQ(data(*model).filters[0].groups, 0b11111u);
+  EXPECT_LE(model->height(), height_bound(500));
 }
 
 TEST(BuildModel, FarFromTheOriginVolumesStillCover) {
@@ -190,7 +191,7 @@ TEST(BuildModel, LateralAxesFollowAnElongatedPatch) {
   }
   const auto model = build_model(mesh);
   check_model(*model);
-  const BvhNodeLateral& root = model->laterals[0];
+  const BvhNodeLateral& root = data(*model).laterals[0];
   const double width[2] = {double(root.lateral_hi[0]) - root.lateral_lo[0], double(root.lateral_hi[1]) - root.lateral_lo[1]};
   EXPECT_LT(std::min(width[0], width[1]), 0.011) << width[0] << " " << width[1];
   EXPECT_GT(std::max(width[0], width[1]), 0.99) << width[0] << " " << width[1];
@@ -201,17 +202,17 @@ TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
   mesh.vertices = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
   mesh.triangles = {{0, 1, 2}};
   const auto model = build_model(mesh);
-  ASSERT_EQ(model->nodes.size(), 1u);
-  EXPECT_TRUE(model->nodes[0].is_leaf());
-  EXPECT_LT(model->filters[0].cone_angle, 0.0f) << "a degenerate triangle has no normal";
-  EXPECT_EQ(model->normals[0], Eigen::Vector3d::Zero());
+  ASSERT_EQ(data(*model).nodes.size(), 1u);
+  EXPECT_TRUE(data(*model).nodes[0].is_leaf());
+  EXPECT_LT(data(*model).filters[0].cone_angle, 0.0f) << "a degenerate triangle has no normal";
+  EXPECT_EQ(model->normals()[0], Eigen::Vector3d::Zero());
   check_model(*model);
 }
 
 /// The triangles sharing a vertex position with t, sorted and distinct.
 std::vector<std::uint32_t> neighbours(const Model& model, std::uint32_t t) {
   std::vector<std::uint32_t> out;
-  model.for_each_neighbour(t, [&](std::uint32_t u) { out.push_back(u); });
+  data(model).for_each_neighbour(t, [&](std::uint32_t u) { out.push_back(u); });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -248,27 +249,28 @@ TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
     std::shared_ptr<const Model> many;
     parallel::Executor executor(threads);
     executor.execute([&] { many = build_model(mesh); });
-    EXPECT_EQ(bytes(many->nodes), bytes(one->nodes)) << threads << " threads";
-    EXPECT_EQ(bytes(many->filters), bytes(one->filters)) << threads << " threads";
-    EXPECT_EQ(bytes(many->laterals), bytes(one->laterals)) << threads << " threads";
-    EXPECT_EQ(many->first_leaf, one->first_leaf);
-    EXPECT_EQ(many->leaf_position, one->leaf_position);
-    EXPECT_EQ(bytes(many->normals), bytes(one->normals));
-    EXPECT_EQ(many->corner_vertex, one->corner_vertex);
-    EXPECT_EQ(many->vertex_offsets, one->vertex_offsets);
-    EXPECT_EQ(many->vertex_triangles, one->vertex_triangles);
-    EXPECT_EQ(many->height, one->height);
-    EXPECT_EQ(many->extent, one->extent);
+    EXPECT_EQ(bytes(data(*many).nodes), bytes(data(*one).nodes)) << threads << " threads";
+    EXPECT_EQ(bytes(data(*many).filters), bytes(data(*one).filters)) << threads << " threads";
+    EXPECT_EQ(bytes(data(*many).laterals), bytes(data(*one).laterals)) << threads << " threads";
+    EXPECT_EQ(data(*many).first_leaf, data(*one).first_leaf);
+    EXPECT_EQ(data(*many).leaf_position, data(*one).leaf_position);
+    EXPECT_EQ(bytes(many->normals()), bytes(one->normals()));
+    EXPECT_EQ(data(*many).corner_vertex, data(*one).corner_vertex);
+    EXPECT_EQ(data(*many).vertex_offsets, data(*one).vertex_offsets);
+    EXPECT_EQ(data(*many).vertex_triangles, data(*one).vertex_triangles);
+    EXPECT_EQ(many->height(), one->height());
+    EXPECT_EQ(many->extent(), one->extent());
   }
   // The layout of a depth-first build that appends a node's two children, then builds the left
   // subtree, then the right (the one every earlier version had): the left child's children come
   // right after the pair, the right child's after the left subtree's 2 m - 2 further nodes.
   const Model& m = *one;
-  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
-    if (m.nodes[i].is_leaf()) continue;
-    const std::uint32_t first = m.nodes[i].index;
-    if (!m.nodes[first].is_leaf()) EXPECT_EQ(m.nodes[first].index, first + 2) << "node " << i;
-    if (!m.nodes[first + 1].is_leaf()) EXPECT_EQ(m.nodes[first + 1].index, first + 2 * m.nodes[first].count) << "node " << i;
+  for (std::size_t i = 0; i < data(m).nodes.size(); ++i) {
+    if (data(m).nodes[i].is_leaf()) continue;
+    const std::uint32_t first = data(m).nodes[i].index;
+    if (!data(m).nodes[first].is_leaf()) EXPECT_EQ(data(m).nodes[first].index, first + 2) << "node " << i;
+    if (!data(m).nodes[first + 1].is_leaf())
+      EXPECT_EQ(data(m).nodes[first + 1].index, first + 2 * data(m).nodes[first].count) << "node " << i;
   }
 }
 
@@ -299,8 +301,8 @@ TEST(BuildModel, AdjacencyIsLinearInTheCornersOfAHugeFan) {
   }
   for (std::uint32_t i = 1; i + 1 <= static_cast<std::uint32_t>(n); ++i) mesh.triangles.push_back({0, i, i + 1});
   const auto model = build_model(mesh);
-  EXPECT_EQ(model->vertex_triangles.size(), 3 * mesh.triangles.size());
-  EXPECT_EQ(model->corner_vertex.size(), 3 * mesh.triangles.size());
+  EXPECT_EQ(data(*model).vertex_triangles.size(), 3 * mesh.triangles.size());
+  EXPECT_EQ(data(*model).corner_vertex.size(), 3 * mesh.triangles.size());
   EXPECT_EQ(neighbours(*model, 5).size(), mesh.triangles.size() - 1) << "the hub: every other triangle";
 }
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "support/results.h"
+#include "bvh/model_data.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -37,7 +38,7 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
   const auto probe = build_model(make_box(0.01, 0.01, 0.01, 2));
   const Pose at_surface = Pose::from_values(0.6, 0.0, 0.8, 0.97, 0.1, 0.2, 0.05);
   std::printf("2M-triangle mesh: %zu triangles, write %.1f s, load %.1f s, BVH build %.1f s, %zu nodes\n", big.triangles.size(),
-              write_s, load_s, build_s, model->nodes.size());
+              write_s, load_s, build_s, data(*model).nodes.size());
 
   // Independent check: the big mesh's triangles whose box meets the probe's world box (grown by the
   // tolerance) form a small mesh; brute force on it must give exactly the pairs the BVH query gave.
@@ -48,7 +49,7 @@ TEST(LargeMesh, TwoMillionTrianglesLoadBuildAndQueryExactly) {
     const QueryResult fast = query(*model, Pose{}, *probe, at_surface, request);
     ASSERT_FALSE(fast.contacts.empty()) << "the probe must touch the sphere";
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300);
-    for (const auto& v : probe->mesh.vertices) {
+    for (const auto& v : probe->mesh().vertices) {
       const Eigen::Vector3d w = at_surface.apply(v);
       lo = lo.cwiseMin(w);
       hi = hi.cwiseMax(w);

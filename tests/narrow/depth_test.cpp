@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
@@ -57,7 +58,7 @@ TEST(Depth, IsTheDeepestVertexOfBBehindAsPlane) {
       }
       double want = 0.0;
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d v = pb.apply(sphere->mesh.vertices[sphere->mesh.triangles[c.tri_b][k]]);
+        const Eigen::Vector3d v = pb.apply(sphere->mesh().vertices[sphere->mesh().triangles[c.tri_b][k]]);
         want = std::max(want, c.normal.dot(c.point_a - v));
       }
       EXPECT_NEAR(c.depth, want, 1e-12);

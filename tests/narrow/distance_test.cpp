@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "support/results.h"
+#include "bvh/model_data.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
@@ -45,9 +46,9 @@ Pose separated(std::mt19937_64& rng, const Model& a, const Model& b, double gap)
   std::normal_distribution<double> g(0.0, 1.0);
   Eigen::Vector3d dir(g(rng), g(rng), g(rng));
   dir.normalize();
-  const double ra = a.nodes[0].radius, rb = b.nodes[0].radius;
-  const Eigen::Vector3d ca(a.nodes[0].center[0], a.nodes[0].center[1], a.nodes[0].center[2]);
-  const Eigen::Vector3d cb(b.nodes[0].center[0], b.nodes[0].center[1], b.nodes[0].center[2]);
+  const double ra = data(a).nodes[0].radius, rb = data(b).nodes[0].radius;
+  const Eigen::Vector3d ca(data(a).nodes[0].center[0], data(a).nodes[0].center[1], data(a).nodes[0].center[2]);
+  const Eigen::Vector3d cb(data(b).nodes[0].center[0], data(b).nodes[0].center[1], data(b).nodes[0].center[2]);
   const Eigen::Vector3d where = ca + dir * (ra + rb + gap) - turned.rotation * cb;
   return Pose{turned.rotation, where};
 }

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
@@ -45,8 +46,8 @@ TEST(Gaps2x2, SameBoundsAsGap) {
     const double reach = ctx.reach_for(0.05 + 0.1 * (p % 5));
     std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
     for (std::size_t w = 0; w < work.size() && w < 4000; ++w) {
-      const BvhNode& na = a->nodes[work[w].first];
-      const BvhNode& nb = b->nodes[work[w].second];
+      const BvhNode& na = data(*a).nodes[work[w].first];
+      const BvhNode& nb = data(*b).nodes[work[w].second];
       if (na.is_leaf() || nb.is_leaf()) continue;
       const PairContext::NearA sa[2] = {ctx.near_a(na.index), ctx.near_a(na.index + 1)};
       const PairContext::NearB sb[2] = {ctx.near_b(nb.index), ctx.near_b(nb.index + 1)};

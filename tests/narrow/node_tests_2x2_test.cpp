@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
@@ -32,8 +33,8 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
       // four children are tested, descending into those that pass (where the decisions are close).
       std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
       for (std::size_t w = 0; w < work.size() && w < 20000; ++w) {
-        const BvhNode& na = a->nodes[work[w].first];
-        const BvhNode& nb = b->nodes[work[w].second];
+        const BvhNode& na = data(*a).nodes[work[w].first];
+        const BvhNode& nb = data(*b).nodes[work[w].second];
         if (na.is_leaf() || nb.is_leaf()) continue;
         // Both sides split, then only A's, then only B's (the other side's node given twice).
         const std::uint32_t wa = work[w].first, wb = work[w].second;

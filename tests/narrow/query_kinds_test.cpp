@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/results.h"
+#include "bvh/model_data.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -17,8 +18,8 @@ Pose at(double x, double y = 0, double z = 0) { return Pose::from_values(x, y, z
 /// Triangles of a make_box(…, 1) cube whose normal is `dir`.
 std::vector<std::uint32_t> face(const Model& m, const Eigen::Vector3d& dir) {
   std::vector<std::uint32_t> out;
-  for (std::uint32_t t = 0; t < m.normals.size(); ++t) {
-    if ((m.normals[t] - dir).norm() < 1e-12) out.push_back(t);
+  for (std::uint32_t t = 0; t < m.normals().size(); ++t) {
+    if ((m.normals()[t] - dir).norm() < 1e-12) out.push_back(t);
   }
   return out;
 }

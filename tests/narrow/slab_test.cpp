@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "bvh/model_data.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
@@ -133,10 +134,10 @@ std::vector<Eigen::Vector3d> vertices_below(const Model& model, std::uint32_t n)
   std::vector<Eigen::Vector3d> out;
   std::vector<std::uint32_t> todo{n};
   while (!todo.empty()) {
-    const BvhNode& node = model.nodes[todo.back()];
+    const BvhNode& node = data(model).nodes[todo.back()];
     todo.pop_back();
     if (node.is_leaf()) {
-      for (int k = 0; k < 3; ++k) out.push_back(model.mesh.vertices[model.mesh.triangles[node.index][k]]);
+      for (int k = 0; k < 3; ++k) out.push_back(model.mesh().vertices[model.mesh().triangles[node.index][k]]);
     } else {
       todo.push_back(node.index);
       todo.push_back(node.index + 1);
@@ -187,8 +188,8 @@ TEST(NodeSlab, DisksRefuseOnlyWhatLiesBeyondASlab) {
         const Eigen::Matrix3d to_b = pose_b.rotation_matrix().transpose();
         std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
         for (std::size_t w = 0; w < work.size() && w < 4000; ++w) {
-          const BvhNode& na = a->nodes[work[w].first];
-          const BvhNode& nb = b->nodes[work[w].second];
+          const BvhNode& na = data(*a).nodes[work[w].first];
+          const BvhNode& nb = data(*b).nodes[work[w].second];
           if (na.is_leaf() || nb.is_leaf()) continue;
           for (std::uint32_t k = 0; k < 4; ++k) {
             const std::uint32_t ia = na.index + k / 2, ib = nb.index + k % 2;
@@ -208,8 +209,8 @@ TEST(NodeSlab, DisksRefuseOnlyWhatLiesBeyondASlab) {
               v = to_a * (pose_b.rotation_matrix() * v + pose_b.translation - pose_a.translation);
             for (Eigen::Vector3d& v : below_a)
               v = to_b * (pose_a.rotation_matrix() * v + pose_a.translation - pose_b.translation);
-            const BvhNodeFilter& fa = a->filters[ia];
-            const BvhNodeFilter& fb = b->filters[ib];
+            const BvhNodeFilter& fa = data(*a).filters[ia];
+            const BvhNodeFilter& fb = data(*b).filters[ib];
             EXPECT_TRUE(all_beyond(below_b, fa.cone_axis, fa.slab_lo, fa.slab_hi, tolerance) ||
                         all_beyond(below_a, fb.cone_axis, fb.slab_lo, fb.slab_hi, tolerance))
                 << "pose " << p << " nodes " << ia << " " << ib;

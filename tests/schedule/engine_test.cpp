@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "support/results.h"
+#include "bvh/model_data.h"
 #include "caliber/engine.h"
 #include "caliber/profile.h"
 #include "caliber/error.h"
@@ -278,8 +279,8 @@ TEST_F(EngineScenes, TimelineRecordsEveryPieceOfWork) {
         for (const TaskRoot& root : roots) {
           ASSERT_LT(root.pair, pairs) << what;
           const ObjectPair& pair = got.pair_records[root.pair].pair;
-          EXPECT_LT(root.node_a, world.model(pair.a).nodes.size()) << what;
-          EXPECT_LT(root.node_b, world.model(pair.b).nodes.size()) << what;
+          EXPECT_LT(root.node_a, world.model(pair.a).node_count()) << what;
+          EXPECT_LT(root.node_b, world.model(pair.b).node_count()) << what;
         }
       }
     }

@@ -8,6 +8,7 @@
 #include <queue>
 #include <tuple>
 
+#include "bvh/model_data.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/procedural.h"
@@ -124,7 +125,7 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   EXPECT_EQ(summary[0].contacts, reported.size());
   for (const SummaryNode& s : summary) {
     if (s.children == 0) {
-      EXPECT_TRUE(a->nodes[s.node.a].is_leaf() && b->nodes[s.node.b].is_leaf()) << "only leaf pairs end the summary";
+      EXPECT_TRUE(data(*a).nodes[s.node.a].is_leaf() && data(*b).nodes[s.node.b].is_leaf()) << "only leaf pairs end the summary";
       continue;
     }
     std::uint32_t below = 0;
