@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The distance bound's separation of two Frames along the direction between a point of each
-/// (PairContext::gap's last bound), worked out in the first Frame's coordinates.
+/// (PairContext::gap's last bound), worked out in the first OrientedBox's coordinates.
 
 #include <algorithm>
 #include <cmath>
@@ -10,10 +10,10 @@
 
 namespace caliber::narrow {
 
-/// How Frame b lies against Frame a (both in A's frame; d: b's center less a's): r[i][k], a's
+/// How OrientedBox b lies against OrientedBox a (both in A's frame; d: b's center less a's): r[i][k], a's
 /// axis i . b's axis k, and t[i], a's axis i . d (b's center in a's coordinates). What
 /// frames_apart reads.
-inline void frames_relative(const Frame& a, const Frame& b, const double d[3], double r[3][3], double t[3]) {
+inline void frames_relative(const OrientedBox& a, const OrientedBox& b, const double d[3], double r[3][3], double t[3]) {
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) r[i][k] = a.axis[i][0] * b.axis[k][0] + a.axis[i][1] * b.axis[k][1] + a.axis[i][2] * b.axis[k][2];
     t[i] = a.axis[i][0] * d[0] + a.axis[i][1] * d[1] + a.axis[i][2] * d[2];
@@ -29,7 +29,7 @@ inline void frames_relative(const Frame& a, const Frame& b, const double d[3], d
 ///
 /// For any n, the world direction N = sum_i n_i a_i has N . a_k = n_k, N . b_k = (r^T n)_k,
 /// N . d = n . t and |N| = |n|, each up to the axes' rounding (orthonormal to about 1e-15) and
-/// the products' (a few ulps of |n|, and of |n| |d| for n . t); along N, a Frame's triangles
+/// the products' (a few ulps of |n|, and of |n| |d| for n . t); along N, a OrientedBox's triangles
 /// lie within center . N +- sum_k half_k |N . axis_k|, so the gap between the two intervals over
 /// |N| bounds the distance. For n along the boxes' closest pair it is their distance, and p to q
 /// is near that pair when the boxes are small beside their distance or one is flat and the other

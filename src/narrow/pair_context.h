@@ -142,7 +142,7 @@ class PairContext {
   /// safety margin (rounding in the transformed centers and vertices, certified far below it).
   [[nodiscard]] double reach_for(double d) const { return d + kRelativeMargin * (mScale + d); }
 
-  using Frame = narrow::Frame;
+  using OrientedBox = narrow::OrientedBox;
   using NearA = narrow::NearA;
   using NearB = narrow::NearB;
 
@@ -150,7 +150,7 @@ class PairContext {
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
     NearA s;
     fill_box_a(ia, s);
-    Frame computed;
+    OrientedBox computed;
     s.frame = own_frame(mA, ia, computed);
     return s;
   }
@@ -159,8 +159,8 @@ class PairContext {
   [[nodiscard]] NearB near_b(std::uint32_t ib) const {
     NearB s;
     fill_box_b(ib, s);
-    Frame computed;
-    const Frame& own = own_frame(mB, ib, computed);
+    OrientedBox computed;
+    const OrientedBox& own = own_frame(mB, ib, computed);
     for (int i = 0; i < 3; ++i) {
       s.frame.center[i] = mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mTrans[i];
     }
@@ -323,9 +323,9 @@ class PairContext {
     const double c[3] = {n.center[0], n.center[1], n.center[2]};
     for (int i = 0; i < 3; ++i) s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
   }
-  /// A node's Frame in its own model's frame: the model's oriented box where it keeps them, else
+  /// A node's oriented box in its own model's frame: the model's oriented box where it keeps them, else
   /// computed by the same function.
-  static const Frame& own_frame(const ModelData& m, std::uint32_t i, Frame& computed) {
+  static const OrientedBox& own_frame(const ModelData& m, std::uint32_t i, OrientedBox& computed) {
     if (!m.oriented_boxes.empty()) return m.oriented_boxes[i];
     node_oriented_box(m.nodes[i], m.filters[i], m.laterals[i], computed);
     return computed;

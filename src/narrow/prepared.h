@@ -65,15 +65,15 @@ struct SideB : NodeB {
 };
 /// A box around a node's triangles, for the distance bound: its axes (orthonormal up to
 /// rounding), center and half-extents along them (caliber::node_oriented_box).
-using Frame = BvhNodeOrientedBox;
-/// A node of A prepared for the distance bound: its box and its Frame (no sphere: the bound does not
+using OrientedBox = BvhNodeOrientedBox;
+/// A node of A prepared for the distance bound: its box and its OrientedBox (no sphere: the bound does not
 /// use it).
 struct NearA : BoxA {
-  Frame frame;
+  OrientedBox frame;
 };
-/// A node of B prepared for the distance bound: its box and its Frame brought into A's frame.
+/// A node of B prepared for the distance bound: its box and its OrientedBox brought into A's frame.
 struct NearB : BoxB {
-  Frame frame;
+  OrientedBox frame;
 };
 
 /// The nodes one distance traversal has prepared, kept as a tree that follows the BVH's: a

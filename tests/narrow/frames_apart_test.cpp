@@ -16,18 +16,18 @@ namespace caliber::narrow {
 namespace {
 
 /// frames_apart with PairContext's allowances.
-double apart_of(const Frame& a, const Frame& b, const double d[3]) {
+double apart_of(const OrientedBox& a, const OrientedBox& b, const double d[3]) {
   double r[3][3], t[3];
   frames_relative(a, b, d, r, t);
   return frames_apart(a.half, b.half, r, t, 1e-12, 1.0 - 3e-9);
 }
 
-Frame random_frame(std::mt19937_64& rng, double spread) {
+OrientedBox random_frame(std::mt19937_64& rng, double spread) {
   std::normal_distribution<double> normal;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const Eigen::Matrix3d r =
       Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
-  Frame f{};
+  OrientedBox f{};
   for (int k = 0; k < 3; ++k) {
     for (int i = 0; i < 3; ++i) f.axis[k][i] = r(i, k);
     f.center[k] = spread * normal(rng);
@@ -39,7 +39,7 @@ Frame random_frame(std::mt19937_64& rng, double spread) {
 }
 
 /// The point of f at frame coordinates t (each in [-1, 1] of the half-extents).
-Eigen::Vector3d point_of(const Frame& f, const double t[3]) {
+Eigen::Vector3d point_of(const OrientedBox& f, const double t[3]) {
   Eigen::Vector3d x(f.center[0], f.center[1], f.center[2]);
   for (int k = 0; k < 3; ++k) x += t[k] * f.half[k] * Eigen::Vector3d(f.axis[k][0], f.axis[k][1], f.axis[k][2]);
   return x;
@@ -51,7 +51,7 @@ TEST(FramesApart, NeverAboveThePointsDistance) {
   std::uniform_int_distribution<int> corner(0, 1);
   long positive = 0, checked = 0;
   for (int trial = 0; trial < 4000; ++trial) {
-    const Frame a = random_frame(rng, 1.0), b = random_frame(rng, trial % 2 == 0 ? 1.0 : 4.0);
+    const OrientedBox a = random_frame(rng, 1.0), b = random_frame(rng, trial % 2 == 0 ? 1.0 : 4.0);
     const double d[3] = {b.center[0] - a.center[0], b.center[1] - a.center[1], b.center[2] - a.center[2]};
     const double apart = apart_of(a, b, d);
     ASSERT_GE(apart, 0.0);
@@ -80,7 +80,7 @@ TEST(FramesApart, NeverAboveThePointsDistance) {
 TEST(FramesApart, TightWhereTheFramesAxesAreNot) {
   // Two unit squares (no thickness) in the plane z = 0, offset by 3 along x and y: 1 apart along
   // each axis, sqrt(2) apart. The Frames' own axes see 1; frames_apart sees about sqrt(2).
-  Frame a{}, b{};
+  OrientedBox a{}, b{};
   for (int k = 0; k < 3; ++k) a.axis[k][k] = b.axis[k][k] = 1.0;
   a.half[0] = a.half[1] = b.half[0] = b.half[1] = 1.0;
   b.center[0] = b.center[1] = 3.0;
