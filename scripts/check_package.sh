@@ -75,7 +75,7 @@ cmake --build "$work/shared-build" -j "${JOBS:-2}" >/dev/null
 cmake --install "$work/shared-build" --prefix "$work/shared" >/dev/null
 so="$(ls "$work"/shared/lib/libcaliber.so.* | head -1)"
 [ -L "$work/shared/lib/libcaliber.so" ] || fail "shared: no libcaliber.so link"
-readelf -d "$so" | grep -q "SONAME.*libcaliber.so.0.1" || fail "shared: no versioned SONAME"
+readelf -d "$so" | grep -q "SONAME.*libcaliber.so.1.0" || fail "shared: no versioned SONAME"
 nm -DC --defined-only "$so" > "$work/symbols"
 internal="$(grep -c ' caliber::\(narrow\|tasks\|schedule\|parallel\|geometry\|mesh_io\|bvh\|util\)::' "$work/symbols" || true)"
 [ "$internal" = 0 ] || fail "shared: $internal internal symbols exported"
