@@ -130,8 +130,9 @@ struct EngineOptions {
 };
 
 /// Runs frames with a method on the threads the host allows (EngineOptions::threads). Keeps,
-/// between steps, what the temporal methods learn of each object pair. Not thread-safe itself: one
-/// step at a time (use one engine per thread to step several at once).
+/// between steps, what the temporal methods learn of each object pair. One step at a time: a step
+/// or forget() called while another call on the same engine runs throws caliber::Error (use one
+/// engine per thread to step several at once).
 class CALIBER_EXPORT Engine {
  public:
   /// Throws caliber::Error on a thread count outside 0..1024, a negative stealing depth, a beta

@@ -191,3 +191,56 @@ def test_distance_without_a_tolerance_takes_any_distance():
     assert len(caliber.query(a, caliber.Pose(), a, far, kind="distance", tolerance=1.0)) == 0
     with pytest.raises(caliber.Error):
         caliber.query(a, caliber.Pose(), a, far, kind="proximity", tolerance=float("inf"))
+
+
+def uv_sphere(radius, rings, segments):
+    """A closed UV sphere as (vertices, faces) arrays."""
+    verts = [(0.0, 0.0, radius)]
+    for i in range(1, rings):
+        t = np.pi * i / rings
+        for j in range(segments):
+            p = 2 * np.pi * j / segments
+            verts.append((radius * np.sin(t) * np.cos(p), radius * np.sin(t) * np.sin(p), radius * np.cos(t)))
+    verts.append((0.0, 0.0, -radius))
+    faces = []
+    ring = lambda i, j: 1 + (i - 1) * segments + j % segments
+    for j in range(segments):
+        faces.append((0, ring(1, j), ring(1, j + 1)))
+    for i in range(1, rings - 1):
+        for j in range(segments):
+            faces += [(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)), (ring(i, j), ring(i + 1, j + 1), ring(i, j + 1))]
+    last = len(verts) - 1
+    for j in range(segments):
+        faces.append((ring(rings - 1, j + 1), ring(rings - 1, j), last))
+    return np.array(verts), np.array(faces)
+
+
+def test_a_second_step_on_a_busy_engine_is_an_error_not_a_crash():
+    ball = caliber.Model(caliber.Mesh(*uv_sphere(1.0, 120, 160)))
+    models, heavy = [ball, ball], [caliber.Pose(), caliber.Pose((1.9, 0.0, 0.0))]
+    far = [caliber.Pose(), caliber.Pose((9.0, 0.0, 0.0))]
+    alone = caliber.Engine(threads=2).step(models, heavy, [(0, 1)], kind="proximity", tolerance=0.2)
+    assert len(alone) > 0
+    engine = caliber.Engine(threads=2)
+    done, got, refused = threading.Event(), [], []
+
+    def worker():
+        while True:
+            try:
+                got.append(engine.step(models, heavy, [(0, 1)], kind="proximity", tolerance=0.2))
+                break
+            except caliber.Error:  # the main thread held the engine first
+                pass
+        done.set()
+
+    thread = threading.Thread(target=worker)
+    thread.start()
+    while not done.is_set():
+        try:
+            engine.step(models, far, [(0, 1)], kind="proximity", tolerance=0.2)
+        except caliber.Error as e:
+            assert "another call on the same engine is running" in str(e)
+            refused.append(e)
+    thread.join()
+    assert refused, "the heavy step never overlapped a second call"
+    assert got[0].pairs.tolist() == alone.pairs.tolist() and np.array_equal(got[0].points_a, alone.points_a)

@@ -10,6 +10,7 @@
 #include "caliber/engine.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -133,6 +134,8 @@ class ContextStore {
 
 struct Engine::Impl {
   explicit Impl(int threads) : executor(threads) {}
+  /// Set while a step (or forget) runs: a second call meanwhile is refused, not a data race.
+  std::atomic<bool> busy{false};
   parallel::Executor executor;
   schedule::Workers workers;
   /// What the temporal methods remember of each pair. Changes only how work is cut.
@@ -165,7 +168,34 @@ Engine::~Engine() = default;
 
 int Engine::threads() const { return mImpl->executor.threads(); }
 
-void Engine::forget() { mImpl->history = tasks::History{}; }
+namespace {
+
+/// Holds an engine for one call; a call made while another holds it is an Error (an engine keeps
+/// state between steps: two steps at once would corrupt it).
+class OneCallAtATime {
+ public:
+  OneCallAtATime(std::atomic<bool>& busy, const char* what) : mBusy(busy) {
+    if (mBusy.exchange(true, std::memory_order_acquire)) {
+      throw Error(ErrorCode::bad_argument, "engine",
+                  std::string(what) +
+                      " called while another call on the same engine is running (an engine runs one step at a time: "
+                      "use one engine per thread)");
+    }
+  }
+  ~OneCallAtATime() { mBusy.store(false, std::memory_order_release); }
+  OneCallAtATime(const OneCallAtATime&) = delete;
+  OneCallAtATime& operator=(const OneCallAtATime&) = delete;
+
+ private:
+  std::atomic<bool>& mBusy;
+};
+
+}  // namespace
+
+void Engine::forget() {
+  const OneCallAtATime hold(mImpl->busy, "forget");
+  mImpl->history = tasks::History{};
+}
 
 namespace {
 
@@ -209,6 +239,7 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
 }  // namespace
 
 StepResult Engine::step(const Frame& frame) {
+  const OneCallAtATime hold(mImpl->busy, "step");
   validate_frame(frame);
   StepResult out;
   const auto start = util::Clock::now();

@@ -2,7 +2,9 @@
 // many threads at once, and a World may be stepped by many threads and Engines at once; every
 // answer equals the one computed alone, to the bit.
 
+#include <atomic>
 #include <filesystem>
+#include <string>
 #include <random>
 #include <thread>
 #include <vector>
@@ -10,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "caliber/engine.h"
+#include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
@@ -115,6 +118,71 @@ TEST(Concurrency, ManyEnginesStepTheSameWorldAtOnce) {
         ASSERT_EQ(g[i].normal, w[i].normal);
       }
     }
+  }
+}
+
+TEST(Concurrency, ASecondCallOnABusyEngineIsAnErrorNotARace) {
+  // A heavy step on one thread; meanwhile the main thread calls step and forget on the same engine
+  // until the heavy step ends: every such call is refused with an Error, the heavy step's contacts
+  // are those of an engine used alone, and the engine works afterwards.
+  const auto fine = build_model(make_torus(1.0, 0.3, 160, 80));
+  const auto ball = build_model(make_sphere(0.32, 60, 90));
+  Frame heavy;
+  heavy.models = {fine, ball};
+  heavy.poses = {Pose{}, Pose::from_values(1.0, 0.0, 0.3, 1, 0, 0, 0)};
+  heavy.pairs = {ObjectPair{0, 1}};
+  heavy.request.kind = QueryKind::proximity;
+  heavy.request.tolerance = 0.05;
+  Frame light = heavy;
+  light.poses[1] = Pose::from_values(9.0, 0.0, 0.0, 1, 0, 0, 0);  // far apart: a trivial step
+  for (const Method method : {Method::sequential, Method::stealing, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 2;
+    const StepResult alone = Engine(options).step(heavy);
+    ASSERT_FALSE(alone.contacts.empty());
+    Engine shared(options);
+    std::atomic<bool> started{false}, done{false};
+    StepResult got;
+    std::thread worker([&] {
+      started = true;
+      for (;;) {  // the main thread may hold the engine at first: then this call is the refused one
+        try {
+          got = shared.step(heavy);
+          break;
+        } catch (const Error&) {
+          std::this_thread::yield();
+        }
+      }
+      done = true;
+    });
+    while (!started) std::this_thread::yield();
+    int refused = 0, ran = 0;
+    while (!done) {
+      try {
+        (void)shared.step(light);
+        ++ran;  // between the worker's start and its step's, or after it
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("engine: step called while another call on the same engine is running"),
+                  std::string::npos)
+            << e.what();
+        ++refused;
+      }
+      try {
+        shared.forget();
+      } catch (const Error&) {
+        ++refused;
+      }
+    }
+    worker.join();
+    ASSERT_EQ(got.contacts.size(), alone.contacts.size()) << to_string(method);
+    for (std::size_t i = 0; i < got.contacts.size(); ++i) {
+      ASSERT_EQ(got.contacts[i].tri_a, alone.contacts[i].tri_a);
+      ASSERT_EQ(got.contacts[i].tri_b, alone.contacts[i].tri_b);
+      ASSERT_EQ(got.contacts[i].point_a, alone.contacts[i].point_a);
+    }
+    EXPECT_GT(refused, 0) << to_string(method) << ": the heavy step ran alone (" << ran << " light steps got in)";
+    EXPECT_EQ(shared.step(heavy).contacts.size(), alone.contacts.size()) << "the engine works after refusing";
   }
 }
 
