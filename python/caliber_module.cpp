@@ -41,6 +41,26 @@ caliber::Mesh mesh_from_arrays(const Vertices& vertices, const Faces& faces) {
   return caliber::mesh_from_buffers(xyz, indices, "arrays");
 }
 
+/// A mesh from the arrays a user hands in: faces must hold integers and vertices real numbers
+/// (float or integer); a float, bool or complex face array, or a bool or complex vertex array, is
+/// refused rather than cast (0.9 would become vertex 0).
+caliber::Mesh mesh_from_user_arrays(const py::object& vertex_data, const py::object& face_data) {
+  const py::array vertices = py::array::ensure(vertex_data), faces = py::array::ensure(face_data);
+  if (!vertices) throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices", "must be an n x 3 array");
+  if (!faces) throw caliber::Error(caliber::ErrorCode::bad_argument, "faces", "must be an m x 3 array");
+  const char vk = vertices.dtype().kind(), fk = faces.dtype().kind();
+  if (vk != 'f' && vk != 'i' && vk != 'u') {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "vertices",
+                         std::string("must hold real numbers, not dtype ") + py::str(vertices.dtype()).cast<std::string>());
+  }
+  if (fk != 'i' && fk != 'u') {
+    throw caliber::Error(
+        caliber::ErrorCode::bad_argument, "faces",
+        std::string("must hold integer vertex indices, not dtype ") + py::str(faces.dtype()).cast<std::string>());
+  }
+  return mesh_from_arrays(vertices.cast<Vertices>(), faces.cast<Faces>());
+}
+
 py::array_t<double> vertices_of(const caliber::Mesh& mesh) {
   py::array_t<double> out({static_cast<py::ssize_t>(mesh.vertices.size()), py::ssize_t{3}});
   auto o = out.mutable_unchecked<2>();
@@ -172,7 +192,7 @@ PYBIND11_MODULE(caliber, m) {
   });
 
   py::class_<caliber::Mesh>(m, "Mesh", "Vertices (n x 3 float64) and triangles (m x 3 int); triangle ids are row numbers.")
-      .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("faces"))
+      .def(py::init(&mesh_from_user_arrays), py::arg("vertices"), py::arg("faces"))
       .def_static(
           "load", [](const std::string& path) { return caliber::load_mesh(path); }, py::arg("path"),
           "Reads .off, .ply, .obj or .stl (the extension chooses the reader).")

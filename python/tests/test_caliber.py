@@ -244,3 +244,18 @@ def test_a_second_step_on_a_busy_engine_is_an_error_not_a_crash():
     thread.join()
     assert refused, "the heavy step never overlapped a second call"
     assert got[0].pairs.tolist() == alone.pairs.tolist() and np.array_equal(got[0].points_a, alone.points_a)
+
+
+def test_mesh_refuses_faces_that_are_not_integers_and_vertices_that_are_not_real():
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    assert len(caliber.Mesh(v, np.array([[0, 1, 2]], dtype=np.int32))) == 1
+    assert len(caliber.Mesh(v.astype(np.float32), np.array([[0, 1, 2]], dtype=np.uint16))) == 1
+    assert len(caliber.Mesh(v.astype(np.int64), [[0, 1, 2]])) == 1  # integer coordinates are real numbers
+    with pytest.raises(caliber.Error, match="faces: must hold integer vertex indices, not dtype float64"):
+        caliber.Mesh(v, np.array([[0.9, 1.0, 2.0]]))  # would have become vertex 0
+    with pytest.raises(caliber.Error, match="faces: must hold integer vertex indices, not dtype bool"):
+        caliber.Mesh(v, np.array([[True, False, True]]))
+    with pytest.raises(caliber.Error, match="vertices: must hold real numbers, not dtype complex128"):
+        caliber.Mesh(v.astype(complex), np.array([[0, 1, 2]]))
+    with pytest.raises(caliber.Error, match="vertices: must hold real numbers, not dtype bool"):
+        caliber.Mesh(v.astype(bool), np.array([[0, 1, 2]]))

@@ -1,6 +1,7 @@
 // Mesh loading: the reader chosen by the file's extension (caliber's own for OFF and PLY, assimp's
 // for OBJ and STL), keeping the file's face order as triangle ids.
 
+#include <cstdio>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -24,6 +25,27 @@
 
 namespace caliber {
 namespace {
+
+/// An importer's message as caliber reports it: bytes outside printable ASCII shown as \xNN (a
+/// message may quote the file: NULs, control bytes, any encoding), and at most kMessageBytes of it
+/// (a parser may quote the rest of a "one-line" file).
+std::string bounded(const std::string& message) {
+  constexpr std::size_t kMessageBytes = 300;
+  std::string out;
+  std::size_t i = 0;
+  for (; i < message.size() && out.size() < kMessageBytes; ++i) {
+    const auto c = static_cast<unsigned char>(message[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  if (i < message.size()) out += "... (" + std::to_string(message.size()) + " bytes in all)";
+  return out;
+}
 
 void check_file(const std::filesystem::path& path) {
   std::error_code ec;
@@ -133,10 +155,10 @@ Mesh read_with_assimp(const std::filesystem::path& path, const char* format) {
   if (scene == nullptr) {
     std::string why = reader->GetErrorText();
     if (why.empty()) why = "unknown error";
-    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + why);
+    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + bounded(why));
   }
   if (!errors->first().empty()) {
-    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + strip_log_prefix(errors->first()));
+    throw Error(ErrorCode::unreadable, path.string(), "cannot parse mesh: " + bounded(strip_log_prefix(errors->first())));
   }
   return convert(*scene, path);
 }

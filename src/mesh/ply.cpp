@@ -6,6 +6,7 @@
 
 #include "mesh/readers.h"
 
+#include <cstdio>
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -272,9 +273,16 @@ void read_indices(Reader& reader, const Property& p, Format format, const std::s
     const double index = reader.next(p.type, what);
     if (!keep) continue;
     if (index < 0 || index >= static_cast<double>(std::numeric_limits<std::uint32_t>::max())) {
+      // As written: an integer where it is one (a cast of 1e300 to an integer would be undefined).
+      char written[32];
+      if (std::abs(index) < 0x1p53 && index == std::floor(index)) {
+        std::snprintf(written, sizeof written, "%.0f", index);
+      } else {
+        *std::to_chars(written, written + sizeof written - 1, index).ptr = '\0';  // shortest round trip
+      }
       throw Error(ErrorCode::bad_index, path,
-                  "face " + std::to_string(face) + " refers to vertex " + std::to_string(static_cast<long long>(index)) +
-                      " but there are only " + std::to_string(mesh.vertices.size()));
+                  "face " + std::to_string(face) + " refers to vertex " + written + " but there are only " +
+                      std::to_string(mesh.vertices.size()));
     }
     corners.push_back(static_cast<std::uint32_t>(index));
   }

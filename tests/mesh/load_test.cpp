@@ -229,6 +229,13 @@ std::filesystem::path write(const std::string& name, const std::string& bytes) {
   return path;
 }
 
+/// Writes `bytes` to a file of that name (its extension chooses the reader) in the temp dir.
+std::filesystem::path write_named(const std::string& name, const std::string& bytes) {
+  const auto path = std::filesystem::temp_directory_path() / ("caliber_load_test_" + name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
 template <class T>
 std::string raw(T value, bool big_endian) {
   std::string b(sizeof(T), '\0');
@@ -281,6 +288,21 @@ TEST(LoadPly, AsciiWithCrLfQuadsAndPlusSigns) {
   EXPECT_EQ(m.vertices[3].z(), 0.5);
 }
 
+TEST(LoadMeshErrors, AnImportersMessageIsBounded) {
+  // assimp's STL reader quotes the token it cannot parse, here the rest of a 200,000-byte line.
+  const std::filesystem::path file =
+      ply::write_named("long_token.stl", "solid x\n facet normal 0 0 1\n outer loop\n vertex " + std::string(200000, 'q'));
+  try {
+    (void)load_mesh(file);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_LT(what.size(), 600u) << "a message of a few hundred bytes, not the file";
+    EXPECT_NE(what.find("cannot parse mesh: "), std::string::npos) << what;
+    EXPECT_NE(what.find("... (200"), std::string::npos) << "says how much was cut: " << what;
+  }
+}
+
 TEST(LoadPly, BadFilesFailClearly) {
   const std::string head =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -303,6 +325,10 @@ TEST(LoadPly, BadFilesFailClearly) {
   expect_error(ply::write("two", head + "end_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), ErrorCode::bad_index, "2 corner");
   expect_error(ply::write("range", head + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), ErrorCode::bad_index,
                "refers to vertex 7");
+  expect_error(ply::write("huge_index", head + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n"), ErrorCode::bad_index,
+               "refers to vertex 1e+300 but there are only 3");
+  expect_error(ply::write("negative_index", head + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n"), ErrorCode::bad_index,
+               "refers to vertex -1 but");
   expect_error(ply::write("fraction", head + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1.5\n"), ErrorCode::unreadable,
                "not an integer");
   expect_error(ply::write("format", "ply\nformat binary_middle_endian 1.0\nend_header\n"), ErrorCode::unreadable,
