@@ -132,11 +132,10 @@ void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryRe
     out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
-    for (Contact c : r.contacts) {  // the pair's object ids (a result of caliber::query has 0 and 1)
-      c.object_a = pairs[i].a;
-      c.object_b = pairs[i].b;
-      out.contacts.push_back(c);
-    }
+    CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
+                               [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
+                   "the finalization wrote the pair's object ids");
+    out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
   }
 }
 

@@ -114,7 +114,7 @@ void finalize_pairs(StepState& state,
 
 /// The reduction of a step: per-pair records and the contacts of every pair, in pair order (pairs
 /// are sorted and each result is sorted, so the concatenation is canonical). Fills out.pair_records,
-/// out.contacts and out.stats.
+/// out.contacts and out.stats. Each result's contacts carry its pair's object ids already.
 void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results, StepResult& out);
 
 }  // namespace caliber::schedule

@@ -7,6 +7,7 @@
 
 #include "caliber/query.h"
 #include "caliber/world.h"
+#include "support/results.h"
 #include "schedule/workers.h"
 
 namespace caliber::test {
@@ -17,6 +18,7 @@ inline StepResult reference_step(const World& world, int k) {
   results.reserve(frame.pairs.size());
   for (const ObjectPair& t : frame.pairs) {
     results.push_back(query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request));
+    results.back().contacts = between(results.back(), t.a, t.b);  // the frame's object ids, as the engine writes them
   }
   StepResult out;
   out.step = k;
