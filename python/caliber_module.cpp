@@ -2,6 +2,7 @@
 // three query kinds with numpy results, and the parallel engine over in-memory frames or scenes.
 // Every query and step releases the GIL, so Python threads can query at once.
 
+#include <pybind11/eval.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -17,6 +18,7 @@
 #include "caliber/caliber.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
+#include "half_built.h"
 
 namespace py = pybind11;
 
@@ -24,6 +26,21 @@ namespace {
 
 using Vertices = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Faces = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+/// A path as the file system has it: str (undecodable bytes as surrogate escapes, as os.listdir
+/// gives them), bytes or any os.PathLike, through os.fsencode; so a file whose name is not UTF-8
+/// can be named, and its name reaches messages as written (escaped there by caliber::Error).
+std::string file_path(const py::object& path) {
+  py::object encoded;
+  try {
+    encoded = py::module_::import("os").attr("fsencode")(path);
+  } catch (const py::error_already_set&) {
+    throw caliber::Error(
+        caliber::ErrorCode::bad_argument, "path",
+        "must be a str, bytes or os.PathLike, not " + py::str(path.get_type().attr("__name__")).cast<std::string>());
+  }
+  return encoded.cast<std::string>();
+}
 
 /// A built model, shared (the C++ side holds it as shared_ptr<const Model>).
 struct PyModel {
@@ -177,7 +194,68 @@ caliber::Frame make_frame(const std::vector<PyModel>& models, const std::vector<
   return frame;
 }
 
+py::object model_state(const PyModel& p) {
+  return py::make_tuple(vertices_of(p.model->mesh()), faces_of(p.model->mesh()), p.model->has_adjacency(),
+                        p.model->has_oriented_boxes());
+}
+
+/// How pickle rebuilds an object: `function` of module caliber called with `args`. Every picklable
+/// class defines __reduce__ this way, so that every protocol (0 and 1 included, where pybind11's
+/// default would abort the interpreter) gives a pickle that unpickles through a checked function.
+py::tuple rebuilt_by(const char* function, py::tuple args) {
+  return py::make_tuple(py::module_::import("caliber").attr(function), std::move(args));
+}
+
+caliber::Error not_picklable(const char* name, const std::string& instead) {
+  return caliber::Error(caliber::ErrorCode::bad_argument, name, std::string("cannot be pickled: ") + instead);
+}
+
+/// A Pose from its pickled state: the same checks as Pose(translation, quaternion), and the
+/// quaternion kept exactly as pickled (it was unit to rounding when pickled).
+caliber::Pose pose_from_state(const std::array<double, 3>& t, const std::array<double, 4>& q) {
+  caliber::Pose pose = caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3], "pickle");
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(std::abs(norm - 1.0) <= 1e-12))
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Pose state: the quaternion is not unit");
+  pose.rotation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  return pose;
+}
+
+/// A Model from its pickled state (vertices, faces, adjacency[, oriented_boxes]): the arrays are
+/// checked as Mesh(vertices, faces) checks them and the BVH is built again, so no tampered state
+/// yields a model that was not built from a valid mesh.
+PyModel model_from_state(const py::object& state) {
+  const auto refuse = [](const std::string& why) {
+    return caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state: " + why);
+  };
+  if (!py::isinstance<py::tuple>(state))
+    throw refuse("expected a tuple, got " + std::string(py::str(state.get_type().attr("__name__"))));
+  const auto t = state.cast<py::tuple>();
+  if (t.size() != 3 && t.size() != 4) throw refuse("expected 3 or 4 items, got " + std::to_string(t.size()));
+  for (std::size_t i = 2; i < t.size(); ++i) {
+    if (!py::isinstance<py::bool_>(t[i])) throw refuse("item " + std::to_string(i) + " must be True or False");
+  }
+  caliber::BuildOptions options;
+  options.adjacency = t[2].cast<bool>();
+  options.oriented_boxes = t.size() == 4 && t[3].cast<bool>();
+  caliber::Mesh mesh;
+  try {
+    mesh = mesh_from_user_arrays(t[0], t[1]);
+  } catch (const caliber::Error& e) {
+    throw refuse(e.what());
+  }
+  py::gil_scoped_release release;
+  return PyModel{caliber::build_model(std::move(mesh), options)};
+}
+
 }  // namespace
+
+CALIBER_REFUSE_HALF_BUILT(caliber::Mesh, "Mesh")
+CALIBER_REFUSE_HALF_BUILT(PyModel, "Model")
+CALIBER_REFUSE_HALF_BUILT(caliber::Pose, "Pose")
+CALIBER_REFUSE_HALF_BUILT(PyResult, "Result")
+CALIBER_REFUSE_HALF_BUILT(caliber::Engine, "Engine")
+CALIBER_REFUSE_HALF_BUILT(caliber::World, "World")
 
 PYBIND11_MODULE(caliber, m) {
   m.doc() = "caliber: exact collision detection between rigid triangle meshes, parallelized by task calibration";
@@ -194,11 +272,13 @@ PYBIND11_MODULE(caliber, m) {
   py::class_<caliber::Mesh>(m, "Mesh", "Vertices (n x 3 float64) and triangles (m x 3 int); triangle ids are row numbers.")
       .def(py::init(&mesh_from_user_arrays), py::arg("vertices"), py::arg("faces"))
       .def_static(
-          "load", [](const std::string& path) { return caliber::load_mesh(path); }, py::arg("path"),
+          "load", [](const py::object& path) { return caliber::load_mesh(file_path(path)); }, py::arg("path"),
           "Reads .off, .ply, .obj or .stl (the extension chooses the reader).")
       .def_property_readonly("vertices", &vertices_of)
       .def_property_readonly("faces", &faces_of)
-      .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); });
+      .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); })
+      .def("__reduce__",
+           [](const caliber::Mesh& mesh) { return rebuilt_by("Mesh", py::make_tuple(vertices_of(mesh), faces_of(mesh))); });
 
   py::class_<PyModel>(m, "Model", "A mesh with its BVH, built once; immutable, shareable between threads, picklable.")
       .def(py::init([](const caliber::Mesh& mesh, bool adjacency, bool oriented_boxes) {
@@ -212,8 +292,8 @@ PYBIND11_MODULE(caliber, m) {
            "adjacency: for contact queries; oriented_boxes: kept per node (120 bytes each), for faster distance queries")
       .def_static(
           "load",
-          [](const std::string& path, bool adjacency, bool oriented_boxes) {
-            caliber::Mesh mesh = caliber::load_mesh(path);
+          [](const py::object& path, bool adjacency, bool oriented_boxes) {
+            caliber::Mesh mesh = caliber::load_mesh(file_path(path));
             caliber::BuildOptions options;
             options.adjacency = adjacency;
             options.oriented_boxes = oriented_boxes;
@@ -227,19 +307,8 @@ PYBIND11_MODULE(caliber, m) {
       .def_property_readonly(
           "oriented_boxes", [](const PyModel& p) { return p.model->has_oriented_boxes(); },
           "whether each node's oriented box is kept (for faster distance queries)")
-      .def(py::pickle(
-          [](const PyModel& p) {
-            return py::make_tuple(vertices_of(p.model->mesh()), faces_of(p.model->mesh()), p.model->has_adjacency(),
-                                  p.model->has_oriented_boxes());
-          },
-          [](const py::tuple& t) {
-            if (t.size() != 3 && t.size() != 4)
-              throw caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Model state");
-            caliber::BuildOptions options;
-            options.adjacency = t[2].cast<bool>();
-            options.oriented_boxes = t.size() == 4 && t[3].cast<bool>();
-            return PyModel{caliber::build_model(mesh_from_arrays(t[0].cast<Vertices>(), t[1].cast<Faces>()), options)};
-          }));
+      .def(py::pickle(&model_state, &model_from_state))
+      .def("__reduce__", [](const PyModel& p) { return rebuilt_by("_model_from_state", py::make_tuple(model_state(p))); });
 
   py::class_<caliber::Pose>(m, "Pose", "A rigid transform: x_world = R x + t.")
       .def(py::init([](std::array<double, 3> t, std::array<double, 4> q, const std::string& order) {
@@ -279,15 +348,35 @@ PYBIND11_MODULE(caliber, m) {
             throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
           },
           py::arg("order"), "the unit quaternion in `order`, 'wxyz' or 'xyzw'")
-      .def("matrix", [](const caliber::Pose& p) {
-        py::array_t<double> out({py::ssize_t{4}, py::ssize_t{4}});
-        auto o = out.mutable_unchecked<2>();
-        const Eigen::Matrix3d r = p.rotation_matrix();
-        for (int i = 0; i < 4; ++i) {
-          for (int j = 0; j < 4; ++j) o(i, j) = i < 3 ? (j < 3 ? r(i, j) : p.translation[i]) : (j == 3 ? 1.0 : 0.0);
-        }
-        return out;
+      .def("matrix",
+           [](const caliber::Pose& p) {
+             py::array_t<double> out({py::ssize_t{4}, py::ssize_t{4}});
+             auto o = out.mutable_unchecked<2>();
+             const Eigen::Matrix3d r = p.rotation_matrix();
+             for (int i = 0; i < 4; ++i) {
+               for (int j = 0; j < 4; ++j) o(i, j) = i < 3 ? (j < 3 ? r(i, j) : p.translation[i]) : (j == 3 ? 1.0 : 0.0);
+             }
+             return out;
+           })
+      .def("__reduce__", [](const caliber::Pose& p) {
+        const std::array<double, 3> t{p.translation.x(), p.translation.y(), p.translation.z()};
+        const std::array<double, 4> q{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
+        return rebuilt_by("_pose_from_state", py::make_tuple(t, q));
       });
+  m.def("_checked_model", &model_from_state);
+  m.def("_checked_pose", &pose_from_state);
+  // What pickles name to rebuild a Model or a Pose: Python functions of module caliber (pickle
+  // cannot name a pybind11 function at protocols 0 and 1), calling the checked builders above.
+  py::exec(R"(
+def _model_from_state(state):
+    """How a pickled Model is rebuilt: its state checked, its BVH built again."""
+    return _checked_model(state)
+
+def _pose_from_state(translation, quaternion):
+    """How a pickled Pose is rebuilt: its values checked."""
+    return _checked_pose(translation, quaternion)
+)",
+           m.attr("__dict__"));
 
   py::class_<PyResult>(m, "Result",
                        "Reported triangle pairs, sorted, with points, normals and distances (zero for interference).")
@@ -301,7 +390,8 @@ PYBIND11_MODULE(caliber, m) {
       .def_readonly("node_tests", &PyResult::node_tests)
       .def_readonly("limit_reached", &PyResult::limit_reached)
       .def_readonly("leaf_tests", &PyResult::leaf_tests)
-      .def("__len__", [](const PyResult& r) { return static_cast<std::size_t>(r.distances.shape(0)); });
+      .def("__len__", [](const PyResult& r) { return static_cast<std::size_t>(r.distances.shape(0)); })
+      .def("__reduce__", [](const PyResult&) -> py::object { throw not_picklable("Result", "pickle its arrays"); });
 
   m.def(
       "query",
@@ -333,6 +423,10 @@ PYBIND11_MODULE(caliber, m) {
            "method: sequential, exploitation, stealing (the default), aposteriori, apriori or hybrid. threads: 0, every "
            "hardware thread the process may use (oneTBB's arena and limit); 1, the calling thread alone; N, at most N.")
       .def_property_readonly("threads", &caliber::Engine::threads)
+      .def("__reduce__",
+           [](const caliber::Engine&) -> py::object {
+             throw not_picklable("Engine", "it holds temporal state and threads; make a new Engine where it is needed");
+           })
       .def("forget", &caliber::Engine::forget)
       .def(
           "step",
@@ -378,8 +472,8 @@ PYBIND11_MODULE(caliber, m) {
       "one flag per object (pairs of two fixed objects are skipped); ignored: pairs never tested.");
 
   py::class_<caliber::World>(m, "World", "A scene file's objects, poses and broad phase.")
-      .def(py::init([](const std::string& path) {
-             caliber::Scene scene = caliber::load_scene(path);
+      .def(py::init([](const py::object& path) {
+             caliber::Scene scene = caliber::load_scene(file_path(path));
              py::gil_scoped_release release;
              return std::make_unique<caliber::World>(std::move(scene));
            }),
@@ -401,5 +495,16 @@ PYBIND11_MODULE(caliber, m) {
             }
             return to_result(s.contacts, s.stats);
           },
-          py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.");
+          py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.")
+      .def("__reduce__", [](const caliber::World&) -> py::object {
+        throw not_picklable("World", "load the scene file again where it is needed");
+      });
+
+  // No object is built twice (see half_built.h).
+  caliber_python::refuse_second<caliber::Mesh>(m.attr("Mesh"), "__init__", "Mesh");
+  caliber_python::refuse_second<PyModel>(m.attr("Model"), "__init__", "Model");
+  caliber_python::refuse_second<PyModel>(m.attr("Model"), "__setstate__", "Model");
+  caliber_python::refuse_second<caliber::Pose>(m.attr("Pose"), "__init__", "Pose");
+  caliber_python::refuse_second<caliber::Engine>(m.attr("Engine"), "__init__", "Engine");
+  caliber_python::refuse_second<caliber::World>(m.attr("World"), "__init__", "World");
 }

@@ -22,11 +22,14 @@ enum class ErrorCode {
 /// Thrown for every bad input: missing or malformed files, non-finite values, bad options.
 /// `what()` is a complete message that names the source (file path or option) and the problem.
 /// Nothing in the library crashes or returns a silent wrong answer on such input instead.
+///
+/// `what()` is one line of valid UTF-8 of bounded length, whatever the source and the problem
+/// hold: control characters (newline and NUL included) and bytes that are not UTF-8 are written
+/// as \xNN, and a source past 300 bytes or a problem past 500 is cut, ending in "...".
 class CALIBER_EXPORT Error : public std::runtime_error {
  public:
   /// `source` names where the problem is (a file path, an option name); may be empty.
-  Error(ErrorCode code, std::string source, const std::string& problem)
-      : std::runtime_error(source.empty() ? problem : source + ": " + problem), mCode(code), mSource(std::move(source)) {}
+  Error(ErrorCode code, std::string source, const std::string& problem);
 
   /// The kind of problem.
   [[nodiscard]] ErrorCode code() const noexcept { return mCode; }

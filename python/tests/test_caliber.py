@@ -3,6 +3,7 @@ which prints every double exactly), bit for bit; meshes from arrays; poses from 
 engine over in-memory frames and scenes; pickled models; errors as caliber.Error."""
 import json
 import os
+import pathlib
 import pickle
 import subprocess
 import threading
@@ -259,3 +260,96 @@ def test_mesh_refuses_faces_that_are_not_integers_and_vertices_that_are_not_real
         caliber.Mesh(v.astype(complex), np.array([[0, 1, 2]]))
     with pytest.raises(caliber.Error, match="vertices: must hold real numbers, not dtype bool"):
         caliber.Mesh(v.astype(bool), np.array([[0, 1, 2]]))
+
+
+# A pickle that creates a Model (NEWOBJ) and never gives it its state (no BUILD): 17 bytes.
+MODEL_WITHOUT_STATE = b"\x80\x02ccaliber\nModel\nq\x00)\x81q\x01."
+
+
+def test_objects_made_without_their_state_refuse_every_use():
+    good = caliber.Model.load(TETRA)
+    husk = caliber.Model.__new__(caliber.Model)
+    for use in (lambda: husk.triangles, lambda: husk.mesh, lambda: pickle.dumps(husk),
+                lambda: caliber.query(husk, caliber.Pose(), good, caliber.Pose()),
+                lambda: caliber.query(good, caliber.Pose(), pickle.loads(MODEL_WITHOUT_STATE), caliber.Pose()),
+                lambda: caliber.Engine().step([good, husk], [caliber.Pose()] * 2, [(0, 1)]),
+                lambda: caliber.broad_phase([good, husk], [caliber.Pose()] * 2)):
+        with pytest.raises(caliber.Error, match="Model: was never built"):
+            use()
+    engine = caliber.Engine.__new__(caliber.Engine)
+    with pytest.raises(caliber.Error, match="Engine: was never built"):
+        engine.step([good, good], [caliber.Pose()] * 2, [(0, 1)])
+    with pytest.raises(caliber.Error, match="World: was never built"):
+        caliber.World.__new__(caliber.World).steps
+    with pytest.raises(caliber.Error, match="Pose: was never built"):
+        caliber.query(good, caliber.Pose.__new__(caliber.Pose), good, caliber.Pose())
+    with pytest.raises(caliber.Error, match="Mesh: was never built"):
+        caliber.Model(caliber.Mesh.__new__(caliber.Mesh))
+    with pytest.raises(caliber.Error, match="Result: was never built"):
+        len(caliber.Result.__new__(caliber.Result))
+    # The husk's state can still be given once, as unpickling does; then it is an ordinary model.
+    husk.__setstate__(good.__getstate__())
+    assert husk.triangles == good.triangles
+
+
+def test_built_objects_are_not_built_again():
+    model = caliber.Model.load(TETRA)
+    with pytest.raises(caliber.Error, match="Model: is already built: __setstate__ runs once"):
+        model.__setstate__(caliber.Model.load(FAN).__getstate__())
+    with pytest.raises(caliber.Error, match="Model: is already built: __init__ runs once"):
+        model.__init__(caliber.Mesh.load(FAN))
+    assert model.triangles == caliber.Model.load(TETRA).triangles
+    engine = caliber.Engine("sequential", 1)
+    with pytest.raises(caliber.Error, match="Engine: is already built"):
+        engine.__init__("stealing", 2)
+    assert engine.threads == 1
+
+
+def test_tampered_model_states_are_caliber_errors():
+    v, f, adjacency, boxes = caliber.Model.load(TETRA).__getstate__()
+    states = {
+        "expected a tuple, got int": 5,
+        "expected 3 or 4 items, got 2": (v, f),
+        "item 2 must be True or False": (v, f, "yes"),
+        "item 3 must be True or False": (v, f, True, 1),
+        "vertices: must hold real numbers, not dtype <U1": (np.array([["a", "b", "c"]]), f, True),
+        "vertices: must be an n x 3 array": (v[:, :2], f, True),
+        "vertices: must hold real numbers, not dtype object": (np.array([[None, 1, 2]]), f, True),
+        "faces: must hold integer vertex indices, not dtype float64": (v, f.astype(float), True),
+        "faces: must be an m x 3 array": (v, np.zeros((2, 2, 2), dtype=int), True),
+        "refers to vertex 99": (v, np.array([[0, 1, 99]]), True),
+        "refers to vertex -1": (v, np.array([[0, 1, -1]]), True),
+        "non-finite": (np.where(v == v.max(), np.nan, v), f, True),
+    }
+    for message, state in states.items():
+        husk = caliber.Model.__new__(caliber.Model)
+        with pytest.raises(caliber.Error, match="pickle: not a caliber.Model state: .*" + message.replace("(", r"\(")):
+            husk.__setstate__(state)
+        with pytest.raises(caliber.Error, match="Model: was never built"):
+            husk.triangles  # a refused state leaves the object unusable, not half-built
+
+
+def test_paths_that_are_not_utf8_are_named_escaped(tmp_path):
+    raw = os.fsencode(tmp_path) + b"/caf\xe9\nname.obj"
+    with open(raw, "wb") as f:
+        f.write(b"v 1\xff\x00 0 0\n")
+    for path in (raw, os.fsdecode(raw)):  # bytes, or str with the byte as a surrogate escape
+        with pytest.raises(caliber.Error) as error:
+            caliber.Mesh.load(path)
+        assert str(error.value).endswith("/caf\\xe9\\x0aname.obj: cannot parse mesh: line 1: '1\\xff\\x00' is not a number")
+    with pytest.raises(caliber.Error, match="path: must be a str, bytes or os.PathLike, not int"):
+        caliber.Model.load(5)
+    assert caliber.Model.load(pathlib.Path(TETRA)).triangles == 4
+
+
+def test_every_protocol_pickles_meshes_models_and_poses_and_refuses_the_rest():
+    model, p = caliber.Model.load(FAN, oriented_boxes=True), caliber.Pose([1, 2, 3], [0.3, 0.1, 0.2, 0.9])
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        again = pickle.loads(pickle.dumps(model, protocol))
+        assert again.triangles == model.triangles and again.oriented_boxes
+        assert np.array_equal(again.mesh.vertices, model.mesh.vertices)
+        assert pickle.loads(pickle.dumps(p, protocol)).quaternion == p.quaternion
+        assert np.array_equal(pickle.loads(pickle.dumps(model.mesh, protocol)).faces, model.mesh.faces)
+        for thing, name in ((caliber.Engine(), "Engine"), (caliber.World(os.path.join(DATA, "scenes", "tetras.json")), "World")):
+            with pytest.raises(caliber.Error, match=name + ": cannot be pickled"):
+                pickle.dumps(thing, protocol)

@@ -1,5 +1,5 @@
-// Mesh loading: the reader chosen by the file's extension (caliber's own for OFF and PLY, assimp's
-// for OBJ and STL), keeping the file's face order as triangle ids.
+// Mesh loading: the reader chosen by the file's extension (caliber's own for OFF, PLY and OBJ,
+// assimp's for STL), keeping the file's face order as triangle ids.
 
 #include <cstdio>
 #include <algorithm>
@@ -132,9 +132,9 @@ Mesh convert(const aiScene& scene_ref, const std::filesystem::path& path) {
   return mesh;
 }
 
-/// OBJ and STL through assimp, the importer chosen by the extension and never by sniffing the
-/// content: a file is only ever read by the reader its name asks for. Neither format has a scene
-/// graph with transforms, so the meshes' vertices are the object's.
+/// STL through assimp, the importer chosen by the extension and never by sniffing the content: a
+/// file is only ever read by the reader its name asks for. STL has no scene graph with transforms,
+/// so the meshes' vertices are the object's.
 Mesh read_with_assimp(const std::filesystem::path& path, const char* format) {
   std::lock_guard<std::mutex> lock(logger_mutex());
   Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
@@ -171,14 +171,16 @@ Mesh load_mesh(const std::filesystem::path& path) {
   check_file(path);
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  // The extension alone chooses the reader. OFF and PLY: caliber's own strict readers
-  // (src/mesh/readers.h); assimp crashes or hangs on some bad files of both formats.
+  // The extension alone chooses the reader. OFF, PLY and OBJ: caliber's own strict readers
+  // (src/mesh/readers.h); assimp crashes, hangs or reads wrong on some files of those formats.
   Mesh mesh;
   if (ext == ".off") {
     mesh = mesh_io::read_off(path);
   } else if (ext == ".ply") {
     mesh = mesh_io::read_ply(path);
-  } else if (ext == ".obj" || ext == ".stl") {
+  } else if (ext == ".obj") {
+    mesh = mesh_io::read_obj(path);
+  } else if (ext == ".stl") {
     mesh = read_with_assimp(path, ext.c_str() + 1);
   } else {
     throw Error(ErrorCode::unreadable, path.string(),

@@ -156,7 +156,7 @@ std::string quote_token(std::string_view token) {
       out += static_cast<char>(c);
     } else {
       char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
       out += hex;
     }
   }

@@ -4,64 +4,17 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "caliber/error.h"
 #include "mesh/readers.h"
+#include "mesh/text_lines.h"
 
 namespace caliber::mesh_io {
 namespace {
-
-/// The file as lines of whitespace-separated tokens: comments ('#' to the end of the line) and
-/// blank lines dropped, each line remembering its number for error messages. Flat arrays, so that
-/// a file of millions of lines costs no allocation per line.
-struct Lines {
-  std::vector<std::string_view> tokens;
-  std::vector<std::size_t> first;   ///< line l's tokens are tokens[first[l] .. first[l + 1])
-  std::vector<std::size_t> number;  ///< line l's number in the file (1-based)
-
-  [[nodiscard]] std::size_t size() const { return number.size(); }
-  [[nodiscard]] bool empty() const { return number.empty(); }
-  [[nodiscard]] std::size_t count(std::size_t l) const { return first[l + 1] - first[l]; }
-  [[nodiscard]] std::string_view token(std::size_t l, std::size_t k) const { return tokens[first[l] + k]; }
-};
-
-Lines tokenize(const std::string& data) {
-  Lines lines;
-  lines.first.push_back(0);
-  std::size_t pos = 0, number = 0;
-  if (data.rfind("\xEF\xBB\xBF", 0) == 0) pos = 3;  // a UTF-8 byte order mark says nothing about the mesh
-  while (pos < data.size()) {
-    // Lines end with LF, CR LF or a lone CR (old Mac files).
-    std::size_t eol = data.find_first_of("\r\n", pos);
-    if (eol == std::string::npos) eol = data.size();
-    const std::size_t next = (eol + 1 < data.size() && data[eol] == '\r' && data[eol + 1] == '\n') ? eol + 2 : eol + 1;
-    ++number;
-    std::string_view text(data.data() + pos, eol - pos);
-    if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
-    const std::size_t before = lines.tokens.size();
-    std::size_t i = 0;
-    while (i < text.size()) {
-      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-      std::size_t j = i;
-      while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
-      if (j > i) lines.tokens.push_back(text.substr(i, j - i));
-      i = j;
-    }
-    if (lines.tokens.size() > before) {
-      lines.first.push_back(lines.tokens.size());
-      lines.number.push_back(number);
-    }
-    pos = next;
-  }
-  return lines;
-}
 
 /// "OFF" and the variants whose extra per-vertex values follow x y z: ST (texture), C (colour),
 /// N (normal). "4OFF", "nOFF" (other dimensions) and binary OFF are not supported.
@@ -86,21 +39,14 @@ bool looks_like_off(const std::string& head) {
 
 Mesh read_off(const std::filesystem::path& file) {
   const std::string path = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string data = read_file(path);
   const auto fail = [&](const std::string& why) { throw Error(ErrorCode::unreadable, path, "cannot parse mesh: " + why); };
   const Lines lines = tokenize(data);
   const auto where = [&](std::size_t l) { return "line " + std::to_string(lines.number[l]); };
   const auto number = [&](std::size_t l, std::size_t k, const char* what) {
-    std::string_view t = lines.token(l, k);
-    if (!t.empty() && t[0] == '+') t.remove_prefix(1);
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (ec != std::errc() || end != t.data() + t.size()) {
-      fail(where(l) + ": " + quote_token(lines.token(l, k)) + " is not " + what);
-    }
-    return v;
+    const std::optional<double> v = parse_number(lines.token(l, k));
+    if (!v) fail(where(l) + ": " + quote_token(lines.token(l, k)) + " is not " + what);
+    return *v;
   };
   const auto count = [&](std::size_t l, std::size_t k, const char* what) -> std::uint64_t {
     const double v = number(l, k, what);
@@ -160,6 +106,10 @@ Mesh read_off(const std::filesystem::path& file) {
       idx.push_back(static_cast<std::uint32_t>(i));
     }
     for (std::size_t c = 1; c + 1 < idx.size(); ++c) mesh.triangles.push_back({idx[0], idx[c], idx[c + 1]});
+  }
+  if (l < lines.size()) {
+    fail(where(l) + ": content after the " + std::to_string(nf) + " faces the header announces (" +
+         quote_token(lines.token(l, 0)) + "...): a wrong face count?");
   }
   if (mesh.triangles.empty()) throw Error(ErrorCode::empty_mesh, path, "mesh has no triangles");
   return mesh;

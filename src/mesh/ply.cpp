@@ -136,6 +136,12 @@ class Reader {
   /// Bytes (binary) or characters (ascii) not read yet.
   [[nodiscard]] std::size_t remaining() const { return mData.size() - mPos; }
 
+  /// True when nothing but (ascii) white space is left.
+  [[nodiscard]] bool at_end() const {
+    return mFormat != Format::ascii ? mPos == mData.size()
+                                    : mData.find_first_not_of(" \t\r\n", mPos) == std::string::npos;
+  }
+
   [[noreturn]] void fail(const std::string& why) const { throw Error(ErrorCode::unreadable, mPath, "cannot parse mesh: " + why); }
 
  private:
@@ -262,7 +268,7 @@ Header read_header(const std::string& data, const std::string& path) {
 
 /// Reads one face's vertex index list (kept when `keep`) into corners.
 void read_indices(Reader& reader, const Property& p, Format format, const std::string& what, bool keep, std::uint64_t face,
-                  const Mesh& mesh, const std::string& path, std::vector<std::uint32_t>& corners) {
+                  std::uint64_t vertex_count, const std::string& path, std::vector<std::uint32_t>& corners) {
   const double count = reader.next(p.count_type, what);
   if (count < 0) parse_failure(path, what + ": negative list length");
   const std::size_t item = format == Format::ascii ? 2 : size_of(p.type);
@@ -282,32 +288,34 @@ void read_indices(Reader& reader, const Property& p, Format format, const std::s
       }
       throw Error(ErrorCode::bad_index, path,
                   "face " + std::to_string(face) + " refers to vertex " + written + " but there are only " +
-                      std::to_string(mesh.vertices.size()));
+                      std::to_string(vertex_count));
     }
     corners.push_back(static_cast<std::uint32_t>(index));
   }
 }
 
 /// Adds a face's triangles (a fan over its corners) to the mesh, its corners checked.
-void add_face(const std::vector<std::uint32_t>& corners, std::uint64_t i, const std::string& path, Mesh& mesh) {
+void add_face(const std::vector<std::uint32_t>& corners, std::uint64_t i, std::uint64_t vertex_count, const std::string& path,
+              Mesh& mesh) {
   if (corners.size() < 3) {
     throw Error(ErrorCode::bad_index, path,
                 "face " + std::to_string(i) + " has " + std::to_string(corners.size()) + " corner(s); a face needs at least 3");
   }
   for (const std::uint32_t c : corners) {
-    if (c >= mesh.vertices.size()) {
+    if (c >= vertex_count) {
       throw Error(ErrorCode::bad_index, path,
                   "face " + std::to_string(i) + " refers to vertex " + std::to_string(c) + " but there are only " +
-                      std::to_string(mesh.vertices.size()));
+                      std::to_string(vertex_count));
     }
   }
   for (std::size_t c = 1; c + 1 < corners.size(); ++c) mesh.triangles.push_back({corners[0], corners[c], corners[c + 1]});
 }
 
-/// Reads every entry of one element; the first 'vertex' element gives the vertices, the first
-/// 'face' element the faces, the others are read past.
-void read_element(Reader& reader, const Element& e, Format format, bool is_vertex, bool is_face, const std::string& path,
-                  Mesh& mesh) {
+/// Reads every entry of one element; the first 'vertex' element gives the vertices (vertex_count
+/// of them, whichever element comes first), the first 'face' element the faces, the others are
+/// read past.
+void read_element(Reader& reader, const Element& e, Format format, bool is_vertex, bool is_face, std::uint64_t vertex_count,
+                  const std::string& path, Mesh& mesh) {
   const auto fail = [&](const std::string& why) { parse_failure(path, why); };
   // Every element takes at least one byte (binary) or two characters (ascii): a count the file
   // cannot hold is an error before anything is allocated.
@@ -340,7 +348,7 @@ void read_element(Reader& reader, const Element& e, Format format, bool is_verte
       const Property& p = e.properties[k];
       const std::string what = e.name + " " + std::to_string(i) + ", property '" + p.name + "'";
       if (p.list) {
-        read_indices(reader, p, format, what, is_face && indices == static_cast<int>(k), i, mesh, path, corners);
+        read_indices(reader, p, format, what, is_face && indices == static_cast<int>(k), i, vertex_count, path, corners);
         continue;
       }
       const double value = reader.next(p.type, what);
@@ -352,7 +360,7 @@ void read_element(Reader& reader, const Element& e, Format format, bool is_verte
       if (!v.allFinite()) throw Error(ErrorCode::bad_value, path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
       mesh.vertices.push_back(v);
     }
-    if (is_face) add_face(corners, i, path, mesh);
+    if (is_face) add_face(corners, i, vertex_count, path, mesh);
   }
 }
 
@@ -368,13 +376,21 @@ Mesh read_ply(const std::filesystem::path& file) {
   Reader reader(path, header.format, data, header.body);
   Mesh mesh;
   mesh.source = path;
+  // PLY lets 'face' come before 'vertex': faces are checked against the declared vertex count.
+  const auto vertex_element = std::find_if(header.elements.begin(), header.elements.end(),
+                                           [](const Element& e) { return e.name == "vertex"; });
+  const std::uint64_t vertex_count = vertex_element == header.elements.end() ? 0 : vertex_element->count;
   bool have_vertices = false, have_faces = false;
   for (const Element& e : header.elements) {
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;
-    read_element(reader, e, header.format, is_vertex, is_face, path, mesh);
+    read_element(reader, e, header.format, is_vertex, is_face, vertex_count, path, mesh);
     have_vertices = have_vertices || is_vertex;
     have_faces = have_faces || is_face;
+  }
+  if (!reader.at_end()) {
+    parse_failure(path, std::to_string(reader.remaining()) +
+                            " bytes after the last element the header declares (a wrong element count?)");
   }
   if (!have_vertices) parse_failure(path, "no 'vertex' element");
   if (!have_faces) throw Error(ErrorCode::empty_mesh, path, "mesh has no triangles (no 'face' element)");

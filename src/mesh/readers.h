@@ -1,7 +1,8 @@
 #pragma once
-// caliber's own readers for PLY (src/mesh/ply.cpp) and OFF (src/mesh/off.cpp): load_mesh sends
-// those formats here; assimp reads the others (OBJ, STL). Both readers are strict: every problem is
-// a caliber::Error naming the file, and no count is trusted before the bytes behind it are there.
+// caliber's own readers for PLY (src/mesh/ply.cpp), OFF (src/mesh/off.cpp) and OBJ
+// (src/mesh/obj.cpp): load_mesh sends those formats here; assimp reads STL. The readers are
+// strict: every problem is a caliber::Error naming the file, and no count is trusted before the
+// bytes behind it are there.
 
 #include <filesystem>
 #include <string>
@@ -32,5 +33,11 @@ namespace caliber::mesh_io {
 /// colours are skipped). Polygons are fanned from their first corner, in file order. Throws
 /// caliber::Error naming the file on any problem; does not call validate_mesh.
 [[nodiscard]] Mesh read_off(const std::filesystem::path& path);
+
+/// Reads the polygonal geometry of an OBJ file (v and f; see src/mesh/obj.cpp for what else is
+/// read, ignored or refused). Material libraries are never opened. Polygons are fanned from their
+/// first corner, in file order. Throws caliber::Error naming the file and line on any problem;
+/// does not call validate_mesh.
+[[nodiscard]] Mesh read_obj(const std::filesystem::path& path);
 
 }  // namespace caliber::mesh_io

@@ -154,7 +154,7 @@ TEST(LoadMeshErrors, FaceWithTwoCorners) { expect_error(kData / "bad/two_corners
 TEST(LoadMeshErrors, NoTriangles) { expect_error(kData / "bad/no_faces.off", ErrorCode::empty_mesh, "no triangles"); }
 
 TEST(LoadMeshErrors, OtherFormats) {
-  expect_error(kData / "bad/index_range.obj", ErrorCode::unreadable, "out of range");
+  expect_error(kData / "bad/index_range.obj", ErrorCode::bad_index, "a face refers to vertex 7 (1-based) but the file has 3");
   expect_error(kData / "bad/index_range.ply", ErrorCode::bad_index, "refers to vertex 9");
   expect_error(kData / "bad/nan.obj", ErrorCode::bad_value, "non-finite");
   expect_error(kData / "bad/no_faces.obj", ErrorCode::empty_mesh, "no triangles");
