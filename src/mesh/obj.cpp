@@ -29,14 +29,14 @@ namespace {
 
 bool is_ignored(std::string_view keyword) {
   static const std::unordered_set<std::string_view> kIgnored = {
-      "o",      "g",       "s",        "mg",         "usemtl",    "mtllib", "usemap", "maplib", "lod",
+      "o",     "g",        "s",        "mg",         "usemtl",    "mtllib", "usemap", "maplib", "lod",
       "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech",  "stech",  "l",      "p"};
   return kIgnored.count(keyword) > 0;
 }
 
 bool is_free_form(std::string_view keyword) {
-  static const std::unordered_set<std::string_view> kFreeForm = {
-      "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con"};
+  static const std::unordered_set<std::string_view> kFreeForm = {"cstype", "deg",  "bmat", "step", "curv", "curv2", "surf",
+                                                                 "parm",   "trim", "hole", "scrv", "sp",   "end",   "con"};
   return kFreeForm.count(keyword) > 0;
 }
 
@@ -80,7 +80,8 @@ class ObjReader {
     const std::string_view keyword = token(0);
     const std::size_t values = mLines.count(mLine) - 1;
     if (keyword == "v") {
-      if (values < 3 || values > 7) fail("'v' needs x y z (then at most a weight or a colour), not " + std::to_string(values) + " values");
+      if (values < 3 || values > 7)
+        fail("'v' needs x y z (then at most a weight or a colour), not " + std::to_string(values) + " values");
       Eigen::Vector3d p;
       for (std::size_t k = 1; k <= values; ++k) {
         const double x = number(k);
@@ -91,7 +92,8 @@ class ObjReader {
                     "vertex " + std::to_string(mMesh.vertices.size() + 1) + " (line " + std::to_string(mLines.number[mLine]) +
                         ") has a non-finite coordinate");
       }
-      if (mMesh.vertices.size() == std::numeric_limits<std::uint32_t>::max()) fail("more vertices than caliber indexes (2^32 - 1)");
+      if (mMesh.vertices.size() == std::numeric_limits<std::uint32_t>::max())
+        fail("more vertices than caliber indexes (2^32 - 1)");
       mMesh.vertices.push_back(p);
     } else if (keyword == "vt" || keyword == "vn" || keyword == "vp") {
       const std::size_t need = keyword == "vn" ? 3 : 1;
@@ -135,7 +137,8 @@ class ObjReader {
       const std::string_view corner = token(k);
       const std::size_t s1 = corner.find('/');
       const std::uint64_t v = reference(corner.substr(0, s1), mMesh.vertices.size(), "vertex");
-      if (v >= std::numeric_limits<std::uint32_t>::max()) fail("vertex index " + std::string(corner.substr(0, s1)) + " is too large");
+      if (v >= std::numeric_limits<std::uint32_t>::max())
+        fail("vertex index " + std::string(corner.substr(0, s1)) + " is too large");
       if (s1 != std::string_view::npos) {
         const std::string_view rest = corner.substr(s1 + 1);
         const std::size_t s2 = rest.find('/');
@@ -143,7 +146,8 @@ class ObjReader {
         if (!vt.empty()) mLastTexCoord = std::max(mLastTexCoord, reference(vt, mTexCoords, "texture coordinate") + 1);
         if (s2 != std::string_view::npos) {
           const std::string_view vn = rest.substr(s2 + 1);
-          if (vn.empty() || vn.find('/') != std::string_view::npos) fail("corner " + quote_token(corner) + " is not v, v/vt, v//vn or v/vt/vn");
+          if (vn.empty() || vn.find('/') != std::string_view::npos)
+            fail("corner " + quote_token(corner) + " is not v, v/vt, v//vn or v/vt/vn");
           mLastNormal = std::max(mLastNormal, reference(vn, mNormals, "normal") + 1);
         } else if (vt.empty()) {
           fail("corner " + quote_token(corner) + " is not v, v/vt, v//vn or v/vt/vn");

@@ -138,8 +138,7 @@ class Reader {
 
   /// True when nothing but (ascii) white space is left.
   [[nodiscard]] bool at_end() const {
-    return mFormat != Format::ascii ? mPos == mData.size()
-                                    : mData.find_first_not_of(" \t\r\n", mPos) == std::string::npos;
+    return mFormat != Format::ascii ? mPos == mData.size() : mData.find_first_not_of(" \t\r\n", mPos) == std::string::npos;
   }
 
   [[noreturn]] void fail(const std::string& why) const { throw Error(ErrorCode::unreadable, mPath, "cannot parse mesh: " + why); }
@@ -377,8 +376,8 @@ Mesh read_ply(const std::filesystem::path& file) {
   Mesh mesh;
   mesh.source = path;
   // PLY lets 'face' come before 'vertex': faces are checked against the declared vertex count.
-  const auto vertex_element = std::find_if(header.elements.begin(), header.elements.end(),
-                                           [](const Element& e) { return e.name == "vertex"; });
+  const auto vertex_element =
+      std::find_if(header.elements.begin(), header.elements.end(), [](const Element& e) { return e.name == "vertex"; });
   const std::uint64_t vertex_count = vertex_element == header.elements.end() ? 0 : vertex_element->count;
   bool have_vertices = false, have_faces = false;
   for (const Element& e : header.elements) {
@@ -389,8 +388,8 @@ Mesh read_ply(const std::filesystem::path& file) {
     have_faces = have_faces || is_face;
   }
   if (!reader.at_end()) {
-    parse_failure(path, std::to_string(reader.remaining()) +
-                            " bytes after the last element the header declares (a wrong element count?)");
+    parse_failure(
+        path, std::to_string(reader.remaining()) + " bytes after the last element the header declares (a wrong element count?)");
   }
   if (!have_vertices) parse_failure(path, "no 'vertex' element");
   if (!have_faces) throw Error(ErrorCode::empty_mesh, path, "mesh has no triangles (no 'face' element)");

@@ -31,7 +31,7 @@ Lines tokenize(const std::string& data, bool backslash_joins) {
   Lines lines;
   std::size_t pos = 0, number = 0;
   if (data.rfind("\xEF\xBB\xBF", 0) == 0) pos = 3;  // a UTF-8 byte order mark says nothing about the mesh
-  bool numbered = false;  // the logical line being read (tokens from first.back() on) has its number
+  bool numbered = false;                            // the logical line being read (tokens from first.back() on) has its number
   while (pos < data.size()) {
     std::size_t eol = data.find_first_of("\r\n", pos);
     if (eol == std::string::npos) eol = data.size();

@@ -71,8 +71,7 @@ TEST(LoadObj, FacesMayNameVerticesDefinedFurtherDown) {
 TEST(LoadObj, NumbersAreNumbersOnlyAsWritten) {
   const std::string rest = " 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
   for (const std::string bad : {"1d2", "0x10", "2abc", "1-2", "++1", "+-1", "--1", "-", "1.0.0", "1e", ",5"}) {
-    EXPECT_NE(error_of("number.obj", "v " + bad + rest).find("line 1: '" + bad + "' is not a number"), std::string::npos)
-        << bad;
+    EXPECT_NE(error_of("number.obj", "v " + bad + rest).find("line 1: '" + bad + "' is not a number"), std::string::npos) << bad;
   }
   // Indices are integers: no fractions, exponents, hex or stray signs.
   const std::string three = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
@@ -86,8 +85,9 @@ TEST(LoadObj, NumbersAreNumbersOnlyAsWritten) {
 TEST(LoadObj, BadIndicesAndStatementsNameTheLine) {
   const std::string three = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   EXPECT_NE(error_of("zero.obj", three + "f 1 2 0\n").find("line 4: vertex index 0 (OBJ indices start at 1"), std::string::npos);
-  EXPECT_NE(error_of("back.obj", three + "f 1 2 -4\n").find("line 4: vertex index -4 counts back past the first (3 defined so far)"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("back.obj", three + "f 1 2 -4\n").find("line 4: vertex index -4 counts back past the first (3 defined so far)"),
+      std::string::npos);
   EXPECT_NE(error_of("past.obj", three + "f 1 2 4\n").find("a face refers to vertex 4 (1-based) but the file has 3"),
             std::string::npos);
   EXPECT_NE(error_of("huge.obj", three + "f 1 2 99999999999999999999\n").find("'99999999999999999999' is not a vertex index"),
@@ -99,8 +99,9 @@ TEST(LoadObj, BadIndicesAndStatementsNameTheLine) {
             std::string::npos);
   EXPECT_NE(error_of("two.obj", three + "f 1 2\n").find("line 4: a face has 2 corner(s)"), std::string::npos);
   EXPECT_NE(error_of("short_v.obj", "v 0 0\n").find("line 1: 'v' needs x y z"), std::string::npos);
-  EXPECT_NE(error_of("curve.obj", three + "cstype bspline\ncurv 0 1 1 2\n").find("line 4: free-form curves and surfaces ('cstype')"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("curve.obj", three + "cstype bspline\ncurv 0 1 1 2\n").find("line 4: free-form curves and surfaces ('cstype')"),
+      std::string::npos);
   EXPECT_NE(error_of("unknown.obj", three + "frobnicate 1\n").find("line 4: unknown statement 'frobnicate'"), std::string::npos);
   EXPECT_NE(error_of("nan.obj", "v 0 nan 0\n").find("vertex 1 (line 1) has a non-finite coordinate"), std::string::npos);
   EXPECT_NE(error_of("no_faces.obj", three).find("mesh has no triangles (no 'f' line)"), std::string::npos);
@@ -140,7 +141,8 @@ TEST(LoadPly, FacesMayComeBeforeVerticesAndNothingAfterTheElements) {
                 .find("face 0 refers to vertex 3 but there are only 3"),
             std::string::npos);
   EXPECT_EQ(load_mesh(write("white.ply", faces_first + "\n \n")).triangles.size(), 1u);
-  EXPECT_NE(error_of("extra.ply", faces_first + "3 0 1 2\n").find("after the last element the header declares"), std::string::npos);
+  EXPECT_NE(error_of("extra.ply", faces_first + "3 0 1 2\n").find("after the last element the header declares"),
+            std::string::npos);
   const std::string binary =
       "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty uchar x\nproperty uchar y\nproperty uchar z\n"
       "element face 1\nproperty list uchar uchar vertex_indices\nend_header\n" +

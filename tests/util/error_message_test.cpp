@@ -17,13 +17,13 @@ std::string what(const std::string& source, const std::string& problem) {
 
 TEST(ErrorMessage, ControlAndNonUtf8BytesAreEscaped) {
   EXPECT_EQ(what(std::string("a\0b.off", 7), "line 1\nline 2\t\x7f"), "a\\x00b.off: line 1\\x0aline 2\\x09\\x7f");
-  EXPECT_EQ(what("caf\xe9.off", "x"), "caf\\xe9.off: x");                         // Latin-1, not UTF-8
+  EXPECT_EQ(what("caf\xe9.off", "x"), "caf\\xe9.off: x");                                   // Latin-1, not UTF-8
   EXPECT_EQ(what("caf\xc3\xa9.off", "\xe2\x82\xac 1"), "caf\xc3\xa9.off: \xe2\x82\xac 1");  // UTF-8 kept
-  EXPECT_EQ(what("", "\xc0\xaf"), "\\xc0\\xaf");                                  // overlong '/'
-  EXPECT_EQ(what("", "\xed\xa0\x80"), "\\xed\\xa0\\x80");                         // a surrogate
-  EXPECT_EQ(what("", "\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");                // past U+10FFFF
-  EXPECT_EQ(what("", "ok \xe2\x82"), "ok \\xe2\\x82");                            // cut short
-  EXPECT_EQ(what("", "\xf0\x9f\x98\x80"), "\xf0\x9f\x98\x80");                    // 4 bytes, valid
+  EXPECT_EQ(what("", "\xc0\xaf"), "\\xc0\\xaf");                                            // overlong '/'
+  EXPECT_EQ(what("", "\xed\xa0\x80"), "\\xed\\xa0\\x80");                                   // a surrogate
+  EXPECT_EQ(what("", "\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");                          // past U+10FFFF
+  EXPECT_EQ(what("", "ok \xe2\x82"), "ok \\xe2\\x82");                                      // cut short
+  EXPECT_EQ(what("", "\xf0\x9f\x98\x80"), "\xf0\x9f\x98\x80");                              // 4 bytes, valid
 }
 
 TEST(ErrorMessage, IsBoundedAndKeepsTheRawSource) {
