@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "caliber/error.h"
+#include "caliber/scene.h"
 
 namespace caliber::cli {
 namespace {
@@ -83,8 +84,7 @@ void OutputFile::commit() {
   }
 }
 
-void check_distinct_files(const std::vector<std::pair<std::string, std::string>>& outputs,
-                          const std::vector<std::pair<std::string, std::string>>& inputs) {
+void check_distinct_files(const NamedFiles& outputs, const NamedFiles& inputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].second.empty()) continue;
     const auto mine = canonical_or_same(outputs[i].second);
@@ -101,6 +101,12 @@ void check_distinct_files(const std::vector<std::pair<std::string, std::string>>
       }
     }
   }
+}
+
+NamedFiles scene_inputs(const std::string& scene_file, const Scene& scene) {
+  NamedFiles inputs{{"scene file", scene_file}};
+  for (const SceneObject& o : scene.objects) inputs.emplace_back("mesh of object '" + o.name + "'", o.mesh.string());
+  return inputs;
 }
 
 void check_stdout() {

@@ -10,6 +10,10 @@
 #include <utility>
 #include <vector>
 
+namespace caliber {
+struct Scene;
+}
+
 namespace caliber::cli {
 
 class OutputFile {
@@ -36,10 +40,16 @@ class OutputFile {
   bool mDone = false;
 };
 
+/// (what, path) pairs: an option or an input's description, and the file it names.
+using NamedFiles = std::vector<std::pair<std::string, std::string>>;
+
 /// Refuses outputs that name the same file as each other or as an input: `outputs` and `inputs`
 /// are (option, path) pairs, empty paths skipped. Throws caliber::Error naming both options.
-void check_distinct_files(const std::vector<std::pair<std::string, std::string>>& outputs,
-                          const std::vector<std::pair<std::string, std::string>>& inputs);
+/// Every command that writes calls it before it opens (or creates) anything.
+void check_distinct_files(const NamedFiles& outputs, const NamedFiles& inputs);
+
+/// The files a scene reads, for check_distinct_files: the scene file and every object's mesh.
+[[nodiscard]] NamedFiles scene_inputs(const std::string& scene_file, const Scene& scene);
 
 /// Flushes standard output and throws caliber::Error if anything written to it was lost (a full
 /// disk, a closed pipe), so that a command never exits 0 after failing to write its answer.

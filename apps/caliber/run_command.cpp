@@ -146,11 +146,9 @@ int run_scene(const RunOptions& opt) {
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
   // Every output is checked, and kept apart from every input, before any work is done.
-  std::vector<std::pair<std::string, std::string>> inputs{{"the scene", opt.scene}};
-  for (const SceneObject& o : scene.objects) inputs.emplace_back("mesh of object '" + o.name + "'", o.mesh.string());
-  std::vector<std::pair<std::string, std::string>> outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
+  NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
   for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
-  check_distinct_files(outputs, inputs);
+  check_distinct_files(outputs, scene_inputs(opt.scene, scene));
   std::unique_ptr<Exporter> exporter;
   if (!opt.exports.dir.empty()) exporter = std::make_unique<Exporter>(opt.exports, scene.steps);
   std::unique_ptr<OutputFile> json_out, contacts_out;

@@ -159,9 +159,7 @@ int view_scene(const ViewOptions& opt) {
   options.method = parse_method(opt.method);
   options.threads = opt.threads;
   options.timeline = true;
-  std::vector<std::pair<std::string, std::string>> inputs{{"the scene", opt.scene}};
-  for (const SceneObject& o : scene.objects) inputs.emplace_back("mesh of object '" + o.name + "'", o.mesh.string());
-  check_distinct_files({{"--out", opt.out}}, inputs);
+  check_distinct_files({{"--out", opt.out}}, scene_inputs(opt.scene, scene));
   OutputFile out(opt.out, "--out");
 
   const World world(std::move(scene));

@@ -537,12 +537,32 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
   if (!figures_note.empty()) std::printf("%s\n", figures_note.c_str());
 }
 
+/// Every file the bench writes in `out` (scenes named `scene_names`), as (what, path) pairs.
+NamedFiles bench_outputs(const std::filesystem::path& out, const std::vector<std::string>& scene_names) {
+  NamedFiles files;
+  std::vector<std::string> names = {"results.json", "report.md", "fcl_compare.md"};
+  for (const std::string& figure : {std::string("correlation"), std::string("gantt")}) {
+    names.insert(names.end(), {figure + ".png", figure + ".svg"});
+  }
+  for (const std::string& s : scene_names) names.insert(names.end(), {"speedup_" + s + ".png", "speedup_" + s + ".svg"});
+  for (const std::string& name : names) files.emplace_back("--out's " + name, (out / name).string());
+  return files;
+}
+
 /// `caliber bench --from-log FILE`: the report of a bench run from its log, whole or cut short.
 int report_from_log(const BenchOptions& opt) {
   const std::filesystem::path log_file = opt.from_log;
   const std::vector<Json> records = read_bench_log(log_file);
   std::filesystem::path out = opt.out.empty() ? log_file.parent_path() : std::filesystem::path(opt.out);
   if (out.empty()) out = ".";
+  std::vector<std::string> names;
+  for (const Json& r : records) {
+    if (r.value("kind", "") != "header" || !r.contains("scenes") || !r["scenes"].is_array()) continue;
+    for (const Json& s : r["scenes"]) {
+      if (s.contains("name") && s["name"].is_string()) names.push_back(s["name"].get<std::string>());
+    }
+  }
+  check_distinct_files(bench_outputs(out, names), {{"--from-log", opt.from_log}});
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out)) {
     throw Error(ErrorCode::bad_value, "--out", "'" + out.string() + "' exists and is not a folder");
   }
@@ -597,9 +617,21 @@ int run_bench(BenchOptions opt) {
   if (std::filesystem::exists(opt.out) && !std::filesystem::is_directory(opt.out)) {
     throw Error(ErrorCode::bad_value, "--out", "'" + opt.out + "' exists and is not a folder");
   }
-  std::filesystem::create_directories(opt.out);
   const std::filesystem::path log_path =
       opt.log.empty() ? std::filesystem::path(opt.out) / "runs.jsonl" : std::filesystem::path(opt.log);
+  // Nothing the bench writes may be one of its inputs (a --log naming a mesh emptied it): checked
+  // before the folder is created or the log opened.
+  NamedFiles inputs;
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const NamedFiles read = scene_inputs(opt.scenes[i], scenes[i]);
+    inputs.insert(inputs.end(), read.begin(), read.end());
+    names.push_back(scenes[i].name);
+  }
+  NamedFiles outputs = bench_outputs(opt.out, names);
+  outputs.insert(outputs.begin(), {opt.log.empty() ? "--out's runs.jsonl" : "--log", log_path.string()});
+  check_distinct_files(outputs, inputs);
+  std::filesystem::create_directories(opt.out);
   BenchLog log(log_path);  // opened before the long work: an unwritable log fails now
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 

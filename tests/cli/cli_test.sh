@@ -392,7 +392,7 @@ fi
 check out-same-file 2 "$cli" run "$data/scenes/tetras.json" --json "$r2/o.json" --contacts "$r2/o.json"
 contains out-same-file "names the same file as --json"
 check out-over-input 2 "$cli" run "$r2/s/q.json" --contacts "$r2/s/q.json"
-contains out-over-input "would overwrite the input the scene"
+contains out-over-input "would overwrite the input scene file"
 check out-over-mesh 2 "$cli" run "$r2/s/q.json" --json "$r2/s/tetra.off"
 check out-no-folder 2 "$cli" run "$data/scenes/tetras.json" --json /nonexistent/r.json
 contains out-no-folder "no folder /nonexistent"

@@ -96,5 +96,26 @@ check view-over-scene 2 "$cli" view "$scene" --out "$scene"
 check view-bad-method 2 "$cli" view "$scene" --out "$tmp/v.html" --method fastest
 check view-no-folder 2 "$cli" view "$scene" --out "$tmp/no/such/v.html"
 
+# bench: nothing it writes may be one of its inputs, checked before its folder or log exists (a
+# --log naming a mesh emptied the mesh; naming the scene replaced it and exited 0).
+mkdir -p "$tmp/b"
+cp "$data/tetra.off" "$tmp/b/tetra.off"
+printf '{"name": "b", "steps": 1, "objects": [{"name": "a", "mesh": "tetra.off"}, {"name": "c", "mesh": "tetra.off", "position": [0.1, 0, 0]}]}\n' > "$tmp/b/s.json"
+cp "$tmp/b/s.json" "$tmp/b/results.json"
+before=$(cat "$tmp/b/"* | md5sum)
+quick=(--threads 1 --repeat 1 --no-fcl --no-figures --simulate 2)
+check bench-log-over-mesh 2 "$cli" bench "$tmp/b/s.json" --log "$tmp/b/tetra.off" --out "$tmp/b/out1" "${quick[@]}"
+contains bench-log-over-mesh "--log: would overwrite the input mesh of object 'a'"
+check bench-log-over-scene 2 "$cli" bench "$tmp/b/s.json" --log "$tmp/b/s.json" --out "$tmp/b/out2" "${quick[@]}"
+contains bench-log-over-scene "--log: would overwrite the input scene file"
+check bench-out-over-scene 2 "$cli" bench "$tmp/b/results.json" --out "$tmp/b" "${quick[@]}"
+contains bench-out-over-scene "--out's results.json: would overwrite the input scene file"
+[ "$(cat "$tmp/b/"* | md5sum)" = "$before" ] || { echo "FAIL bench-inputs: an input changed"; failures=$((failures + 1)); }
+[ -e "$tmp/b/out1" ] || [ -e "$tmp/b/out2" ] && { echo "FAIL bench-inputs: a refused bench made its folder"; failures=$((failures + 1)); }
+check bench-from-log-over-log 0 "$cli" bench "$tmp/b/s.json" --out "$tmp/b/out3" "${quick[@]}"
+cp "$tmp/b/out3/runs.jsonl" "$tmp/b/out3/report.md"
+check bench-from-log-over-log 2 "$cli" bench --from-log "$tmp/b/out3/report.md"
+contains bench-from-log-over-log "--out's report.md: would overwrite the input --from-log"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
