@@ -1,6 +1,10 @@
 #pragma once
 // JSON forms of the library's results, for the CLI's --json output.
 
+#include <ostream>
+#include <string>
+#include <string_view>
+
 #include <nlohmann/json.hpp>
 
 #include "caliber/query.h"
@@ -13,5 +17,32 @@ inline constexpr int kSchemaVersion = 1;
 
 /// {"kind":…, "pairs":[[ia,ib],…], "contacts":[…], "stats":{"node_tests":…, "leaf_tests":…}}
 nlohmann::json to_json(const QueryResult& result);
+
+/// A path or a name as a JSON string: bytes that are not UTF-8 (a file name in Latin-1, say)
+/// written as the text \xNN, so that any path reaches the report (JSON holds only Unicode).
+[[nodiscard]] std::string json_text(std::string_view text);
+
+/// A JSON object written member by member: an array of many records (a run's steps) goes out one
+/// record at a time as the records are made, and is never held whole. `filter` (optional)
+/// rewrites each piece of JSON text before it is written (the viewer's script_safe).
+class JsonObjectWriter {
+ public:
+  explicit JsonObjectWriter(std::ostream& out, std::string (*filter)(const std::string&) = nullptr);
+  /// "key": value
+  void member(std::string_view key, const nlohmann::json& value);
+  /// "key": [ ... then item() for each element, then close_array().
+  void open_array(std::string_view key);
+  void item(const nlohmann::json& value);
+  void close_array();
+  /// The closing brace.
+  void close();
+
+ private:
+  void put(const std::string& json);
+  void key(std::string_view key);
+  std::ostream& mOut;
+  std::string (*mFilter)(const std::string&);
+  bool mFirstMember = true, mFirstItem = true;
+};
 
 }  // namespace caliber::cli

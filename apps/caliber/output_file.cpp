@@ -88,7 +88,10 @@ void check_distinct_files(const NamedFiles& outputs, const NamedFiles& inputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].second.empty()) continue;
     const auto mine = canonical_or_same(outputs[i].second);
-    for (std::size_t j = 0; j < i; ++j) {
+    // Two outputs may share a device or a pipe (--json /dev/null --contacts /dev/null), not a file.
+    std::error_code ec;
+    const bool shareable = std::filesystem::exists(mine, ec) && !std::filesystem::is_regular_file(mine, ec);
+    for (std::size_t j = 0; j < i && !shareable; ++j) {
       if (!outputs[j].second.empty() && canonical_or_same(outputs[j].second) == mine) {
         throw Error(ErrorCode::bad_value, outputs[i].first,
                     "names the same file as " + outputs[j].first + " (" + outputs[i].second + "); give each output its own file");

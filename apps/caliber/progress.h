@@ -1,6 +1,9 @@
 #pragma once
-// A progress bar on a terminal, plain lines elsewhere (logs, CI, pipes).
+// A progress bar on a terminal, plain lines elsewhere (logs, CI, pipes): every unit's line for the
+// first 100, then at most one a second and the last, so that a run of a million steps does not
+// write a million lines.
 
+#include <chrono>
 #include <cstdio>
 #include <string>
 
@@ -25,14 +28,20 @@ class Progress {
                    std::string(kWidth - filled, '.').c_str(), done, mTotal, line.c_str());
       if (done == mTotal) std::fputc('\n', stderr);
     } else {
+      const auto now = std::chrono::steady_clock::now();
+      if (++mLines > kEveryLine && done != mTotal && now - mLast < std::chrono::seconds(1)) return;
+      mLast = now;
       std::fprintf(stderr, "%s\n", line.c_str());
     }
     std::fflush(stderr);
   }
 
  private:
+  static constexpr std::size_t kEveryLine = 100;
   std::size_t mTotal;
   bool mTerminal;
+  mutable std::size_t mLines = 0;
+  mutable std::chrono::steady_clock::time_point mLast{};
 };
 
 }  // namespace caliber::cli

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,8 +95,8 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
   for (const Contact& c : s.contacts) {
     nlohmann::json j = {{"object_a", c.object_a},
                         {"object_b", c.object_b},
-                        {"name_a", world.scene().objects[c.object_a].name},
-                        {"name_b", world.scene().objects[c.object_b].name},
+                        {"name_a", json_text(world.scene().objects[c.object_a].name)},
+                        {"name_b", json_text(world.scene().objects[c.object_b].name)},
                         {"tri_a", c.tri_a},
                         {"tri_b", c.tri_b}};
     if (points) {
@@ -167,7 +168,27 @@ int run_scene(const RunOptions& opt) {
               std::string(to_string(engine.options().method)).c_str(), engine.threads());
   std::fflush(stdout);
 
-  nlohmann::json steps = nlohmann::json::array();
+  // The report is streamed: what is known now, then each step as it ends, then the summary; so
+  // its memory does not grow with the steps, and a failure leaves only the temporary file, removed.
+  std::optional<JsonObjectWriter> report;
+  if (json_out) {
+    report.emplace(json_out->stream());
+    nlohmann::json objects = nlohmann::json::array();
+    for (std::size_t i = 0; i < world.object_count(); ++i) {
+      objects.push_back({{"id", i}, {"name", json_text(sc.objects[i].name)}, {"mesh", json_text(sc.objects[i].mesh.string())}});
+    }
+    report->member("schema_version", kSchemaVersion);
+    report->member("scene", json_text(sc.name));
+    report->member("file", json_text(sc.file.string()));
+    report->member("objects", objects);
+    report->member(
+        "query",
+        {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}});
+    report->member("dt", sc.dt);
+    report->member("method", std::string(to_string(engine.options().method)));
+    report->member("threads", engine.threads());
+    report->open_array("steps");
+  }
   RunStats stats;
   // Load-balance simulation, over the whole run.
   std::vector<SimulatedRun> sims;
@@ -185,7 +206,7 @@ int run_scene(const RunOptions& opt) {
     stats.add(s);
     limited_steps += s.limit_reached ? 1 : 0;
     for (SimulatedRun& sim : sims) sim.add(s);
-    if (json_out) steps.push_back(step_record(s));
+    if (report) report->item(step_record(s));
     if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
     if (exporter && exporter->wants(k)) exporter->write(world, s);
     char line[256];
@@ -228,38 +249,23 @@ int run_scene(const RunOptions& opt) {
     std::printf("\n");
   }
 
-  if (json_out) {
-    nlohmann::json objects = nlohmann::json::array();
-    for (std::size_t i = 0; i < world.object_count(); ++i) {
-      objects.push_back({{"id", i}, {"name", sc.objects[i].name}, {"mesh", sc.objects[i].mesh.string()}});
-    }
-    nlohmann::json report = {
-        {"schema_version", kSchemaVersion},
-        {"scene", sc.name},
-        {"objects", objects},
-        {"file", sc.file.string()},
-        {"query",
-         {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}}},
-        {"dt", sc.dt},
-        {"method", std::string(to_string(engine.options().method))},
-        {"threads", engine.threads()},
-        {"summary",
-         {{"steps", stats.steps()},
-          {"objects", world.object_count()},
-          {"triangles", world.triangle_count()},
-          {"median_step_ms", stats.median_step_ms()},
-          {"mean_step_ms", stats.mean_step_ms()},
-          {"node_tests_per_step", stats.mean_node_tests()},
-          {"contacts_per_step", stats.mean_contacts()},
-          {"pairs_per_step", stats.mean_tasks()},
-          {"candidate_pairs", stats.candidate_pairs()},
-          {"steps_with_contacts", stats.steps_with_contacts()},
-          {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
-          {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
-          {"simulated_speedup", simulated}}},
-        {"steps", steps}};
-    if (interrupted) report["interrupted"] = true;
-    json_out->stream() << report.dump(1) << '\n';
+  if (report) {
+    report->close_array();
+    report->member("summary", {{"steps", stats.steps()},
+                               {"objects", world.object_count()},
+                               {"triangles", world.triangle_count()},
+                               {"median_step_ms", stats.median_step_ms()},
+                               {"mean_step_ms", stats.mean_step_ms()},
+                               {"node_tests_per_step", stats.mean_node_tests()},
+                               {"contacts_per_step", stats.mean_contacts()},
+                               {"pairs_per_step", stats.mean_tasks()},
+                               {"candidate_pairs", stats.candidate_pairs()},
+                               {"steps_with_contacts", stats.steps_with_contacts()},
+                               {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
+                               {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
+                               {"simulated_speedup", simulated}});
+    if (interrupted) report->member("interrupted", true);
+    report->close();
     json_out->commit();
   }
   check_stdout();

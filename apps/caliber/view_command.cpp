@@ -133,14 +133,18 @@ nlohmann::json step_view(const World& world, const StepResult& s, const std::vec
           {"timeline", timeline}};
 }
 
-/// JSON placed inside <script>: "</" written "<\/" (the same string to JSON) so that no text in it
-/// (an object's name, say) can end the script element.
+/// JSON placed inside <script>: every '<' written "\\u003c" (the same string to JSON; in JSON text a
+/// '<' can only be inside a string) so that no text in it (an object's name, say: "</script>",
+/// "<!--") can end or change the script element.
 std::string script_safe(const std::string& json) {
   std::string out;
   out.reserve(json.size());
-  for (std::size_t i = 0; i < json.size(); ++i) {
-    out += json[i];
-    if (json[i] == '<' && i + 1 < json.size() && json[i + 1] == '/') out += '\\';
+  for (const char c : json) {
+    if (c == '<') {
+      out += "\\u003c";
+    } else {
+      out += c;
+    }
   }
   return out;
 }
@@ -165,32 +169,38 @@ int view_scene(const ViewOptions& opt) {
   const World world(std::move(scene));
   Engine engine(options);
   const Scene& sc = world.scene();
-  nlohmann::json meshes = nlohmann::json::array(), objects = nlohmann::json::array();
+  // The page is streamed: its head, the data (meshes and objects, then each step as it ends), its
+  // tail; so its memory does not grow with the steps.
+  out.stream() << kPageHead;
+  JsonObjectWriter data(out.stream(), &script_safe);
+  data.member("schema_version", kSchemaVersion);
+  data.member("scene", json_text(sc.name));
+  data.member("query", std::string(to_string(sc.query.kind)));
+  data.member("method", std::string(to_string(engine.options().method)));
+  data.member("threads", engine.threads());
+  nlohmann::json objects = nlohmann::json::array();
   std::map<const Model*, std::size_t> mesh_index;
+  data.open_array("meshes");
   for (std::size_t i = 0; i < world.object_count(); ++i) {
     const Model* model = &world.model(i);
     const auto [it, added] = mesh_index.emplace(model, mesh_index.size());
-    if (added) meshes.push_back(mesh_record(model->mesh()));
-    objects.push_back({{"name", sc.objects[i].name}, {"mesh", it->second}});
+    if (added) data.item(mesh_record(model->mesh()));
+    objects.push_back({{"name", json_text(sc.objects[i].name)}, {"mesh", it->second}});
   }
-  nlohmann::json steps = nlohmann::json::array();
+  data.close_array();
+  data.member("objects", objects);
+  data.open_array("steps");
   const Progress progress(static_cast<std::size_t>(sc.steps));
   for (int k = 0; k < sc.steps; ++k) {
     const StepResult s = step(world, engine, k);
-    steps.push_back(step_view(world, s, world.poses_at(k), opt.max_boxes));
+    data.item(step_view(world, s, world.poses_at(k), opt.max_boxes));
     progress.update(static_cast<std::size_t>(k + 1), "step " + std::to_string(k) + ": " + std::to_string(s.contacts.size()) +
                                                          " contacts, " + std::to_string(s.schedule->task_node_tests.size()) +
                                                          " run-time tasks");
   }
-  const nlohmann::json data = {{"schema_version", kSchemaVersion},
-                               {"scene", sc.name},
-                               {"query", std::string(to_string(sc.query.kind))},
-                               {"method", std::string(to_string(engine.options().method))},
-                               {"threads", engine.threads()},
-                               {"meshes", meshes},
-                               {"objects", objects},
-                               {"steps", steps}};
-  out.stream() << kPageHead << script_safe(data.dump()) << kPageMiddle << kViewerScript << kPageTail;
+  data.close_array();
+  data.close();
+  out.stream() << kPageMiddle << kViewerScript << kPageTail;
   out.commit();
   std::printf("wrote %s: %s, %d steps, %zu objects, %s on %d thread(s)\n", opt.out.c_str(), sc.name.c_str(), sc.steps,
               world.object_count(), std::string(to_string(engine.options().method)).c_str(), engine.threads());

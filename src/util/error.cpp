@@ -1,9 +1,12 @@
-// caliber::Error's message: one printable line of valid UTF-8, bounded (see caliber/error.h).
+// caliber::Error's message: one printable line of valid UTF-8, bounded (see caliber/error.h); and
+// the same escaping for names and paths written into outputs (src/util/printable.h).
 
 #include "caliber/error.h"
 
 #include <cstdio>
 #include <string_view>
+
+#include "util/printable.h"
 
 namespace caliber {
 namespace {
@@ -33,7 +36,14 @@ std::size_t utf8_sequence(std::string_view text, std::size_t i) {
   return n;
 }
 
-/// `text` with control characters and non-UTF-8 bytes as \xNN, cut after `limit` bytes.
+void escape(std::string& out, unsigned char c) {
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "\\x%02x", c);
+  out += hex;
+}
+
+}  // namespace
+
 std::string printable(std::string_view text, std::size_t limit) {
   std::string out;
   for (std::size_t i = 0; i < text.size();) {
@@ -46,14 +56,32 @@ std::string printable(std::string_view text, std::size_t limit) {
       out.append(text.substr(i, n));
       i += n;
     } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
+      escape(out, c);
       ++i;
     }
   }
   return out;
 }
+
+std::string utf8_or_escaped(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const std::size_t n = c < 0x80 ? 1 : utf8_sequence(text, i);
+    if (n > 0) {
+      out.append(text.substr(i, n));
+      i += n;
+    } else {
+      escape(out, c);
+      ++i;
+    }
+  }
+  return out;
+}
+
+namespace {
+
 
 std::string message(const std::string& source, const std::string& problem) {
   constexpr std::size_t kSourceBytes = 300, kProblemBytes = 500;

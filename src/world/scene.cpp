@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -184,13 +185,60 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   return query;
 }
 
+/// A parser callback that refuses a key given twice in one object (JSON parsers keep one of the
+/// two values, silently), naming its path ("objects[1].motion.type").
+Json::parser_callback_t refuse_duplicate_keys(const std::string& source) {
+  struct Level {
+    bool object = false;
+    std::set<std::string> keys;
+    std::string key;
+    std::size_t index = 0;
+  };
+  auto levels = std::make_shared<std::vector<Level>>();
+  return [levels, source](int, Json::parse_event_t event, Json& parsed) {
+    auto& stack = *levels;
+    const auto element_done = [&] {
+      if (!stack.empty() && !stack.back().object) ++stack.back().index;
+    };
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        stack.push_back(Level{event == Json::parse_event_t::object_start, {}, {}, 0});
+        break;
+      case Json::parse_event_t::key: {
+        const std::string key = parsed.get<std::string>();
+        if (!stack.back().keys.insert(key).second) {
+          std::string path;
+          for (std::size_t i = 0; i + 1 < stack.size(); ++i) {
+            path += stack[i].object ? (path.empty() ? "" : ".") + stack[i].key : "[" + std::to_string(stack[i].index) + "]";
+          }
+          path += (path.empty() ? "" : ".") + key;
+          throw Error(ErrorCode::unreadable, source,
+                      "'" + path + "': the key is given twice in one object (which value was meant?)");
+        }
+        stack.back().key = key;
+        break;
+      }
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        stack.pop_back();
+        element_done();
+        break;
+      case Json::parse_event_t::value:
+        element_done();
+        break;
+    }
+    return true;
+  };
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir, const std::string& source) {
   const Reader r(source);
   Json root;
   try {
-    root = Json::parse(text);
+    root = Json::parse(text, refuse_duplicate_keys(source));
   } catch (const Json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     throw Error(ErrorCode::unreadable, source, std::string("not valid JSON: ") + e.what());
   }

@@ -90,11 +90,21 @@ std::vector<Pose> World::poses_at(int step) const {
   std::vector<Pose> poses;
   poses.reserve(mScene.objects.size());
   const double t = step * mScene.dt;
-  for (const SceneObject& o : mScene.objects) {
+  // A motion that leaves caliber's range is named by file, object and key.
+  const std::string source = mScene.file.empty() ? "scene " + mScene.name : mScene.file.string();
+  for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
+    const SceneObject& o = mScene.objects[i];
     poses.push_back(pose_at(o.pose, o.motion, t));
+    const std::string key = "objects[" + std::to_string(i) + "].motion";
     if (!poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
-      throw Error(ErrorCode::bad_value, "scene " + mScene.name,
-                  "object '" + o.name + "' moves beyond +-1e15 (caliber's limit on coordinates) by step " + std::to_string(step));
+      throw Error(ErrorCode::bad_value, source,
+                  "object '" + o.name + "' (" + key + ") moves beyond +-1e15 (caliber's limit on coordinates) by step " +
+                      std::to_string(step));
+    }
+    if (!poses.back().rotation.coeffs().allFinite()) {
+      throw Error(ErrorCode::bad_value, source,
+                  "object '" + o.name + "' (" + key + ".angular): the turn by step " + std::to_string(step) +
+                      " (angular velocity x time) overflows a double");
     }
   }
   return poses;

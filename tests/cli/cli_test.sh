@@ -72,7 +72,7 @@ check no-args 2 "$cli"
 check unknown-flag 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --frobnicate
 
 # The distance query: the closest pair, a bound that answers "not closer than d", the same answer
-# from every engine method on a scene, and no engine run without a finite tolerance.
+# from every engine method on a scene, and through the engine without a tolerance as without it.
 check distance 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --json
 python3 - "$out" <<'PY' || { echo "FAIL distance-json"; failures=$((failures + 1)); }
 import json, math, sys
@@ -83,8 +83,14 @@ assert 0.9 < c["distance"] < 2.0 and abs(math.dist(c["point_a"], c["point_b"]) -
 PY
 check distance-bounded 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --tolerance 0.5
 contains distance-bounded "none within the tolerance 0.5"
-check distance-engine-unbounded 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind distance --method hybrid
-contains distance-engine-unbounded "finite tolerance"
+check distance-engine-unbounded 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --json --method hybrid
+unbounded_hybrid="$out"
+check distance-engine-unbounded 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "2 0.1 0 1 0 0 0" --kind distance --json
+python3 - "$unbounded_hybrid" "$out" <<'PY' || { echo "FAIL distance-engine-unbounded: not the query's answer"; failures=$((failures + 1)); }
+import json, sys
+a, b = json.loads(sys.argv[1]), json.loads(sys.argv[2])
+assert a["contacts"] == b["contacts"] and len(a["contacts"]) == 1, (a, b)
+PY
 check distance-negative 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind distance --tolerance -1
 dtmp=$(mktemp -d)
 for m in sequential exploitation stealing aposteriori apriori hybrid; do

@@ -117,5 +117,53 @@ cp "$tmp/b/out3/runs.jsonl" "$tmp/b/out3/report.md"
 check bench-from-log-over-log 2 "$cli" bench --from-log "$tmp/b/out3/report.md"
 contains bench-from-log-over-log "--out's report.md: would overwrite the input --from-log"
 
+# Reports are streamed: a million-step run --json keeps its memory (max RSS) under 100 MB; a run
+# that fails mid-way leaves no report and no temporary file. (Not under ASan: its shadow memory.)
+printf '{"name": "spin", "steps": 10, "dt": 0.01, "query": {"kind": "contact", "tolerance": 0.05}, "objects": [{"name": "fixed", "mesh": "%s"}, {"name": "spinner", "mesh": "%s", "position": [0.2, 0.1, 0.1], "motion": {"type": "velocity", "linear": [0, 0, 0], "angular": [0, 0, 0.5]}}]}\n' \
+  "$data/tetra.off" "$data/tetra.off" > "$tmp/spin.json"
+if [ -z "${ASAN_OPTIONS:-}" ]; then
+  python3 - "$cli" "$tmp/spin.json" <<'PY' && passes=$((passes + 1)) || { echo "FAIL run-json-memory"; failures=$((failures + 1)); }
+import resource, subprocess, sys
+subprocess.run([sys.argv[1], "run", sys.argv[2], "--steps", "1000000", "--json", "/dev/null", "--contacts", "/dev/null",
+                "--simulate-cores", "2"], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+assert peak_kb < 100 * 1024, f"a million steps took {peak_kb} KB"
+PY
+fi
+mkdir -p "$tmp/fail"
+printf '{"name": "away", "steps": 40, "dt": 1, "objects": [{"name": "still", "mesh": "%s"}, {"name": "rocket", "mesh": "%s", "motion": {"type": "velocity", "linear": [1e14, 0, 0]}}]}\n' \
+  "$data/tetra.off" "$data/tetra.off" > "$tmp/fail/away.json"
+check run-fails-midway 2 "$cli" run "$tmp/fail/away.json" --json "$tmp/fail/r.json" --contacts "$tmp/fail/c.jsonl"
+contains run-fails-midway "rocket"
+[ "$(ls -A "$tmp/fail")" = "away.json" ] || { echo "FAIL run-fails-midway: left $(ls -A "$tmp/fail")"; failures=$((failures + 1)); }
+check view-fails-midway 2 "$cli" view "$tmp/fail/away.json" --out "$tmp/fail/v.html"
+[ "$(ls -A "$tmp/fail")" = "away.json" ] || { echo "FAIL view-fails-midway: left $(ls -A "$tmp/fail")"; failures=$((failures + 1)); }
+
+# Paths and names as data: a folder whose name is not UTF-8, object names with a newline and with
+# "<!--<script>": every output is written, the names escaped (\xe9 in JSON text, \x0a in a PLY
+# comment, \u003c in the page).
+odd="$tmp/caf$(printf '\351')"
+mkdir -p "$odd"
+cp "$data/tetra.off" "$odd/m.off"
+printf '{"name": "odd", "steps": 2, "objects": [{"name": "line\\nbreak", "mesh": "m.off"}, {"name": "<!--<script>", "mesh": "m.off", "position": [0.2, 0.1, 0.1], "motion": {"type": "velocity", "linear": [0, 0, 0], "angular": [0, 0, 0.1]}}]}\n' > "$odd/s.json"
+check odd-run 0 "$cli" run "$odd/s.json" --json "$odd/r.json" --contacts "$odd/c.jsonl" --export "$odd/ply" --export-steps 0
+check odd-view 0 "$cli" view "$odd/s.json" --out "$odd/v.html"
+python3 - "$odd" <<'PY' && passes=$((passes + 1)) || { echo "FAIL odd-names"; failures=$((failures + 1)); }
+import json, os, re, sys
+odd = os.fsencode(sys.argv[1])
+r = json.load(open(odd + b"/r.json", encoding="utf-8"))
+assert r["file"].endswith("caf\\xe9/s.json"), r["file"]
+assert [o["name"] for o in r["objects"]] == ["line\nbreak", "<!--<script>"]
+assert r["objects"][0]["mesh"].endswith("caf\\xe9/m.off")
+lines = [json.loads(l) for l in open(odd + b"/c.jsonl", encoding="utf-8")]
+assert lines[0]["contacts"] and lines[0]["contacts"][0]["name_b"] == "<!--<script>"
+header = open(odd + b"/ply/step0_objects.ply", "rb").read().split(b"end_header")[0].decode()
+assert "comment object 0 line\\x0abreak\n" in header and all(l.split(" ")[0] in ("ply", "format", "comment", "element", "property", "") for l in header.split("\n")), header
+page = open(odd + b"/v.html", encoding="utf-8").read()
+data = re.search(r'<script id="caliber-data" type="application/json">(.*?)</script>', page, re.S).group(1)
+assert "<" not in data and "\\u003c!--\\u003cscript>" in data
+assert [o["name"] for o in json.loads(data)["objects"]] == ["line\nbreak", "<!--<script>"]
+PY
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

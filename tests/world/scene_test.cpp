@@ -178,5 +178,37 @@ TEST(Motion, MovingBeyondTheCoordinateLimitIsAnErrorNamingTheObject) {
   }
 }
 
+TEST(SceneFile, AKeyGivenTwiceIsAnErrorNamingItsPath) {
+  expect_scene_error(R"({"name": "a", "name": "b", "objects": [{"mesh": "tetra.off"}]})",
+                     "'name': the key is given twice in one object");
+  expect_scene_error(R"({"objects": [{"mesh": "tetra.off"}, {"mesh": "tetra.off", "motion": {"type": "velocity",
+      "linear": [1, 0, 0], "type": "fixed"}}]})",
+                     "'objects[1].motion.type': the key is given twice");
+  expect_scene_error(R"({"objects": [[], {"mesh": "tetra.off", "mesh": "tetra.off"}]})",
+                     "'objects[1].mesh': the key is given twice");
+  // The same key in two objects is not a duplicate.
+  EXPECT_EQ(parse_scene(R"({"objects": [{"name": "a", "mesh": "tetra.off"}, {"name": "b", "mesh": "tetra.off"}]})",
+                        CALIBER_TEST_DATA, "two.json")
+                .objects.size(),
+            2u);
+}
+
+TEST(Motion, AnOverflowingTurnIsAnErrorNamingTheFileObjectAndKey) {
+  const auto file = std::filesystem::temp_directory_path() / "caliber_scene_test_spin.json";
+  std::ofstream(file) << R"({"dt": 0.5, "objects": [{"mesh": ")" << CALIBER_TEST_DATA << R"(/tetra.off"},
+      {"name": "spinner", "mesh": ")"
+                      << CALIBER_TEST_DATA << R"(/tetra.off",
+       "motion": {"type": "velocity", "linear": [0, 0, 0], "angular": [1e308, 1e308, 0]}}]})";
+  const World world(load_scene(file));
+  EXPECT_NO_THROW((void)world.poses_at(0));
+  try {
+    (void)world.poses_at(1);
+    FAIL() << "|angular| overflows";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(file.string() + ": object 'spinner' (objects[1].motion.angular): the turn by step 1", 0), 0u) << what;
+  }
+}
+
 }  // namespace
 }  // namespace caliber
