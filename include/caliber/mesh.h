@@ -51,8 +51,9 @@ inline constexpr double kMinCoordinate = 0x1p-120;
 [[nodiscard]] CALIBER_EXPORT std::string_view supported_mesh_formats();
 
 /// Loads a mesh, the reader chosen by the file's extension (any case) and never by its content:
-/// .off and .ply by caliber's own strict readers, .obj and .stl (ascii and binary) by assimp's
-/// importer of that format. Any other extension, or none, is refused. Triangle ids follow the
+/// .off, .ply and .obj by caliber's own strict readers (OBJ: polygonal geometry only; material
+/// libraries are never opened), .stl (ascii and binary) by assimp's STL importer. Any other
+/// extension, or none, is refused. Triangle ids follow the
 /// file's face order; a polygon with n > 3 corners becomes n-2 triangles
 /// fanned from its first corner, in place. Vertices are not merged or reordered.
 /// Throws caliber::Error naming the file on a missing file, a parse error, a non-finite coordinate,
