@@ -42,17 +42,15 @@ void escape(std::string& out, unsigned char c) {
   out += hex;
 }
 
-}  // namespace
-
-std::string printable(std::string_view text, std::size_t limit) {
+/// `text` with bytes that are not UTF-8, and control characters unless `keep_controls`, as \xNN;
+/// cut after `limit` bytes.
+std::string escaped(std::string_view text, std::size_t limit, bool keep_controls) {
   std::string out;
   for (std::size_t i = 0; i < text.size();) {
     if (out.size() >= limit) return out + "...";
     const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-      ++i;
-    } else if (const std::size_t n = c >= 0x80 ? utf8_sequence(text, i) : 0; n > 0) {
+    const bool plain = c < 0x80 && (keep_controls || (c >= 0x20 && c < 0x7f));
+    if (const std::size_t n = plain ? 1 : c >= 0x80 ? utf8_sequence(text, i) : 0; n > 0) {
       out.append(text.substr(i, n));
       i += n;
     } else {
@@ -63,25 +61,13 @@ std::string printable(std::string_view text, std::size_t limit) {
   return out;
 }
 
-std::string utf8_or_escaped(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (std::size_t i = 0; i < text.size();) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    const std::size_t n = c < 0x80 ? 1 : utf8_sequence(text, i);
-    if (n > 0) {
-      out.append(text.substr(i, n));
-      i += n;
-    } else {
-      escape(out, c);
-      ++i;
-    }
-  }
-  return out;
-}
+}  // namespace
+
+std::string printable(std::string_view text, std::size_t limit) { return escaped(text, limit, false); }
+
+std::string utf8_or_escaped(std::string_view text) { return escaped(text, std::string_view::npos, true); }
 
 namespace {
-
 
 std::string message(const std::string& source, const std::string& problem) {
   constexpr std::size_t kSourceBytes = 300, kProblemBytes = 500;
