@@ -109,7 +109,8 @@ TEST(LoadObj, BadIndicesAndStatementsNameTheLine) {
 }
 
 TEST(LoadObj, MessagesEscapeBytesThatDoNotPrint) {
-  const std::string message = error_of("bytes.obj", std::string("v 1\0x\xff 0 0\n", 13));
+  static const char kBytes[] = "v 1\0x\xff 0 0\n";
+  const std::string message = error_of("bytes.obj", std::string(kBytes, sizeof kBytes - 1));
   EXPECT_NE(message.find("'1\\x00x\\xff' is not a number"), std::string::npos) << message;
   const std::string long_token = error_of("long.obj", "v " + std::string(100000, '7') + "x 0 0\n");
   EXPECT_NE(long_token.find("..."), std::string::npos) << long_token;
