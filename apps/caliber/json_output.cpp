@@ -42,11 +42,15 @@ void JsonObjectWriter::key(std::string_view key) {
   put(nlohmann::json(json_text(key)).dump() + ":");
 }
 
-void JsonObjectWriter::member(std::string_view key, const nlohmann::json& value) {
-  this->key(key);
+void JsonObjectWriter::put_value(const nlohmann::json& value) {
   // Every string put in was made valid UTF-8 (json_text); replacing is the last guard, so that a
   // report is never lost at its end to a byte that slipped through.
   put(value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+void JsonObjectWriter::member(std::string_view key, const nlohmann::json& value) {
+  this->key(key);
+  put_value(value);
 }
 
 void JsonObjectWriter::open_array(std::string_view key) {
@@ -58,7 +62,7 @@ void JsonObjectWriter::open_array(std::string_view key) {
 void JsonObjectWriter::item(const nlohmann::json& value) {
   mOut << (mFirstItem ? "\n" : ",\n");
   mFirstItem = false;
-  put(value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  put_value(value);
 }
 
 void JsonObjectWriter::close_array() { mOut << "\n]"; }

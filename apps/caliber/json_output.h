@@ -39,6 +39,7 @@ class JsonObjectWriter {
 
  private:
   void put(const std::string& json);
+  void put_value(const nlohmann::json& value);
   void key(std::string_view key);
   std::ostream& mOut;
   std::string (*mFilter)(const std::string&);

@@ -22,6 +22,7 @@
 #include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "mesh/readers.h"
+#include "util/printable.h"
 
 namespace caliber {
 namespace {
@@ -32,18 +33,9 @@ namespace {
 std::string bounded(const std::string& message) {
   constexpr std::size_t kMessageBytes = 300;
   std::string out;
-  std::size_t i = 0;
-  for (; i < message.size() && out.size() < kMessageBytes; ++i) {
-    const auto c = static_cast<unsigned char>(message[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
+  if (append_ascii_escaped(out, message, kMessageBytes) < message.size()) {
+    out += "... (" + std::to_string(message.size()) + " bytes in all)";
   }
-  if (i < message.size()) out += "... (" + std::to_string(message.size()) + " bytes in all)";
   return out;
 }
 

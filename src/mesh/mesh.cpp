@@ -9,6 +9,7 @@
 #include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "mesh/readers.h"
+#include "util/printable.h"
 
 namespace caliber {
 namespace {
@@ -149,18 +150,10 @@ void scale_mesh(Mesh& mesh, double factor) {
 namespace mesh_io {
 
 std::string quote_token(std::string_view token) {
+  constexpr std::size_t kTokenBytes = 40;
   std::string out = "'";
-  for (std::size_t i = 0; i < token.size() && i < 40; ++i) {
-    const auto c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
-  }
-  if (token.size() > 40) out += "...";
+  append_ascii_escaped(out, token.substr(0, kTokenBytes));
+  if (token.size() > kTokenBytes) out += "...";
   return out + "'";
 }
 

@@ -5,6 +5,7 @@
 // is an error naming the file.
 
 #include "mesh/readers.h"
+#include "mesh/text_lines.h"
 
 #include <cstdio>
 #include <algorithm>
@@ -15,8 +16,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -367,9 +366,7 @@ void read_element(Reader& reader, const Element& e, Format format, bool is_verte
 
 Mesh read_ply(const std::filesystem::path& file) {
   const std::string path = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCode::unreadable, path, "cannot be opened for reading");
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string data = read_file(path);
   if (!looks_like_ply(data)) parse_failure(path, "a PLY file starts with the line 'ply'");
   const Header header = read_header(data, path);
   Reader reader(path, header.format, data, header.body);

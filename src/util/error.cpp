@@ -67,6 +67,19 @@ std::string printable(std::string_view text, std::size_t limit) { return escaped
 
 std::string utf8_or_escaped(std::string_view text) { return escaped(text, std::string_view::npos, true); }
 
+std::size_t append_ascii_escaped(std::string& out, std::string_view text, std::size_t max_out) {
+  std::size_t i = 0;
+  for (; i < text.size() && out.size() < max_out; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      escape(out, c);
+    }
+  }
+  return i;
+}
+
 namespace {
 
 std::string message(const std::string& source, const std::string& problem) {

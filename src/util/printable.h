@@ -17,4 +17,9 @@ namespace caliber {
 /// `text` with only the bytes that are not UTF-8 written as \xNN: valid UTF-8, for JSON strings.
 [[nodiscard]] std::string utf8_or_escaped(std::string_view text);
 
+/// Appends `text` to `out` with every byte outside printable ASCII as \xNN, while `out` is shorter
+/// than `max_out` bytes; returns how many bytes of `text` went in (a quoted token, an importer's
+/// message).
+std::size_t append_ascii_escaped(std::string& out, std::string_view text, std::size_t max_out = std::string::npos);
+
 }  // namespace caliber
