@@ -162,9 +162,10 @@ def one(data):
 def worker(args):
     """Runs inputs in this process; the parent restarts it after a crash and saves the input."""
     # A mutated memo index (LONG_BINPUT 1268021601) makes pickle itself allocate gigabytes: bounded,
-    # such an input fails fast with MemoryError, pickle's error and not caliber's. (Under ASan, whose
-    # shadow memory is terabytes of address space, its max_allocation_size_mb bounds it instead.)
-    if "libasan" not in os.environ.get("LD_PRELOAD", ""):
+    # such an input fails fast with MemoryError, pickle's error and not caliber's. (Under ASan or
+    # TSan, whose shadow memory is terabytes of address space, max_allocation_size_mb bounds it.)
+    preloaded = os.environ.get("LD_PRELOAD", "")
+    if "libasan" not in preloaded and "libtsan" not in preloaded:
         resource.setrlimit(resource.RLIMIT_AS, (6 << 30, 6 << 30))
     rng = random.Random(args.seed)
     corpus = seeds()
