@@ -237,7 +237,7 @@ Json results_from_records(const std::vector<Json>& records) {
   std::map<std::string, std::size_t> index;
   for (const Json& info : h["scenes"]) {
     index[info["name"].get<std::string>()] = scenes.size();
-    scenes.push_back(SceneRecords{info, Json(), {}, {}, {}, {}});
+    scenes.push_back(SceneRecords{info, Json(), {}, {}, {}, {}, {}});
   }
   const auto scene_of = [&](const Json& r) -> SceneRecords& {
     const auto it = index.find(r.value("scene", std::string()));
