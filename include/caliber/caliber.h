@@ -6,6 +6,7 @@
 /// caliber/scene.h and caliber/world.h (scene files and the world that makes frames from them),
 /// caliber/procedural.h (small generated meshes). docs/api.md lists every public type.
 
+#include "caliber/batch.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"

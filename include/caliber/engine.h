@@ -7,9 +7,11 @@
 #include "caliber/export.h"
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
+#include "caliber/batch.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
@@ -147,6 +149,16 @@ class CALIBER_EXPORT Engine {
   /// of the result are left to the caller (caliber::step fills them for a World).
   /// Throws caliber::Error, naming the problem, on a frame that breaks Frame's rules.
   [[nodiscard]] StepResult step(const Frame& frame);
+  /// Tests model A against model B at many poses: entry i answers caliber::query(a, poses_a[i], b,
+  /// poses_b[i], request), bit for bit, whatever the method and threads. A side given one pose keeps
+  /// it for every entry; otherwise both sides give the same number of poses. The entries run in
+  /// parallel on the engine's threads, and the method splits a heavy entry's traversal as it splits
+  /// a heavy pair; with max_pairs each entry is traversed whole by one thread, so that the pairs it
+  /// finds first are those caliber::query finds. Leaves what the temporal methods remember as it is.
+  /// Throws caliber::Error on pose counts that do not match, a bad pose (named by its side and
+  /// index) or a bad request, before any work.
+  [[nodiscard]] BatchResult query_many(const Model& a, std::span<const Pose> poses_a, const Model& b,
+                                       std::span<const Pose> poses_b, const QueryRequest& request);
   /// Drops what the temporal methods remember of every pair (after a jump in the motion, or when
   /// object indices start to denote other objects).
   void forget();

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "caliber/batch.h"
 #include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "caliber/pose.h"
@@ -115,6 +116,44 @@ void validate_pose(const Pose& pose, std::string_view source) {
   if (std::abs(pose.rotation.norm() - 1.0) > 1e-9) {
     throw Error(ErrorCode::bad_value, std::string(source), "quaternion is not unit length");
   }
+}
+
+namespace {
+
+/// Converts each of `count` rows with `make(row, source)`; the first row that throws is converted
+/// again with its own name, `source`[i], so that the message names it (no name is made otherwise).
+template <class Make>
+std::vector<Pose> poses_from_rows(std::size_t values, std::size_t width, std::string_view source, Make&& make) {
+  if (values % width != 0) {
+    throw Error(ErrorCode::bad_argument, std::string(source),
+                std::to_string(values) + " values are not a whole number of poses of " + std::to_string(width));
+  }
+  std::vector<Pose> poses(values / width);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    try {
+      poses[i] = make(i, std::string_view());
+    } catch (const Error&) {
+      poses[i] = make(i, std::string(source) + "[" + std::to_string(i) + "]");  // throws again, naming the row
+    }
+  }
+  return poses;
+}
+
+}  // namespace
+
+std::vector<Pose> poses_from_matrices(std::span<const double> values, double tolerance, std::string_view source) {
+  return poses_from_rows(values.size(), 16, source, [&](std::size_t i, std::string_view name) {
+    return Pose::from_matrix(Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(values.data() + 16 * i), tolerance,
+                             name);
+  });
+}
+
+std::vector<Pose> poses_from_vectors(std::span<const double> values, QuaternionOrder order, std::string_view source) {
+  return poses_from_rows(values.size(), 7, source, [&](std::size_t i, std::string_view name) {
+    const double* v = values.data() + 7 * i;
+    return order == QuaternionOrder::wxyz ? Pose::from_values(v[0], v[1], v[2], v[3], v[4], v[5], v[6], name)
+                                          : Pose::from_values(v[0], v[1], v[2], v[6], v[3], v[4], v[5], name);
+  });
 }
 
 }  // namespace caliber

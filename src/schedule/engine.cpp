@@ -25,6 +25,7 @@
 #include "caliber/profile.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"
+#include "schedule/engine_impl.h"
 #include "schedule/runner.h"
 #include "schedule/workers.h"
 #include "tasks/plan.h"
@@ -90,58 +91,6 @@ void validate_frame(const Frame& frame) {
   validate_request(frame.request);  // a distance query may be unbounded: the frame names its pairs
 }
 
-namespace {
-
-/// The step's pair contexts, built into storage kept from step to step (no allocation once it has
-/// grown to the largest frame), in parallel for a large frame. The frame is validated first, so no
-/// context throws.
-class ContextStore {
- public:
-  [[nodiscard]] narrow::PairContexts build(const Frame& frame) {
-    static_assert(std::is_trivially_destructible_v<narrow::PairContext>, "contexts are overwritten without destruction");
-    const std::size_t n = frame.pairs.size();
-    if (mCapacity < n) {
-      mSlots = std::make_unique<Slot[]>(n);
-      mCapacity = n;
-    }
-    auto* const base = reinterpret_cast<narrow::PairContext*>(mSlots.get());
-    // A context takes about 50 ns (front_car's 209: 0.01 ms a step on the 2-core VM): chunks of 64
-    // keep a small frame on this thread and spread a large one.
-    parallel::parallel_for(0, n, 64, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t i = lo; i != hi; ++i) {
-        const ObjectPair& t = frame.pairs[i];
-        new (&base[i])
-            narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-      }
-    });
-    return {std::launder(base), n};
-  }
-
- private:
-  struct alignas(narrow::PairContext) Slot {
-    std::byte bytes[sizeof(narrow::PairContext)];
-  };
-  std::unique_ptr<Slot[]> mSlots;
-  std::size_t mCapacity = 0;
-};
-
-}  // namespace
-
-struct Engine::Impl {
-  explicit Impl(int threads) : executor(threads) {}
-  /// Set while a step (or forget) runs: a second call meanwhile is refused, not a data race.
-  std::atomic<bool> busy{false};
-  parallel::Executor executor;
-  schedule::Workers workers;
-  /// What the temporal methods remember of each pair. Changes only how work is cut.
-  tasks::History history;
-  /// Who ran what when, this step (EngineOptions::timeline).
-  schedule::Timeline timeline;
-  ContextStore contexts;
-  /// This step's schedule record when nobody asked for it.
-  ScheduleRecord record;
-};
-
 Engine::Engine(const EngineOptions& options) : mOptions(options) {
   if (mOptions.threads < 0 || mOptions.threads > 1024) {
     throw Error(ErrorCode::bad_value, "threads", "must be between 0 and 1024 (0: the arena caliber is called from)");
@@ -163,32 +112,8 @@ Engine::~Engine() = default;
 
 int Engine::threads() const { return mImpl->executor.threads(); }
 
-namespace {
-
-/// Holds an engine for one call; a call made while another holds it is an Error (an engine keeps
-/// state between steps: two steps at once would corrupt it).
-class OneCallAtATime {
- public:
-  OneCallAtATime(std::atomic<bool>& busy, const char* what) : mBusy(busy) {
-    if (mBusy.exchange(true, std::memory_order_acquire)) {
-      throw Error(ErrorCode::bad_argument, "engine",
-                  std::string(what) +
-                      " called while another call on the same engine is running (an engine runs one step at a time: "
-                      "use one engine per thread)");
-    }
-  }
-  ~OneCallAtATime() { mBusy.store(false, std::memory_order_release); }
-  OneCallAtATime(const OneCallAtATime&) = delete;
-  OneCallAtATime& operator=(const OneCallAtATime&) = delete;
-
- private:
-  std::atomic<bool>& mBusy;
-};
-
-}  // namespace
-
 void Engine::forget() {
-  const OneCallAtATime hold(mImpl->busy, "forget");
+  const schedule::OneCallAtATime hold(mImpl->busy, "forget");
   mImpl->history = tasks::History{};
 }
 
@@ -233,53 +158,67 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
 
 }  // namespace
 
+schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method method, const std::vector<ObjectPair>& pairs,
+                                           const QueryRequest& request, const tasks::History& plan_history,
+                                           const std::function<void(std::size_t, void*)>& make, std::vector<QueryResult>& results,
+                                           ScheduleRecord& record) {
+  const std::size_t n = pairs.size();
+  results.assign(n, QueryResult{});
+  workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
+  schedule::StepState state{{}, workers, timeline, results, options.threads > 1, nullptr, {}, pairs.data()};
+  std::unique_ptr<narrow::PairLimit[]> limits;
+  if (request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
+    limits = std::make_unique<narrow::PairLimit[]>(n);
+    for (std::size_t i = 0; i < n; ++i) limits[i].max = request.max_pairs;
+    state.limits = limits.get();
+  }
+  schedule::PairsRun run;
+  executor.execute([&] {
+    // The contexts are made on the executor's threads, inside the call's first parallel region.
+    state.contexts = contexts.build(n, make);
+    if (method == Method::stealing) {
+      schedule::run_stealing(options.stealing_depth, state, record);
+      return;
+    }
+    const auto planning = util::Clock::now();
+    if (method == Method::sequential || method == Method::exploitation) {
+      run.plan = tasks::plan_pairs(n);
+    } else {
+      run.plan = tasks::plan_calibrated(
+          options, pairs, state.contexts, plan_history,
+          [&](std::size_t pair, const std::function<void()>& stage) { timeline.record(TaskSpan::Phase::stage, pair, stage); });
+    }
+    record.calibrate_ms = util::ms_since(planning);
+    run.stage_root_tests = schedule::run_plan(run.plan, state, record);
+  });
+  run.candidates = std::move(state.candidates);
+  return run;
+}
+
 StepResult Engine::step(const Frame& frame) {
-  const OneCallAtATime hold(mImpl->busy, "step");
+  const schedule::OneCallAtATime hold(mImpl->busy, "step");
   validate_frame(frame);
   StepResult out;
   const auto start = util::Clock::now();
   const std::size_t n = frame.pairs.size();
-  std::vector<QueryResult> results(n);
-  mImpl->workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
+  std::vector<QueryResult> results;
   mImpl->timeline.begin(mOptions.timeline);
-  // Its contexts are made on the executor's threads, inside the step's first parallel region.
   // The work is cut for the threads this step really has (the host's arena and limit decide).
   EngineOptions options = mOptions;
   options.threads = mImpl->executor.threads();
-  schedule::StepState state{{}, mImpl->workers, mImpl->timeline, results, options.threads > 1, nullptr, {}, frame.pairs.data()};
-  std::unique_ptr<narrow::PairLimit[]> limits;
-  if (frame.request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
-    limits = std::make_unique<narrow::PairLimit[]>(n);
-    for (std::size_t i = 0; i < n; ++i) limits[i].max = frame.request.max_pairs;
-    state.limits = limits.get();
-  }
   // The runners always keep their record (the engine's own bookkeeping, in storage reused from step
   // to step); it is handed out only when asked for.
   const bool profile = mOptions.profile || mOptions.timeline;
   std::shared_ptr<ScheduleRecord> handed = profile ? std::make_shared<ScheduleRecord>() : nullptr;
   if (!profile) reset_keeping_storage(mImpl->record);
   ScheduleRecord& record = profile ? *handed : mImpl->record;
-  tasks::Plan plan;
-  std::vector<std::vector<std::uint64_t>> stage_root_tests;
-  mImpl->executor.execute([&] {
-    state.contexts = mImpl->contexts.build(frame);
-    if (mOptions.method == Method::stealing) {
-      schedule::run_stealing(mOptions.stealing_depth, state, record);
-      return;
-    }
-    const auto planning = util::Clock::now();
-    if (mOptions.method == Method::sequential || mOptions.method == Method::exploitation) {
-      plan = tasks::plan_pairs(n);
-    } else {
-      plan = tasks::plan_calibrated(options, frame.pairs, state.contexts, mImpl->history,
-                                    [&](std::size_t pair, const std::function<void()>& stage) {
-                                      mImpl->timeline.record(TaskSpan::Phase::stage, pair, stage);
-                                    });
-    }
-    record.calibrate_ms = util::ms_since(planning);
-    stage_root_tests = schedule::run_plan(plan, state, record);
-  });
-  remember(mOptions, frame.pairs, results, plan, stage_root_tests, mImpl->history);
+  const auto make = [&frame](std::size_t i, void* where) {
+    const ObjectPair& t = frame.pairs[i];
+    new (where) narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+  };
+  const schedule::PairsRun run =
+      mImpl->run_pairs(options, mOptions.method, frame.pairs, frame.request, mImpl->history, make, results, record);
+  remember(mOptions, frame.pairs, results, run.plan, run.stage_root_tests, mImpl->history);
   mImpl->workers.for_each([&](const schedule::WorkerSlots& w) {
     if (w.stats.size() != n) return;
     std::uint64_t tests = 0;
@@ -294,7 +233,7 @@ StepResult Engine::step(const Frame& frame) {
 
   const auto reduce = util::Clock::now();
   schedule::gather_step(frame.pairs, results, out);
-  for (std::size_t i = 0; i < n && i < state.candidates.size(); ++i) out.pair_records[i].candidates = state.candidates[i];
+  for (std::size_t i = 0; i < n && i < run.candidates.size(); ++i) out.pair_records[i].candidates = run.candidates[i];
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
                                 [](const Contact& x, const Contact& y) {
                                   return std::tie(x.object_a, x.object_b, x.tri_a, x.tri_b) <

@@ -1,0 +1,112 @@
+#pragma once
+/// \file
+/// The engine's state between calls (Engine::Impl) and the pieces its two entry points share:
+/// Engine::step (schedule/engine.cpp) runs a frame's pairs, Engine::query_many
+/// (schedule/batch.cpp) a batch's poses, both through run_pairs.
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <new>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "caliber/engine.h"
+#include "caliber/error.h"
+#include "caliber/profile.h"
+#include "narrow/pair_context.h"
+#include "parallel/executor.h"
+#include "schedule/workers.h"
+#include "tasks/plan.h"
+
+namespace caliber::schedule {
+
+/// A call's pair contexts, built into storage kept from call to call (no allocation once it has
+/// grown to the largest call), in parallel for many pairs. The input is validated first, so no
+/// context throws.
+class ContextStore {
+ public:
+  /// Makes n contexts, context i by make(i, where) (a placement new at `where`).
+  template <class Make>
+  [[nodiscard]] narrow::PairContexts build(std::size_t n, Make&& make) {
+    static_assert(std::is_trivially_destructible_v<narrow::PairContext>, "contexts are overwritten without destruction");
+    if (mCapacity < n) {
+      mSlots = std::make_unique<Slot[]>(n);
+      mCapacity = n;
+    }
+    auto* const base = reinterpret_cast<narrow::PairContext*>(mSlots.get());
+    // A context takes about 50 ns (front_car's 209: 0.01 ms a step on the 2-core VM): chunks of 64
+    // keep a small call on this thread and spread a large one.
+    parallel::parallel_for(0, n, 64, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) make(i, static_cast<void*>(&base[i]));
+    });
+    return {std::launder(base), n};
+  }
+
+ private:
+  struct alignas(narrow::PairContext) Slot {
+    std::byte bytes[sizeof(narrow::PairContext)];
+  };
+  std::unique_ptr<Slot[]> mSlots;
+  std::size_t mCapacity = 0;
+};
+
+/// Holds an engine for one call; a call made while another holds it is an Error (an engine keeps
+/// state between steps: two steps at once would corrupt it).
+class OneCallAtATime {
+ public:
+  OneCallAtATime(std::atomic<bool>& busy, const char* what) : mBusy(busy) {
+    if (mBusy.exchange(true, std::memory_order_acquire)) {
+      throw Error(ErrorCode::bad_argument, "engine",
+                  std::string(what) +
+                      " called while another call on the same engine is running (an engine runs one step at a time: "
+                      "use one engine per thread)");
+    }
+  }
+  ~OneCallAtATime() { mBusy.store(false, std::memory_order_release); }
+  OneCallAtATime(const OneCallAtATime&) = delete;
+  OneCallAtATime& operator=(const OneCallAtATime&) = delete;
+
+ private:
+  std::atomic<bool>& mBusy;
+};
+
+/// What one run of the method over a set of pairs leaves besides their results: the plan, and per
+/// split of the plan the weight-driven stage's root counts (tasks::subtree_counts reads them).
+struct PairsRun {
+  tasks::Plan plan;
+  std::vector<std::vector<std::uint64_t>> stage_root_tests;
+  std::vector<std::size_t> candidates;  ///< per pair: the candidates its finalization took in
+};
+
+}  // namespace caliber::schedule
+
+namespace caliber {
+
+struct Engine::Impl {
+  explicit Impl(int threads) : executor(threads) {}
+  /// Set while a step (or forget) runs: a second call meanwhile is refused, not a data race.
+  std::atomic<bool> busy{false};
+  parallel::Executor executor;
+  schedule::Workers workers;
+  /// What the temporal methods remember of each pair. Changes only how work is cut.
+  tasks::History history;
+  /// Who ran what when, this step (EngineOptions::timeline).
+  schedule::Timeline timeline;
+  schedule::ContextStore contexts;
+  /// This step's schedule record when nobody asked for it.
+  ScheduleRecord record;
+
+  /// Runs `method` over the pairs whose contexts `make` builds (schedule::ContextStore::build), on
+  /// the engine's executor: fills results (one per pair; `pairs` are the object ids each pair's
+  /// contacts carry), `record`, and with max_pairs the pairs' limits. A calibrated method plans with
+  /// `history` (keyed by `pairs`). Leaves the workers' slots for the caller's bookkeeping.
+  schedule::PairsRun run_pairs(const EngineOptions& options, Method method, const std::vector<ObjectPair>& pairs,
+                               const QueryRequest& request, const tasks::History& history,
+                               const std::function<void(std::size_t, void*)>& make, std::vector<QueryResult>& results,
+                               ScheduleRecord& record);
+};
+
+}  // namespace caliber

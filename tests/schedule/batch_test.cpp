@@ -1,0 +1,214 @@
+// Engine::query_many: every entry equals caliber::query at its poses, bit for bit, for every kind,
+// method and thread count, with max_pairs, across the batch's internal chunks, with one side fixed
+// or both moving; poses from raw arrays; bad batches refused naming the pose.
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/batch.h"
+#include "caliber/engine.h"
+#include "caliber/error.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "support/random_poses.h"
+
+namespace caliber {
+namespace {
+
+struct Shapes {
+  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.35, 24, 16));
+  std::shared_ptr<const Model> sphere = build_model(make_sphere(0.9, 16, 24));
+};
+
+const Shapes& shapes() {
+  static const Shapes s;
+  return s;
+}
+
+/// Poses near the origin: about half of them put the sphere through the torus.
+std::vector<Pose> poses_near(std::size_t n, std::uint64_t seed, double spread) {
+  std::mt19937_64 rng(seed);
+  std::vector<Pose> out;
+  for (std::size_t i = 0; i < n; ++i) out.push_back(test::random_pose(rng, spread));
+  return out;
+}
+
+/// Entry i of `batch` is caliber::query at its poses, to the last bit.
+void expect_queries(const BatchResult& batch, std::span<const Pose> pa, std::span<const Pose> pb, const QueryRequest& request,
+                    const std::string& what) {
+  const std::size_t n = std::max(pa.size(), pb.size());
+  ASSERT_EQ(batch.size(), n) << what;
+  ASSERT_EQ(batch.limit_reached.size(), n) << what;
+  EXPECT_EQ(batch.kind, request.kind) << what;
+  QueryStats total;
+  for (std::size_t i = 0; i < n; ++i) {
+    const QueryResult want =
+        query(*shapes().torus, pa[pa.size() == 1 ? 0 : i], *shapes().sphere, pb[pb.size() == 1 ? 0 : i], request);
+    QueryResult got;
+    got.kind = batch.kind;
+    const std::span<const Contact> c = batch.contacts_of(i);
+    got.contacts.assign(c.begin(), c.end());
+    EXPECT_EQ(batch.hit(i), !want.contacts.empty()) << what << " entry " << i;
+    EXPECT_EQ(batch.limit_reached[i] != 0, want.limit_reached) << what << " entry " << i;
+    for (const Contact& k : got.contacts) ASSERT_TRUE(k.object_a == 0 && k.object_b == 1) << what;
+    test::expect_identical(got, want, what + " entry " + std::to_string(i));
+    total.node_tests += want.stats.node_tests;
+    total.leaf_tests += want.stats.leaf_tests;
+  }
+  // Depth-first traversals: the same work as the single queries, however split. (The pieces of a
+  // split distance traversal each look for their own nearest pair: more work, the same answer.)
+  if (request.kind != QueryKind::distance) {
+    EXPECT_EQ(batch.stats.node_tests, total.node_tests) << what;
+    EXPECT_EQ(batch.stats.leaf_tests, total.leaf_tests) << what;
+  }
+}
+
+const Method kMethods[] = {Method::sequential,  Method::exploitation, Method::stealing,
+                           Method::aposteriori, Method::apriori,      Method::hybrid};
+
+TEST(Batch, EveryKindMethodAndThreadCountEqualsSingleQueries) {
+  // 40 entries, then 2: few enough that stealing and the calibrated methods split them.
+  for (const std::size_t entries : {std::size_t{40}, std::size_t{2}}) {
+    const std::vector<Pose> pb = poses_near(entries, 11, 0.3);
+    const std::vector<Pose> pa{Pose::from_values(0.05, -0.02, 0.01, 1, 0.1, 0, 0.05)};
+    for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact, QueryKind::distance}) {
+      QueryRequest request;
+      request.kind = kind;
+      request.tolerance = kind == QueryKind::distance ? kUnbounded : 0.03;
+      for (const Method method : kMethods) {
+        for (const int threads : {1, 2, 3}) {
+          EngineOptions options;
+          options.method = method;
+          options.threads = threads;
+          Engine engine(options);
+          const std::string what = std::to_string(entries) + " entries " + std::string(to_string(kind)) + " " +
+                                   std::string(to_string(method)) + " " + std::to_string(threads) + " threads";
+          expect_queries(engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request), pa, pb, request, what);
+        }
+      }
+    }
+  }
+}
+
+TEST(Batch, MaxPairsEntriesAreTheQueriesFirstPairs) {
+  const std::vector<Pose> pa = poses_near(30, 5, 0.6);
+  const std::vector<Pose> pb = poses_near(30, 6, 0.6);
+  for (const std::size_t limit : {std::size_t{1}, std::size_t{7}}) {
+    for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
+      QueryRequest request;
+      request.kind = kind;
+      request.tolerance = 0.05;
+      request.max_pairs = limit;
+      for (const Method method : kMethods) {
+        EngineOptions options;
+        options.method = method;
+        options.threads = 2;
+        Engine engine(options);
+        const std::string what =
+            std::string(to_string(kind)) + " max_pairs " + std::to_string(limit) + " " + std::string(to_string(method));
+        const BatchResult batch = engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request);
+        expect_queries(batch, pa, pb, request, what);
+        std::size_t cut = 0;
+        for (const std::uint8_t r : batch.limit_reached) cut += r;
+        EXPECT_GT(cut, 0u) << what << ": some entries must find more pairs than the limit";
+      }
+    }
+  }
+}
+
+TEST(Batch, ManyEntriesAcrossChunksAndEitherSideFixed) {
+  // More entries than one run of the method takes (8192), cheap ones: the sphere far off most
+  // of the time.
+  const std::vector<Pose> many = poses_near(8192 + 300, 21, 3.0);
+  const std::vector<Pose> one{Pose{}};
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  request.tolerance = 0.5;
+  EngineOptions options;
+  options.threads = 2;
+  Engine engine(options);
+  expect_queries(engine.query_many(*shapes().torus, one, *shapes().sphere, many, request), one, many, request, "B moves");
+  const std::vector<Pose> few(many.begin(), many.begin() + 50);
+  expect_queries(engine.query_many(*shapes().torus, few, *shapes().sphere, one, request), few, one, request, "A moves");
+  const BatchResult empty = engine.query_many(*shapes().torus, one, *shapes().sphere, {}, request);
+  EXPECT_EQ(empty.size(), 0u);
+  EXPECT_TRUE(empty.contacts.empty());
+}
+
+TEST(Batch, BadBatchesAreErrorsNamingThePose) {
+  Engine engine;
+  const std::vector<Pose> three = poses_near(3, 1, 1.0), two = poses_near(2, 2, 1.0);
+  const QueryRequest request;
+  try {
+    (void)engine.query_many(*shapes().torus, three, *shapes().sphere, two, request);
+    FAIL() << "3 poses of A against 2 of B must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("3 poses of A but 2 of B"), std::string::npos) << e.what();
+  }
+  std::vector<Pose> bad = three;
+  bad[2].translation.y() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    (void)engine.query_many(*shapes().torus, std::span<const Pose>(two).first(1), *shapes().sphere, bad, request);
+    FAIL() << "a NaN pose must be refused";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.source(), "poses of B[2]");
+  }
+  QueryRequest negative;
+  negative.kind = QueryKind::proximity;
+  negative.tolerance = -1.0;
+  EXPECT_THROW((void)engine.query_many(*shapes().torus, three, *shapes().sphere, three, negative), Error);
+}
+
+TEST(Batch, PosesFromMatricesAndVectors) {
+  const std::vector<Pose> poses = poses_near(5, 9, 2.0);
+  std::vector<double> matrices, wxyz, xyzw;
+  for (const Pose& p : poses) {
+    const Eigen::Matrix4d m = p.matrix();
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) matrices.push_back(m(r, c));
+    }
+    const Eigen::Quaterniond& q = p.rotation;
+    for (const double v : {p.translation.x(), p.translation.y(), p.translation.z(), q.w(), q.x(), q.y(), q.z()})
+      wxyz.push_back(v);
+    for (const double v : {p.translation.x(), p.translation.y(), p.translation.z(), q.x(), q.y(), q.z(), q.w()})
+      xyzw.push_back(v);
+  }
+  const std::vector<Pose> from_m = poses_from_matrices(matrices);
+  const std::vector<Pose> from_w = poses_from_vectors(wxyz, QuaternionOrder::wxyz);
+  const std::vector<Pose> from_x = poses_from_vectors(xyzw, QuaternionOrder::xyzw);
+  ASSERT_EQ(from_m.size(), 5u);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const Pose m = Pose::from_matrix(poses[i].matrix());
+    EXPECT_EQ(from_m[i].rotation.coeffs(), m.rotation.coeffs());
+    EXPECT_EQ(from_m[i].translation, m.translation);
+    const Pose& p = poses[i];
+    const Pose w = Pose::from_values(p.translation.x(), p.translation.y(), p.translation.z(), p.rotation.w(), p.rotation.x(),
+                                     p.rotation.y(), p.rotation.z());
+    EXPECT_EQ(from_w[i].rotation.coeffs(), w.rotation.coeffs());
+    EXPECT_EQ(from_x[i].rotation.coeffs(), w.rotation.coeffs());
+    EXPECT_EQ(from_x[i].translation, w.translation);
+  }
+  matrices[16 * 3 + 1] = 0.5;  // the fourth matrix is no longer a rotation
+  try {
+    (void)poses_from_matrices(matrices, 1e-9, "link poses");
+    FAIL() << "a matrix that is not a rotation must be refused";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.source(), "link poses[3]");
+  }
+  xyzw[7 * 1 + 3] = xyzw[7 * 1 + 4] = xyzw[7 * 1 + 5] = xyzw[7 * 1 + 6] = 0.0;
+  try {
+    (void)poses_from_vectors(xyzw, QuaternionOrder::xyzw);
+    FAIL() << "a zero quaternion must be refused";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.source(), "poses[1]");
+  }
+  EXPECT_THROW((void)poses_from_vectors(std::vector<double>(13, 0.0)), Error);
+  EXPECT_THROW((void)poses_from_matrices(std::vector<double>(15, 0.0)), Error);
+}
+
+}  // namespace
+}  // namespace caliber
