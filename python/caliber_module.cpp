@@ -18,6 +18,7 @@
 #include "caliber/caliber.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
+#include "batch.h"
 #include "half_built.h"
 
 namespace py = pybind11;
@@ -248,6 +249,20 @@ PyModel model_from_state(const py::object& state) {
   return PyModel{caliber::build_model(std::move(mesh), options)};
 }
 
+/// Engine.query_many and caliber.query_many: the poses read (errors naming the side and row), then
+/// the batch with the GIL released once.
+caliber_python::PyBatch query_many(caliber::Engine& engine, const PyModel& a, const py::object& poses_a, const PyModel& b,
+                                   const py::object& poses_b, const caliber::QueryRequest& request, const std::string& order) {
+  const caliber::QuaternionOrder o = caliber_python::parse_order(order);
+  const caliber_python::SidePoses pa(poses_a, o, "poses_a"), pb(poses_b, o, "poses_b");
+  caliber::BatchResult result;
+  {
+    py::gil_scoped_release release;
+    result = engine.query_many(*a.model, pa.poses, *b.model, pb.poses, request);
+  }
+  return caliber_python::PyBatch(result);
+}
+
 }  // namespace
 
 CALIBER_REFUSE_HALF_BUILT(caliber::Mesh, "Mesh")
@@ -256,6 +271,7 @@ CALIBER_REFUSE_HALF_BUILT(caliber::Pose, "Pose")
 CALIBER_REFUSE_HALF_BUILT(PyResult, "Result")
 CALIBER_REFUSE_HALF_BUILT(caliber::Engine, "Engine")
 CALIBER_REFUSE_HALF_BUILT(caliber::World, "World")
+CALIBER_REFUSE_HALF_BUILT(caliber_python::PyBatch, "Batch")
 
 PYBIND11_MODULE(caliber, m) {
   m.doc() = "caliber: exact collision detection between rigid triangle meshes, parallelized by task calibration";
@@ -411,6 +427,23 @@ def _pose_from_state(translation, quaternion):
       "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
       "limit_reached (1: any pair).");
 
+  caliber_python::bind_batch(m);
+  m.def(
+      "query_many",
+      [](const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b, const std::string& kind,
+         std::optional<double> tolerance, double angle, std::size_t max_pairs, const std::string& order, int threads) {
+        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs);
+        caliber::EngineOptions options;
+        options.threads = threads;
+        caliber::Engine engine(options);
+        return query_many(engine, a, poses_a, b, poses_b, request, order);
+      },
+      py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
+      py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
+      py::arg("order") = "wxyz", py::arg("threads") = 0,
+      "Engine(threads=threads).query_many(...): model a against model b at many poses, in parallel, the GIL released "
+      "once. Returns a Batch: per entry hit, distance, limit_reached; per reported pair a row with its entry.");
+
   py::class_<caliber::Engine>(m, "Engine",
                               "The parallel engine: a method on the threads the process allows; keeps temporal state.")
       .def(py::init([](const std::string& method, int threads) {
@@ -428,6 +461,20 @@ def _pose_from_state(translation, quaternion):
              throw not_picklable("Engine", "it holds temporal state and threads; make a new Engine where it is needed");
            })
       .def("forget", &caliber::Engine::forget)
+      .def(
+          "query_many",
+          [](caliber::Engine& engine, const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b,
+             const std::string& kind, std::optional<double> tolerance, double angle, std::size_t max_pairs,
+             const std::string& order) {
+            return query_many(engine, a, poses_a, b, poses_b, make_request(kind, tolerance, angle, max_pairs), order);
+          },
+          py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
+          py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
+          py::arg("order") = "wxyz",
+          "Model a against model b at many poses, on this engine's threads: entry i is query(a, poses_a[i], b, poses_b[i], "
+          "...) bit for bit. Each side is one Pose (kept for every entry), a list of Poses, or an array of N x 4 x 4 "
+          "matrices or N x 7 rows (translation, then the quaternion in `order`: 'wxyz' or 'xyzw'), float32 or float64. "
+          "Returns a Batch.")
       .def(
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,

@@ -1,0 +1,106 @@
+"""Batch queries: every entry of query_many equals query at its poses, bit for bit, whatever the
+pose format (Poses, N x 7 rows in either quaternion order, N x 4 x 4 matrices in float64 or
+float32), the kind, the method and the threads; bad batches are caliber.Error naming the side and
+row."""
+import os
+import pickle
+
+import numpy as np
+import pytest
+
+import caliber
+
+DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests", "data")
+TETRA = caliber.Model.load(os.path.join(DATA, "tetra.off"))
+FAN = caliber.Model.load(os.path.join(DATA, "quad_fan.off"))
+
+
+def rows(n, seed):
+    """n poses near the one where the fan passes through the tetrahedron: about half touch."""
+    rng = np.random.default_rng(seed)
+    out = np.zeros((n, 7))
+    out[:, :3] = np.array([0.2, 0.2, 0.3]) + rng.uniform(-0.6, 0.6, (n, 3))
+    out[:, 3:] = rng.normal(size=(n, 4))
+    return out
+
+
+def expect_entries(batch, poses_b, kind, tolerance, max_pairs=0):
+    assert len(batch) == len(poses_b)
+    for i, p in enumerate(poses_b):
+        r = caliber.query(TETRA, caliber.Pose(), FAN, p, kind=kind, tolerance=tolerance, max_pairs=max_pairs)
+        lo, hi = batch.offsets[i], batch.offsets[i + 1]
+        assert batch.pairs[lo:hi].tolist() == r.pairs.tolist()
+        assert (batch.entries[lo:hi] == i).all()
+        assert batch.hit[i] == (len(r) > 0)
+        assert batch.limit_reached[i] == r.limit_reached
+        assert batch.points_a[lo:hi].tobytes() == r.points_a.tobytes()
+        assert batch.points_b[lo:hi].tobytes() == r.points_b.tobytes()
+        assert batch.normals[lo:hi].tobytes() == r.normals.tobytes()
+        assert batch.distances[lo:hi].tobytes() == r.distances.tobytes()
+        assert batch.depths[lo:hi].tobytes() == r.depths.tobytes()
+        assert batch.distance[i] == (r.distances.min() if len(r) else np.inf)
+
+
+@pytest.mark.parametrize("kind", ["interference", "proximity", "contact", "distance"])
+@pytest.mark.parametrize("method,threads", [("sequential", 1), ("stealing", 2), ("exploitation", 2), ("hybrid", 2)])
+def test_entries_equal_single_queries(kind, method, threads):
+    values = rows(60, 3)
+    poses = [caliber.Pose(v[:3], v[3:]) for v in values]
+    tolerance = None if kind == "distance" else 0.05
+    engine = caliber.Engine(method, threads)
+    batch = engine.query_many(TETRA, caliber.Pose(), FAN, values, kind=kind, tolerance=tolerance)
+    assert 0 < batch.hit.sum() < len(poses) or kind == "distance"
+    expect_entries(batch, poses, kind, tolerance)
+    limited = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind=kind, tolerance=tolerance, max_pairs=1)
+    expect_entries(limited, poses, kind, tolerance, max_pairs=1)
+
+
+def test_every_pose_format_gives_the_same_batch():
+    values = rows(40, 5)
+    poses = [caliber.Pose(v[:3], v[3:]) for v in values]
+    matrices = np.stack([p.matrix() for p in poses])
+    xyzw = np.concatenate([values[:, :3], values[:, 4:], values[:, 3:4]], axis=1)
+    want = caliber.query_many(TETRA, caliber.Pose(), FAN, poses, kind="proximity", tolerance=0.05)
+    for given, order in ((values, "wxyz"), (xyzw, "xyzw"), (values.tolist(), "wxyz")):
+        got = caliber.query_many(TETRA, caliber.Pose(), FAN, given, kind="proximity", tolerance=0.05, order=order)
+        assert got.pairs.tolist() == want.pairs.tolist() and got.distances.tobytes() == want.distances.tobytes()
+    # Matrices give each pose through its rotation matrix: the same pairs (the last bits of a point
+    # may differ, as Pose.from_matrix's do).
+    from_matrices = caliber.query_many(TETRA, caliber.Pose(), FAN, matrices, kind="proximity", tolerance=0.05)
+    expect_entries(from_matrices, [caliber.Pose.from_matrix(m) for m in matrices], "proximity", 0.05)
+    single = caliber.query_many(TETRA, caliber.Pose(), FAN, matrices.astype(np.float32), kind="interference")
+    assert len(single) == 40
+    # Both sides moving; A given as matrices, B fixed.
+    both = caliber.query_many(TETRA, matrices, FAN, matrices[::-1].copy(), kind="interference")
+    assert len(both) == 40
+    a_moves = caliber.query_many(TETRA, matrices, FAN, caliber.Pose(), kind="interference")
+    for i, m in enumerate(matrices):
+        r = caliber.query(TETRA, caliber.Pose.from_matrix(m), FAN, caliber.Pose())
+        assert a_moves.pairs[a_moves.offsets[i]:a_moves.offsets[i + 1]].tolist() == r.pairs.tolist()
+
+
+def test_bad_batches_are_caliber_errors_naming_the_row():
+    values = rows(5, 7)
+    values[3, 3:] = 0.0
+    with pytest.raises(caliber.Error, match=r"poses_b\[3\]: quaternion is \(nearly\) zero"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, values)
+    bad = np.stack([np.eye(4)] * 3)
+    bad[1, 0, 1] = 0.3
+    with pytest.raises(caliber.Error, match=r"poses_a\[1\]: is not a rigid transform"):
+        caliber.query_many(TETRA, bad, FAN, caliber.Pose())
+    with pytest.raises(caliber.Error, match="3 poses of A but 5 of B"):
+        caliber.query_many(TETRA, np.stack([np.eye(4)] * 3), FAN, rows(5, 8))
+    with pytest.raises(caliber.Error, match="must be 4 x 4, N x 4 x 4, 7 or N x 7"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, np.zeros((3, 6)))
+    with pytest.raises(caliber.Error, match=r"poses_b\[1\]: must be a caliber.Pose"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, [caliber.Pose(), "x"])
+    with pytest.raises(caliber.Error, match="poses_b: must be a caliber.Pose, a list of them"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, "poses")
+    with pytest.raises(caliber.Error, match="order: must be 'wxyz' or 'xyzw'"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, rows(2, 1), order="zyxw")
+    with pytest.raises(caliber.Error, match="Batch: cannot be pickled"):
+        pickle.dumps(caliber.query_many(TETRA, caliber.Pose(), FAN, rows(2, 1)))
+    with pytest.raises(caliber.Error, match="Batch: was never built"):
+        caliber.Batch.__new__(caliber.Batch).hit
+    empty = caliber.query_many(TETRA, caliber.Pose(), FAN, np.zeros((0, 7)))
+    assert len(empty) == 0 and empty.offsets.tolist() == [0]
