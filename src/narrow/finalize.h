@@ -25,4 +25,10 @@ inline constexpr std::size_t kFinalizeGrain = 128;
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
                      bool parallel = false);
 
+/// One pair's whole query on the calling thread: the depth-first or distance traversal from the
+/// root (stopping at the request's max_pairs) and the finalization, with the thread's kept
+/// scratch; `candidates` is scratch too (cleared first). What caliber::query runs, and the batch
+/// for every entry it does not split.
+QueryResult query_whole(const PairContext& ctx, std::vector<Candidate>& candidates);
+
 }  // namespace caliber::narrow

@@ -56,24 +56,32 @@ void validate_request(const QueryRequest& request) {
   }
 }
 
-/// The most traversal scratch query() keeps on a thread between calls.
+namespace narrow {
+
+/// The most traversal scratch a thread keeps between whole queries.
 constexpr std::size_t kKeptScratchBytes = std::size_t{2} << 20;
+
+QueryResult query_whole(const PairContext& ctx, std::vector<Candidate>& candidates) {
+  // Kept from call to call on each thread: the distance queue's tables cost more to make than a
+  // small query takes.
+  thread_local TraversalScratch scratch;
+  candidates.clear();
+  QueryStats stats;
+  PairLimit limit;
+  limit.max = ctx.request().max_pairs;
+  traverse(ctx, NodePair{0, 0}, scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
+  // A large query's scratch is let go: the thread would hold it, and every later query would
+  // clear its tables. (Such a query takes far longer than making them again.)
+  if (scratch.footprint() > kKeptScratchBytes) scratch = TraversalScratch{};
+  return finalize(ctx, candidates, stats, ObjectPair{0, 1});
+}
+
+}  // namespace narrow
 
 QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {
   const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
-  // Kept from call to call on each thread: the distance queue's tables cost more to make than a
-  // small query takes.
-  thread_local narrow::TraversalScratch scratch;
   std::vector<narrow::Candidate> candidates;
-  QueryStats stats;
-  narrow::PairLimit limit;
-  limit.max = request.max_pairs;
-  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, candidates, stats, narrow::RootTest::as_root, {},
-                   request.max_pairs != 0 ? &limit : nullptr);
-  // A large query's scratch is let go: the thread would hold it, and every later query would
-  // clear its tables. (Such a query takes far longer than making them again.)
-  if (scratch.footprint() > kKeptScratchBytes) scratch = narrow::TraversalScratch{};
-  return narrow::finalize(ctx, candidates, stats, ObjectPair{0, 1});
+  return narrow::query_whole(ctx, candidates);
 }
 
 QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,

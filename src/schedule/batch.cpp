@@ -8,6 +8,8 @@
 #include "caliber/batch.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "narrow/finalize.h"
+#include "parallel/executor.h"
 #include "schedule/engine_impl.h"
 
 namespace caliber {
@@ -28,14 +30,25 @@ std::size_t entries(std::size_t na, std::size_t nb) {
                   " of B (give both sides the same number, or one pose to a side that does not move)");
 }
 
-/// Stealing: how deep a run of `n` entries is split. Every level above the cut-off is split work
-/// (and a split distance traversal's pieces each look for their own nearest pair, more node tests
-/// than one traversal), so only as deep as it takes to give each thread eight pieces: not at all
-/// for a batch of many entries, a few levels for a few heavy ones; never deeper than the engine's
-/// stealing depth.
+/// Below this many entries per thread, a run is cut by the engine's method (a heavy entry split as
+/// a heavy pair is); from it up, each entry is traversed whole by one thread (splitting would only
+/// add work: a split distance traversal's pieces each look for their own nearest pair).
+constexpr std::size_t kEntriesPerThread = 8;
+
+/// Entries traversed whole: at most this many to a task (few enough to balance heavy entries,
+/// enough that a light entry's task costs little beside it).
+constexpr std::size_t kWholeGrain = 4;
+
+/// The most candidate storage a thread keeps between whole entries.
+constexpr std::size_t kKeptCandidateBytes = std::size_t{2} << 20;
+
+/// Stealing: how deep a run of `n` entries is split: as deep as it takes to give each thread
+/// kEntriesPerThread pieces, never deeper than the engine's stealing depth.
 int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
   int depth = 0;
-  for (std::size_t pieces = n; depth < stealing_depth && pieces < 8 * static_cast<std::size_t>(threads); pieces *= 4) ++depth;
+  for (std::size_t pieces = n; depth < stealing_depth && pieces < kEntriesPerThread * static_cast<std::size_t>(threads);
+       pieces *= 4)
+    ++depth;
   return depth;
 }
 
@@ -64,9 +77,6 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   out.limit_reached.reserve(n);
   EngineOptions options = mOptions;
   options.threads = mImpl->executor.threads();
-  // With max_pairs, which pairs an entry keeps depends on the order its traversal met them: one
-  // thread traverses each entry whole, in caliber::query's order.
-  const Method method = request.max_pairs != 0 && mOptions.method != Method::sequential ? Method::exploitation : mOptions.method;
   // Entries are not objects that persist from call to call: the calibrated methods plan with no
   // history, and the engine's is left as it is.
   const tasks::History no_history;
@@ -74,14 +84,37 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {
     const std::size_t count = std::min(kChunk, n - first);
-    const std::vector<ObjectPair> chunk_pairs(count, ObjectPair{0, 1});  // the object ids every contact carries
     const auto make = [&](std::size_t i, void* where) {
       const std::size_t e = first + i;
       new (where) narrow::PairContext(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e], request);
     };
-    options.stealing_depth = stealing_cutoff(count, options.threads, mOptions.stealing_depth);
-    ScheduleRecord record;
-    mImpl->run_pairs(options, method, chunk_pairs, request, no_history, make, results, record);
+    // With max_pairs, which pairs an entry keeps depends on the order its traversal met them: one
+    // thread traverses each entry whole, in caliber::query's order. So does a run of many entries.
+    if (request.max_pairs != 0 || count >= kEntriesPerThread * static_cast<std::size_t>(options.threads) ||
+        mOptions.method == Method::sequential) {
+      results.assign(count, QueryResult{});
+      mImpl->executor.execute([&] {
+        parallel::parallel_for(0, count, kWholeGrain, [&](std::size_t lo, std::size_t hi) {
+          thread_local std::vector<narrow::Candidate> candidates;
+          for (std::size_t i = lo; i != hi; ++i) {
+            const std::size_t e = first + i;
+            const narrow::PairContext ctx(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e],
+                                          request);
+            results[i] = narrow::query_whole(ctx, candidates);
+            // Kept for the thread's next entry unless a large one grew it (as query_whole's scratch).
+            if (candidates.capacity() * sizeof(narrow::Candidate) > kKeptCandidateBytes) candidates = {};
+          }
+        });
+      });
+    } else {
+      options.stealing_depth = stealing_cutoff(count, options.threads, mOptions.stealing_depth);
+      const std::vector<ObjectPair> chunk_pairs(count, ObjectPair{0, 1});  // the object ids every contact carries
+      ScheduleRecord record;
+      mImpl->run_pairs(options, mOptions.method, chunk_pairs, request, no_history, make, results, record);
+    }
+    std::size_t total = out.contacts.size();
+    for (const QueryResult& r : results) total += r.contacts.size();
+    out.contacts.reserve(total);
     for (const QueryResult& r : results) {
       out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
       out.offsets.push_back(out.contacts.size());

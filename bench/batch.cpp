@@ -1,0 +1,238 @@
+// Batch queries against FCL 0.7's loop: a link (CGAL's turbine, scaled) swept along a path through
+// the bunny, N poses, about half of them colliding. Per query kind (first hit, every intersecting
+// pair, minimum distance) and per subset (free poses, colliding poses): microseconds per pose of
+// FCL's loop (fcl::collide / fcl::distance, OBBRSS), a loop of caliber::query, and
+// Engine::query_many on 1 and 2 threads. Interleaved rounds, medians; the entries of every batch
+// are checked against the single queries (same pairs and distances, bit for bit).
+//
+//   bench_batch [--meshes DIR] [--poses N] [--repeat R] [--out FILE.md]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/distance.h>
+
+#include "caliber/batch.h"
+#include "caliber/engine.h"
+#include "caliber/mesh.h"
+#include "caliber/model.h"
+#include "caliber/query.h"
+#include "fcl_support.h"
+#include "machine.h"
+
+namespace {
+
+using namespace caliber;
+
+/// The link's poses: its box center along a line through the bunny's box (from 0.9 of its
+/// diagonal on one side to 0.9 on the other), turning about a tilted axis one and a half times.
+std::vector<Pose> path(const Mesh& a, const Mesh& b, std::size_t n) {
+  Eigen::Vector3d ca, cb;
+  double da, db;
+  bench::box_center(a, ca, da);
+  bench::box_center(b, cb, db);
+  const Eigen::Vector3d from = ca + Eigen::Vector3d(-0.45, -0.1, 0.05) * da, to = ca + Eigen::Vector3d(0.45, 0.1, -0.05) * da;
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, 1.0, 0.2).normalized();
+  std::vector<Pose> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s = n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 0.0;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(3.0 * std::numbers::pi * s, axis));
+    const Eigen::Vector3d t = from + s * (to - from) - q * cb;
+    out.push_back(Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z()));
+  }
+  return out;
+}
+
+struct Config {
+  std::string name;
+  std::function<void(const std::vector<Pose>&)> run;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path meshes = bench::default_meshes_dir();
+  std::size_t poses_n = 10000;
+  int repeat = 5;
+  std::string out_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--meshes" && has_value) {
+      meshes = argv[++i];
+    } else if (arg == "--poses" && has_value) {
+      poses_n = std::stoul(argv[++i]);
+    } else if (arg == "--repeat" && has_value) {
+      repeat = std::max(1, std::stoi(argv[++i]));
+    } else if (arg == "--out" && has_value) {
+      out_path = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: bench_batch [--meshes DIR] [--poses N] [--repeat R] [--out FILE.md]\n");
+      return 2;
+    }
+  }
+  const Mesh bunny = load_mesh((meshes / "bunny00.off").string());
+  Mesh link = load_mesh((meshes / "turbine.off").string());
+  scale_mesh(link, 0.3);
+  const auto a = build_model(bunny), b = build_model(link);
+  const auto fa = bench::build_fcl(bunny), fb = bench::build_fcl(link);
+  const std::vector<Pose> all = path(bunny, link, poses_n);
+
+  // Which poses collide, by the first hit.
+  QueryRequest first;
+  first.max_pairs = 1;
+  std::vector<Pose> colliding, free;
+  for (const Pose& p : all) (query(*a, Pose{}, *b, p, first).contacts.empty() ? free : colliding).push_back(p);
+
+  struct Kind {
+    std::string name;
+    QueryRequest request;
+  };
+  std::vector<Kind> kinds(3);
+  kinds[0].name = "first hit";
+  kinds[0].request.max_pairs = 1;
+  kinds[1].name = "interference (every pair)";
+  kinds[2].name = "distance";
+  kinds[2].request.kind = QueryKind::distance;
+  kinds[2].request.tolerance = kUnbounded;
+
+  EngineOptions one_thread, two_threads;
+  one_thread.threads = 1;
+  two_threads.threads = 2;
+  Engine engine1(one_thread), engine2(two_threads);
+  const std::vector<Pose> identity{Pose{}};
+  fcl::CollisionObjectd oa(fa, bench::to_fcl(Pose{}));
+  fcl::CollisionObjectd ob(fb, bench::to_fcl(Pose{}));
+
+  std::string table;
+  char line[512];
+  for (const Kind& k : kinds) {
+    const QueryRequest& request = k.request;
+    const bool distance = request.kind == QueryKind::distance;
+    std::size_t checksum = 0;
+    std::vector<Config> configs;
+    configs.push_back({"FCL loop", [&](const std::vector<Pose>& poses) {
+                         for (const Pose& p : poses) {
+                           ob.setTransform(bench::to_fcl(p));
+                           ob.computeAABB();
+                           if (distance) {
+                             fcl::DistanceRequestd dreq(true, true, 0.0, 0.0);
+                             fcl::DistanceResultd dres;
+                             fcl::distance(&oa, &ob, dreq, dres);
+                             checksum += dres.min_distance > 0.0;
+                           } else {
+                             fcl::CollisionRequestd creq(request.max_pairs == 1 ? 1 : 100000000, false);
+                             fcl::CollisionResultd cres;
+                             fcl::collide(&oa, &ob, creq, cres);
+                             checksum += cres.numContacts();
+                           }
+                         }
+                       }});
+    configs.push_back({"query loop", [&](const std::vector<Pose>& poses) {
+                         for (const Pose& p : poses) checksum += query(*a, Pose{}, *b, p, request).contacts.size();
+                       }});
+    configs.push_back({"batch, 1 thread", [&](const std::vector<Pose>& poses) {
+                         checksum += engine1.query_many(*a, identity, *b, poses, request).contacts.size();
+                       }});
+    configs.push_back({"batch, 2 threads", [&](const std::vector<Pose>& poses) {
+                         checksum += engine2.query_many(*a, identity, *b, poses, request).contacts.size();
+                       }});
+    for (const auto& [subset, poses] :
+         {std::pair<std::string, const std::vector<Pose>*>{"free", &free}, {"colliding", &colliding}}) {
+      if (poses->empty()) continue;
+      // Every batch's entries are the single queries', bit for bit.
+      const BatchResult check = engine2.query_many(*a, identity, *b, *poses, request);
+      for (std::size_t i = 0; i < poses->size(); i += std::max<std::size_t>(1, poses->size() / 50)) {
+        const QueryResult q = query(*a, Pose{}, *b, (*poses)[i], request);
+        const auto got = check.contacts_of(i);
+        bool same = got.size() == q.contacts.size();
+        for (std::size_t c = 0; same && c < got.size(); ++c) {
+          same = got[c].tri_a == q.contacts[c].tri_a && got[c].tri_b == q.contacts[c].tri_b &&
+                 got[c].distance == q.contacts[c].distance && got[c].point_a == q.contacts[c].point_a;
+        }
+        if (!same) {
+          std::fprintf(stderr, "bench_batch: %s, %s pose %zu: the batch differs from the query\n", k.name.c_str(), subset.c_str(),
+                       i);
+          return 1;
+        }
+      }
+      std::map<std::string, std::vector<double>> times;
+      for (int r = 0; r < repeat; ++r) {
+        for (const Config& c : configs) {
+          const auto start = std::chrono::steady_clock::now();
+          c.run(*poses);
+          times[c.name].push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() /
+                                  static_cast<double>(poses->size()));
+        }
+      }
+      const double fcl_us = median(times["FCL loop"]), loop_us = median(times["query loop"]);
+      const double b1 = median(times["batch, 1 thread"]), b2 = median(times["batch, 2 threads"]);
+      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f | %.2f | %.2f | %.2f | %.3f | %.3f | %.2f |\n", k.name.c_str(),
+                    subset.c_str(), poses->size(), fcl_us, loop_us, b1, b2, loop_us / fcl_us, b1 / fcl_us, b1 / b2);
+      std::fputs(line, stdout);
+      std::fflush(stdout);
+      table += line;
+    }
+    if (checksum == 0) std::fputs("", stdout);
+  }
+
+  // The fixed cost of one distance call: two tetrahedra, 1e5 calls, ours against FCL's.
+  const Mesh tetra = mesh_from_buffers(std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1},
+                                       std::vector<std::int64_t>{0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3}, "tetrahedron");
+  const auto ta = build_model(tetra);
+  const auto tfa = bench::build_fcl(tetra);
+  const Pose apart = Pose::from_values(1.5, 0.2, 0.1, 1, 0.1, 0.2, 0.3);
+  fcl::CollisionObjectd ta_obj(tfa, bench::to_fcl(Pose{})), tb_obj(tfa, bench::to_fcl(apart));
+  std::vector<double> tiny_ours, tiny_fcl;
+  QueryRequest dist;
+  dist.kind = QueryKind::distance;
+  dist.tolerance = kUnbounded;
+  double sink = 0.0;
+  for (int r = 0; r < repeat; ++r) {
+    constexpr int calls = 100000;
+    auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < calls; ++i) sink += query(*ta, Pose{}, *ta, apart, dist).contacts.front().distance;
+    tiny_ours.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() / calls);
+    start = std::chrono::steady_clock::now();
+    for (int i = 0; i < calls; ++i) {
+      fcl::DistanceRequestd dreq(true, true, 0.0, 0.0);
+      fcl::DistanceResultd dres;
+      fcl::distance(&ta_obj, &tb_obj, dreq, dres);
+      sink += dres.min_distance;
+    }
+    tiny_fcl.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() / calls);
+  }
+  std::snprintf(line, sizeof line,
+                "\nOne distance call on two tetrahedra: caliber::query %.3f us, fcl::distance %.3f us (%.2f)\n",
+                median(tiny_ours), median(tiny_fcl), median(tiny_ours) / median(tiny_fcl));
+  std::fputs(line, stdout);
+  const std::string tiny = line;
+
+  if (!out_path.empty()) {
+    std::ofstream out(out_path);
+    out << "# Batch queries against FCL 0.7's loop\n\n"
+        << "Machine: " << bench::machine_description() << "\n\n"
+        << "CGAL's turbine (" << link.triangles.size() << " triangles, scaled 0.3) swept along a path through the bunny ("
+        << bunny.triangles.size() << " triangles): " << all.size() << " poses, " << colliding.size()
+        << " colliding. Microseconds per pose, medians of " << repeat
+        << " interleaved rounds; each batch's entries checked against the single queries.\n\n"
+        << "| query | poses | count | FCL loop | query loop | batch, 1 thread | batch, 2 threads | loop / FCL | batch 1t / FCL "
+           "| 2 threads / 1 |\n|---|---|---|---|---|---|---|---|---|---|\n"
+        << table << tiny;
+  }
+  return sink < 0.0 ? 1 : 0;
+}
