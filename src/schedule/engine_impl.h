@@ -103,10 +103,12 @@ struct Engine::Impl {
   /// the engine's executor: fills results (one per pair; `pairs` are the object ids each pair's
   /// contacts carry), `record`, and with max_pairs the pairs' limits. A calibrated method plans with
   /// `history` (keyed by `pairs`). Leaves the workers' slots for the caller's bookkeeping.
-  schedule::PairsRun run_pairs(const EngineOptions& options, Method method, const std::vector<ObjectPair>& pairs,
-                               const QueryRequest& request, const tasks::History& history,
-                               const std::function<void(std::size_t, void*)>& make, std::vector<QueryResult>& results,
-                               ScheduleRecord& record);
+  /// (Hidden: a member of the exported Engine's nested type would otherwise be exported.)
+  [[gnu::visibility("hidden")]] schedule::PairsRun run_pairs(const EngineOptions& options, Method method,
+                                                             const std::vector<ObjectPair>& pairs, const QueryRequest& request,
+                                                             const tasks::History& history,
+                                                             const std::function<void(std::size_t, void*)>& make,
+                                                             std::vector<QueryResult>& results, ScheduleRecord& record);
 };
 
 }  // namespace caliber
