@@ -120,10 +120,10 @@ int main(int argc, char** argv) {
 
   std::string table;
   char line[512];
+  std::size_t checksum = 0;  // what every timed run found, kept so that no run is optimized away
   for (const Kind& k : kinds) {
     const QueryRequest& request = k.request;
     const bool distance = request.kind == QueryKind::distance;
-    std::size_t checksum = 0;
     std::vector<Config> configs;
     configs.push_back({"FCL loop", [&](const std::vector<Pose>& poses) {
                          for (const Pose& p : poses) {
@@ -187,7 +187,6 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       table += line;
     }
-    if (checksum == 0) std::fputs("", stdout);
   }
 
   // The fixed cost of one distance call: two tetrahedra, 1e5 calls, ours against FCL's.
@@ -234,5 +233,6 @@ int main(int argc, char** argv) {
            "| 2 threads / 1 |\n|---|---|---|---|---|---|---|---|---|---|\n"
         << table << tiny;
   }
+  sink += static_cast<double>(checksum);
   return sink < 0.0 ? 1 : 0;
 }

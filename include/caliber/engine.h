@@ -152,9 +152,10 @@ class CALIBER_EXPORT Engine {
   /// Tests model A against model B at many poses: entry i answers caliber::query(a, poses_a[i], b,
   /// poses_b[i], request), bit for bit, whatever the method and threads. A side given one pose keeps
   /// it for every entry; otherwise both sides give the same number of poses. The entries run in
-  /// parallel on the engine's threads, and the method splits a heavy entry's traversal as it splits
-  /// a heavy pair; with max_pairs each entry is traversed whole by one thread, so that the pairs it
-  /// finds first are those caliber::query finds. Leaves what the temporal methods remember as it is.
+  /// parallel on the engine's threads. With max_pairs, or at least 8 entries per thread, each entry
+  /// is traversed whole by one thread (with max_pairs, the pairs it finds first are then those
+  /// caliber::query finds); fewer entries go through the method, which splits a heavy entry's
+  /// traversal as it splits a heavy pair. Leaves what the temporal methods remember as it is.
   /// Throws caliber::Error on pose counts that do not match, a bad pose (named by its side and
   /// index) or a bad request, before any work.
   [[nodiscard]] BatchResult query_many(const Model& a, std::span<const Pose> poses_a, const Model& b,

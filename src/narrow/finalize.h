@@ -27,8 +27,8 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
 
 /// One pair's whole query on the calling thread: the depth-first or distance traversal from the
 /// root (stopping at the request's max_pairs) and the finalization, with the thread's kept
-/// scratch; `candidates` is scratch too (cleared first). What caliber::query runs, and the batch
-/// for every entry it does not split.
-QueryResult query_whole(const PairContext& ctx, std::vector<Candidate>& candidates);
+/// scratch and candidate storage (let go past 2 MiB). What caliber::query runs, and the batch for
+/// every entry it does not split.
+QueryResult query_whole(const PairContext& ctx);
 
 }  // namespace caliber::narrow

@@ -61,10 +61,11 @@ namespace narrow {
 /// The most traversal scratch a thread keeps between whole queries.
 constexpr std::size_t kKeptScratchBytes = std::size_t{2} << 20;
 
-QueryResult query_whole(const PairContext& ctx, std::vector<Candidate>& candidates) {
+QueryResult query_whole(const PairContext& ctx) {
   // Kept from call to call on each thread: the distance queue's tables cost more to make than a
-  // small query takes.
+  // small query takes, and a batch's entries reuse the candidates' storage.
   thread_local TraversalScratch scratch;
+  thread_local std::vector<Candidate> candidates;
   candidates.clear();
   QueryStats stats;
   PairLimit limit;
@@ -73,15 +74,15 @@ QueryResult query_whole(const PairContext& ctx, std::vector<Candidate>& candidat
   // A large query's scratch is let go: the thread would hold it, and every later query would
   // clear its tables. (Such a query takes far longer than making them again.)
   if (scratch.footprint() > kKeptScratchBytes) scratch = TraversalScratch{};
-  return finalize(ctx, candidates, stats, ObjectPair{0, 1});
+  QueryResult result = finalize(ctx, candidates, stats, ObjectPair{0, 1});
+  if (candidates.capacity() * sizeof(Candidate) > kKeptScratchBytes) candidates = {};
+  return result;
 }
 
 }  // namespace narrow
 
 QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {
-  const narrow::PairContext ctx(a, pose_a, b, pose_b, request);
-  std::vector<narrow::Candidate> candidates;
-  return narrow::query_whole(ctx, candidates);
+  return narrow::query_whole(narrow::PairContext(a, pose_a, b, pose_b, request));
 }
 
 QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,

@@ -1,5 +1,6 @@
-// Batch queries: one pair of models at many poses, run as the engine runs a frame's pairs (each
-// entry one pair of the run, the same traversal and finalization), in chunks.
+// Batch queries: one pair of models at many poses, in chunks. Each entry is caliber::query's own
+// path (narrow::query_whole) in a parallel loop, or, for a few heavy entries, a pair of a run of
+// the engine's method (the same traversal and finalization, split as a heavy pair is).
 
 #include <algorithm>
 #include <new>
@@ -38,9 +39,6 @@ constexpr std::size_t kEntriesPerThread = 8;
 /// Entries traversed whole: at most this many to a task (few enough to balance heavy entries,
 /// enough that a light entry's task costs little beside it).
 constexpr std::size_t kWholeGrain = 4;
-
-/// The most candidate storage a thread keeps between whole entries.
-constexpr std::size_t kKeptCandidateBytes = std::size_t{2} << 20;
 
 /// Stealing: how deep a run of `n` entries is split: as deep as it takes to give each thread
 /// kEntriesPerThread pieces, never deeper than the engine's stealing depth.
@@ -84,9 +82,9 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {
     const std::size_t count = std::min(kChunk, n - first);
-    const auto make = [&](std::size_t i, void* where) {
+    const auto context = [&](std::size_t i) {  // entry first + i's
       const std::size_t e = first + i;
-      new (where) narrow::PairContext(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e], request);
+      return narrow::PairContext(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e], request);
     };
     // With max_pairs, which pairs an entry keeps depends on the order its traversal met them: one
     // thread traverses each entry whole, in caliber::query's order. So does a run of many entries.
@@ -95,21 +93,14 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
       results.assign(count, QueryResult{});
       mImpl->executor.execute([&] {
         parallel::parallel_for(0, count, kWholeGrain, [&](std::size_t lo, std::size_t hi) {
-          thread_local std::vector<narrow::Candidate> candidates;
-          for (std::size_t i = lo; i != hi; ++i) {
-            const std::size_t e = first + i;
-            const narrow::PairContext ctx(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e],
-                                          request);
-            results[i] = narrow::query_whole(ctx, candidates);
-            // Kept for the thread's next entry unless a large one grew it (as query_whole's scratch).
-            if (candidates.capacity() * sizeof(narrow::Candidate) > kKeptCandidateBytes) candidates = {};
-          }
+          for (std::size_t i = lo; i != hi; ++i) results[i] = narrow::query_whole(context(i));
         });
       });
     } else {
       options.stealing_depth = stealing_cutoff(count, options.threads, mOptions.stealing_depth);
       const std::vector<ObjectPair> chunk_pairs(count, ObjectPair{0, 1});  // the object ids every contact carries
       ScheduleRecord record;
+      const auto make = [&](std::size_t i, void* where) { new (where) narrow::PairContext(context(i)); };
       mImpl->run_pairs(options, mOptions.method, chunk_pairs, request, no_history, make, results, record);
     }
     std::size_t total = out.contacts.size();

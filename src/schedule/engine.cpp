@@ -15,7 +15,6 @@
 #include <functional>
 #include <memory>
 #include <new>
-#include <type_traits>
 #include <numeric>
 #include <tuple>
 #include <string>

@@ -14,19 +14,12 @@
 #include "caliber/procedural.h"
 #include "caliber/query.h"
 #include "support/random_poses.h"
+#include "support/torus_sphere.h"
 
 namespace caliber {
 namespace {
 
-struct Shapes {
-  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.35, 24, 16));
-  std::shared_ptr<const Model> sphere = build_model(make_sphere(0.9, 16, 24));
-};
-
-const Shapes& shapes() {
-  static const Shapes s;
-  return s;
-}
+const test::TorusSphere& shapes() { return test::torus_sphere(); }
 
 /// Every reported pair of `part` is in `full`, with the same contact to the last bit.
 void expect_part_of(const QueryResult& part, const QueryResult& full, const std::string& what) {

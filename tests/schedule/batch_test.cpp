@@ -15,19 +15,12 @@
 #include "caliber/procedural.h"
 #include "caliber/query.h"
 #include "support/random_poses.h"
+#include "support/torus_sphere.h"
 
 namespace caliber {
 namespace {
 
-struct Shapes {
-  std::shared_ptr<const Model> torus = build_model(make_torus(1.0, 0.35, 24, 16));
-  std::shared_ptr<const Model> sphere = build_model(make_sphere(0.9, 16, 24));
-};
-
-const Shapes& shapes() {
-  static const Shapes s;
-  return s;
-}
+const test::TorusSphere& shapes() { return test::torus_sphere(); }
 
 /// Poses near the origin: about half of them put the sphere through the torus.
 std::vector<Pose> poses_near(std::size_t n, std::uint64_t seed, double spread) {
