@@ -99,9 +99,10 @@ py::array_t<std::int64_t> faces_of(const caliber::Mesh& mesh) {
 
 /// `tolerance` None: 0, or for a distance query, any distance (caliber::kUnbounded).
 caliber::QueryRequest make_request(const std::string& kind, std::optional<double> tolerance, double angle,
-                                   std::size_t max_pairs = 0) {
+                                   std::size_t max_pairs = 0, bool lowest_ids = false) {
   caliber::QueryRequest request;
   request.max_pairs = max_pairs;
+  request.lowest_ids = lowest_ids;
   request.kind = caliber::parse_query_kind(kind);
   request.tolerance = tolerance ? *tolerance : request.kind == caliber::QueryKind::distance ? caliber::kUnbounded : 0.0;
   request.angle_deg = angle;
@@ -412,8 +413,8 @@ def _pose_from_state(translation, quaternion):
   m.def(
       "query",
       [](const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b, const std::string& kind,
-         std::optional<double> tolerance, double angle, std::size_t max_pairs) {
-        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs);
+         std::optional<double> tolerance, double angle, std::size_t max_pairs, bool lowest_ids) {
+        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
         caliber::QueryResult q;
         {
           py::gil_scoped_release release;
@@ -422,17 +423,20 @@ def _pose_from_state(translation, quaternion):
         return query_result(q);
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference",
-      py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
+      py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
+      py::arg("lowest_ids") = false,
       "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
       "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
-      "limit_reached (1: any pair).");
+      "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal, "
+      "or with lowest_ids=True the lowest ids at distance 0 (slower).");
 
   caliber_python::bind_batch(m);
   m.def(
       "query_many",
       [](const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b, const std::string& kind,
-         std::optional<double> tolerance, double angle, std::size_t max_pairs, const std::string& order, int threads) {
-        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs);
+         std::optional<double> tolerance, double angle, std::size_t max_pairs, const std::string& order, int threads,
+         bool lowest_ids) {
+        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
         caliber::EngineOptions options;
         options.threads = threads;
         caliber::Engine engine(options);
@@ -440,7 +444,7 @@ def _pose_from_state(translation, quaternion):
       },
       py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
       py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
-      py::arg("order") = "wxyz", py::arg("threads") = 0,
+      py::arg("order") = "wxyz", py::arg("threads") = 0, py::arg("lowest_ids") = false,
       "Engine(threads=threads).query_many(...): model a against model b at many poses, in parallel, the GIL released "
       "once. Returns a Batch: per entry hit, distance, limit_reached; per reported pair a row with its entry.");
 
@@ -465,12 +469,13 @@ def _pose_from_state(translation, quaternion):
           "query_many",
           [](caliber::Engine& engine, const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b,
              const std::string& kind, std::optional<double> tolerance, double angle, std::size_t max_pairs,
-             const std::string& order) {
-            return query_many(engine, a, poses_a, b, poses_b, make_request(kind, tolerance, angle, max_pairs), order);
+             const std::string& order, bool lowest_ids) {
+            return query_many(engine, a, poses_a, b, poses_b, make_request(kind, tolerance, angle, max_pairs, lowest_ids),
+                              order);
           },
           py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
           py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
-          py::arg("order") = "wxyz",
+          py::arg("order") = "wxyz", py::arg("lowest_ids") = false,
           "Model a against model b at many poses, on this engine's threads: entry i is query(a, poses_a[i], b, poses_b[i], "
           "...) bit for bit. Each side is one Pose (kept for every entry), a list of Poses, or an array of N x 4 x 4 "
           "matrices or N x 7 rows (translation, then the quaternion in `order`: 'wxyz' or 'xyzw'), float32 or float64. "
@@ -479,8 +484,9 @@ def _pose_from_state(translation, quaternion):
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind,
-             std::optional<double> tolerance, double angle, std::size_t max_pairs) {
-            const caliber::Frame frame = make_frame(models, poses, pairs, make_request(kind, tolerance, angle, max_pairs));
+             std::optional<double> tolerance, double angle, std::size_t max_pairs, bool lowest_ids) {
+            const caliber::Frame frame =
+                make_frame(models, poses, pairs, make_request(kind, tolerance, angle, max_pairs, lowest_ids));
             caliber::StepResult s;
             {
               py::gil_scoped_release release;
@@ -491,7 +497,8 @@ def _pose_from_state(translation, quaternion):
             return r;
           },
           py::arg("models"), py::arg("poses"), py::arg("pairs"), py::arg("kind") = "interference",
-          py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0,
+          py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
+          py::arg("lowest_ids") = false,
           "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair past that many "
           "triangle pairs and sets limit_reached (1: does each pair touch at all?).");
 

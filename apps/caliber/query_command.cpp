@@ -38,6 +38,7 @@ struct QueryOptions {
   int repeat = 1;
   std::size_t max_pairs = 0;
   bool first = false;
+  bool lowest_ids = false;
 };
 
 bool same_result(const caliber::QueryResult& x, const caliber::QueryResult& y) {
@@ -72,6 +73,7 @@ int run_query(const QueryOptions& opt) {
   if (request.kind == caliber::QueryKind::distance && !opt.tolerance_given) request.tolerance = caliber::kUnbounded;
   request.angle_deg = opt.angle;
   request.max_pairs = opt.first ? 1 : opt.max_pairs;
+  request.lowest_ids = opt.lowest_ids;
   caliber::validate_request(request);
   const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
   const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
@@ -213,6 +215,9 @@ Runner add_query_command(CLI::App& app) {
       ->check(at_least(0))
       ->capture_default_str();
   cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1");
+  cmd->add_flag("--lowest-ids", opt->lowest_ids,
+                "Distance on intersecting meshes: report the intersecting pair with the lowest triangle ids (every "
+                "pair at distance 0 examined) instead of the traversal's first");
   cmd->add_option("--repeat", opt->repeat,
                   "Run the query R times: stats.query_ms is the first (cold) run, stats.query_ms_warm the median of "
                   "the others (every run must give the same result)")

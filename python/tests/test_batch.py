@@ -24,10 +24,11 @@ def rows(n, seed):
     return out
 
 
-def expect_entries(batch, poses_b, kind, tolerance, max_pairs=0):
+def expect_entries(batch, poses_b, kind, tolerance, max_pairs=0, lowest_ids=False):
     assert len(batch) == len(poses_b)
     for i, p in enumerate(poses_b):
-        r = caliber.query(TETRA, caliber.Pose(), FAN, p, kind=kind, tolerance=tolerance, max_pairs=max_pairs)
+        r = caliber.query(TETRA, caliber.Pose(), FAN, p, kind=kind, tolerance=tolerance, max_pairs=max_pairs,
+                          lowest_ids=lowest_ids)
         lo, hi = batch.offsets[i], batch.offsets[i + 1]
         assert batch.pairs[lo:hi].tolist() == r.pairs.tolist()
         assert (batch.entries[lo:hi] == i).all()
@@ -53,6 +54,23 @@ def test_entries_equal_single_queries(kind, method, threads):
     expect_entries(batch, poses, kind, tolerance)
     limited = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind=kind, tolerance=tolerance, max_pairs=1)
     expect_entries(limited, poses, kind, tolerance, max_pairs=1)
+
+
+@pytest.mark.parametrize("method,threads", [("sequential", 1), ("hybrid", 2)])
+def test_distance_at_contact_first_pair_or_lowest_ids(method, threads):
+    # Where the fan passes through the tetrahedron, several pairs are at distance 0: the default
+    # reports the traversal's first, lowest_ids=True the lowest ids (never higher); both are 0.
+    poses = [caliber.Pose(v[:3], v[3:]) for v in rows(60, 8)]
+    engine = caliber.Engine(method, threads)
+    first = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind="distance")
+    lowest = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind="distance", lowest_ids=True)
+    expect_entries(first, poses, "distance", None)
+    expect_entries(lowest, poses, "distance", None, lowest_ids=True)
+    touching = first.distance == 0
+    assert touching.sum() > 5 and (lowest.distance[touching] == 0).all()
+    assert (first.distance[~touching] == lowest.distance[~touching]).all()
+    for i in np.flatnonzero(touching):
+        assert tuple(lowest.pairs[lowest.offsets[i]]) <= tuple(first.pairs[first.offsets[i]])
 
 
 def test_every_pose_format_gives_the_same_batch():

@@ -17,13 +17,26 @@ namespace caliber::narrow {
 /// finalization would otherwise be serial work).
 inline constexpr std::size_t kFinalizeGrain = 128;
 
+/// Where a distance answer of 0 comes from. as_found: the candidates came from one traversal from
+/// the root (caliber::query's, whose first intersecting pair is the answer) or from the brute force
+/// (the lowest ids). from_root: they came from pieces of the traversal (a method's tasks), each
+/// stopped at its own first intersecting pair; the answer is the first intersecting pair of the
+/// traversal from the root, found again here, so that it does not depend on the cut.
+enum class ContactPair { as_found, from_root };
+
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
 /// object pair canonically (by triangle ids) and converts them to world coordinates, as contacts
 /// between `objects` (their ids in the frame; 0 and 1 for caliber::query). With
 /// `parallel`, a large candidate list is processed by several tasks of the current executor (same
-/// result).
+/// result). A distance query's closest pair is the candidates' closest, ties to the lowest ids, but
+/// at distance 0 as `contact_pair` says (unless the request asks for the lowest ids).
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
-                     bool parallel = false);
+                     ContactPair contact_pair, bool parallel = false);
+
+/// The first intersecting pair of the distance traversal from the root (the pair caliber::query
+/// reports on meshes that intersect), on the calling thread with its kept scratch; its node and
+/// leaf tests added to `stats`. The meshes must have a pair at distance 0.
+Candidate first_contact(const PairContext& ctx, QueryStats& stats);
 
 /// One pair's whole query on the calling thread: the depth-first or distance traversal from the
 /// root (stopping at the request's max_pairs) and the finalization, with the thread's kept

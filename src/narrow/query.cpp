@@ -12,6 +12,7 @@
 #include "narrow/pair_context.h"
 #include "narrow/finalize.h"
 #include "narrow/traversal.h"
+#include "util/assert.h"
 
 namespace caliber {
 
@@ -58,25 +59,45 @@ void validate_request(const QueryRequest& request) {
 
 namespace narrow {
 
+namespace {
+
 /// The most traversal scratch a thread keeps between whole queries.
 constexpr std::size_t kKeptScratchBytes = std::size_t{2} << 20;
 
+/// Kept from call to call on each thread: the distance queue's tables cost more to make than a
+/// small query takes, and a batch's entries reuse the candidates' storage.
+thread_local TraversalScratch t_scratch;
+thread_local std::vector<Candidate> t_candidates;
+
+/// A large query's scratch is let go: the thread would hold it, and every later query would clear
+/// its tables. (Such a query takes far longer than making them again.)
+void let_go_if_large() {
+  if (t_scratch.footprint() > kKeptScratchBytes) t_scratch = TraversalScratch{};
+}
+
+}  // namespace
+
 QueryResult query_whole(const PairContext& ctx) {
-  // Kept from call to call on each thread: the distance queue's tables cost more to make than a
-  // small query takes, and a batch's entries reuse the candidates' storage.
-  thread_local TraversalScratch scratch;
-  thread_local std::vector<Candidate> candidates;
+  std::vector<Candidate>& candidates = t_candidates;
   candidates.clear();
   QueryStats stats;
   PairLimit limit;
   limit.max = ctx.request().max_pairs;
-  traverse(ctx, NodePair{0, 0}, scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
-  // A large query's scratch is let go: the thread would hold it, and every later query would
-  // clear its tables. (Such a query takes far longer than making them again.)
-  if (scratch.footprint() > kKeptScratchBytes) scratch = TraversalScratch{};
-  QueryResult result = finalize(ctx, candidates, stats, ObjectPair{0, 1});
+  traverse(ctx, NodePair{0, 0}, t_scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
+  let_go_if_large();
+  QueryResult result = finalize(ctx, candidates, stats, ObjectPair{0, 1}, ContactPair::as_found);
   if (candidates.capacity() * sizeof(Candidate) > kKeptScratchBytes) candidates = {};
   return result;
+}
+
+Candidate first_contact(const PairContext& ctx, QueryStats& stats) {
+  CALIBER_ASSERT(ctx.request().kind == QueryKind::distance && !ctx.request().lowest_ids,
+                 "the first contact is that of a distance traversal that stops at contact");
+  Nearest nearest;
+  traverse_nearest(ctx, NodePair{0, 0}, t_scratch, nearest, stats);
+  let_go_if_large();
+  CALIBER_ASSERT(nearest.found && nearest.best.distance == 0.0, "the traversal from the root finds a pair at distance 0");
+  return nearest.best;
 }
 
 }  // namespace narrow
@@ -107,7 +128,7 @@ QueryResult query_brute_force(const Model& a, const Pose& pose_a, const Model& b
     }
   }
   if (best) candidates.push_back(*best);
-  return narrow::finalize(ctx, candidates, stats, ObjectPair{0, 1});
+  return narrow::finalize(ctx, candidates, stats, ObjectPair{0, 1}, narrow::ContactPair::as_found);
 }
 
 }  // namespace caliber

@@ -4,6 +4,7 @@
 
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -68,17 +69,22 @@ TEST(Batch, EveryKindMethodAndThreadCountEqualsSingleQueries) {
   for (const std::size_t entries : {std::size_t{40}, std::size_t{2}}) {
     const std::vector<Pose> pb = poses_near(entries, 11, 0.3);
     const std::vector<Pose> pa{Pose::from_values(0.05, -0.02, 0.01, 1, 0.1, 0, 0.05)};
-    for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact, QueryKind::distance}) {
+    // Distance twice: stopping at the first contact, and with ties at 0 to the lowest ids.
+    for (const auto& [kind, lowest_ids] : {std::pair{QueryKind::interference, false}, std::pair{QueryKind::proximity, false},
+                                           std::pair{QueryKind::contact, false}, std::pair{QueryKind::distance, false},
+                                           std::pair{QueryKind::distance, true}}) {
       QueryRequest request;
       request.kind = kind;
       request.tolerance = kind == QueryKind::distance ? kUnbounded : 0.03;
+      request.lowest_ids = lowest_ids;
       for (const Method method : kMethods) {
         for (const int threads : {1, 2, 3}) {
           EngineOptions options;
           options.method = method;
           options.threads = threads;
           Engine engine(options);
-          const std::string what = std::to_string(entries) + " entries " + std::string(to_string(kind)) + " " +
+          const std::string what = std::to_string(entries) + " entries " + std::string(to_string(kind)) +
+                                   (request.lowest_ids ? " (lowest ids) " : " ") +
                                    std::string(to_string(method)) + " " + std::to_string(threads) + " threads";
           expect_queries(engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request), pa, pb, request, what);
         }
