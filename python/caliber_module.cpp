@@ -470,8 +470,7 @@ def _pose_from_state(translation, quaternion):
           [](caliber::Engine& engine, const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b,
              const std::string& kind, std::optional<double> tolerance, double angle, std::size_t max_pairs,
              const std::string& order, bool lowest_ids) {
-            return query_many(engine, a, poses_a, b, poses_b, make_request(kind, tolerance, angle, max_pairs, lowest_ids),
-                              order);
+            return query_many(engine, a, poses_a, b, poses_b, make_request(kind, tolerance, angle, max_pairs, lowest_ids), order);
           },
           py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
           py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),

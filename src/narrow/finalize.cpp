@@ -124,8 +124,7 @@ double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::V
 /// pair; the closest of those, ties to the lowest ids, is the pair's answer whatever the cut. At 0,
 /// pieces stopped at their own first intersecting pair: the traversal from the root finds its own
 /// again (its tests added to `stats`).
-Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidates, ContactPair contact_pair,
-                  QueryStats& stats) {
+Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidates, ContactPair contact_pair, QueryStats& stats) {
   const Candidate best = *std::min_element(candidates.begin(), candidates.end(), closer);
   const bool again = best.distance == 0.0 && !ctx.request().lowest_ids && contact_pair == ContactPair::from_root;
   return again ? first_contact(ctx, stats) : best;
@@ -155,7 +154,8 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     }
     candidates = local_minima(ctx, candidates, grain);
   }
-  if (result.kind == QueryKind::distance && !candidates.empty()) candidates = {closest(ctx, candidates, contact_pair, result.stats)};
+  if (result.kind == QueryKind::distance && !candidates.empty())
+    candidates = {closest(ctx, candidates, contact_pair, result.stats)};
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && candidates.size() >= kFinalizeGrain) {
     parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);

@@ -70,9 +70,9 @@ TEST(Batch, EveryKindMethodAndThreadCountEqualsSingleQueries) {
     const std::vector<Pose> pb = poses_near(entries, 11, 0.3);
     const std::vector<Pose> pa{Pose::from_values(0.05, -0.02, 0.01, 1, 0.1, 0, 0.05)};
     // Distance twice: stopping at the first contact, and with ties at 0 to the lowest ids.
-    for (const auto& [kind, lowest_ids] : {std::pair{QueryKind::interference, false}, std::pair{QueryKind::proximity, false},
-                                           std::pair{QueryKind::contact, false}, std::pair{QueryKind::distance, false},
-                                           std::pair{QueryKind::distance, true}}) {
+    for (const auto& [kind, lowest_ids] :
+         {std::pair{QueryKind::interference, false}, std::pair{QueryKind::proximity, false}, std::pair{QueryKind::contact, false},
+          std::pair{QueryKind::distance, false}, std::pair{QueryKind::distance, true}}) {
       QueryRequest request;
       request.kind = kind;
       request.tolerance = kind == QueryKind::distance ? kUnbounded : 0.03;
@@ -84,8 +84,8 @@ TEST(Batch, EveryKindMethodAndThreadCountEqualsSingleQueries) {
           options.threads = threads;
           Engine engine(options);
           const std::string what = std::to_string(entries) + " entries " + std::string(to_string(kind)) +
-                                   (request.lowest_ids ? " (lowest ids) " : " ") +
-                                   std::string(to_string(method)) + " " + std::to_string(threads) + " threads";
+                                   (request.lowest_ids ? " (lowest ids) " : " ") + std::string(to_string(method)) + " " +
+                                   std::to_string(threads) + " threads";
           expect_queries(engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request), pa, pb, request, what);
         }
       }
