@@ -110,55 +110,76 @@ caliber::QueryRequest make_request(const std::string& kind, std::optional<double
   return request;
 }
 
-/// A query's or a step's answer as numpy arrays (one row per reported triangle pair).
+/// A query's or a step's answer: the contacts as numpy arrays (one row per reported triangle pair),
+/// made on the first read of any of them (a query that answers "no" builds none; a planner that
+/// reads only len() or limit_reached builds none either). The contacts are let go once copied.
 struct PyResult {
-  py::array_t<std::uint32_t> objects;               ///< k x 2 object ids (steps only)
-  py::array_t<std::uint32_t> pairs;                 ///< k x 2 triangle ids
-  py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
-  py::array_t<double> distances;                    ///< k
-  py::array_t<double> depths;                       ///< k: Contact::depth (intersecting pairs' penetration estimate)
+  std::vector<caliber::Contact> contacts;  ///< until the arrays are made
+  std::size_t rows = 0;
   std::uint64_t node_tests = 0, leaf_tests = 0;
   bool limit_reached = false;  ///< more than max_pairs were found: a partial answer
+
+  struct Arrays {
+    py::array_t<std::uint32_t> objects;               ///< k x 2 object ids (steps only)
+    py::array_t<std::uint32_t> pairs;                 ///< k x 2 triangle ids
+    py::array_t<double> points_a, points_b, normals;  ///< k x 3 (zero for interference)
+    py::array_t<double> distances;                    ///< k
+    py::array_t<double> depths;                       ///< k: Contact::depth (intersecting pairs' penetration estimate)
+  };
+  std::optional<Arrays> arrays;
+
+  const Arrays& get() {
+    if (!arrays) arrays = make_arrays();
+    return *arrays;
+  }
+
+ private:
+  Arrays make_arrays() {
+    const auto k = static_cast<py::ssize_t>(rows);
+    Arrays r{py::array_t<std::uint32_t>({k, py::ssize_t{2}}),
+             py::array_t<std::uint32_t>({k, py::ssize_t{2}}),
+             py::array_t<double>({k, py::ssize_t{3}}),
+             py::array_t<double>({k, py::ssize_t{3}}),
+             py::array_t<double>({k, py::ssize_t{3}}),
+             py::array_t<double>(k),
+             py::array_t<double>(k)};
+    auto obj = r.objects.mutable_unchecked<2>();
+    auto tri = r.pairs.mutable_unchecked<2>();
+    auto pa = r.points_a.mutable_unchecked<2>();
+    auto pb = r.points_b.mutable_unchecked<2>();
+    auto nn = r.normals.mutable_unchecked<2>();
+    auto dd = r.distances.mutable_unchecked<1>();
+    auto dp = r.depths.mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < k; ++i) {
+      const caliber::Contact& c = contacts[static_cast<std::size_t>(i)];
+      obj(i, 0) = c.object_a;
+      obj(i, 1) = c.object_b;
+      tri(i, 0) = c.tri_a;
+      tri(i, 1) = c.tri_b;
+      for (int d = 0; d < 3; ++d) {
+        pa(i, d) = c.point_a[d];
+        pb(i, d) = c.point_b[d];
+        nn(i, d) = c.normal[d];
+      }
+      dd(i) = c.distance;
+      dp(i) = c.depth;
+    }
+    contacts = {};
+    return r;
+  }
 };
 
-PyResult to_result(const std::vector<caliber::Contact>& contacts, const caliber::QueryStats& stats) {
-  const auto k = static_cast<py::ssize_t>(contacts.size());
+PyResult to_result(std::vector<caliber::Contact> contacts, const caliber::QueryStats& stats) {
   PyResult r;
-  r.objects = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
-  r.pairs = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
-  r.points_a = py::array_t<double>({k, py::ssize_t{3}});
-  r.points_b = py::array_t<double>({k, py::ssize_t{3}});
-  r.normals = py::array_t<double>({k, py::ssize_t{3}});
-  r.distances = py::array_t<double>(k);
-  r.depths = py::array_t<double>(k);
-  auto obj = r.objects.mutable_unchecked<2>();
-  auto tri = r.pairs.mutable_unchecked<2>();
-  auto pa = r.points_a.mutable_unchecked<2>();
-  auto pb = r.points_b.mutable_unchecked<2>();
-  auto nn = r.normals.mutable_unchecked<2>();
-  auto dd = r.distances.mutable_unchecked<1>();
-  auto dp = r.depths.mutable_unchecked<1>();
-  for (py::ssize_t i = 0; i < k; ++i) {
-    const caliber::Contact& c = contacts[static_cast<std::size_t>(i)];
-    obj(i, 0) = c.object_a;
-    obj(i, 1) = c.object_b;
-    tri(i, 0) = c.tri_a;
-    tri(i, 1) = c.tri_b;
-    for (int d = 0; d < 3; ++d) {
-      pa(i, d) = c.point_a[d];
-      pb(i, d) = c.point_b[d];
-      nn(i, d) = c.normal[d];
-    }
-    dd(i) = c.distance;
-    dp(i) = c.depth;
-  }
+  r.rows = contacts.size();
+  r.contacts = std::move(contacts);
   r.node_tests = stats.node_tests;
   r.leaf_tests = stats.leaf_tests;
   return r;
 }
 
-PyResult query_result(const caliber::QueryResult& q) {
-  PyResult r = to_result(q.contacts, q.stats);
+PyResult query_result(caliber::QueryResult&& q) {
+  PyResult r = to_result(std::move(q.contacts), q.stats);
   r.limit_reached = q.limit_reached;
   return r;
 }
@@ -297,7 +318,8 @@ PYBIND11_MODULE(caliber, m) {
       .def("__reduce__",
            [](const caliber::Mesh& mesh) { return rebuilt_by("Mesh", py::make_tuple(vertices_of(mesh), faces_of(mesh))); });
 
-  py::class_<PyModel>(m, "Model", "A mesh with its BVH, built once; immutable, shareable between threads, picklable.")
+  py::class_<PyModel>(m, "Model", py::module_local(),
+                      "A mesh with its BVH, built once; immutable, shareable between threads, picklable.")
       .def(py::init([](const caliber::Mesh& mesh, bool adjacency, bool oriented_boxes) {
              caliber::BuildOptions options;
              options.adjacency = adjacency;
@@ -327,7 +349,7 @@ PYBIND11_MODULE(caliber, m) {
       .def(py::pickle(&model_state, &model_from_state))
       .def("__reduce__", [](const PyModel& p) { return rebuilt_by("_model_from_state", py::make_tuple(model_state(p))); });
 
-  py::class_<caliber::Pose>(m, "Pose", "A rigid transform: x_world = R x + t.")
+  py::class_<caliber::Pose>(m, "Pose", py::module_local(), "A rigid transform: x_world = R x + t.")
       .def(py::init([](std::array<double, 3> t, std::array<double, 4> q, const std::string& order) {
              q = quaternion_wxyz(q, order);
              return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3]);
@@ -395,19 +417,26 @@ def _pose_from_state(translation, quaternion):
 )",
            m.attr("__dict__"));
 
-  py::class_<PyResult>(m, "Result",
+  py::class_<PyResult>(m, "Result", py::module_local(),
                        "Reported triangle pairs, sorted, with points, normals and distances (zero for interference).")
-      .def_readonly("objects", &PyResult::objects, "k x 2 object ids (steps; 0 and 1 for a query)")
-      .def_readonly("pairs", &PyResult::pairs, "k x 2 triangle ids")
-      .def_readonly("points_a", &PyResult::points_a)
-      .def_readonly("points_b", &PyResult::points_b)
-      .def_readonly("normals", &PyResult::normals)
-      .def_readonly("distances", &PyResult::distances)
-      .def_readonly("depths", &PyResult::depths)
+      .def_property_readonly(
+          "objects", [](PyResult& r) { return r.get().objects; }, "k x 2 object ids (steps; 0 and 1 for a query)")
+      .def_property_readonly(
+          "pairs", [](PyResult& r) { return r.get().pairs; }, "k x 2 triangle ids")
+      .def_property_readonly(
+          "points_a", [](PyResult& r) { return r.get().points_a; }, "k x 3 closest points on A (world)")
+      .def_property_readonly(
+          "points_b", [](PyResult& r) { return r.get().points_b; }, "k x 3 closest points on B (world)")
+      .def_property_readonly(
+          "normals", [](PyResult& r) { return r.get().normals; }, "k x 3 contact normals (world)")
+      .def_property_readonly(
+          "distances", [](PyResult& r) { return r.get().distances; }, "k distances (0: intersecting)")
+      .def_property_readonly(
+          "depths", [](PyResult& r) { return r.get().depths; }, "k penetration estimates of intersecting pairs")
       .def_readonly("node_tests", &PyResult::node_tests)
       .def_readonly("limit_reached", &PyResult::limit_reached)
       .def_readonly("leaf_tests", &PyResult::leaf_tests)
-      .def("__len__", [](const PyResult& r) { return static_cast<std::size_t>(r.distances.shape(0)); })
+      .def("__len__", [](const PyResult& r) { return r.rows; })
       .def("__reduce__", [](const PyResult&) -> py::object { throw not_picklable("Result", "pickle its arrays"); });
 
   m.def(
@@ -420,7 +449,7 @@ def _pose_from_state(translation, quaternion):
           py::gil_scoped_release release;
           q = caliber::query(*a.model, pose_a, *b.model, pose_b, request);
         }
-        return query_result(q);
+        return query_result(std::move(q));
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference",
       py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
@@ -491,7 +520,7 @@ def _pose_from_state(translation, quaternion):
               py::gil_scoped_release release;
               s = engine.step(frame);
             }
-            PyResult r = to_result(s.contacts, s.stats);
+            PyResult r = to_result(std::move(s.contacts), s.stats);
             r.limit_reached = s.limit_reached;
             return r;
           },
@@ -546,7 +575,7 @@ def _pose_from_state(translation, quaternion):
               py::gil_scoped_release release;
               s = caliber::step(world, engine, k);
             }
-            return to_result(s.contacts, s.stats);
+            return to_result(std::move(s.contacts), s.stats);
           },
           py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.")
       .def("__reduce__", [](const caliber::World&) -> py::object {

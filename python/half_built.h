@@ -13,12 +13,13 @@
 
 namespace caliber_python {
 
-/// True when `object` is an instance of T whose C++ value was never constructed.
-template <class T>
-bool is_half_built(pybind11::handle object) {
-  if (!object || !pybind11::isinstance<T>(object)) return false;
+/// True when `object` is an instance of the bound class `type` whose C++ value was never
+/// constructed. (The caster passes the type it already looked up: each lookup hashes the C++ type's
+/// name, and a small query's arguments would pay for several.)
+inline bool is_half_built(pybind11::handle object, const pybind11::detail::type_info* type) {
+  if (!object || type == nullptr || !PyObject_TypeCheck(object.ptr(), type->type)) return false;
   auto* instance = reinterpret_cast<pybind11::detail::instance*>(object.ptr());
-  const auto value = instance->get_value_and_holder(pybind11::detail::get_type_info(typeid(T)), false);
+  const auto value = instance->get_value_and_holder(type, false);
   return !value || !value.holder_constructed();
 }
 
@@ -34,7 +35,8 @@ void refuse_second(pybind11::object cls, const char* method, const char* name) {
   const std::string guard_name = std::string(method) + "once";
   auto guarded = pybind11::cpp_function(
       [original, message, name](pybind11::handle self, pybind11::args args, pybind11::kwargs kwargs) {
-        if (!is_half_built<T>(self)) throw caliber::Error(caliber::ErrorCode::bad_argument, name, message);
+        if (!is_half_built(self, pybind11::detail::get_type_info(typeid(T))))
+          throw caliber::Error(caliber::ErrorCode::bad_argument, name, message);
         original(self, *args, **kwargs);
       },
       pybind11::name(guard_name.c_str()), pybind11::is_method(cls), pybind11::doc(doc.c_str()));
@@ -50,7 +52,7 @@ void refuse_second(pybind11::object cls, const char* method, const char* name) {
   class type_caster<Type> : public type_caster_base<Type> {                                                       \
    public:                                                                                                        \
     bool load(handle src, bool convert) {                                                                         \
-      if (caliber_python::is_half_built<Type>(src)) {                                                             \
+      if (caliber_python::is_half_built(src, this->typeinfo)) {                                                   \
         throw caliber::Error(caliber::ErrorCode::bad_argument, name,                                              \
                              "was never built (made by __new__, or unpickled without its state); build one with " \
                              "its constructor or unpickle a complete state");                                     \

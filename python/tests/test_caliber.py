@@ -49,6 +49,22 @@ def test_query_equals_the_cpp_api_bit_for_bit(kind):
         assert r.distances[i] == c["distance"]
 
 
+@pytest.mark.parametrize("where", [(1.5, 0.2, 0.1), (0.2, 0.2, 0.2)])
+def test_result_arrays_are_made_once_whatever_is_read_first(where):
+    model = caliber.Model.load(TETRA)
+    pose = caliber.Pose(list(where), [1, 0, 0, 0])
+    first = caliber.query(model, caliber.Pose(), model, pose, kind="proximity", tolerance=0.05)
+    again = caliber.query(model, caliber.Pose(), model, pose, kind="proximity", tolerance=0.05)
+    n = len(first)
+    assert (n == 0) == (where[0] > 1)
+    assert first.distances is first.distances  # made on the first read, then kept
+    assert first.pairs.shape == (n, 2) and first.points_a.shape == (n, 3) and first.depths.shape == (n,)
+    assert len(first) == n
+    # Read in another order, the same rows.
+    for name in ["depths", "normals", "points_b", "points_a", "pairs", "objects", "distances"]:
+        assert getattr(again, name).tobytes() == getattr(first, name).tobytes()
+
+
 def test_meshes_from_arrays_equal_meshes_from_files():
     m = caliber.Mesh.load(FAN)
     again = caliber.Mesh(m.vertices, m.faces)
