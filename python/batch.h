@@ -6,7 +6,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -50,7 +52,7 @@ struct SidePoses {
       throw caliber::Error(caliber::ErrorCode::bad_argument, side,
                            "must be a caliber.Pose, a list of them, or an array of N x 4 x 4 matrices or N x 7 rows");
     }
-    const bool single = raw.dtype().is(py::dtype::of<float>());
+    const bool single = raw.dtype().kind() == 'f' && raw.dtype().itemsize() == 4;  // any float32 dtype object
     const py::array_t<double, py::array::c_style | py::array::forcecast> values(raw);
     const std::span<const double> flat(values.data(), static_cast<std::size_t>(values.size()));
     const auto nd = values.ndim();
@@ -79,39 +81,21 @@ struct PyBatch {
   py::array_t<double> distances, depths;            ///< k
   std::uint64_t node_tests = 0, leaf_tests = 0;
 
+  PyBatch() = default;
+
   explicit PyBatch(const caliber::BatchResult& b) {
-    const auto n = static_cast<py::ssize_t>(b.size());
-    const auto k = static_cast<py::ssize_t>(b.contacts.size());
-    offsets = py::array_t<std::int64_t>(n + 1);
-    hit = py::array_t<bool>(n);
-    limit_reached = py::array_t<bool>(n);
-    distance = py::array_t<double>(n);
-    pairs = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
-    entries = py::array_t<std::int64_t>(k);
-    points_a = py::array_t<double>({k, py::ssize_t{3}});
-    points_b = py::array_t<double>({k, py::ssize_t{3}});
-    normals = py::array_t<double>({k, py::ssize_t{3}});
-    distances = py::array_t<double>(k);
-    depths = py::array_t<double>(k);
+    allocate(static_cast<py::ssize_t>(b.size()), static_cast<py::ssize_t>(b.contacts.size()));
     std::int64_t* const off = offsets.mutable_data();
-    bool* const h = hit.mutable_data();
     bool* const lr = limit_reached.mutable_data();
-    double* const dist = distance.mutable_data();
     std::uint32_t* const tri = pairs.mutable_data();
-    std::int64_t* const ent = entries.mutable_data();
     double *const pa = points_a.mutable_data(), *const pb = points_b.mutable_data(), *const nn = normals.mutable_data();
     double *const dd = distances.mutable_data(), *const dp = depths.mutable_data();
-    py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i <= n; ++i) off[i] = static_cast<std::int64_t>(b.offsets[static_cast<std::size_t>(i)]);
-    for (py::ssize_t i = 0; i < n; ++i) {
-      const auto e = static_cast<std::size_t>(i);
-      h[i] = b.hit(e);
-      lr[i] = b.limit_reached[e] != 0;
-      dist[i] = std::numeric_limits<double>::infinity();
-      for (std::size_t r = b.offsets[e]; r != b.offsets[e + 1]; ++r) {
+    {
+      py::gil_scoped_release release;
+      for (std::size_t i = 0; i < b.offsets.size(); ++i) off[i] = static_cast<std::int64_t>(b.offsets[i]);
+      for (std::size_t i = 0; i < b.size(); ++i) lr[i] = b.limit_reached[i] != 0;
+      for (std::size_t r = 0; r < b.contacts.size(); ++r) {
         const caliber::Contact& c = b.contacts[r];
-        dist[i] = std::min(dist[i], c.distance);
-        ent[r] = i;
         tri[2 * r] = c.tri_a;
         tri[2 * r + 1] = c.tri_b;
         for (std::size_t d = 0; d < 3; ++d) {
@@ -123,8 +107,131 @@ struct PyBatch {
         dp[r] = c.depth;
       }
     }
+    derive();
     node_tests = b.stats.node_tests;
     leaf_tests = b.stats.leaf_tests;
+  }
+
+  /// What pickle keeps: the arrays the others derive from, and the counters.
+  [[nodiscard]] py::tuple state() const {
+    return py::make_tuple(offsets, limit_reached, pairs, points_a, points_b, normals, distances, depths, node_tests, leaf_tests);
+  }
+
+  /// A Batch from its pickled state, every array checked (dtype converted, shape and offsets
+  /// refused with caliber.Error when they do not fit together).
+  static PyBatch from_state(const py::object& state) {
+    const auto refuse = [](const std::string& why) {
+      return caliber::Error(caliber::ErrorCode::bad_argument, "pickle", "not a caliber.Batch state: " + why);
+    };
+    if (!py::isinstance<py::tuple>(state) || py::len(state) != 10) throw refuse("expected a tuple of 10 items");
+    const auto t = state.cast<py::tuple>();
+    try {
+      const auto off = array_of<std::int64_t>(t[0]);
+      if (off.ndim() != 1 || off.shape(0) < 1) throw refuse("offsets must be N + 1 integers");
+      const py::ssize_t n = off.shape(0) - 1;
+      const std::int64_t* o = off.data();
+      for (py::ssize_t i = 0; i < n; ++i) {
+        if (o[i + 1] < o[i]) throw refuse("offsets must not decrease");
+      }
+      if (o[0] != 0) throw refuse("offsets must start at 0");
+      const py::ssize_t k = static_cast<py::ssize_t>(o[n]);
+      const auto dist = array_of<double>(t[6]);
+      if (!dist || dist.ndim() != 1 || dist.shape(0) != k) throw refuse("distances must have offsets[-1] rows");
+      PyBatch b;
+      b.allocate(n, k);
+      copy_checked(off, b.offsets, {n + 1}, "offsets", refuse);
+      copy_checked(array_of<bool>(t[1]), b.limit_reached, {n}, "limit_reached", refuse);
+      copy_checked(array_of<std::uint32_t>(t[2]), b.pairs, {k, 2}, "pairs", refuse);
+      copy_checked(array_of<double>(t[3]), b.points_a, {k, 3}, "points_a", refuse);
+      copy_checked(array_of<double>(t[4]), b.points_b, {k, 3}, "points_b", refuse);
+      copy_checked(array_of<double>(t[5]), b.normals, {k, 3}, "normals", refuse);
+      copy_checked(dist, b.distances, {k}, "distances", refuse);
+      copy_checked(array_of<double>(t[7]), b.depths, {k}, "depths", refuse);
+      b.node_tests = t[8].cast<std::uint64_t>();
+      b.leaf_tests = t[9].cast<std::uint64_t>();
+      b.derive();
+      return b;
+    } catch (const py::cast_error&) {
+      throw refuse("the counters must be integers >= 0");
+    } catch (const py::error_already_set& e) {
+      throw refuse(std::string("an array could not be read: ") + e.what());
+    }
+  }
+
+  /// The batches one after the other: one batch of all their entries, in order.
+  static PyBatch concatenate(const std::vector<const PyBatch*>& parts) {
+    py::ssize_t n = 0, k = 0;
+    for (const PyBatch* p : parts) {
+      n += p->hit.shape(0);
+      k += p->distances.shape(0);
+    }
+    PyBatch b;
+    b.allocate(n, k);
+    py::ssize_t e = 0, r = 0;
+    b.offsets.mutable_data()[0] = 0;
+    for (const PyBatch* p : parts) {
+      const py::ssize_t pn = p->hit.shape(0), pk = p->distances.shape(0);
+      for (py::ssize_t i = 0; i < pn; ++i) b.offsets.mutable_data()[e + i + 1] = r + p->offsets.data()[i + 1];
+      std::copy_n(p->limit_reached.data(), pn, b.limit_reached.mutable_data() + e);
+      std::copy_n(p->pairs.data(), 2 * pk, b.pairs.mutable_data() + 2 * r);
+      std::copy_n(p->points_a.data(), 3 * pk, b.points_a.mutable_data() + 3 * r);
+      std::copy_n(p->points_b.data(), 3 * pk, b.points_b.mutable_data() + 3 * r);
+      std::copy_n(p->normals.data(), 3 * pk, b.normals.mutable_data() + 3 * r);
+      std::copy_n(p->distances.data(), pk, b.distances.mutable_data() + r);
+      std::copy_n(p->depths.data(), pk, b.depths.mutable_data() + r);
+      b.node_tests += p->node_tests;
+      b.leaf_tests += p->leaf_tests;
+      e += pn;
+      r += pk;
+    }
+    b.derive();
+    return b;
+  }
+
+ private:
+  void allocate(py::ssize_t n, py::ssize_t k) {
+    offsets = py::array_t<std::int64_t>(n + 1);
+    hit = py::array_t<bool>(n);
+    limit_reached = py::array_t<bool>(n);
+    distance = py::array_t<double>(n);
+    pairs = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
+    entries = py::array_t<std::int64_t>(k);
+    points_a = py::array_t<double>({k, py::ssize_t{3}});
+    points_b = py::array_t<double>({k, py::ssize_t{3}});
+    normals = py::array_t<double>({k, py::ssize_t{3}});
+    distances = py::array_t<double>(k);
+    depths = py::array_t<double>(k);
+  }
+
+  /// hit, distance and entries, from offsets and distances.
+  void derive() {
+    const std::int64_t* const off = offsets.data();
+    const double* const dd = distances.data();
+    bool* const h = hit.mutable_data();
+    double* const dist = distance.mutable_data();
+    std::int64_t* const ent = entries.mutable_data();
+    for (py::ssize_t i = 0; i + 1 < offsets.shape(0); ++i) {
+      h[i] = off[i + 1] > off[i];
+      dist[i] = std::numeric_limits<double>::infinity();
+      for (std::int64_t r = off[i]; r != off[i + 1]; ++r) {
+        dist[i] = std::min(dist[i], dd[r]);
+        ent[r] = i;
+      }
+    }
+  }
+
+  template <class T>
+  static py::array_t<T, py::array::c_style | py::array::forcecast> array_of(py::handle h) {
+    return py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(h);
+  }
+
+  template <class T, class Refuse>
+  static void copy_checked(const py::array_t<T, py::array::c_style | py::array::forcecast>& from, py::array_t<T>& to,
+                           std::initializer_list<py::ssize_t> shape, const char* name, const Refuse& refuse) {
+    bool fits = from && from.ndim() == static_cast<py::ssize_t>(shape.size());
+    for (std::size_t d = 0; fits && d < shape.size(); ++d) fits = from.shape(static_cast<py::ssize_t>(d)) == shape.begin()[d];
+    if (!fits) throw refuse(std::string(name) + " does not have the shape the offsets give");
+    std::copy_n(from.data(), to.size(), to.mutable_data());
   }
 };
 
@@ -155,9 +262,20 @@ inline void bind_batch(py::module_& m) {
       .def_readonly("node_tests", &PyBatch::node_tests)
       .def_readonly("leaf_tests", &PyBatch::leaf_tests)
       .def("__len__", [](const PyBatch& b) { return static_cast<std::size_t>(b.hit.shape(0)); })
-      .def("__reduce__", [](const PyBatch&) -> py::object {
-        throw caliber::Error(caliber::ErrorCode::bad_argument, "Batch", "cannot be pickled: pickle its arrays");
+      .def_static(
+          "concatenate",
+          [](const std::vector<const PyBatch*>& parts) {
+            for (const PyBatch* p : parts) {
+              if (p == nullptr) throw caliber::Error(caliber::ErrorCode::bad_argument, "Batch.concatenate", "got None");
+            }
+            return PyBatch::concatenate(parts);
+          },
+          py::arg("batches"),
+          "One Batch of the given batches' entries, in order (what a sweep cut in chunks gathers); counters summed.")
+      .def("__reduce__", [](const PyBatch& b) {
+        return py::make_tuple(py::module_::import("caliber").attr("_batch_from_state"), py::make_tuple(b.state()));
       });
+  m.def("_checked_batch", &PyBatch::from_state);
 }
 
 }  // namespace caliber_python

@@ -7,8 +7,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <dlfcn.h>
+
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -186,7 +189,8 @@ PyResult query_result(caliber::QueryResult&& q) {
 
 caliber::Pose pose_from_matrix(const py::array& m) {
   // float32 matrices are rotations only to float32's rounding: they get that tolerance.
-  const bool single = m.dtype().is(py::dtype::of<float>());
+  const bool single =
+      m.dtype().kind() == 'f' && m.dtype().itemsize() == 4;  // (not dtype identity: an unpickled array has its own)
   const py::array_t<double, py::array::c_style | py::array::forcecast> d(m);
   if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4)
     throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
@@ -402,6 +406,13 @@ PYBIND11_MODULE(caliber, m) {
         const std::array<double, 4> q{p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z()};
         return rebuilt_by("_pose_from_state", py::make_tuple(t, q));
       });
+  // caliber's pure-Python modules (caliber.distributed) sit in the folder caliber/ beside this
+  // file: with that folder as the module's __path__, `import caliber.distributed` finds them.
+  if (Dl_info info{}; dladdr(reinterpret_cast<const void*>(&model_state), &info) != 0 && info.dli_fname != nullptr) {
+    py::list path;
+    path.append((std::filesystem::path(info.dli_fname).parent_path() / "caliber").string());
+    m.attr("__path__") = path;
+  }
   m.def("_checked_model", &model_from_state);
   m.def("_checked_pose", &pose_from_state);
   // What pickles name to rebuild a Model or a Pose: Python functions of module caliber (pickle
@@ -414,6 +425,10 @@ def _model_from_state(state):
 def _pose_from_state(translation, quaternion):
     """How a pickled Pose is rebuilt: its values checked."""
     return _checked_pose(translation, quaternion)
+
+def _batch_from_state(state):
+    """How a pickled Batch is rebuilt: its arrays checked against its offsets."""
+    return _checked_batch(state)
 )",
            m.attr("__dict__"));
 

@@ -88,6 +88,12 @@ def test_every_pose_format_gives_the_same_batch():
     expect_entries(from_matrices, [caliber.Pose.from_matrix(m) for m in matrices], "proximity", 0.05)
     single = caliber.query_many(TETRA, caliber.Pose(), FAN, matrices.astype(np.float32), kind="interference")
     assert len(single) == 40
+    # float32 is float32 whatever dtype object carries it (an unpickled array has its own).
+    unpickled = pickle.loads(pickle.dumps(matrices.astype(np.float32)))
+    assert unpickled.dtype is not np.dtype(np.float32)
+    again = caliber.query_many(TETRA, caliber.Pose(), FAN, unpickled, kind="interference")
+    assert again.pairs.tobytes() == single.pairs.tobytes()
+    assert caliber.Pose.from_matrix(unpickled[0]).matrix().tobytes() == caliber.Pose.from_matrix(matrices.astype(np.float32)[0]).matrix().tobytes()
     # Both sides moving; A given as matrices, B fixed.
     both = caliber.query_many(TETRA, matrices, FAN, matrices[::-1].copy(), kind="interference")
     assert len(both) == 40
@@ -116,9 +122,49 @@ def test_bad_batches_are_caliber_errors_naming_the_row():
         caliber.query_many(TETRA, caliber.Pose(), FAN, "poses")
     with pytest.raises(caliber.Error, match="order: must be 'wxyz' or 'xyzw'"):
         caliber.query_many(TETRA, caliber.Pose(), FAN, rows(2, 1), order="zyxw")
-    with pytest.raises(caliber.Error, match="Batch: cannot be pickled"):
-        pickle.dumps(caliber.query_many(TETRA, caliber.Pose(), FAN, rows(2, 1)))
     with pytest.raises(caliber.Error, match="Batch: was never built"):
         caliber.Batch.__new__(caliber.Batch).hit
     empty = caliber.query_many(TETRA, caliber.Pose(), FAN, np.zeros((0, 7)))
     assert len(empty) == 0 and empty.offsets.tolist() == [0]
+
+
+FIELDS = ["offsets", "hit", "limit_reached", "distance", "pairs", "entries", "points_a", "points_b", "normals",
+          "distances", "depths"]
+
+
+def test_batches_pickle_and_concatenate_to_the_whole_batch():
+    values = rows(60, 4)
+    whole = caliber.query_many(TETRA, caliber.Pose(), FAN, values, kind="proximity", tolerance=0.05, max_pairs=2)
+    assert whole.limit_reached.any() and 0 < whole.hit.sum() < 60
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        again = pickle.loads(pickle.dumps(whole, protocol))
+        for name in FIELDS:
+            assert getattr(again, name).tobytes() == getattr(whole, name).tobytes(), name
+        assert (again.node_tests, again.leaf_tests) == (whole.node_tests, whole.leaf_tests)
+    parts = [caliber.query_many(TETRA, caliber.Pose(), FAN, values[lo:hi], kind="proximity", tolerance=0.05, max_pairs=2)
+             for lo, hi in [(0, 0), (0, 17), (17, 18), (18, 60)]]
+    joined = caliber.Batch.concatenate(parts)
+    for name in FIELDS:
+        assert getattr(joined, name).tobytes() == getattr(whole, name).tobytes(), name
+    assert len(caliber.Batch.concatenate([])) == 0
+
+
+def test_tampered_batch_states_are_refused():
+    whole = caliber.query_many(TETRA, caliber.Pose(), FAN, rows(10, 4), kind="proximity", tolerance=0.05)
+    state = list(whole.__reduce__()[1][0])
+    assert len(whole.pairs) > 0
+
+    def refused(change, match):
+        s = list(state)
+        change(s)
+        with pytest.raises(caliber.Error, match="not a caliber.Batch state: " + match):
+            caliber._batch_from_state(tuple(s))
+
+    refused(lambda s: s.pop(), "expected a tuple of 10 items")
+    refused(lambda s: s.__setitem__(0, s[0][::-1].copy()), "offsets must not decrease")
+    refused(lambda s: s.__setitem__(0, s[0] + 1), "offsets must start at 0")
+    refused(lambda s: s.__setitem__(0, np.array([0, 10**15])), "distances must have offsets")
+    refused(lambda s: s.__setitem__(2, s[2][:-1]), "pairs does not have the shape")
+    refused(lambda s: s.__setitem__(1, s[1][:-1]), "limit_reached does not have the shape")
+    refused(lambda s: s.__setitem__(3, "points"), "points_a")
+    refused(lambda s: s.__setitem__(8, -1), "the counters must be integers")
