@@ -80,6 +80,7 @@ struct PyBatch {
   py::array_t<double> points_a, points_b, normals;  ///< k x 3, world coordinates (zero for interference)
   py::array_t<double> distances, depths;            ///< k
   std::uint64_t node_tests = 0, leaf_tests = 0;
+  double batch_ms = 0.0;  ///< wall time of the C++ batch (Engine::query_many), without the arrays' conversion
 
   PyBatch() = default;
 
@@ -261,6 +262,9 @@ inline void bind_batch(py::module_& m) {
       .def_readonly("depths", &PyBatch::depths)
       .def_readonly("node_tests", &PyBatch::node_tests)
       .def_readonly("leaf_tests", &PyBatch::leaf_tests)
+      .def_readonly("batch_ms", &PyBatch::batch_ms,
+                    "wall time of the C++ batch in milliseconds, without reading the poses or making these arrays (0 for a "
+                    "Batch unpickled or joined)")
       .def("__len__", [](const PyBatch& b) { return static_cast<std::size_t>(b.hit.shape(0)); })
       .def_static(
           "concatenate",

@@ -10,6 +10,7 @@
 #include <dlfcn.h>
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -282,11 +283,16 @@ caliber_python::PyBatch query_many(caliber::Engine& engine, const PyModel& a, co
   const caliber::QuaternionOrder o = caliber_python::parse_order(order);
   const caliber_python::SidePoses pa(poses_a, o, "poses_a"), pb(poses_b, o, "poses_b");
   caliber::BatchResult result;
+  double ms = 0.0;
   {
     py::gil_scoped_release release;
+    const auto start = std::chrono::steady_clock::now();
     result = engine.query_many(*a.model, pa.poses, *b.model, pb.poses, request);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
-  return caliber_python::PyBatch(result);
+  caliber_python::PyBatch batch(result);
+  batch.batch_ms = ms;
+  return batch;
 }
 
 }  // namespace
