@@ -120,6 +120,34 @@ double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::V
   return depth;
 }
 
+/// A kept candidate as a Contact in world coordinates (A's pose; `ra` its rotation matrix): the
+/// normal from A to B (the direction between the points, else A's face normal, else B's), and the
+/// depth of an intersecting pair.
+Contact world_contact(const PairContext& ctx, const Candidate& c, ObjectPair objects, const Eigen::Matrix3d& ra) {
+  const Pose& pose = ctx.pose_a();
+  Contact contact;
+  contact.object_a = objects.a;
+  contact.object_b = objects.b;
+  contact.tri_a = c.tri_a;
+  contact.tri_b = c.tri_b;
+  contact.distance = c.distance;
+  contact.point_a = ra * c.point_a + pose.translation;
+  contact.point_b = ra * c.point_b + pose.translation;
+  const Eigen::Vector3d gap = c.point_b - c.point_a;
+  const double gap_norm = gap.norm();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  if (c.distance > 0.0 && gap_norm > 0.0) {
+    normal = gap / gap_norm;
+  } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
+    normal = ctx.a().normals[c.tri_a];
+  } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
+    normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
+  }
+  contact.normal = ra * normal;
+  if (c.distance == 0.0 && normal.squaredNorm() > 0.0) contact.depth = depth_estimate(ctx, c, normal);
+  return contact;
+}
+
 /// A distance query's answer: each traversal (a whole pair, or one task of it) brought its closest
 /// pair; the closest of those, ties to the lowest ids, is the pair's answer whatever the cut. At 0,
 /// pieces stopped at their own first intersecting pair: the traversal from the root finds its own
@@ -154,8 +182,10 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     }
     candidates = local_minima(ctx, candidates, grain);
   }
-  if (result.kind == QueryKind::distance && !candidates.empty())
-    candidates = {closest(ctx, candidates, contact_pair, result.stats)};
+  if (result.kind == QueryKind::distance && !candidates.empty()) {
+    const Candidate best = closest(ctx, candidates, contact_pair, result.stats);
+    candidates.assign(1, best);  // in the caller's storage (query_whole keeps it from call to call)
+  }
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && candidates.size() >= kFinalizeGrain) {
     parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
@@ -178,35 +208,17 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     return result;
   }
 
-  const Pose& pose = ctx.pose_a();
-  const Eigen::Matrix3d ra = pose.rotation_matrix();
+  const Eigen::Matrix3d ra = ctx.pose_a().rotation_matrix();
   result.contacts.resize(candidates.size());
-  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) {
-      const Candidate& c = candidates[i];
-      Contact contact;
-      contact.object_a = objects.a;
-      contact.object_b = objects.b;
-      contact.tri_a = c.tri_a;
-      contact.tri_b = c.tri_b;
-      contact.distance = c.distance;
-      contact.point_a = ra * c.point_a + pose.translation;
-      contact.point_b = ra * c.point_b + pose.translation;
-      const Eigen::Vector3d gap = c.point_b - c.point_a;
-      const double gap_norm = gap.norm();
-      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-      if (c.distance > 0.0 && gap_norm > 0.0) {
-        normal = gap / gap_norm;
-      } else if (ctx.a().normals[c.tri_a].squaredNorm() > 0.0) {
-        normal = ctx.a().normals[c.tri_a];
-      } else if (ctx.b().normals[c.tri_b].squaredNorm() > 0.0) {
-        normal = -(ctx.rotation_b_to_a() * ctx.b().normals[c.tri_b]).normalized();
-      }
-      contact.normal = ra * normal;
-      if (c.distance == 0.0 && normal.squaredNorm() > 0.0) contact.depth = depth_estimate(ctx, c, normal);
-      result.contacts[i] = contact;
-    }
-  });
+  const auto contacts = [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) result.contacts[i] = world_contact(ctx, candidates[i], objects, ra);
+  };
+  // Serial: called here, not through parallel_for's std::function (an allocation per query).
+  if (candidates.size() <= grain) {
+    contacts(0, candidates.size());
+  } else {
+    parallel::parallel_for(0, candidates.size(), grain, contacts);
+  }
   return result;
 }
 

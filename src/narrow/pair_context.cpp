@@ -39,9 +39,15 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
     }
     mNodeFrame.trans[i] = mTrans[i];
   }
+  // The angle is read by the contact kind's tests alone (cones_can_face, normals_allow): the
+  // other kinds skip the cosine and sine (a tenth of a small query's context).
   mTheta = request.angle_deg * std::numbers::pi / 180.0;
-  mCosTheta = std::cos(mTheta);
-  mSinTheta = std::sin(mTheta);
+  mCosTheta = 1.0;
+  mSinTheta = 0.0;
+  if (request.kind == QueryKind::contact) {
+    mCosTheta = std::cos(mTheta);
+    mSinTheta = std::sin(mTheta);
+  }
 }
 
 bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const {
@@ -239,8 +245,9 @@ void PairContext::finish_staged(LeafStage& stage, std::vector<Candidate>& out) c
 }
 
 void PairContext::flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const {
-  refuse_staged(stage, out);
-  finish_staged(stage, out);
+  // An empty batch appends nothing: skipped (a traversal that reached no leaf pays nothing).
+  if (stage.refusal.batch.size != 0) refuse_staged(stage, out);
+  if (stage.closest.batch.size != 0) finish_staged(stage, out);
 }
 
 bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {
