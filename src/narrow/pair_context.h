@@ -354,8 +354,8 @@ class PairContext {
   double mReach;                     ///< tolerance + safety margin added to the sum of radii
   double mSlabReach;                 ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
   double mTheta;                     ///< contact angle, radians
-  double mCosTheta;                  ///< cos(theta)
-  double mSinTheta;                  ///< sin(theta)
+  double mCosTheta;                  ///< cos(theta) (contact only; 1 otherwise)
+  double mSinTheta;                  ///< sin(theta) (contact only; 0 otherwise)
   detail::NodeTestFrame mNodeFrame;  ///< what node_tests_2x2's AVX2 form reads of the above
 };
 
