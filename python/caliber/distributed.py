@@ -53,7 +53,7 @@ def _side(poses, name, order):
 
 
 def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=None, angle=30.0, max_pairs=0, *,
-               order="wxyz", lowest_ids=False, chunk=20000, threads=1):
+               order="wxyz", lowest_ids=False, chunk=2500, threads=1):
     """caliber.query_many(a, poses_a, b, poses_b, ...) on the workers of `client` (a
     dask.distributed Client): the same arguments and the same Batch, bit for bit. `chunk`: poses
     per task (a dead worker's chunks run again); `threads`: threads per chunk on its worker (1 fits
