@@ -38,8 +38,8 @@ void finalize_pairs(StepState& state,
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
       state.candidates[i] = all.size();
-      state.results[i] =
-          narrow::finalize(state.contexts[i], all, stats, state.pairs[i], narrow::ContactPair::from_root, state.parallel_finalize);
+      state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.pairs[i], narrow::ContactPair::from_root,
+                                          state.parallel_finalize);
     });
   });
 }
