@@ -151,11 +151,12 @@ Contact world_contact(const PairContext& ctx, const Candidate& c, ObjectPair obj
 /// A distance query's answer: each traversal (a whole pair, or one task of it) brought its closest
 /// pair; the closest of those, ties to the lowest ids, is the pair's answer whatever the cut. At 0,
 /// pieces stopped at their own first intersecting pair: the traversal from the root finds its own
-/// again (its tests added to `stats`).
-Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidates, ContactPair contact_pair, QueryStats& stats) {
+/// again. (Its tests are not the pair's counters, which stay the sum of what its pieces did.)
+Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidates, ContactPair contact_pair) {
   const Candidate best = *std::min_element(candidates.begin(), candidates.end(), closer);
   const bool again = best.distance == 0.0 && !ctx.request().lowest_ids && contact_pair == ContactPair::from_root;
-  return again ? first_contact(ctx, stats) : best;
+  QueryStats search;
+  return again ? first_contact(ctx, search) : best;
 }
 
 }  // namespace
@@ -183,7 +184,7 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     candidates = local_minima(ctx, candidates, grain);
   }
   if (result.kind == QueryKind::distance && !candidates.empty()) {
-    const Candidate best = closest(ctx, candidates, contact_pair, result.stats);
+    const Candidate best = closest(ctx, candidates, contact_pair);
     candidates.assign(1, best);  // in the caller's storage (query_whole keeps it from call to call)
   }
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
