@@ -33,9 +33,9 @@ def _run_chunk(a, poses_a, b, poses_b, first, request):
         raise caliber.Error(message) from None
 
 
-def _side(poses, name, order):
-    """(count, take): how many poses a side gives (1: the same pose for every entry) and how to cut
-    rows [lo, hi) of it."""
+def _side(poses, name):
+    """(count, take): how many poses a side gives (1: the same pose for every entry, which take
+    gives whatever the rows asked) and how to cut rows [lo, hi) of it."""
     if isinstance(poses, caliber.Pose):
         return 1, lambda lo, hi: poses
     if isinstance(poses, (list, tuple)) and (len(poses) == 0 or isinstance(poses[0], caliber.Pose)):
@@ -62,8 +62,8 @@ def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=No
         raise caliber.Error(f"chunk: must be an integer >= 1, not {chunk!r}")
     if not isinstance(a, caliber.Model) or not isinstance(b, caliber.Model):
         raise caliber.Error("a, b: must be caliber.Model")
-    na, take_a = _side(poses_a, "poses_a", order)
-    nb, take_b = _side(poses_b, "poses_b", order)
+    na, take_a = _side(poses_a, "poses_a")
+    nb, take_b = _side(poses_b, "poses_b")
     if na != 1 and nb != 1 and na != nb:
         raise caliber.Error(f"poses_a: {na} poses of A but {nb} of B (each side gives one pose or one per entry)")
     n = max(na, nb) if na != 0 and nb != 0 else 0
@@ -75,7 +75,5 @@ def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=No
     futures = []
     for lo in range(0, n, chunk):
         hi = min(n, lo + chunk)
-        part_a = take_a(lo, hi) if na != 1 else take_a(0, 1)
-        part_b = take_b(lo, hi) if nb != 1 else take_b(0, 1)
-        futures.append(client.submit(_run_chunk, model_a, part_a, model_b, part_b, lo, request, pure=False))
+        futures.append(client.submit(_run_chunk, model_a, take_a(lo, hi), model_b, take_b(lo, hi), lo, request, pure=False))
     return caliber.Batch.concatenate(client.gather(futures))
