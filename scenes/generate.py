@@ -4,10 +4,17 @@
 them in data/meshes/, which git ignores). Re-run after changing a parameter here:
 
     python3 scenes/generate.py
+
+With --grid N [N ...] it writes instead the scenes of many parts (data/scenes/grid_N.json, which
+git ignores: 100,000 parts make 40 MB of JSON): N copies of CGAL's `eight` refined twice (10,144
+triangles each) on a jittered cubic grid, neighbours touching, each drifting and turning, contact
+query, 20 steps. `caliber bench --grid` reads them.
 """
+import argparse
 import json
 import math
 import os
+import random
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = "../data/meshes/"
@@ -201,8 +208,47 @@ ROD_RINGS = 64
 ROD_SEGMENTS = 48
 HEAVY2 = (3, 3, 0.433)
 
+# --- grid_N: N parts on a jittered cubic grid, each drifting and turning (the many-object scenes).
+GRID_SPACING = 0.88  # the part is 0.49 x 0.21 x 1.0, turned at random: neighbours touch
+GRID_JITTER = 0.05
+GRID_STEPS = 20
+
+
+def grid(n, out_dir):
+    rng = random.Random(n)
+    side = math.ceil(n ** (1.0 / 3.0) - 1e-9)
+    mesh = os.path.relpath(os.path.join(HERE, DATA, "eight.off"), out_dir)
+    objects = []
+    for i in range(n):
+        cell = (i % side, (i // side) % side, i // (side * side))
+        position = [GRID_SPACING * c + rng.uniform(-GRID_JITTER, GRID_JITTER) for c in cell]
+        axis = [rng.gauss(0, 1) for _ in range(3)]
+        objects.append({"name": "part%d" % i, "mesh": mesh, "refine": 2, "position": rnd(position),
+                        "orientation": rnd(quat(axis, rng.uniform(0, 360))),
+                        "motion": {"type": "velocity",
+                                   "linear": rnd([rng.uniform(-0.2, 0.2) for _ in range(3)]),
+                                   "angular": rnd([rng.uniform(-0.5, 0.5) for _ in range(3)])}})
+    path = os.path.join(out_dir, "grid_%d.json" % n)
+    with open(path, "w") as f:
+        json.dump({"name": "grid_%d" % n, "steps": GRID_STEPS, "dt": DT,
+                   "query": {"kind": "contact", "tolerance": 0.0, "angle": 30}, "objects": objects}, f)
+        f.write("\n")
+    return path
+
+
 if __name__ == "__main__":
-    two_small()
-    two_large()
-    funnel()
-    front_car()
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--grid", type=int, nargs="+", metavar="N", help="write grid_N.json for each N instead")
+    parser.add_argument("--out-dir", default=os.path.join(HERE, "..", "data", "scenes"), help="where grid scenes go")
+    args = parser.parse_args()
+    if args.grid:
+        os.makedirs(args.out_dir, exist_ok=True)
+        for n in args.grid:
+            if n < 1:
+                parser.error("--grid: a scene needs at least one part")
+            print(grid(n, os.path.abspath(args.out_dir)))
+    else:
+        two_small()
+        two_large()
+        funnel()
+        front_car()

@@ -19,7 +19,10 @@ namespace caliber {
 /// within `reach` of each other is kept (pass the request's reach(request): 0 for interference,
 /// the tolerance otherwise). `fixed` is empty or holds one flag per object: a pair of two fixed
 /// objects is skipped (they never move against each other). `ignored` lists pairs never tested
-/// (a < b, any order). Sweep and prune along x.
+/// (a < b, any order). The pairs are exactly those whose boxes overlap (closed intervals on the
+/// three axes): a tree of boxes over the objects in Morton order prunes the search, each pair met
+/// once. Runs on the calling thread; Engine::find_pairs runs the same search on the engine's threads
+/// and keeps the tree from one frame to the next.
 /// Throws caliber::Error (source "broad phase") on a null model, sizes that do not match, a
 /// negative or non-finite reach, or an ignored pair that names no two objects a < b.
 [[nodiscard]] CALIBER_EXPORT std::vector<ObjectPair> broad_phase(const std::vector<std::shared_ptr<const Model>>& models,

@@ -160,8 +160,14 @@ class CALIBER_EXPORT Engine {
   /// index) or a bad request, before any work.
   [[nodiscard]] BatchResult query_many(const Model& a, std::span<const Pose> poses_a, const Model& b,
                                        std::span<const Pose> poses_b, const QueryRequest& request);
-  /// Drops what the temporal methods remember of every pair (after a jump in the motion, or when
-  /// object indices start to denote other objects).
+  /// The broad phase on the engine's threads: sets frame.pairs to caliber::broad_phase(frame.models,
+  /// frame.poses, reach(frame.request), fixed, ignored), the same pairs, starting from what it
+  /// kept of the previous call (the objects' order in its tree, re-sorted only when the tree
+  /// refitted over that order has grown by a quarter, and its buffers). Throws caliber::Error as
+  /// caliber::broad_phase does, and on a bad request.
+  void find_pairs(Frame& frame, const std::vector<bool>& fixed = {}, const std::vector<ObjectPair>& ignored = {});
+  /// Drops what the temporal methods and the broad phase remember (after a jump in the motion, or
+  /// when object indices start to denote other objects).
   void forget();
   /// The threads a step called from this thread now would run on (the caller included): 1 for
   /// `sequential` or threads = 1; else the arena's concurrency, at most the process's limit. A

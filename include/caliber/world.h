@@ -45,6 +45,10 @@ class CALIBER_EXPORT World {
   /// Step k as a frame: every object's model and pose, the broad phase's pairs, the request.
   /// The frame points to this world's group table: it must not outlive the world.
   [[nodiscard]] Frame frame(int step) const;
+  /// Step k as a frame whose pairs the engine's broad phase finds (Engine::find_pairs: the same
+  /// pairs, on the engine's threads, from what it kept of the previous step). Not const on the
+  /// engine: one engine per thread.
+  [[nodiscard]] Frame frame(int step, Engine& engine) const;
   /// The query request every task runs (with the scene's group compatibility when it has one).
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
 
@@ -56,8 +60,8 @@ class CALIBER_EXPORT World {
   std::vector<ObjectPair> mIgnored;
 };
 
-/// Step k of a world on an engine: its frame (poses and broad phase, timed as broad_ms), then
-/// engine.step; fills the result's step, time and broad_ms.
+/// Step k of a world on an engine: its frame (poses and the engine's broad phase, timed as
+/// broad_ms), then engine.step; fills the result's step, time and broad_ms.
 [[nodiscard]] CALIBER_EXPORT StepResult step(const World& world, Engine& engine, int k);
 
 }  // namespace caliber

@@ -114,6 +114,14 @@ int Engine::threads() const { return mImpl->executor.threads(); }
 void Engine::forget() {
   const schedule::OneCallAtATime hold(mImpl->busy, "forget");
   mImpl->history = tasks::History{};
+  mImpl->broad = broad::State{};
+}
+
+void Engine::find_pairs(Frame& frame, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
+  const schedule::OneCallAtATime hold(mImpl->busy, "find_pairs");
+  validate_request(frame.request);
+  mImpl->executor.execute(
+      [&] { broad::find_pairs(mImpl->broad, frame.models, frame.poses, reach(frame.request), fixed, ignored, frame.pairs); });
 }
 
 namespace {

@@ -15,6 +15,7 @@
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "broad/broad_phase.h"
 #include "caliber/profile.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"
@@ -96,6 +97,8 @@ struct Engine::Impl {
   /// Who ran what when, this step (EngineOptions::timeline).
   schedule::Timeline timeline;
   schedule::ContextStore contexts;
+  /// The broad phase's tree and buffers (Engine::find_pairs).
+  broad::State broad;
   /// This step's schedule record when nobody asked for it.
   ScheduleRecord record;
 

@@ -1,4 +1,4 @@
-// The world: shared models, poses per step, broad phase (sweep and prune), the frames it makes.
+// The world: shared models, poses per step, the broad phase, the frames it makes.
 
 #include "caliber/world.h"
 
@@ -10,13 +10,13 @@
 #include "caliber/broad_phase.h"
 #include "caliber/error.h"
 #include "util/timing.h"
-#include "world/world_box.h"
+#include "broad/world_box.h"
 
 namespace caliber {
 namespace {
 
-using world::world_box;
-using world::WorldBox;
+using broad::world_box;
+using broad::WorldBox;
 
 using util::Clock;
 using util::ms_since;
@@ -128,9 +128,18 @@ Frame World::frame(int step) const {
   return frame;
 }
 
+Frame World::frame(int step, Engine& engine) const {
+  Frame frame;
+  frame.poses = poses_at(step);
+  frame.models = mModels;
+  frame.request = mRequest;
+  engine.find_pairs(frame, mStatic, mIgnored);
+  return frame;
+}
+
 StepResult step(const World& world, Engine& engine, int k) {
   const auto start = Clock::now();
-  const Frame frame = world.frame(k);
+  const Frame frame = world.frame(k, engine);
   const double broad_ms = ms_since(start);
   StepResult out = engine.step(frame);
   out.step = k;

@@ -7,7 +7,7 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 
-namespace caliber::world {
+namespace caliber::broad {
 
 /// A world-space box of an object: its root box moved by its pose (conservative: |R| h).
 struct WorldBox {
@@ -28,4 +28,4 @@ inline WorldBox world_box(const Model& model, const Pose& pose, double grow) {
   return {center - half - Eigen::Vector3d::Constant(margin), center + half + Eigen::Vector3d::Constant(margin)};
 }
 
-}  // namespace caliber::world
+}  // namespace caliber::broad

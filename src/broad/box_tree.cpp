@@ -1,0 +1,227 @@
+// The broad phase's tree: Morton order, refit, and the ordered pair search (broad/box_tree.h).
+
+#include "broad/box_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+#include "parallel/executor.h"
+
+namespace caliber::broad {
+namespace {
+
+/// Objects per leaf of the tree.
+constexpr std::size_t kLeaf = 4;
+/// Positions per parallel chunk of the pair search (about 0.1 ms of work on a grid of parts).
+constexpr std::size_t kChunk = 1024;
+/// Refitting over the old order is kept while the tree's boxes have grown by less than this
+/// factor of their area right after the last sort.
+constexpr double kResortGrowth = 1.25;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr FlatBox kEmpty{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};  ///< overlaps nothing
+
+inline bool overlap(const FlatBox& x, const FlatBox& b) {
+  return x.lo[0] <= b.hi[0] && b.lo[0] <= x.hi[0] && x.lo[1] <= b.hi[1] && b.lo[1] <= x.hi[1] && x.lo[2] <= b.hi[2] &&
+         b.lo[2] <= x.hi[2];
+}
+
+inline FlatBox merge(const FlatBox& x, const FlatBox& y) {
+  FlatBox m;
+  for (int i = 0; i < 3; ++i) {
+    m.lo[i] = std::min(x.lo[i], y.lo[i]);
+    m.hi[i] = std::max(x.hi[i], y.hi[i]);
+  }
+  return m;
+}
+
+/// The 10 low bits of v spread to every third bit.
+inline std::uint32_t spread(std::uint32_t v) {
+  v = (v | (v << 16)) & 0x030000FFu;
+  v = (v | (v << 8)) & 0x0300F00Fu;
+  v = (v | (v << 4)) & 0x030C30C3u;
+  v = (v | (v << 2)) & 0x09249249u;
+  return v;
+}
+
+}  // namespace
+
+void BoxTree::sort_order(std::span<const WorldBox> boxes) {
+  const std::size_t n = boxes.size();
+  std::array<double, 3> lo{kInf, kInf, kInf};
+  std::array<double, 3> hi{-kInf, -kInf, -kInf};
+  for (const WorldBox& b : boxes) {
+    for (int i = 0; i < 3; ++i) {
+      const double c = 0.5 * (b.lo[i] + b.hi[i]);
+      lo[i] = std::min(lo[i], c);
+      hi[i] = std::max(hi[i], c);
+    }
+  }
+  std::array<double, 3> scale{};
+  for (int i = 0; i < 3; ++i) scale[i] = hi[i] > lo[i] ? 1023.0 / (hi[i] - lo[i]) : 0.0;
+  mCodes.resize(n);
+  parallel::parallel_for(0, n, 8192, [&](std::size_t first, std::size_t last) {
+    for (std::size_t j = first; j != last; ++j) {
+      std::uint32_t code = 0;
+      for (int i = 0; i < 3; ++i) {
+        const double c = (0.5 * (boxes[j].lo[i] + boxes[j].hi[i]) - lo[i]) * scale[i];
+        code |= spread(static_cast<std::uint32_t>(std::clamp(c, 0.0, 1023.0))) << (2 - i);
+      }
+      mCodes[j] = code;
+    }
+  });
+  // A stable radix sort of the previous order (or the objects' own) by code: 3 passes of 10 bits.
+  if (mOrder.size() != n) {
+    mOrder.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) mOrder[i] = i;
+  }
+  mScratch.resize(n);
+  std::array<std::uint32_t, 1025> count{};
+  for (int shift = 0; shift < 30; shift += 10) {
+    count.fill(0);
+    for (const std::uint32_t o : mOrder) ++count[((mCodes[o] >> shift) & 1023u) + 1];
+    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+    for (const std::uint32_t o : mOrder) mScratch[count[(mCodes[o] >> shift) & 1023u]++] = o;
+    mOrder.swap(mScratch);
+  }
+  ++mSorts;
+}
+
+void BoxTree::refit() {
+  // Leaves from the sorted boxes, then each level from the one below (in parallel when wide).
+  const std::size_t leaves = mLeaves;
+  parallel::parallel_for(0, leaves, 4096, [&](std::size_t first, std::size_t last) {
+    for (std::size_t l = first; l != last; ++l) {
+      FlatBox b = mSorted[l * kLeaf];
+      for (std::size_t i = 1; i < kLeaf; ++i) b = merge(b, mSorted[l * kLeaf + i]);
+      mNodes[leaves + l] = b;
+    }
+  });
+  for (std::size_t width = leaves / 2; width >= 1; width /= 2) {
+    parallel::parallel_for(width, 2 * width, 4096, [&](std::size_t first, std::size_t last) {
+      for (std::size_t k = first; k != last; ++k) mNodes[k] = merge(mNodes[2 * k], mNodes[2 * k + 1]);
+    });
+  }
+}
+
+double BoxTree::node_area() const {
+  double area = 0.0;
+  for (std::size_t k = 1; k < mLeaves; ++k) {
+    const FlatBox& b = mNodes[k];
+    if (!(b.lo[0] <= b.hi[0])) continue;  // empty padding
+    const double x = b.hi[0] - b.lo[0];
+    const double y = b.hi[1] - b.lo[1];
+    const double z = b.hi[2] - b.lo[2];
+    area += x * y + y * z + z * x;
+  }
+  return area;
+}
+
+void BoxTree::pairs(std::span<const WorldBox> boxes, const PairFilter& filter, std::vector<ObjectPair>& out) {
+  out.clear();
+  const std::size_t n = boxes.size();
+  if (n < 2) {
+    mOrder.clear();
+    return;
+  }
+  const bool fresh = mOrder.size() != n;
+  if (fresh) sort_order(boxes);
+  mLeaves = 1;
+  while (mLeaves * kLeaf < n) mLeaves *= 2;
+  mSorted.resize(mLeaves * kLeaf);
+  mNodes.resize(2 * mLeaves);
+  const auto fill = [&] {
+    parallel::parallel_for(0, mSorted.size(), 8192, [&](std::size_t first, std::size_t last) {
+      for (std::size_t p = first; p != last; ++p) {
+        if (p >= n) {
+          mSorted[p] = kEmpty;
+          continue;
+        }
+        const WorldBox& b = boxes[mOrder[p]];
+        mSorted[p] = FlatBox{{b.lo.x(), b.lo.y(), b.lo.z()}, {b.hi.x(), b.hi.y(), b.hi.z()}};
+      }
+    });
+    refit();
+  };
+  fill();
+  if (fresh) {
+    mSortedArea = node_area();
+  } else if (node_area() > kResortGrowth * mSortedArea) {
+    sort_order(boxes);
+    fill();
+    mSortedArea = node_area();
+  }
+  collect(filter, n, out);
+}
+
+void BoxTree::collect(const PairFilter& filter, std::size_t n, std::vector<ObjectPair>& out) {
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  if (mFound.size() < chunks) mFound.resize(chunks);
+  const auto keep = [&](std::uint32_t a, std::uint32_t b) {
+    if (filter.fixed != nullptr && (*filter.fixed)[a] && (*filter.fixed)[b]) return false;
+    return filter.ignored == nullptr ||
+           !std::binary_search(filter.ignored->begin(), filter.ignored->end(), std::uint64_t{a} << 32 | b);
+  };
+  parallel::parallel_for(0, chunks, 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c != c1; ++c) {
+      std::vector<std::uint64_t>& found = mFound[c];
+      found.clear();
+      for (std::size_t p = c * kChunk; p != std::min(n, (c + 1) * kChunk); ++p) {
+        const FlatBox& b = mSorted[p];
+        const std::uint32_t self = mOrder[p];
+        const auto test = [&](std::size_t q) {
+          if (!overlap(mSorted[q], b)) return;
+          const std::uint32_t other = mOrder[q];
+          const std::uint32_t a = std::min(self, other);
+          const std::uint32_t z = std::max(self, other);
+          if (keep(a, z)) found.push_back(std::uint64_t{a} << 32 | z);
+        };
+        // The rest of p's leaf, then the right sibling of each node on the way up: together the
+        // positions after p.
+        const std::size_t leaf = p / kLeaf;
+        for (std::size_t q = p + 1; q != (leaf + 1) * kLeaf; ++q) test(q);
+        std::array<std::size_t, 64> stack{};
+        for (std::size_t k = mLeaves + leaf; k > 1; k /= 2) {
+          if (k % 2 != 0) continue;
+          std::size_t top = 0;
+          stack[top++] = k + 1;
+          while (top != 0) {
+            const std::size_t node = stack[--top];
+            if (!overlap(mNodes[node], b)) continue;
+            if (node >= mLeaves) {
+              const std::size_t first = (node - mLeaves) * kLeaf;
+              for (std::size_t q = first; q != first + kLeaf; ++q) test(q);
+            } else {
+              stack[top++] = 2 * node + 1;
+              stack[top++] = 2 * node;
+            }
+          }
+        }
+      }
+    }
+  });
+  // A counting sort by the first object, then each object's few partners sorted.
+  mStart.assign(n + 1, 0);
+  std::size_t total = 0;
+  for (std::size_t c = 0; c != chunks; ++c) {
+    total += mFound[c].size();
+    for (const std::uint64_t v : mFound[c]) ++mStart[(v >> 32) + 1];
+  }
+  for (std::size_t a = 1; a <= n; ++a) mStart[a] += mStart[a - 1];
+  out.resize(total);
+  for (std::size_t c = 0; c != chunks; ++c) {
+    for (const std::uint64_t v : mFound[c]) {
+      out[mStart[v >> 32]++] = ObjectPair{static_cast<std::uint32_t>(v >> 32), static_cast<std::uint32_t>(v)};
+    }
+  }
+  // mStart[a] is now the end of a's run (and the start of a + 1's).
+  parallel::parallel_for(0, n, 4096, [&](std::size_t first, std::size_t last) {
+    for (std::size_t a = first; a != last; ++a) {
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(a == 0 ? 0 : mStart[a - 1]),
+                out.begin() + static_cast<std::ptrdiff_t>(mStart[a]));
+    }
+  });
+}
+
+}  // namespace caliber::broad

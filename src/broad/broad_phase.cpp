@@ -1,0 +1,72 @@
+// The broad phase: the objects' world boxes and the pairs whose boxes overlap (broad/box_tree.h).
+
+#include "broad/broad_phase.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "caliber/broad_phase.h"
+#include "caliber/error.h"
+#include "parallel/executor.h"
+
+namespace caliber {
+namespace broad {
+namespace {
+
+Error bad(const std::string& problem) { return Error(ErrorCode::bad_argument, "broad phase", problem); }
+
+void validate(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses, double reach,
+              const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
+  const std::size_t n = models.size();
+  if (poses.size() != n) throw bad(std::to_string(n) + " models but " + std::to_string(poses.size()) + " poses (one per object)");
+  if (!fixed.empty() && fixed.size() != n) {
+    throw bad(std::to_string(n) + " objects but " + std::to_string(fixed.size()) + " fixed flags (none, or one per object)");
+  }
+  if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!models[i]) throw bad("object " + std::to_string(i) + " has no model");
+    try {
+      validate_pose(poses[i], {});
+    } catch (const Error&) {
+      validate_pose(poses[i], "broad phase: pose of object " + std::to_string(i));  // throws again, naming it
+    }
+  }
+  for (const ObjectPair& p : ignored) {
+    if (p.a >= p.b || p.b >= n) {
+      throw bad("ignored pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) + ") must name two objects a < b < " +
+                std::to_string(n));
+    }
+  }
+}
+
+}  // namespace
+
+void find_pairs(State& state, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
+                double reach, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored,
+                std::vector<ObjectPair>& out) {
+  validate(models, poses, reach, fixed, ignored);
+  state.ignored.clear();
+  for (const ObjectPair& p : ignored) state.ignored.push_back(std::uint64_t{p.a} << 32 | p.b);
+  std::sort(state.ignored.begin(), state.ignored.end());
+  const std::size_t n = models.size();
+  const double grow = 0.5 * reach;
+  state.boxes.resize(n);
+  parallel::parallel_for(0, n, 4096, [&](std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i != last; ++i) state.boxes[i] = world_box(*models[i], poses[i], grow);
+  });
+  const PairFilter filter{fixed.empty() ? nullptr : &fixed, state.ignored.empty() ? nullptr : &state.ignored};
+  state.tree.pairs(state.boxes, filter, out);
+}
+
+}  // namespace broad
+
+std::vector<ObjectPair> broad_phase(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
+                                    double reach, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
+  broad::State state;
+  std::vector<ObjectPair> pairs;
+  broad::find_pairs(state, models, poses, reach, fixed, ignored, pairs);
+  return pairs;
+}
+
+}  // namespace caliber
