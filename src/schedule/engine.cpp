@@ -148,15 +148,20 @@ void reset_keeping_storage(ScheduleRecord& r) {
 /// After a step: what the temporal methods keep of each pair for the next one.
 void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
               const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, tasks::History& history) {
-  for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests[pairs[i]] = results[i].stats.node_tests;
+  // Only what the method reads next step: the other methods keep nothing per pair.
+  if (options.method != Method::hybrid && options.method != Method::aposteriori) return;
+  history.node_tests.reset(pairs);
+  for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests.value(i) = results[i].stats.node_tests;
   if (options.method == Method::aposteriori) {
+    history.reported.reset(pairs);
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-      std::vector<TrianglePair>& reported = history.reported[pairs[i]];
+      std::vector<TrianglePair>& reported = history.reported.value(i);
       reported.clear();
       for (const Contact& c : results[i].contacts) reported.push_back(TrianglePair{c.tri_a, c.tri_b});
     }
   }
   if (options.method == Method::hybrid && options.node_history) {
+    history.node_counts.clear();
     for (std::size_t s = 0; s < plan.splits.size(); ++s) {
       history.node_counts[pairs[plan.split_pairs[s]]] = tasks::subtree_counts(plan.splits[s].stage, stage_root_tests[s]);
     }

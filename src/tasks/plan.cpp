@@ -30,8 +30,8 @@ InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pai
   w.scale.assign(n, 1.0);
   if (method == Method::hybrid || method == Method::aposteriori) {
     const auto last = [&](std::size_t i) -> std::uint64_t {
-      const auto it = history.node_tests.find(pairs[i]);
-      return it == history.node_tests.end() ? 0 : it->second;
+      const std::uint64_t* tests = history.node_tests.find(pairs[i]);
+      return tests == nullptr ? 0 : *tests;
     };
     double measured = 0.0, estimated = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -62,9 +62,9 @@ void split_by_summary(const EngineOptions& options, const std::vector<ObjectPair
   std::vector<PosterioriSplit> chosen(to_split.size());
   parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
     const std::size_t i = to_split[s];
-    const auto it = history.reported.find(pairs[i]);
-    if (it == history.reported.end()) return;
-    const auto summary = build_summary(contexts[i], it->second);
+    const std::vector<TrianglePair>* reported = history.reported.find(pairs[i]);
+    if (reported == nullptr) return;
+    const auto summary = build_summary(contexts[i], *reported);
     chosen[s] = split_aposteriori(summary, static_cast<std::uint32_t>(i), weight[i], plan.omega, options.epsilon * plan.omega,
                                   static_cast<std::size_t>(options.taboo_cap));
     chosen[s].rest = chosen[s].taboo.empty() ? weight[i] : chosen[s].rest;
@@ -98,11 +98,7 @@ void split_by_stage(const EngineOptions& options, const std::vector<ObjectPair>&
   plan.splits.resize(to_split.size());
   parallel::parallel_for_each(0, to_split.size(), [&](std::size_t s) {
     const std::size_t i = to_split[s];
-    const NodeCounts* measured = nullptr;
-    if (node_history) {
-      const auto it = history.node_counts.find(pairs[i]);
-      if (it != history.node_counts.end()) measured = &it->second;
-    }
+    const NodeCounts* measured = node_history ? history.node_counts.find(pairs[i]) : nullptr;
     const auto stage = [&] {
       plan.splits[s] = split_task(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], w.scale[i], plan.omega,
                                   options.epsilon * plan.omega, measured);

@@ -6,8 +6,8 @@
 /// stage uses the executor it is called in, with the same result on any number of threads).
 
 #include <cstdint>
+#include <algorithm>
 #include <functional>
-#include <map>
 #include <vector>
 
 #include "caliber/engine.h"
@@ -17,12 +17,51 @@
 
 namespace caliber::tasks {
 
-/// What the engine remembers of each object pair from the last step it was tested (keyed by the
-/// pair's object indices, Frame::pairs). Changes only how work is cut, never the contacts.
+/// A value per object pair, sorted by pair: what one step leaves for the next (its size follows the
+/// step's pairs, not the run's).
+template <class T>
+class PairTable {
+ public:
+  /// The value of pair p, or null.
+  [[nodiscard]] const T* find(const ObjectPair& p) const {
+    const auto it = std::lower_bound(mKeys.begin(), mKeys.end(), p);
+    return it == mKeys.end() || *it != p ? nullptr : &mValues[static_cast<std::size_t>(it - mKeys.begin())];
+  }
+  /// The value of pair p, inserted (value-initialized) if absent; at once when p comes after every
+  /// pair held.
+  T& operator[](const ObjectPair& p) {
+    auto it = mKeys.empty() || mKeys.back() < p ? mKeys.end() : std::lower_bound(mKeys.begin(), mKeys.end(), p);
+    const auto at = static_cast<std::size_t>(it - mKeys.begin());
+    if (it == mKeys.end() || *it != p) {
+      mKeys.insert(it, p);
+      mValues.insert(mValues.begin() + static_cast<std::ptrdiff_t>(at), T{});
+    }
+    return mValues[at];
+  }
+  /// Keys `pairs` (sorted, each once), their values left for the caller to set (value(i) is
+  /// pairs[i]'s; values keep their storage from the last call).
+  void reset(const std::vector<ObjectPair>& pairs) {
+    mKeys = pairs;
+    mValues.resize(pairs.size());
+  }
+  [[nodiscard]] T& value(std::size_t i) { return mValues[i]; }
+  void clear() {
+    mKeys.clear();
+    mValues.clear();
+  }
+  [[nodiscard]] std::size_t size() const { return mKeys.size(); }
+
+ private:
+  std::vector<ObjectPair> mKeys;
+  std::vector<T> mValues;
+};
+
+/// What the engine remembers of each object pair of the last step (keyed by the pair's object
+/// indices, Frame::pairs). Changes only how work is cut, never the contacts.
 struct History {
-  std::map<ObjectPair, std::uint64_t> node_tests;            ///< node tests at its last step
-  std::map<ObjectPair, std::vector<TrianglePair>> reported;  ///< a posteriori: the triangle pairs it reported
-  std::map<ObjectPair, NodeCounts> node_counts;              ///< hybrid with node history: stage subtrees' node tests
+  PairTable<std::uint64_t> node_tests;            ///< hybrid and a posteriori: its node tests
+  PairTable<std::vector<TrianglePair>> reported;  ///< a posteriori: the triangle pairs it reported
+  PairTable<NodeCounts> node_counts;              ///< hybrid with node history: stage subtrees' node tests
 };
 
 /// A method's plan for one step.
