@@ -1,9 +1,10 @@
 #pragma once
 /// \file
 /// The broad phase's structure: the objects' world boxes sorted along a Morton curve of their
-/// centres, a binary tree of boxes over runs of them, and the pairs whose boxes overlap found by
-/// querying each box against the part of the tree that lies after it in that order (so each pair
-/// is met once), in parallel on the executor the caller runs in. The order only steers the pruning:
+/// centres, a binary tree of boxes over that order split where the curve's codes split (as a linear
+/// BVH's), and the pairs whose boxes overlap found by querying each box against the part of the
+/// tree that lies after it in that order (so each pair is met once), in parallel on the executor
+/// the caller runs in. The order only steers the pruning:
 /// the pairs are those whose boxes overlap (closed intervals on the three axes), whatever it is.
 /// Kept from frame to frame: the order is re-sorted only when refitting the tree over the old one
 /// has let its boxes grow (temporal coherence), and the buffers are reused.
@@ -40,7 +41,15 @@ class BoxTree {
   [[nodiscard]] std::size_t sorts() const { return mSorts; }
 
  private:
+  /// A node: its box and its run of positions; its first child follows it, `right` is its second
+  /// (0 for a leaf).
+  struct Node {
+    FlatBox box;
+    std::uint32_t first, count, right;
+  };
+
   void sort_order(std::span<const WorldBox> boxes);
+  void build_nodes(std::uint32_t first, std::uint32_t count);
   void refit();
   [[nodiscard]] double node_area() const;
   void collect(const PairFilter& filter, std::size_t objects, std::vector<ObjectPair>& out);
@@ -48,9 +57,8 @@ class BoxTree {
   std::vector<std::uint32_t> mOrder;    ///< object at each position
   std::vector<std::uint32_t> mScratch;  ///< the radix sort's other buffer
   std::vector<std::uint32_t> mCodes;    ///< Morton code per object
-  std::vector<FlatBox> mSorted;         ///< box per position, padded with empty boxes to whole leaves
-  std::vector<FlatBox> mNodes;          ///< heap layout: node k's children 2k, 2k + 1; leaves from mLeaves
-  std::size_t mLeaves = 0;              ///< leaf nodes (a power of two)
+  std::vector<FlatBox> mSorted;         ///< box per position
+  std::vector<Node> mNodes;             ///< the tree in preorder (the root first)
   double mSortedArea = 0.0;             ///< the tree's node area right after the last sort
   std::size_t mSorts = 0;
   std::vector<std::vector<std::uint64_t>> mFound;  ///< per chunk of positions: pairs (a << 32 | b)
