@@ -95,8 +95,10 @@ std::vector<Pose> World::poses_at(int step) const {
   for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
     const SceneObject& o = mScene.objects[i];
     poses.push_back(pose_at(o.pose, o.motion, t));
+    const bool far = !poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate;
+    if (!far && poses.back().rotation.coeffs().allFinite()) continue;
     const std::string key = "objects[" + std::to_string(i) + "].motion";
-    if (!poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+    if (far) {
       throw Error(ErrorCode::bad_value, source,
                   "object '" + o.name + "' (" + key + ") moves beyond +-1e15 (caliber's limit on coordinates) by step " +
                       std::to_string(step));
