@@ -109,7 +109,9 @@ struct EngineOptions {
   /// plan_threads)); 0 means `threads`. The cut for P threads run on one thread measures each of
   /// its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
   int plan_threads = 0;
-  /// Stealing: CD-tree depth from which a subtree is traversed serially by one task.
+  /// Stealing: CD-tree depth from which a subtree is traversed serially by one task. Only pairs
+  /// whose a priori weight is at least 1 / (64 x threads) of the step's are split; the others run
+  /// whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
   /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_sweep.md): with 2 threads, beta = 2

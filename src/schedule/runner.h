@@ -21,10 +21,11 @@ namespace caliber::schedule {
 /// root (tasks::subtree_counts reads them).
 std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepState& state, ScheduleRecord& record);
 
-/// Stealing: every pair's CD tree split recursively into tasks down to `cutoff` depth, then each
-/// subtree traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
+/// Stealing: the CD tree of every heavy pair (a priori weight at least 1 / (64 x threads) of
+/// the total) split recursively into tasks down to `depth`, the other pairs whole, then each subtree
+/// traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
 /// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.
-void run_stealing(int cutoff, StepState& state, ScheduleRecord& record);
+void run_stealing(int depth, StepState& state, ScheduleRecord& record);
 
 }  // namespace caliber::schedule

@@ -1,9 +1,10 @@
-// The stealing runner: recursive splitting of every pair's CD tree on oneTBB's work stealing.
+// The stealing runner: recursive splitting of the heavy pairs' CD trees on oneTBB's work stealing.
 
 #include <algorithm>
 #include <functional>
 
 #include "schedule/runner.h"
+#include "tasks/weights.h"
 
 namespace caliber::schedule {
 namespace {
@@ -43,18 +44,40 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
 
 }  // namespace
 
-void run_stealing(int cutoff, StepState& state, ScheduleRecord& record) {
+void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   const auto start = util::Clock::now();
   const std::size_t n = state.contexts.size();
+  // Only a pair that may hold a good part of the step's work is split: one whose a priori weight
+  // is at least 1 / (64 x threads) of the total. The lighter ones run whole, in a parallel loop
+  // over them (splitting thousands of light pairs costs more than it balances).
+  std::vector<std::uint32_t> heavy, light;
+  if (depth > 0 && n > 1) {
+    std::vector<double> weight(n);
+    parallel::parallel_for(0, n, 256, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) weight[i] = tasks::apriori_weight(state.contexts[i], narrow::NodePair{0, 0});
+    });
+    double total = 0.0;
+    for (const double w : weight) total += w;
+    const double threshold = total / (64.0 * parallel::concurrency());
+    for (std::uint32_t i = 0; i < n; ++i) (weight[i] >= threshold ? heavy : light).push_back(i);
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
+  }
   parallel::TaskGroup group;
-  for (std::size_t i = 0; i < n; ++i) {
-    group.run([&state, i, cutoff] {
-      if (cutoff > 0) {  // the root is tested above the cut-off: splitting work
-        WorkerSlots& w = local_slots(state.workers, state.contexts.size());
-        ++w.split_node_tests;
-        if (!narrow::test_root(state.contexts[i], narrow::NodePair{0, 0}, w.stats[i])) return;
-      }
-      steal(state, i, narrow::NodePair{0, 0}, 0, cutoff, /*tested=*/cutoff > 0);
+  for (const std::uint32_t i : heavy) {
+    group.run([&state, i, depth] {
+      // The root is tested above the cut-off: splitting work.
+      WorkerSlots& w = local_slots(state.workers, state.contexts.size());
+      ++w.split_node_tests;
+      if (!narrow::test_root(state.contexts[i], narrow::NodePair{0, 0}, w.stats[i])) return;
+      steal(state, i, narrow::NodePair{0, 0}, 0, depth, /*tested=*/true);
+    });
+  }
+  if (!light.empty()) {
+    group.run([&state, &light] {
+      parallel::parallel_for(0, light.size(), 16, [&](std::size_t lo, std::size_t hi) {
+        for (std::size_t k = lo; k != hi; ++k) steal(state, light[k], narrow::NodePair{0, 0}, 0, 0, /*tested=*/false);
+      });
     });
   }
   group.wait();
