@@ -26,6 +26,7 @@
 
 #include <btBulletCollisionCommon.h>
 
+#include "broad/sweep.h"
 #include "broad/world_box.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
@@ -35,6 +36,7 @@
 namespace {
 
 using namespace caliber;
+using broad::sweep_along_x;
 using broad::WorldBox;
 using Clock = std::chrono::steady_clock;
 
@@ -71,28 +73,6 @@ std::vector<WorldBox> boxes_of(const Boxes& s, const std::vector<Pose>& poses) {
   std::vector<WorldBox> out;
   for (std::size_t i = 0; i < poses.size(); ++i) out.push_back(broad::world_box(*s.models[i], poses[i], 0.0));
   return out;
-}
-
-bool overlap(const WorldBox& x, const WorldBox& y) {
-  return (x.lo.array() <= y.hi.array()).all() && (y.lo.array() <= x.hi.array()).all();
-}
-
-/// The sweep and prune along x that caliber used before its tree.
-std::vector<ObjectPair> sweep(const std::vector<WorldBox>& boxes) {
-  std::vector<std::uint32_t> order(boxes.size());
-  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return boxes[a].lo.x() < boxes[b].lo.x() || (boxes[a].lo.x() == boxes[b].lo.x() && a < b);
-  });
-  std::vector<ObjectPair> pairs;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo.x() <= boxes[order[i]].hi.x(); ++j) {
-      if (overlap(boxes[order[i]], boxes[order[j]]))
-        pairs.push_back({std::min(order[i], order[j]), std::max(order[i], order[j])});
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
 }
 
 /// Bullet's dynamic AABB tree with its collision world's pair cache.
@@ -173,7 +153,7 @@ int main(int argc, char** argv) {
     for (int k = 0; k < steps; ++k) {
       poses.push_back(scene.at(k));
       boxes.push_back(boxes_of(scene, poses.back()));
-      want.push_back(sweep(boxes.back()));
+      want.push_back(sweep_along_x(boxes.back()));
     }
     std::map<std::string, std::vector<double>> ms;
     double bullet_pairs = 0.0, bullet_exact = 0.0;
@@ -208,7 +188,7 @@ int main(int argc, char** argv) {
       {
         const auto t = Clock::now();
         for (int k = 1; k < steps; ++k) {
-          if (sweep(boxes_of(scene, poses[k])).size() != want[k].size()) return 1;
+          if (sweep_along_x(boxes_of(scene, poses[k])).size() != want[k].size()) return 1;
         }
         ms["sweep"].push_back(ms_since(t) / (steps - 1));
       }

@@ -13,6 +13,7 @@
 
 #include "support/error_message.h"
 
+#include "broad/sweep.h"
 #include "broad/world_box.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
@@ -26,12 +27,9 @@
 namespace caliber {
 namespace {
 
+using broad::sweep_along_x;
 using broad::world_box;
 using broad::WorldBox;
-
-bool overlap(const WorldBox& x, const WorldBox& y) {
-  return (x.lo.array() <= y.hi.array()).all() && (y.lo.array() <= x.hi.array()).all();
-}
 
 /// Every pair of boxes compared: the pairs the broad phase must give, no more, no less.
 std::vector<ObjectPair> every_overlap(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
@@ -41,28 +39,9 @@ std::vector<ObjectPair> every_overlap(const std::vector<std::shared_ptr<const Mo
   std::vector<ObjectPair> pairs;
   for (std::uint32_t a = 0; a < boxes.size(); ++a) {
     for (std::uint32_t b = a + 1; b < boxes.size(); ++b) {
-      if (overlap(boxes[a], boxes[b])) pairs.push_back({a, b});
+      if (broad::boxes_overlap(boxes[a], boxes[b])) pairs.push_back({a, b});
     }
   }
-  return pairs;
-}
-
-/// A plain sweep and prune along x (the broad phase caliber had before its tree).
-std::vector<ObjectPair> sweep_along_x(const std::vector<WorldBox>& boxes) {
-  std::vector<std::uint32_t> order(boxes.size());
-  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return boxes[a].lo.x() < boxes[b].lo.x() || (boxes[a].lo.x() == boxes[b].lo.x() && a < b);
-  });
-  std::vector<ObjectPair> pairs;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo.x() <= boxes[order[i]].hi.x(); ++j) {
-      if (overlap(boxes[order[i]], boxes[order[j]])) {
-        pairs.push_back({std::min(order[i], order[j]), std::max(order[i], order[j])});
-      }
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
