@@ -24,8 +24,13 @@ namespace py = pybind11;
 
 /// A side's poses, as given: a Pose, a sequence of Poses, or an array of matrices (4 x 4 or
 /// N x 4 x 4) or of translation + quaternion rows (7 or N x 7, the quaternion in `order`).
-/// float32 matrices are rotations to float32's rounding only: they get 1e-6 as the tolerance.
-/// Errors name `side` and the row.
+/// Matrices are checked to rotation_tolerance. Errors name `side` and the row.
+/// The tolerance on a matrix's rotation: float32 arrays are rotations only to float32's rounding
+/// (1e-6), others to 1e-9. By kind and size, not dtype identity (an unpickled array has its own).
+inline double rotation_tolerance(const py::array& a) {
+  return a.dtype().kind() == 'f' && a.dtype().itemsize() == 4 ? 1e-6 : 1e-9;
+}
+
 struct SidePoses {
   std::vector<caliber::Pose> poses;
 
@@ -52,14 +57,14 @@ struct SidePoses {
       throw caliber::Error(caliber::ErrorCode::bad_argument, side,
                            "must be a caliber.Pose, a list of them, or an array of N x 4 x 4 matrices or N x 7 rows");
     }
-    const bool single = raw.dtype().kind() == 'f' && raw.dtype().itemsize() == 4;  // any float32 dtype object
+    const double tolerance = rotation_tolerance(raw);
     const py::array_t<double, py::array::c_style | py::array::forcecast> values(raw);
     const std::span<const double> flat(values.data(), static_cast<std::size_t>(values.size()));
     const auto nd = values.ndim();
     const auto last = nd > 0 ? values.shape(nd - 1) : 0;
     py::gil_scoped_release release;
     if ((nd == 2 || nd == 3) && last == 4 && values.shape(nd - 2) == 4) {
-      poses = caliber::poses_from_matrices(flat, single ? 1e-6 : 1e-9, side);
+      poses = caliber::poses_from_matrices(flat, tolerance, side);
     } else if ((nd == 1 || nd == 2) && last == 7) {
       poses = caliber::poses_from_vectors(flat, order, side);
     } else {

@@ -73,10 +73,15 @@ def tiny(args, lines):
         lines.append(f"| {name} | {c:.3f} | {p:.3f} | {p - c:.3f} |")
 
 
-def sweep(args, lines):
+def models(args):
+    """The bunny and CGAL's turbine scaled 0.3 (the link swept through it)."""
     bunny = caliber.Model.load(os.path.join(args.meshes, "bunny00.off"), oriented_boxes=True)
     mesh = caliber.Mesh.load(os.path.join(args.meshes, "turbine.off"))
-    link = caliber.Model(caliber.Mesh(mesh.vertices * 0.3, mesh.faces), oriented_boxes=True)
+    return bunny, caliber.Model(caliber.Mesh(mesh.vertices * 0.3, mesh.faces), oriented_boxes=True)
+
+
+def sweep(args, lines):
+    bunny, link = models(args)
     poses = path(bunny.mesh, link.mesh, args.poses)
     ident = caliber.Pose()
     hits = caliber.query_many(bunny, ident, link, poses, max_pairs=1).hit
@@ -105,9 +110,7 @@ def sweep(args, lines):
 
 def dask(args, lines):
     import distributed
-    bunny = caliber.Model.load(os.path.join(args.meshes, "bunny00.off"), oriented_boxes=True)
-    mesh = caliber.Mesh.load(os.path.join(args.meshes, "turbine.off"))
-    link = caliber.Model(caliber.Mesh(mesh.vertices * 0.3, mesh.faces), oriented_boxes=True)
+    bunny, link = models(args)
     poses = path(bunny.mesh, link.mesh, args.dask_poses)
     want = None
     seconds = {1: [], 2: []}

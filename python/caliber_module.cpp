@@ -189,9 +189,7 @@ PyResult query_result(caliber::QueryResult&& q) {
 }
 
 caliber::Pose pose_from_matrix(const py::array& m) {
-  // float32 matrices are rotations only to float32's rounding: they get that tolerance.
-  const bool single =
-      m.dtype().kind() == 'f' && m.dtype().itemsize() == 4;  // (not dtype identity: an unpickled array has its own)
+  const double tolerance = caliber_python::rotation_tolerance(m);
   const py::array_t<double, py::array::c_style | py::array::forcecast> d(m);
   if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4)
     throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix", "must be 4 x 4");
@@ -200,7 +198,7 @@ caliber::Pose pose_from_matrix(const py::array& m) {
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) matrix(i, j) = a(i, j);
   }
-  return caliber::Pose::from_matrix(matrix, single ? 1e-6 : 1e-9, "matrix");
+  return caliber::Pose::from_matrix(matrix, tolerance, "matrix");
 }
 
 /// The quaternion (w, x, y, z) of `q` given in `order` ("wxyz", caliber's and Eigen's; "xyzw",

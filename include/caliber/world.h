@@ -53,6 +53,9 @@ class CALIBER_EXPORT World {
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
 
  private:
+  /// Step k's models, poses and request, without pairs.
+  [[nodiscard]] Frame posed_frame(int step) const;
+
   Scene mScene;
   QueryRequest mRequest;
   std::vector<std::shared_ptr<const Model>> mModels;

@@ -86,7 +86,6 @@ void BoxTree::sort_order(std::span<const WorldBox> boxes) {
     for (const std::uint32_t o : mOrder) mScratch[count[(mCodes[o] >> shift) & 1023u]++] = o;
     mOrder.swap(mScratch);
   }
-  ++mSorts;
 }
 
 void BoxTree::build_nodes(std::uint32_t first, std::uint32_t count) {

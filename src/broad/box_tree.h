@@ -37,9 +37,6 @@ class BoxTree {
   /// the previous call's order when there were as many boxes.
   void pairs(std::span<const WorldBox> boxes, const PairFilter& filter, std::vector<ObjectPair>& out);
 
-  /// Calls that re-sorted the order (the first, and those where refitting had grown the tree).
-  [[nodiscard]] std::size_t sorts() const { return mSorts; }
-
  private:
   /// A node: its box and its run of positions; its first child follows it, `right` is its second
   /// (0 for a leaf).
@@ -54,13 +51,12 @@ class BoxTree {
   [[nodiscard]] double node_area() const;
   void collect(const PairFilter& filter, std::size_t objects, std::vector<ObjectPair>& out);
 
-  std::vector<std::uint32_t> mOrder;    ///< object at each position
-  std::vector<std::uint32_t> mScratch;  ///< the radix sort's other buffer
-  std::vector<std::uint32_t> mCodes;    ///< Morton code per object
-  std::vector<FlatBox> mSorted;         ///< box per position
-  std::vector<Node> mNodes;             ///< the tree in preorder (the root first)
-  double mSortedArea = 0.0;             ///< the tree's node area right after the last sort
-  std::size_t mSorts = 0;
+  std::vector<std::uint32_t> mOrder;               ///< object at each position
+  std::vector<std::uint32_t> mScratch;             ///< the radix sort's other buffer
+  std::vector<std::uint32_t> mCodes;               ///< Morton code per object
+  std::vector<FlatBox> mSorted;                    ///< box per position
+  std::vector<Node> mNodes;                        ///< the tree in preorder (the root first)
+  double mSortedArea = 0.0;                        ///< the tree's node area right after the last sort
   std::vector<std::vector<std::uint64_t>> mFound;  ///< per chunk of positions: pairs (a << 32 | b)
   std::vector<std::uint32_t> mStart;               ///< counting sort by a
 };

@@ -8,6 +8,7 @@
 
 #include "caliber/broad_phase.h"
 #include "caliber/error.h"
+#include "mesh/pose_check.h"
 #include "parallel/executor.h"
 
 namespace caliber {
@@ -26,11 +27,7 @@ void validate(const std::vector<std::shared_ptr<const Model>>& models, const std
   if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
   for (std::size_t i = 0; i < n; ++i) {
     if (!models[i]) throw bad("object " + std::to_string(i) + " has no model");
-    try {
-      validate_pose(poses[i], {});
-    } catch (const Error&) {
-      validate_pose(poses[i], "broad phase: pose of object " + std::to_string(i));  // throws again, naming it
-    }
+    validate_pose_named(poses[i], [&] { return "broad phase: pose of object " + std::to_string(i); });
   }
   for (const ObjectPair& p : ignored) {
     if (p.a >= p.b || p.b >= n) {

@@ -155,8 +155,7 @@ Contact world_contact(const PairContext& ctx, const Candidate& c, ObjectPair obj
 Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidates, ContactPair contact_pair) {
   const Candidate best = *std::min_element(candidates.begin(), candidates.end(), closer);
   const bool again = best.distance == 0.0 && !ctx.request().lowest_ids && contact_pair == ContactPair::from_root;
-  QueryStats search;
-  return again ? first_contact(ctx, search) : best;
+  return again ? first_contact(ctx) : best;
 }
 
 }  // namespace

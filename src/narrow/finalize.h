@@ -34,9 +34,9 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
                      ContactPair contact_pair, bool parallel = false);
 
 /// The first intersecting pair of the distance traversal from the root (the pair caliber::query
-/// reports on meshes that intersect), on the calling thread with its kept scratch; its node and
-/// leaf tests added to `stats`. The meshes must have a pair at distance 0.
-Candidate first_contact(const PairContext& ctx, QueryStats& stats);
+/// reports on meshes that intersect), on the calling thread with its kept scratch. Its node and
+/// leaf tests are counted nowhere. The meshes must have a pair at distance 0.
+Candidate first_contact(const PairContext& ctx);
 
 /// One pair's whole query on the calling thread: the depth-first or distance traversal from the
 /// root (stopping at the request's max_pairs) and the finalization, with the thread's kept

@@ -90,10 +90,11 @@ QueryResult query_whole(const PairContext& ctx) {
   return result;
 }
 
-Candidate first_contact(const PairContext& ctx, QueryStats& stats) {
+Candidate first_contact(const PairContext& ctx) {
   CALIBER_ASSERT(ctx.request().kind == QueryKind::distance && !ctx.request().lowest_ids,
                  "the first contact is that of a distance traversal that stops at contact");
   Nearest nearest;
+  QueryStats stats;
   traverse_nearest(ctx, NodePair{0, 0}, t_scratch, nearest, stats);
   let_go_if_large();
   CALIBER_ASSERT(nearest.found && nearest.best.distance == 0.0, "the traversal from the root finds a pair at distance 0");

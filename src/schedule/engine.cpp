@@ -22,6 +22,7 @@
 
 #include "caliber/error.h"
 #include "caliber/profile.h"
+#include "mesh/pose_check.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"
 #include "schedule/engine_impl.h"
@@ -71,13 +72,9 @@ void validate_frame(const Frame& frame) {
     if (!frame.models[i]) throw Error(ErrorCode::bad_argument, "frame", "object " + std::to_string(i) + " has no model");
     // Checked here, once per object: the contexts are then made in parallel and cannot throw.
     try {
-      validate_pose(frame.poses[i], {});
-    } catch (const Error&) {
-      try {  // again, naming the object (no name is made for a good pose)
-        validate_pose(frame.poses[i], "pose of object " + std::to_string(i));
-      } catch (const Error& e) {
-        throw Error(e.code(), "frame", e.what());
-      }
+      validate_pose_named(frame.poses[i], [&] { return "pose of object " + std::to_string(i); });
+    } catch (const Error& e) {
+      throw Error(e.code(), "frame", e.what());
     }
   }
   for (std::size_t k = 0; k < frame.pairs.size(); ++k) {

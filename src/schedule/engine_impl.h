@@ -13,9 +13,9 @@
 #include <type_traits>
 #include <vector>
 
+#include "broad/broad_phase.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
-#include "broad/broad_phase.h"
 #include "caliber/profile.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"

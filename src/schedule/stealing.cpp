@@ -52,10 +52,7 @@ void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   // over them (splitting thousands of light pairs costs more than it balances).
   std::vector<std::uint32_t> heavy, light;
   if (depth > 0 && n > 1) {
-    std::vector<double> weight(n);
-    parallel::parallel_for(0, n, 256, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t i = lo; i != hi; ++i) weight[i] = tasks::apriori_weight(state.contexts[i], narrow::NodePair{0, 0});
-    });
+    const std::vector<double> weight = tasks::root_weights(state.contexts);
     double total = 0.0;
     for (const double w : weight) total += w;
     const double threshold = total / (64.0 * parallel::concurrency());

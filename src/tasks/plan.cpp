@@ -24,8 +24,7 @@ Plan plan_pairs(std::size_t pairs) {
 InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                                const History& history) {
   const std::size_t n = pairs.size();
-  std::vector<double> root(n);
-  parallel::parallel_for_each(0, n, [&](std::size_t i) { root[i] = apriori_weight(contexts[i], {0, 0}); });
+  const std::vector<double> root = root_weights(contexts);
   InitialWeights w;
   w.scale.assign(n, 1.0);
   if (method == Method::hybrid || method == Method::aposteriori) {

@@ -5,8 +5,8 @@
 /// (schedule/runner.h) executes any plan; plans need no threads to be tested (the weight-driven
 /// stage uses the executor it is called in, with the same result on any number of threads).
 
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -49,7 +49,6 @@ class PairTable {
     mKeys.clear();
     mValues.clear();
   }
-  [[nodiscard]] std::size_t size() const { return mKeys.size(); }
 
  private:
   std::vector<ObjectPair> mKeys;

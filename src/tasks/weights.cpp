@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "parallel/executor.h"
+
 namespace caliber::tasks {
 
 namespace {
@@ -43,6 +45,12 @@ double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n) {
   const double share_b = std::sqrt(depth_share(depth, b.radius) * axes_b);
   const double pa = ctx.a().nodes[n.a].count, pb = ctx.b().nodes[n.b].count;
   return 1.0 + 2.0 * (pa * share_a + pb * share_b);
+}
+
+std::vector<double> root_weights(narrow::PairContexts contexts) {
+  std::vector<double> root(contexts.size());
+  parallel::parallel_for_each(0, contexts.size(), [&](std::size_t i) { root[i] = apriori_weight(contexts[i], {0, 0}); });
+  return root;
 }
 
 }  // namespace caliber::tasks

@@ -34,6 +34,8 @@
 /// The paper's printed formula is garbled; this one keeps its ingredients (P, r, the centers'
 /// distance) and its behaviour (heavier when larger and deeper in contact).
 
+#include <vector>
+
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 
@@ -41,5 +43,8 @@ namespace caliber::tasks {
 
 /// The a priori weight of CD-tree node n (see above). Reads the node's spheres only.
 double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n);
+
+/// The a priori weight of every pair's root, in parallel on the caller's executor.
+std::vector<double> root_weights(narrow::PairContexts contexts);
 
 }  // namespace caliber::tasks

@@ -103,11 +103,9 @@ std::vector<Pose> World::poses_at(int step) const {
                   "object '" + o.name + "' (" + key + ") moves beyond +-1e15 (caliber's limit on coordinates) by step " +
                       std::to_string(step));
     }
-    if (!poses.back().rotation.coeffs().allFinite()) {
-      throw Error(ErrorCode::bad_value, source,
-                  "object '" + o.name + "' (" + key + ".angular): the turn by step " + std::to_string(step) +
-                      " (angular velocity x time) overflows a double");
-    }
+    throw Error(ErrorCode::bad_value, source,
+                "object '" + o.name + "' (" + key + ".angular): the turn by step " + std::to_string(step) +
+                    " (angular velocity x time) overflows a double");
   }
   return poses;
 }
@@ -121,20 +119,22 @@ std::vector<ObjectPair> World::broad_phase(const std::vector<Pose>& poses) const
   return caliber::broad_phase(mModels, poses, reach(mRequest), mStatic, mIgnored);
 }
 
-Frame World::frame(int step) const {
+Frame World::posed_frame(int step) const {
   Frame frame;
   frame.poses = poses_at(step);
-  frame.pairs = broad_phase(frame.poses);
   frame.models = mModels;
   frame.request = mRequest;
   return frame;
 }
 
+Frame World::frame(int step) const {
+  Frame frame = posed_frame(step);
+  frame.pairs = broad_phase(frame.poses);
+  return frame;
+}
+
 Frame World::frame(int step, Engine& engine) const {
-  Frame frame;
-  frame.poses = poses_at(step);
-  frame.models = mModels;
-  frame.request = mRequest;
+  Frame frame = posed_frame(step);
   engine.find_pairs(frame, mStatic, mIgnored);
   return frame;
 }
