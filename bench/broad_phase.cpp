@@ -1,14 +1,14 @@
 // The broad phase against Bullet's dynamic AABB tree and a plain sweep along x: N boxes (half-size
 // 0.45) on a jittered cubic grid of spacing 0.9, each drifting, S steps. Per step, after a first
 // step that builds each structure (not timed): caliber's broad phase on an engine of 1 and 2 threads
-// (Engine::find_pairs, its tree kept from step to step), the same search made afresh each step
+// (or those --threads names; Engine::find_pairs, its tree kept from step to step), the same search made afresh each step
 // (caliber::broad_phase), a sweep and prune along x over the same boxes, and Bullet 3's
 // btDbvtBroadphase fed the same boxes (setAabb on every proxy, then calculateOverlappingPairs; the
 // boxes are computed outside its timing). Milliseconds per step, medians of interleaved rounds.
 // caliber's pairs are checked against the sweep's every step; Bullet's pair cache is counted apart:
 // how many of its pairs overlap, and whether it holds every pair that does.
 //
-//   bench_broad_phase [--objects N ...] [--steps S] [--repeat R] [--out FILE.md]
+//   bench_broad_phase [--objects N ...] [--threads T ...] [--steps S] [--repeat R] [--out FILE.md]
 
 #include <algorithm>
 #include <chrono>
@@ -123,6 +123,7 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 int main(int argc, char** argv) {
   std::vector<std::size_t> sizes = {1000, 4096, 32768, 100000};
+  std::vector<int> thread_counts = {1, 2};
   int steps = 20, repeat = 5;
   std::string out_path;
   for (int i = 1; i < argc; ++i) {
@@ -131,6 +132,9 @@ int main(int argc, char** argv) {
     if (arg == "--objects" && more) {
       sizes.clear();
       while (i + 1 < argc && argv[i + 1][0] != '-') sizes.push_back(std::stoul(argv[++i]));
+    } else if (arg == "--threads" && more) {
+      thread_counts.clear();
+      while (i + 1 < argc && argv[i + 1][0] != '-') thread_counts.push_back(std::max(1, std::stoi(argv[++i])));
     } else if (arg == "--steps" && more) {
       steps = std::max(2, std::stoi(argv[++i]));
     } else if (arg == "--repeat" && more) {
@@ -138,13 +142,19 @@ int main(int argc, char** argv) {
     } else if (arg == "--out" && more) {
       out_path = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: bench_broad_phase [--objects N ...] [--steps S] [--repeat R] [--out FILE.md]\n");
+      std::fprintf(stderr,
+                   "usage: bench_broad_phase [--objects N ...] [--threads T ...] [--steps S] [--repeat R] [--out FILE.md]\n");
       return 2;
     }
   }
-  std::string table =
-      "| objects | pairs/step | caliber 1 thread ms | 2 threads ms | afresh ms | sweep along x ms | Bullet dbvt ms | "
-      "caliber / Bullet | Bullet's pairs (overlapping) |\n|---|---|---|---|---|---|---|---|---|\n";
+  if (thread_counts.empty()) thread_counts = {1};
+  std::string table = "| objects | pairs/step |", rule = "|---|---|";
+  for (const int threads : thread_counts) {
+    table += " caliber " + std::to_string(threads) + (threads == 1 ? " thread ms |" : " threads ms |");
+    rule += "---|";
+  }
+  table += " afresh ms | sweep along x ms | Bullet dbvt ms | caliber " + std::to_string(thread_counts[0]) +
+           "t / Bullet | Bullet's pairs (overlapping) |\n" + rule + "---|---|---|---|---|\n";
   for (const std::size_t n : sizes) {
     const Boxes scene = make_boxes(n);
     std::vector<std::vector<Pose>> poses;
@@ -159,7 +169,7 @@ int main(int argc, char** argv) {
     double bullet_pairs = 0.0, bullet_exact = 0.0;
     bool bullet_holds_all = true;
     for (int round = 0; round < repeat; ++round) {
-      for (const int threads : {1, 2}) {
+      for (const int threads : thread_counts) {
         EngineOptions options;
         options.threads = threads;
         Engine engine(options);
@@ -176,7 +186,7 @@ int main(int argc, char** argv) {
             return 1;
           }
         }
-        ms[threads == 1 ? "one" : "two"].push_back(ms_since(t) / (steps - 1));
+        ms["t" + std::to_string(threads)].push_back(ms_since(t) / (steps - 1));
       }
       {
         const auto t = Clock::now();
@@ -213,12 +223,20 @@ int main(int argc, char** argv) {
     }
     double pairs = 0.0;
     for (int k = 1; k < steps; ++k) pairs += static_cast<double>(want[k].size()) / (steps - 1);
-    char row[512];
-    std::snprintf(row, sizeof row, "| %zu | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f (%.0f)%s |\n", n, pairs,
-                  median(ms["one"]), median(ms["two"]), median(ms["fresh"]), median(ms["sweep"]), median(ms["bullet"]),
-                  median(ms["one"]) / median(ms["bullet"]), bullet_pairs, bullet_exact, bullet_holds_all ? "" : " MISSES PAIRS");
+    char cell[512];
+    std::snprintf(cell, sizeof cell, "| %zu | %.0f |", n, pairs);
+    std::string row = cell;
+    for (const int threads : thread_counts) {
+      std::snprintf(cell, sizeof cell, " %.2f |", median(ms["t" + std::to_string(threads)]));
+      row += cell;
+    }
+    const double first = median(ms["t" + std::to_string(thread_counts[0])]);
+    std::snprintf(cell, sizeof cell, " %.2f | %.2f | %.2f | %.2f | %.0f (%.0f)%s |\n", median(ms["fresh"]), median(ms["sweep"]),
+                  median(ms["bullet"]), first / median(ms["bullet"]), bullet_pairs, bullet_exact,
+                  bullet_holds_all ? "" : " MISSES PAIRS");
+    row += cell;
     table += row;
-    std::fputs(row, stdout);
+    std::fputs(row.c_str(), stdout);
     std::fflush(stdout);
   }
   const std::string head =

@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # Packs what another machine needs to run caliber without our Debian packages (for example a
 # 16-core Intel Xeon machine running Ubuntu 24.04, whose glibc is newer than Debian 12's), into
-# .devicepack/ (git-ignored): the Release binary, every shared library it loads except the C
-# library's own, the four scenes and the meshes they read, and run.sh, the one command to run there:
+# .devicepack/ (git-ignored): the Release binary, the benchmarks bench_batch and bench_broad_phase,
+# every shared library they load except the C library's own, the four scenes and the meshes they
+# read, the meshes of the many-part scenes and of bench_batch, and run.sh, the one command to run
+# there:
 #
 #   scripts/device_pack.sh            # here: build (Release) and pack; prints the pack's size
 #   bash .devicepack/run.sh ARGS...   # there (.devicepack copied to the other machine): runs
 #                                     # `caliber ARGS...` with the packed libraries; results go
 #                                     # under $OUT when ARGS name $OUT
+#   bash .devicepack/run.sh bench_batch ARGS...        # the packed benchmarks, likewise
+#   bash .devicepack/run.sh bench_broad_phase ARGS...
 #
 # For example, a bench that cannot lose its results when a time limit (here 10 minutes) cuts it:
 #
@@ -27,8 +31,11 @@ limit_mib=64
 
 rm -rf "$pack"
 mkdir -p "$pack/bin" "$pack/lib" "$pack/scenes" "$pack/data/meshes"
-cp "$root/build/caliber" "$pack/bin/"
-strip "$pack/bin/caliber"
+binaries=(caliber bench_batch bench_broad_phase)
+for binary in "${binaries[@]}"; do
+  cp "$root/build/$binary" "$pack/bin/"
+  strip "$pack/bin/$binary"
+done
 
 # Every library the binary loads, but glibc's own (the C library, its companions, the dynamic
 # loader): those come from the other machine's system (glibc is backward compatible, not forward).
@@ -39,8 +46,10 @@ is_glibc() {
     *) return 1 ;;
   esac
 }
-ldd "$root/build/caliber" | awk '/=> \// {print $3}' | while read -r lib; do
-  is_glibc "$lib" || cp -L "$lib" "$pack/lib/"
+for binary in "${binaries[@]}"; do
+  ldd "$root/build/$binary" | awk '/=> \// {print $3}' | while read -r lib; do
+    is_glibc "$lib" || cp -L "$lib" "$pack/lib/"
+  done
 done
 # oneTBB opens its allocator at run time when present: the same one as here.
 tbb="$(ldd "$root/build/caliber" | awk '/libtbb\.so/ {print $3}')"
@@ -59,15 +68,22 @@ for scene in sorted(pathlib.Path(sys.argv[1]).glob("*.json")):
         if obj["mesh"].startswith("../data/"):
             print(obj["mesh"])
 PY
+# The many-part scenes' mesh (scenes/generate.py --grid N --out-dir .devicepack/data/scenes writes
+# them there) and bench_batch's two (it reads data/meshes from the pack's folder).
+for mesh in eight.off bunny00.off turbine.off; do cp "$root/data/meshes/$mesh" "$pack/data/meshes/"; done
 
 cat > "$pack/run.sh" <<'RUN'
 #!/usr/bin/env bash
 # Runs the packed caliber with the packed libraries (see scripts/device_pack.sh). Scenes are under
-# .devicepack/scenes; `bench` without scenes runs those four.
+# .devicepack/scenes; `bench` without scenes runs those four. `run.sh bench_batch ...` and
+# `run.sh bench_broad_phase ...` run the packed benchmarks.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cd "$here"
+case "${1:-}" in
+  bench_batch|bench_broad_phase) binary="$1"; shift; exec "$here/bin/$binary" "$@" ;;
+esac
 if [ "${1:-}" = bench ]; then
   named=0
   for arg in "$@"; do
@@ -84,7 +100,7 @@ chmod +x "$pack/run.sh"
 
 # The check: with the pack's folder first, every library but glibc's must resolve inside the pack
 # (ldd would otherwise find this machine's copies and hide a library the other machine lacks).
-outside="$(env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/caliber" | awk '/=>/ {print $1, $3}' |
+outside="$(for binary in "${binaries[@]}"; do env -i LD_LIBRARY_PATH="$pack/lib" ldd "$pack/bin/$binary"; done | awk '/=>/ {print $1, $3}' |
   while read -r name path; do
     is_glibc "$name" && continue
     case "$path" in "$pack/lib/"*) ;; *) echo "$name -> $path" ;; esac
