@@ -34,8 +34,12 @@ class ContextStore {
   [[nodiscard]] narrow::PairContexts build(std::size_t n, Make&& make) {
     static_assert(std::is_trivially_destructible_v<narrow::PairContext>, "contexts are overwritten without destruction");
     if (mCapacity < n) {
-      mSlots = std::make_unique<Slot[]>(n);
-      mCapacity = n;
+      // A quarter more than asked: the pairs of a moving scene grow by a few from step to step,
+      // and each regrowth is a fresh allocation whose pages are touched again. Left uninitialized
+      // (no zeroing: 592 bytes a context, 35 MB at 60,000 pairs), the pages are first touched by
+      // the parallel loop below.
+      mCapacity = n + n / 4;
+      mSlots.reset(new Slot[mCapacity]);
     }
     auto* const base = reinterpret_cast<narrow::PairContext*>(mSlots.get());
     // A context takes about 50 ns (front_car's 209: 0.01 ms a step on the 2-core VM): chunks of 64

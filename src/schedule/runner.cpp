@@ -10,36 +10,70 @@
 
 namespace caliber::schedule {
 
-void finalize_pairs(StepState& state,
+namespace {
+
+void finalize_into(StepState& state, std::size_t i, std::vector<narrow::Candidate>& all, const QueryStats& stats) {
+  state.candidates[i] = all.size();
+  state.results[i] =
+      narrow::finalize(state.contexts[i], all, stats, state.pairs[i], narrow::ContactPair::from_root, state.parallel_finalize);
+}
+
+/// A pair that is one root of one task, from its CD tree's root and neither split nor on a taboo
+/// list, is finalized by that task as soon as it is traversed (its candidates are all in that
+/// thread's slots): no second pass over it. Returns per pair 1 for those; `rest` gets the others,
+/// finalized once every task is done.
+std::vector<std::uint8_t> whole_pairs(const tasks::Plan& plan, const std::vector<std::size_t>& split_of,
+                                      std::vector<std::uint32_t>& rest) {
+  const std::size_t n = split_of.size();
+  std::vector<std::uint8_t> roots_of(n, 0);  // 0: none seen, 1: one from the top, 2: otherwise
+  for (const tasks::RunTask& task : plan.run) {
+    for (const tasks::Root& root : task.roots) {
+      const bool from_top = root.node == narrow::NodePair{0, 0} && root.taboo < 0 && root.owner < 0;
+      roots_of[root.pair] = from_top && roots_of[root.pair] == 0 && split_of[root.pair] == SIZE_MAX ? 1 : 2;
+    }
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (roots_of[i] != 1) {
+      rest.push_back(i);
+      roots_of[i] = 0;
+    }
+  }
+  return roots_of;
+}
+
+}  // namespace
+
+void finalize_whole(StepState& state, std::size_t i, WorkerSlots& w) {
+  state.timeline.record(TaskSpan::Phase::finalize, i, [&] { finalize_into(state, i, w.candidates[i], w.stats[i]); });
+}
+
+void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
                     const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start) {
   const std::size_t n = state.contexts.size();
   const std::vector<WorkerSlots*> slots = state.workers.all();
   // A pair's finalization costs about its candidate count: most candidates first, to the next free
   // thread (ties by pair index; the order changes who runs what, never the results).
-  std::vector<std::size_t> candidates(n, 0), order(n);
+  std::vector<std::size_t> candidates(rest.size(), 0), order(rest.size());
   for (const WorkerSlots* w : slots) {
     if (w->stats.size() != n) continue;
-    for (std::size_t i = 0; i < n; ++i) candidates[i] += w->candidates[i].size();
+    for (std::size_t k = 0; k < rest.size(); ++k) candidates[k] += w->candidates[rest[k]].size();
   }
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
-  state.candidates.assign(n, 0);
-  parallel::for_each_in_order(n, [&](std::size_t k) {
-    const std::size_t i = order[k];
+  parallel::for_each_in_order(rest.size(), [&](std::size_t k) {
+    const std::size_t i = rest[order[k]];
     state.timeline.record(TaskSpan::Phase::finalize, i, [&] {
       std::vector<narrow::Candidate> all;
       QueryStats stats;
       if (start) start(i, all, stats);
-      all.reserve(all.size() + candidates[i]);
+      all.reserve(all.size() + candidates[order[k]]);
       for (const WorkerSlots* w : slots) {
         if (w->stats.size() != n) continue;
         all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
         stats.node_tests += w->stats[i].node_tests;
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
-      state.candidates[i] = all.size();
-      state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.pairs[i], narrow::ContactPair::from_root,
-                                          state.parallel_finalize);
+      finalize_into(state, i, all, stats);
     });
   });
 }
@@ -63,6 +97,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
     }
   }
   std::vector<std::size_t> split_of(n, SIZE_MAX);
+  state.candidates.assign(n, 0);
   std::vector<std::vector<std::uint64_t>> stage_root_tests(plan.splits.size());
   for (std::size_t s = 0; s < plan.splits.size(); ++s) {
     split_of[plan.split_pairs[s]] = s;
@@ -82,6 +117,8 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
     sub_tests[t].assign(plan.taboos[t].nodes.size(), 0);
     reached[t].assign(plan.taboos[t].nodes.size(), 0);
   }
+  std::vector<std::uint32_t> rest;
+  const std::vector<std::uint8_t> whole = whole_pairs(plan, split_of, rest);
   // In plan order, each task to the next free thread: the list schedule the simulation replays.
   parallel::for_each_in_order(plan.run.size(), [&](std::size_t t) {
     state.timeline.record(TaskSpan::Phase::traverse, t, [&] {
@@ -97,6 +134,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
         tests += stats.node_tests - before;
         if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
         if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;
+        if (whole[root.pair] != 0) finalize_whole(state, root.pair, w);
       }
       record.task_node_tests[t] = tests;
       if (plan.weighted) record.task_weights[t] = plan.run[t].weight;
@@ -109,7 +147,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
       if (!reached[t][k]) record.taboo_unreached_node_tests += sub_tests[t][k];
     }
   }
-  finalize_pairs(state, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
+  finalize_pairs(state, rest, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
     if (split_of[i] == SIZE_MAX) return;
     const tasks::SplitResult& s = plan.splits[split_of[i]];
     all = s.candidates;

@@ -102,10 +102,25 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
     throw Error(ErrorCode::bad_argument, "predicted_step_ms", "the step has no timeline (EngineOptions::timeline)");
   }
   std::vector<const TaskSpan*> stage, traverse, finalize;
+  // A pair traversed whole by one task is finalized inside that task's span: its finalize span lies
+  // within the traverse span of the same thread, and its time is already the task's.
+  std::vector<const TaskSpan*> by_thread;
+  for (const TaskSpan& t : r.timeline) by_thread.push_back(&t);
+  std::sort(by_thread.begin(), by_thread.end(), [](const TaskSpan* x, const TaskSpan* y) {
+    return x->thread != y->thread       ? x->thread < y->thread
+           : x->start_ms != y->start_ms ? x->start_ms < y->start_ms
+                                        : x->end_ms > y->end_ms;
+  });
   double spans = 0.0;
-  for (const TaskSpan& t : r.timeline) {
-    spans += t.end_ms - t.start_ms;
-    (t.phase == TaskSpan::Phase::stage ? stage : t.phase == TaskSpan::Phase::traverse ? traverse : finalize).push_back(&t);
+  const TaskSpan* open = nullptr;  // the thread's latest traverse span
+  for (const TaskSpan* t : by_thread) {
+    if (open != nullptr && open->thread != t->thread) open = nullptr;
+    if (t->phase == TaskSpan::Phase::finalize && open != nullptr && t->start_ms >= open->start_ms && t->end_ms <= open->end_ms) {
+      continue;
+    }
+    if (t->phase == TaskSpan::Phase::traverse) open = t;
+    spans += t->end_ms - t->start_ms;
+    (t->phase == TaskSpan::Phase::stage ? stage : t->phase == TaskSpan::Phase::traverse ? traverse : finalize).push_back(t);
   }
   const auto by_unit = [](const TaskSpan* x, const TaskSpan* y) {
     return x->unit != y->unit ? x->unit < y->unit : x->start_ms < y->start_ms;

@@ -9,6 +9,15 @@
 namespace caliber::schedule {
 namespace {
 
+/// One depth-first traversal of pair `pair` from n, on this thread (which tests n unless `tested`),
+/// recorded as one piece.
+void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::NodePair n, bool tested) {
+  const std::uint64_t before = w.stats[pair].node_tests;
+  narrow::traverse(state.contexts[pair], n, w.scratch, w.candidates[pair], w.stats[pair],
+                   tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.limit(pair));
+  w.pieces.push_back(w.stats[pair].node_tests - before);
+}
+
 /// Above the cut-off depth, visits CD-tree node n of pair `pair` (it passed its test, made by its
 /// parent's visit or before the first call) and spawns one task per child that passes; from the
 /// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
@@ -21,12 +30,7 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
   {
     WorkerSlots& w = local_slots(state.workers, pairs);
     if (depth >= cutoff) {
-      state.timeline.record(TaskSpan::Phase::traverse, pair, [&] {
-        const std::uint64_t before = w.stats[pair].node_tests;
-        narrow::traverse(ctx, n, w.scratch, w.candidates[pair], w.stats[pair],
-                         tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.limit(pair));
-        w.pieces.push_back(w.stats[pair].node_tests - before);
-      });
+      state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested); });
       return;
     }
     const std::uint64_t before = w.stats[pair].node_tests;
@@ -47,9 +51,11 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
 void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   const auto start = util::Clock::now();
   const std::size_t n = state.contexts.size();
+  state.candidates.assign(n, 0);
   // Only a pair that may hold a good part of the step's work is split: one whose a priori weight
   // is at least 1 / (64 x threads) of the total. The lighter ones run whole, in a parallel loop
-  // over them (splitting thousands of light pairs costs more than it balances).
+  // over them (splitting thousands of light pairs costs more than it balances), each finalized by
+  // the thread that traversed it, at once.
   std::vector<std::uint32_t> heavy, light;
   if (depth > 0 && n > 1) {
     const std::vector<double> weight = tasks::root_weights(state.contexts);
@@ -73,14 +79,21 @@ void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   if (!light.empty()) {
     group.run([&state, &light] {
       parallel::parallel_for(0, light.size(), 16, [&](std::size_t lo, std::size_t hi) {
-        for (std::size_t k = lo; k != hi; ++k) steal(state, light[k], narrow::NodePair{0, 0}, 0, 0, /*tested=*/false);
+        for (std::size_t k = lo; k != hi; ++k) {
+          // One piece, its finalization inside its span.
+          state.timeline.record(TaskSpan::Phase::traverse, light[k], [&] {
+            WorkerSlots& w = local_slots(state.workers, state.contexts.size());
+            traverse_piece(state, w, light[k], narrow::NodePair{0, 0}, /*tested=*/false);
+            finalize_whole(state, light[k], w);
+          });
+        }
       });
     });
   }
   group.wait();
   record.traverse_ms = util::ms_since(start);
   const auto finalize_start = util::Clock::now();
-  finalize_pairs(state, {});
+  finalize_pairs(state, heavy, {});
   record.finalize_ms = util::ms_since(finalize_start);
   state.workers.for_each([&](const WorkerSlots& w) {
     record.task_node_tests.insert(record.task_node_tests.end(), w.pieces.begin(), w.pieces.end());

@@ -98,7 +98,8 @@ struct StepState {
   bool parallel_finalize = true;  ///< let one heavy pair's finalization use several threads
   /// Per pair: its kept pairs against QueryRequest::max_pairs; null when there is no limit.
   narrow::PairLimit* limits = nullptr;
-  /// Per pair: the candidates its finalization took in (filled by finalize_pairs).
+  /// Per pair: the candidates its finalization took in (sized by the runner, filled by the
+  /// finalization).
   std::vector<std::size_t> candidates;
   /// The frame's object pairs (the ids each pair's contacts carry).
   const ObjectPair* pairs = nullptr;
@@ -106,10 +107,15 @@ struct StepState {
   [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
 };
 
-/// Per pair, in parallel, most candidates first: `start` seeds the pair's candidates and counts
-/// (work done outside the workers' slots), every worker's slots are added, and the pair goes through
-/// the one finalization (narrow/finalize.h) into state.results.
-void finalize_pairs(StepState& state,
+/// Pair i, traversed whole by the worker `w` (every candidate and count of it in w's slots), through
+/// the one finalization (narrow/finalize.h) into state.results, on the calling thread: what a
+/// runner does at the end of the task that traversed it.
+void finalize_whole(StepState& state, std::size_t i, WorkerSlots& w);
+
+/// The pairs `rest` (those not finalized by finalize_whole), in parallel, most candidates first:
+/// `start` seeds a pair's candidates and counts (work done outside the workers' slots), every
+/// worker's slots are added, and the pair goes through the one finalization into state.results.
+void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
                     const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start);
 
 /// The reduction of a step: per-pair records and the contacts of every pair, in pair order (pairs

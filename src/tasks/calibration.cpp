@@ -26,7 +26,8 @@ double caliber_threshold(double total, double beta, int threads) {
 }
 
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
-  std::sort(cart.begin(), cart.end(), [](const Root& x, const Root& y) {
+  // A total order (no two items share pair and node): the same on any number of threads.
+  parallel::parallel_sort(cart.begin(), cart.end(), [](const Root& x, const Root& y) {
     if (x.weight != y.weight) return x.weight < y.weight;
     if (x.pair != y.pair) return x.pair < y.pair;
     if (x.node.a != y.node.a) return x.node.a < y.node.a;

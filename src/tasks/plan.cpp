@@ -28,10 +28,8 @@ InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pai
   InitialWeights w;
   w.scale.assign(n, 1.0);
   if (method == Method::hybrid || method == Method::aposteriori) {
-    const auto last = [&](std::size_t i) -> std::uint64_t {
-      const std::uint64_t* tests = history.node_tests.find(pairs[i]);
-      return tests == nullptr ? 0 : *tests;
-    };
+    const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
+    const auto last = [&](std::size_t i) -> std::uint64_t { return known[i] == nullptr ? 0 : *known[i]; };
     double measured = 0.0, estimated = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       if (last(i) > 0) {

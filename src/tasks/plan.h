@@ -27,6 +27,17 @@ class PairTable {
     const auto it = std::lower_bound(mKeys.begin(), mKeys.end(), p);
     return it == mKeys.end() || *it != p ? nullptr : &mValues[static_cast<std::size_t>(it - mKeys.begin())];
   }
+  /// The values of `pairs` (in non-decreasing order), null where absent: one merge of the two sorted
+  /// lists, not a search per pair.
+  [[nodiscard]] std::vector<const T*> find_sorted(const std::vector<ObjectPair>& pairs) const {
+    std::vector<const T*> out(pairs.size(), nullptr);
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < pairs.size() && k < mKeys.size(); ++i) {
+      while (k < mKeys.size() && mKeys[k] < pairs[i]) ++k;
+      if (k < mKeys.size() && mKeys[k] == pairs[i]) out[i] = &mValues[k];
+    }
+    return out;
+  }
   /// The value of pair p, inserted (value-initialized) if absent; at once when p comes after every
   /// pair held.
   T& operator[](const ObjectPair& p) {

@@ -123,6 +123,23 @@ TEST(Plans, HybridScalesByLastStepsNodeTests) {
   expect_covers_like_query(plan_calibrated(options, p.pairs, p.contexts, history), p, "hybrid");
 }
 
+TEST(Plans, PairTableFindsSortedPairsInOneMerge) {
+  PairTable<int> table;
+  for (const auto& [p, v] : {std::pair{ObjectPair{0, 3}, 1}, {ObjectPair{1, 2}, 2}, {ObjectPair{2, 5}, 3}, {ObjectPair{4, 6}, 4}})
+    table[p] = v;
+  // Absent pairs before, between and after the keys; a pair twice (the batch repeats one pair).
+  const std::vector<ObjectPair> asked = {{0, 1}, {0, 3}, {1, 2}, {1, 2}, {1, 9}, {4, 6}, {7, 8}};
+  const std::vector<const int*> found = table.find_sorted(asked);
+  ASSERT_EQ(found.size(), asked.size());
+  for (std::size_t i = 0; i < asked.size(); ++i) EXPECT_EQ(found[i], table.find(asked[i])) << "pair " << i;
+  EXPECT_EQ(*found[1], 1);
+  EXPECT_EQ(*found[3], 2);
+  EXPECT_EQ(*found[5], 4);
+  EXPECT_EQ(found[0], nullptr);
+  EXPECT_EQ(found[6], nullptr);
+  EXPECT_TRUE(PairTable<int>{}.find_sorted(asked)[1] == nullptr);
+}
+
 TEST(Plans, APosterioriSplitsOnLastStepsContactsWithTabooLists) {
   const Pairs p;
   EngineOptions options;
