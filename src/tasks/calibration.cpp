@@ -26,26 +26,48 @@ double caliber_threshold(double total, double beta, int threads) {
 }
 
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
-  // A total order (no two items share pair and node): the same on any number of threads.
-  parallel::parallel_sort(cart.begin(), cart.end(), [](const Root& x, const Root& y) {
+  // Sorted as keys (the roots are twice their size), by a total order (no two items share pair and
+  // node): the same on any number of threads.
+  struct Key {
+    double weight;
+    std::uint32_t pair, a, b, item;
+  };
+  std::vector<Key> keys(cart.size());
+  for (std::size_t k = 0; k < cart.size(); ++k) {
+    keys[k] = Key{cart[k].weight, cart[k].pair, cart[k].node.a, cart[k].node.b, static_cast<std::uint32_t>(k)};
+  }
+  parallel::parallel_sort(keys.begin(), keys.end(), [](const Key& x, const Key& y) {
     if (x.weight != y.weight) return x.weight < y.weight;
     if (x.pair != y.pair) return x.pair < y.pair;
-    if (x.node.a != y.node.a) return x.node.a < y.node.a;
-    return x.node.b < y.node.b;
+    if (x.a != y.a) return x.a < y.a;
+    return x.b < y.b;
   });
-  std::vector<RunTask> tasks;
-  tasks.reserve(cart.size());
-  std::size_t light = 0, heavy = cart.size();
+  // Which task each item joins: the heaviest left takes the lightest left until omega.
+  std::vector<std::uint32_t> task_of(cart.size());
+  std::vector<double> weight;
+  std::vector<std::uint32_t> size;
+  std::size_t light = 0, heavy = keys.size();
   while (light < heavy) {
-    RunTask task;
-    task.roots.push_back(cart[--heavy]);
-    task.weight = cart[heavy].weight;
-    while (task.weight < omega && light < heavy) {
-      task.roots.push_back(cart[light]);
-      task.weight += cart[light++].weight;
+    const auto t = static_cast<std::uint32_t>(weight.size());
+    task_of[keys[--heavy].item] = t;
+    double w = keys[heavy].weight;
+    std::uint32_t n = 1;
+    while (w < omega && light < heavy) {
+      task_of[keys[light].item] = t;
+      w += keys[light++].weight;
+      ++n;
     }
-    tasks.push_back(std::move(task));
+    weight.push_back(w);
+    size.push_back(n);
   }
+  // Each task's roots in the cart's order (pair order for whole pairs): a task then walks the
+  // pairs' contexts in memory order. The order of a task's roots changes no result.
+  std::vector<RunTask> tasks(weight.size());
+  for (std::size_t t = 0; t < tasks.size(); ++t) {
+    tasks[t].weight = weight[t];
+    tasks[t].roots.reserve(size[t]);
+  }
+  for (std::size_t k = 0; k < cart.size(); ++k) tasks[task_of[k]].roots.push_back(cart[k]);
   return tasks;
 }
 

@@ -45,6 +45,10 @@ class RootList {
   RootList(std::initializer_list<Root> roots) {
     for (const Root& r : roots) push_back(r);
   }
+  /// Room for n roots (the heap only when n is more than are held in place).
+  void reserve(std::size_t n) {
+    if (n > kInPlace) mSpill.reserve(n);
+  }
   void push_back(const Root& r) {
     if (mSize < kInPlace) {
       mInPlace[mSize] = r;
@@ -84,6 +88,8 @@ double caliber_threshold(double total, double beta, int threads);
 
 /// Merges the cart: sorted by weight (ties by pair, then node), the heaviest item takes the lightest
 /// ones until their sum reaches omega; repeats until the cart is empty. No task comes out empty.
+/// The tasks come out in that order (the first holds the heaviest item); each task's roots are in
+/// their order in `cart`.
 std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 
 /// One node the weight-driven stage visited (every one passed its node test): what happened to it,

@@ -123,6 +123,7 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
   plan.omega = caliber_threshold(w.total, options.beta, options.plan_threads > 0 ? options.plan_threads : options.threads);
   const double eps = options.epsilon * plan.omega;
   std::vector<Root> cart;
+  cart.reserve(pairs.size());
   std::vector<std::size_t> to_split;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Root whole{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, w.weight[i]};

@@ -42,7 +42,8 @@ TEST(Calibration, CartMergesHeaviestWithLightestUntilOmega) {
                             item(5, 1), item(6, 7), item(7, 3), item(8, 6), item(9, 4)};
   const std::vector<RunTask> tasks = merge_cart(cart, 10.0);
   ASSERT_EQ(tasks.size(), 5u);
-  const std::vector<std::vector<double>> want = {{9, 1}, {8, 1, 2}, {7, 3}, {6, 4}, {5}};
+  // Each task's roots in the cart's order: 9 (pair 2) with 1 (pair 1) comes out {1, 9}.
+  const std::vector<std::vector<double>> want = {{1, 9}, {2, 8, 1}, {7, 3}, {6, 4}, {5}};
   for (std::size_t t = 0; t < tasks.size(); ++t) {
     std::vector<double> got;
     for (const Root& r : tasks[t].roots) got.push_back(r.weight);
