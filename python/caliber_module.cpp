@@ -528,6 +528,31 @@ def _batch_from_state(state):
           "matrices or N x 7 rows (translation, then the quaternion in `order`: 'wxyz' or 'xyzw'), float32 or float64. "
           "Returns a Batch.")
       .def(
+          "find_pairs",
+          [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
+             const std::string& kind, std::optional<double> tolerance, std::vector<bool> fixed,
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+            caliber::Frame frame = make_frame(models, poses, {}, make_request(kind, tolerance, 30.0, 0, false));
+            std::vector<caliber::ObjectPair> skip;
+            for (const auto& [a, b] : ignored) skip.push_back(caliber::ObjectPair{a, b});
+            {
+              py::gil_scoped_release release;
+              engine.find_pairs(frame, fixed, skip);
+            }
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+            out.reserve(frame.pairs.size());
+            for (const caliber::ObjectPair& p : frame.pairs) out.emplace_back(p.a, p.b);
+            return out;
+          },
+          py::arg("models"), py::arg("poses"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
+          py::kw_only(), py::arg("fixed") = std::vector<bool>{},
+          py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
+          "The broad phase on this engine's threads: the object pairs (a < b, sorted) whose world boxes overlap within "
+          "the query's reach (its tolerance for kind 'distance' or 'contact'), what step() takes. The same pairs as "
+          "broad_phase(); the engine keeps its tree of boxes from call to call (refitted), so calls on the same objects "
+          "moving a little are cheaper. fixed: one flag per object (pairs of two fixed objects skipped); ignored: pairs "
+          "never reported.")
+      .def(
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind,

@@ -128,6 +128,26 @@ def test_broad_phase_gives_the_pairs_a_step_takes():
         caliber.broad_phase(models, poses[:2])
 
 
+def test_engine_find_pairs_keeps_its_tree_and_finds_the_broad_phase_pairs():
+    rng = np.random.default_rng(7)
+    models = [caliber.Model.load(TETRA) for _ in range(40)]
+    engine = caliber.Engine(threads=2)
+    for k in range(4):  # the same objects drifting: the engine refits its tree
+        poses = [caliber.Pose(tuple(rng.uniform(0.0, 3.0, 3))) for _ in models]
+        for kind, tolerance, reach in [("interference", None, 0.0), ("proximity", 0.25, 0.25)]:
+            got = engine.find_pairs(models, poses, kind=kind, tolerance=tolerance)
+            assert got == caliber.broad_phase(models, poses, reach), (k, kind)
+            assert len(got) > 0
+    fixed = [i % 2 == 0 for i in range(len(models))]
+    assert engine.find_pairs(models, poses, fixed=fixed) == caliber.broad_phase(models, poses, 0.0, fixed=fixed)
+    some = caliber.broad_phase(models, poses)[:3]
+    assert engine.find_pairs(models, poses, ignored=some) == caliber.broad_phase(models, poses, ignored=some)
+    with pytest.raises(caliber.Error, match="reach must be finite"):
+        engine.find_pairs(models, poses, kind="distance")  # an unbounded distance names its pairs
+    with pytest.raises(caliber.Error, match="3 models but 2 poses"):
+        engine.find_pairs(models[:3], poses[:2])
+
+
 def test_pickled_models_answer_the_same():
     a = caliber.Model.load(FAN)
     b = pickle.loads(pickle.dumps(a))
