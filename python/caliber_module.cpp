@@ -544,9 +544,8 @@ def _batch_from_state(state):
             for (const caliber::ObjectPair& p : frame.pairs) out.emplace_back(p.a, p.b);
             return out;
           },
-          py::arg("models"), py::arg("poses"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(),
-          py::kw_only(), py::arg("fixed") = std::vector<bool>{},
-          py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
+          py::arg("models"), py::arg("poses"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(), py::kw_only(),
+          py::arg("fixed") = std::vector<bool>{}, py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
           "The broad phase on this engine's threads: the object pairs (a < b, sorted) whose world boxes overlap within "
           "the query's reach (its tolerance for kind 'distance' or 'contact'), what step() takes. The same pairs as "
           "broad_phase(); the engine keeps its tree of boxes from call to call (refitted), so calls on the same objects "
