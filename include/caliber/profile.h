@@ -70,8 +70,12 @@ struct ScheduleRecord {
   /// are in stage_task_node_tests).
   std::vector<std::uint64_t> thread_node_tests;
   double calibrate_ms = 0.0;  ///< calibrated methods: weights, keep/split/cart, weight-driven stage, cart
-  double traverse_ms = 0.0;   ///< depth-first traversals of the run-time tasks (or pairs, or pieces)
-  double finalize_ms = 0.0;   ///< per-pair merge, sort, local minima and world coordinates
+  /// Depth-first traversals of the run-time tasks (or pairs, or pieces), with the finalization of
+  /// each pair a task holds whole.
+  double traverse_ms = 0.0;
+  /// After the traversals: the per-pair merge, sort, local minima and world coordinates of the
+  /// pairs cut into pieces.
+  double finalize_ms = 0.0;
   /// Every piece of work with its thread and times, sorted by thread then start; empty unless
   /// EngineOptions::timeline is on.
   std::vector<TaskSpan> timeline;

@@ -1,9 +1,10 @@
 #pragma once
 /// \file
 /// The two runners of the engine. The plan runner executes any method's plan (tasks/plan.h): the
-/// run-time tasks handed out in order, each traversed depth first by one thread, then the one
-/// finalization per pair. Stealing has its own runner (recursive splitting on work stealing). Both
-/// fill the same ScheduleRecord.
+/// run-time tasks handed out in order, each traversed depth first by one thread, which also
+/// finalizes the pairs it holds whole; the pairs cut into pieces are finalized once every task is
+/// done (the same finalization per pair either way). Stealing has its own runner (recursive
+/// splitting on work stealing). Both fill the same ScheduleRecord.
 
 #include <cstdint>
 #include <vector>
