@@ -215,10 +215,10 @@ GRID_JITTER = 0.05
 GRID_STEPS = 20
 
 
-def grid(n, out_dir):
+def grid(n, out_dir, mesh_path):
     rng = random.Random(n)
     side = math.ceil(n ** (1.0 / 3.0) - 1e-9)
-    mesh = os.path.relpath(os.path.join(HERE, DATA, "eight.off"), out_dir)
+    mesh = os.path.relpath(mesh_path, out_dir)
     objects = []
     for i in range(n):
         cell = (i % side, (i // side) % side, i // (side * side))
@@ -241,13 +241,17 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--grid", type=int, nargs="+", metavar="N", help="write grid_N.json for each N instead")
     parser.add_argument("--out-dir", default=os.path.join(HERE, "..", "data", "scenes"), help="where grid scenes go")
+    parser.add_argument("--mesh", default=os.path.join(HERE, DATA, "eight.off"),
+                        help="the parts' mesh (CGAL's eight.off), named in the scene relative to --out-dir")
     args = parser.parse_args()
     if args.grid:
+        if not os.path.isfile(args.mesh):
+            parser.error("--mesh: no such mesh file: %s (scripts/fetch_meshes.sh extracts CGAL's)" % args.mesh)
         os.makedirs(args.out_dir, exist_ok=True)
         for n in args.grid:
             if n < 1:
                 parser.error("--grid: a scene needs at least one part")
-            print(grid(n, os.path.abspath(args.out_dir)))
+            print(grid(n, os.path.abspath(args.out_dir), os.path.abspath(args.mesh)))
     else:
         two_small()
         two_large()

@@ -68,8 +68,9 @@ for scene in sorted(pathlib.Path(sys.argv[1]).glob("*.json")):
         if obj["mesh"].startswith("../data/"):
             print(obj["mesh"])
 PY
-# The many-part scenes' mesh (scenes/generate.py --grid N --out-dir .devicepack/data/scenes writes
-# them there) and bench_batch's two (it reads data/meshes from the pack's folder).
+# The many-part scenes' mesh (there, `python3 scenes/generate.py --grid N --out-dir
+# .devicepack/data/scenes --mesh .devicepack/data/meshes/eight.off` writes the scenes beside it)
+# and bench_batch's two (it reads data/meshes from the pack's folder).
 for mesh in eight.off bunny00.off turbine.off; do cp "$root/data/meshes/$mesh" "$pack/data/meshes/"; done
 
 cat > "$pack/run.sh" <<'RUN'
