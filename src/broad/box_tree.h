@@ -2,9 +2,9 @@
 /// \file
 /// The broad phase's structure: the objects' world boxes sorted along a Morton curve of their
 /// centres, a binary tree of boxes over that order split where the curve's codes split (as a linear
-/// BVH's), and the pairs whose boxes overlap found by querying each box against the part of the
-/// tree that lies after it in that order (so each pair is met once), in parallel on the executor
-/// the caller runs in. The order only steers the pruning:
+/// BVH's), and the pairs whose boxes overlap found by querying each leaf's boxes together against
+/// the part of the tree that lies after them in that order (so each pair is met once), in parallel
+/// on the executor the caller runs in. The order only steers the pruning:
 /// the pairs are those whose boxes overlap (closed intervals on the three axes), whatever it is.
 /// Kept from frame to frame: the order is re-sorted only when refitting the tree over the old one
 /// has let its boxes grow (temporal coherence), and the buffers are reused.
@@ -56,6 +56,7 @@ class BoxTree {
   std::vector<std::uint32_t> mCodes;               ///< Morton code per object
   std::vector<FlatBox> mSorted;                    ///< box per position
   std::vector<Node> mNodes;                        ///< the tree in preorder (the root first)
+  std::vector<std::uint32_t> mLeaves;              ///< the leaves (node indices), in position order
   double mSortedArea = 0.0;                        ///< the tree's node area right after the last sort
   std::vector<std::vector<std::uint64_t>> mFound;  ///< per chunk of positions: pairs (a << 32 | b)
   std::vector<std::uint32_t> mStart;               ///< counting sort by a

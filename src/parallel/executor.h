@@ -198,8 +198,8 @@ void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {
 }
 
 /// Sorts [first, last) by `less`, in parallel where the backend can (std backend, or outside an
-/// executor: one thread). Only for orders where no two elements compare equal, so that the result
-/// is unique.
+/// executor: one thread). Only for orders where no two elements compare equal, or where equal
+/// elements cannot be told apart (plain numbers), so that the result is unique.
 template <class It, class Less>
 void parallel_sort(It first, It last, Less less) {
 #ifdef CALIBER_EXECUTOR_STD

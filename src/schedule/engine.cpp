@@ -177,8 +177,7 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
                                            ScheduleRecord& record) {
   const std::size_t n = pairs.size();
   results.assign(n, QueryResult{});
-  workers.for_each([n](schedule::WorkerSlots& w) { w.reset(n); });
-  schedule::StepState state{{}, workers, timeline, results, options.threads > 1, nullptr, {}, pairs.data()};
+  schedule::StepState state{{}, workers, timeline, results, options.threads > 1, nullptr, {}, pairs.data(), ++runs};
   std::unique_ptr<narrow::PairLimit[]> limits;
   if (request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
     limits = std::make_unique<narrow::PairLimit[]>(n);
@@ -191,18 +190,29 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
     state.contexts = contexts.build(n, make);
     if (method == Method::stealing) {
       schedule::run_stealing(options.stealing_depth, state, record);
-      return;
-    }
-    const auto planning = util::Clock::now();
-    if (method == Method::sequential || method == Method::exploitation) {
-      run.plan = tasks::plan_pairs(n);
     } else {
-      run.plan = tasks::plan_calibrated(
-          options, pairs, state.contexts, plan_history,
-          [&](std::size_t pair, const std::function<void()>& stage) { timeline.record(TaskSpan::Phase::stage, pair, stage); });
+      const auto planning = util::Clock::now();
+      if (method == Method::sequential || method == Method::exploitation) {
+        run.plan = tasks::plan_pairs(n);
+      } else {
+        run.plan = tasks::plan_calibrated(
+            options, pairs, state.contexts, plan_history,
+            [&](std::size_t pair, const std::function<void()>& stage) { timeline.record(TaskSpan::Phase::stage, pair, stage); });
+      }
+      record.calibrate_ms = util::ms_since(planning);
+      run.stage_root_tests = schedule::run_plan(run.plan, state, record);
     }
-    record.calibrate_ms = util::ms_since(planning);
-    run.stage_root_tests = schedule::run_plan(run.plan, state, record);
+    // Each thread's node tests, its slots summed in parallel (threads x pairs counts in all).
+    const std::vector<schedule::WorkerSlots*> slots = workers.all();
+    std::vector<std::uint64_t> tests(slots.size(), 0);
+    parallel::parallel_for_each(0, slots.size(), [&](std::size_t k) {
+      if (!state.current(*slots[k])) return;
+      for (const QueryStats& st : slots[k]->stats) tests[k] += st.node_tests;
+    });
+    for (const std::uint64_t t : tests) {
+      if (t > 0) record.thread_node_tests.push_back(t);
+    }
+    std::sort(record.thread_node_tests.begin(), record.thread_node_tests.end(), std::greater<>());
   });
   run.candidates = std::move(state.candidates);
   return run;
@@ -232,13 +242,6 @@ StepResult Engine::step(const Frame& frame) {
   const schedule::PairsRun run =
       mImpl->run_pairs(options, mOptions.method, frame.pairs, frame.request, mImpl->history, make, results, record);
   remember(mOptions, frame.pairs, results, run.plan, run.stage_root_tests, mImpl->history);
-  mImpl->workers.for_each([&](const schedule::WorkerSlots& w) {
-    if (w.stats.size() != n) return;
-    std::uint64_t tests = 0;
-    for (const QueryStats& st : w.stats) tests += st.node_tests;
-    if (tests > 0) record.thread_node_tests.push_back(tests);
-  });
-  std::sort(record.thread_node_tests.begin(), record.thread_node_tests.end(), std::greater<>());
   out.narrow_ms = util::ms_since(start);
   // After the clock: gathering and sorting the spans is the instrument's cost, not the step's (the
   // timed prediction would count it serial).

@@ -96,6 +96,8 @@ struct Engine::Impl {
   std::atomic<bool> busy{false};
   parallel::Executor executor;
   schedule::Workers workers;
+  /// run_pairs calls so far: the workers' slots hold the work of run `runs` (StepState::run).
+  std::uint64_t runs = 0;
   /// What the temporal methods remember of each pair. Changes only how work is cut.
   tasks::History history;
   /// Who ran what when, this step (EngineOptions::timeline).

@@ -49,13 +49,12 @@ void finalize_whole(StepState& state, std::size_t i, WorkerSlots& w) {
 
 void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
                     const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start) {
-  const std::size_t n = state.contexts.size();
   const std::vector<WorkerSlots*> slots = state.workers.all();
   // A pair's finalization costs about its candidate count: most candidates first, to the next free
   // thread (ties by pair index; the order changes who runs what, never the results).
   std::vector<std::size_t> candidates(rest.size(), 0), order(rest.size());
   for (const WorkerSlots* w : slots) {
-    if (w->stats.size() != n) continue;
+    if (!state.current(*w)) continue;
     for (std::size_t k = 0; k < rest.size(); ++k) candidates[k] += w->candidates[rest[k]].size();
   }
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -68,7 +67,7 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
       if (start) start(i, all, stats);
       all.reserve(all.size() + candidates[order[k]]);
       for (const WorkerSlots* w : slots) {
-        if (w->stats.size() != n) continue;
+        if (!state.current(*w)) continue;
         all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
         stats.node_tests += w->stats[i].node_tests;
         stats.leaf_tests += w->stats[i].leaf_tests;
@@ -122,7 +121,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   // In plan order, each task to the next free thread: the list schedule the simulation replays.
   parallel::for_each_in_order(plan.run.size(), [&](std::size_t t) {
     state.timeline.record(TaskSpan::Phase::traverse, t, [&] {
-      WorkerSlots& w = local_slots(state.workers, n);
+      WorkerSlots& w = local_slots(state);
       std::uint64_t tests = 0;
       for (const tasks::Root& root : plan.run[t].roots) {
         QueryStats& stats = w.stats[root.pair];

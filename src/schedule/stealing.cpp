@@ -23,12 +23,11 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
 /// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
 /// exactly those of a single depth-first traversal of the tree.
 void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested) {
-  const std::size_t pairs = state.contexts.size();
   const narrow::PairContext& ctx = state.contexts[pair];
   narrow::NodePair kids[4];
   int count = 0;
   {
-    WorkerSlots& w = local_slots(state.workers, pairs);
+    WorkerSlots& w = local_slots(state);
     if (depth >= cutoff) {
       state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested); });
       return;
@@ -70,7 +69,7 @@ void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   for (const std::uint32_t i : heavy) {
     group.run([&state, i, depth] {
       // The root is tested above the cut-off: splitting work.
-      WorkerSlots& w = local_slots(state.workers, state.contexts.size());
+      WorkerSlots& w = local_slots(state);
       ++w.split_node_tests;
       if (!narrow::test_root(state.contexts[i], narrow::NodePair{0, 0}, w.stats[i])) return;
       steal(state, i, narrow::NodePair{0, 0}, 0, depth, /*tested=*/true);
@@ -82,7 +81,7 @@ void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
         for (std::size_t k = lo; k != hi; ++k) {
           // One piece, its finalization inside its span.
           state.timeline.record(TaskSpan::Phase::traverse, light[k], [&] {
-            WorkerSlots& w = local_slots(state.workers, state.contexts.size());
+            WorkerSlots& w = local_slots(state);
             traverse_piece(state, w, light[k], narrow::NodePair{0, 0}, /*tested=*/false);
             finalize_whole(state, light[k], w);
           });
@@ -96,11 +95,13 @@ void run_stealing(int depth, StepState& state, ScheduleRecord& record) {
   finalize_pairs(state, heavy, {});
   record.finalize_ms = util::ms_since(finalize_start);
   state.workers.for_each([&](const WorkerSlots& w) {
+    if (!state.current(w)) return;
     record.task_node_tests.insert(record.task_node_tests.end(), w.pieces.begin(), w.pieces.end());
     record.split_node_tests += w.split_node_tests;
   });
-  // Pieces were collected per worker; sort them so the record does not depend on who ran what.
-  std::sort(record.task_node_tests.begin(), record.task_node_tests.end(), std::greater<>());
+  // Pieces were collected per worker; sort them so the record does not depend on who ran what (in
+  // parallel: a step of many pairs has a piece per light pair).
+  parallel::parallel_sort(record.task_node_tests.begin(), record.task_node_tests.end(), std::greater<>());
 }
 
 }  // namespace caliber::schedule

@@ -24,6 +24,9 @@ struct WorkerSlots {
   std::vector<QueryStats> stats;                           ///< per pair
   std::vector<std::uint64_t> pieces;                       ///< stealing: node tests of each depth-first piece
   std::uint64_t split_node_tests = 0;                      ///< stealing: node tests above the cut-off
+  /// The run (StepState::run) whose work the slots hold: the slots of a thread that took no part
+  /// in the current run are stale, and read as empty.
+  std::uint64_t run = 0;
 
   void reset(std::size_t pairs) {
     candidates.resize(pairs);
@@ -35,13 +38,6 @@ struct WorkerSlots {
 };
 
 using Workers = parallel::PerThread<WorkerSlots>;
-
-/// This thread's slots, sized for `pairs` (a thread that joins mid-step starts with empty slots).
-inline WorkerSlots& local_slots(Workers& workers, std::size_t pairs) {
-  WorkerSlots& w = workers.local();
-  if (w.stats.size() != pairs) w.reset(pairs);
-  return w;
-}
 
 /// Optional record of who ran what when (EngineOptions::timeline), for Gantt charts.
 struct Timeline {
@@ -105,7 +101,24 @@ struct StepState {
   const ObjectPair* pairs = nullptr;
   /// The pair's limit for a traversal, or null.
   [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
+  /// This run's number (Engine::Impl counts them): a worker's slots are reset by its own thread
+  /// when it first works in a run (in parallel, not one thread for all of them), and slots of
+  /// another run are stale.
+  std::uint64_t run = 0;
+
+  /// Whether w holds this run's work.
+  [[nodiscard]] bool current(const WorkerSlots& w) const { return w.run == run; }
 };
+
+/// This thread's slots for the run, reset for it on the first call in the run.
+inline WorkerSlots& local_slots(StepState& state) {
+  WorkerSlots& w = state.workers.local();
+  if (w.run != state.run) {
+    w.reset(state.contexts.size());
+    w.run = state.run;
+  }
+  return w;
+}
 
 /// Pair i, traversed whole by the worker `w` (every candidate and count of it in w's slots), through
 /// the one finalization (narrow/finalize.h) into state.results, on the calling thread: what a

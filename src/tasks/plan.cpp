@@ -24,28 +24,56 @@ Plan plan_pairs(std::size_t pairs) {
 InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                                const History& history) {
   const std::size_t n = pairs.size();
-  const std::vector<double> root = root_weights(contexts);
   InitialWeights w;
+  w.weight.resize(n);
   w.scale.assign(n, 1.0);
-  if (method == Method::hybrid || method == Method::aposteriori) {
+  if (method != Method::hybrid && method != Method::aposteriori) {
+    w.weight = root_weights(contexts);
+  } else {
+    // A pair with history weighs its node tests of last step; its root is estimated only for the
+    // fallback ratio, on an evenly spaced sample of at most kRatioSample of those pairs (all of
+    // them when fewer have history), or when it is split (scale_of). A pair without history is
+    // estimated and scaled by the ratio.
     const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
     const auto last = [&](std::size_t i) -> std::uint64_t { return known[i] == nullptr ? 0 : *known[i]; };
-    double measured = 0.0, estimated = 0.0;
+    std::size_t with_history = 0;
+    for (std::size_t i = 0; i < n; ++i) with_history += last(i) > 0 ? 1 : 0;
+    const std::size_t stride = std::max<std::size_t>(1, (with_history + kRatioSample - 1) / kRatioSample);
+    std::vector<std::uint32_t> estimate;  // the pairs whose root is estimated
+    std::size_t seen = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (last(i) > 0) {
-        measured += static_cast<double>(last(i));
-        estimated += root[i];
+      if (last(i) == 0 || seen++ % stride == 0) estimate.push_back(static_cast<std::uint32_t>(i));
+    }
+    std::vector<double> root(estimate.size());
+    parallel::parallel_for_each(0, estimate.size(), [&](std::size_t k) { root[k] = apriori_weight(contexts[estimate[k]], {0, 0}); });
+    double measured = 0.0, estimated = 0.0;
+    for (std::size_t k = 0; k < estimate.size(); ++k) {
+      if (last(estimate[k]) > 0) {
+        measured += static_cast<double>(last(estimate[k]));
+        estimated += root[k];
       }
     }
     const double fallback = estimated > 0.0 ? measured / estimated : 1.0;
-    for (std::size_t i = 0; i < n; ++i) w.scale[i] = last(i) > 0 ? static_cast<double>(last(i)) / root[i] : fallback;
+    for (std::size_t i = 0; i < n; ++i) {
+      w.weight[i] = static_cast<double>(last(i));
+      w.scale[i] = 0.0;  // not estimated: scale_of
+    }
+    for (std::size_t k = 0; k < estimate.size(); ++k) {
+      const std::size_t i = estimate[k];
+      w.scale[i] = last(i) > 0 ? static_cast<double>(last(i)) / root[k] : fallback;
+      if (last(i) == 0) w.weight[i] = fallback * root[k];
+    }
   }
-  w.weight.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    w.weight[i] = w.scale[i] * root[i];
+    w.weight[i] += kPairWeight;
     w.total += w.weight[i];
   }
   return w;
+}
+
+double scale_of(const InitialWeights& w, narrow::PairContexts contexts, std::size_t i) {
+  // (Its weight is its node tests of last step, an integer, plus kPairWeight: the difference is exact.)
+  return w.scale[i] > 0.0 ? w.scale[i] : (w.weight[i] - kPairWeight) / apriori_weight(contexts[i], {0, 0});
 }
 
 namespace {
@@ -97,7 +125,7 @@ void split_by_stage(const EngineOptions& options, const std::vector<ObjectPair>&
     const std::size_t i = to_split[s];
     const NodeCounts* measured = node_history ? history.node_counts.find(pairs[i]) : nullptr;
     const auto stage = [&] {
-      plan.splits[s] = split_task(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], w.scale[i], plan.omega,
+      plan.splits[s] = split_task(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], scale_of(w, contexts, i), plan.omega,
                                   options.epsilon * plan.omega, measured);
     };
     if (around_stage) {

@@ -5,6 +5,9 @@
 #include "tasks/calibration.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
 #include <queue>
 #include <tuple>
 
@@ -68,6 +71,74 @@ TEST(Calibration, CartEdgeCases) {
   const auto tasks = merge_cart(tiny, 25.0);
   EXPECT_EQ(tasks.size(), 12u);
   for (const RunTask& t : tasks) EXPECT_EQ(t.weight, 25.0);
+}
+
+/// The merge by its definition: the items sorted by (weight, pair, node) with std::sort, the
+/// heaviest left taking the lightest left until omega; each task's items in cart order.
+std::vector<std::vector<std::size_t>> reference_merge(const std::vector<Root>& cart, double omega) {
+  std::vector<std::size_t> order(cart.size());
+  for (std::size_t k = 0; k < cart.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    const Root &p = cart[x], &q = cart[y];
+    return std::tie(p.weight, p.pair, p.node.a, p.node.b) < std::tie(q.weight, q.pair, q.node.a, q.node.b);
+  });
+  std::vector<std::vector<std::size_t>> tasks;
+  std::size_t light = 0, heavy = order.size();
+  while (light < heavy) {
+    std::vector<std::size_t>& t = tasks.emplace_back(1, order[--heavy]);
+    double w = cart[t[0]].weight;
+    while (w < omega && light < heavy) {
+      t.push_back(order[light]);
+      w += cart[order[light++]].weight;
+    }
+    std::sort(t.begin(), t.end());
+  }
+  return tasks;
+}
+
+TEST(Calibration, CartMergeEqualsTheDefinitionOnRandomCarts) {
+  // Tied weights (measured node tests are integers), weights spread over many orders of magnitude,
+  // nodes above 2^24 and pairs above 2^16 (every byte of the radix sort's keys), and carts with a
+  // zero or infinite weight (sorted by comparison instead).
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 60; ++trial) {
+    const std::size_t n = 1 + rng() % 3000;
+    std::vector<Root> cart;
+    double total = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      double w = 0.0;
+      switch (trial % 4) {
+        case 0: w = static_cast<double>(1 + rng() % 40); break;                               // ties
+        case 1: w = std::ldexp(1.0 + static_cast<double>(rng() % 1000) / 1000.0, static_cast<int>(rng() % 80) - 40); break;
+        case 2: w = 1.0 + static_cast<double>(rng() % 1000000) * 1e-3; break;
+        default: w = static_cast<double>(rng() % 5); break;                                   // zeros: the fallback
+      }
+      const auto pair = static_cast<std::uint32_t>(rng() % (trial % 2 == 0 ? 50 : 200000));
+      const narrow::NodePair node{static_cast<std::uint32_t>(rng() % 3 == 0 ? rng() : rng() % 8),
+                                  static_cast<std::uint32_t>(rng() % 3 == 0 ? rng() : rng() % 8)};
+      cart.push_back(Root{pair, node, false, w});
+      total += w;
+    }
+    if (trial == 7) cart[n / 2].weight = std::numeric_limits<double>::infinity();
+    // No two items share pair and node (the cart's total order).
+    std::sort(cart.begin(), cart.end(), [](const Root& x, const Root& y) {
+      return std::tie(x.pair, x.node.a, x.node.b) < std::tie(y.pair, y.node.a, y.node.b);
+    });
+    cart.erase(std::unique(cart.begin(), cart.end(),
+                           [](const Root& x, const Root& y) { return x.pair == y.pair && x.node == y.node; }),
+               cart.end());
+    if (trial % 3 != 0) std::shuffle(cart.begin(), cart.end(), rng);  // else in (pair, node) order, as whole pairs come
+    for (std::size_t k = 0; k < cart.size(); ++k) cart[k].stage = static_cast<std::int32_t>(k);  // identifies the item
+    const double omega = total / static_cast<double>(1 + rng() % 40);
+    const std::vector<std::vector<std::size_t>> want = reference_merge(cart, omega);
+    const std::vector<RunTask> got = merge_cart(cart, omega);
+    ASSERT_EQ(got.size(), want.size()) << "trial " << trial;
+    for (std::size_t t = 0; t < got.size(); ++t) {
+      std::vector<std::size_t> items;
+      for (const Root& r : got[t].roots) items.push_back(static_cast<std::size_t>(r.stage));
+      ASSERT_EQ(items, want[t]) << "trial " << trial << ", task " << t;
+    }
+  }
 }
 
 TEST(Calibration, SubtreeCountsAddUpTheStage) {

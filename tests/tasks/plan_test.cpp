@@ -14,6 +14,7 @@
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 #include "tasks/plan.h"
+#include "tasks/weights.h"
 
 namespace caliber::tasks {
 namespace {
@@ -118,9 +119,49 @@ TEST(Plans, HybridScalesByLastStepsNodeTests) {
   History history;
   history.node_tests[p.pairs[0]] = 1000;
   const InitialWeights w = initial_weights(Method::hybrid, p.pairs, p.contexts, history);
-  EXPECT_DOUBLE_EQ(w.weight[0], 1000.0) << "a pair with history weighs what it took";
+  EXPECT_DOUBLE_EQ(w.weight[0], 1000.0 + kPairWeight) << "a pair with history weighs what it took, and the pair's own work";
   EXPECT_DOUBLE_EQ(w.scale[1], w.scale[0]) << "a pair without takes the measured ratio";
+  EXPECT_DOUBLE_EQ(scale_of(w, p.contexts, 0), 1000.0 / apriori_weight(p.contexts[0], {0, 0}));
   expect_covers_like_query(plan_calibrated(options, p.pairs, p.contexts, history), p, "hybrid");
+}
+
+TEST(Plans, HybridRatioComesFromAnEvenSampleOfThePairsWithHistory) {
+  // More pairs with history than the sample holds: the ratio for the pairs without comes from
+  // every stride-th pair with history, and the others' roots are estimated only when asked for.
+  const Pairs p;
+  const std::size_t known = 2 * kRatioSample + 3, fresh = 5, n = known + fresh;
+  std::vector<narrow::PairContext> contexts;
+  std::vector<ObjectPair> pairs;
+  History history;
+  for (std::size_t i = 0; i < n; ++i) {
+    contexts.push_back(p.contexts[i % 2]);
+    pairs.push_back(ObjectPair{0, static_cast<std::uint32_t>(i + 1)});
+    if (i < known) history.node_tests[pairs.back()] = 100 + i % 7;
+  }
+  const narrow::PairContexts view{contexts.data(), contexts.size()};
+  const InitialWeights w = initial_weights(Method::hybrid, pairs, view, history);
+  const std::size_t stride = (known + kRatioSample - 1) / kRatioSample;
+  double measured = 0.0, estimated = 0.0;
+  std::size_t sampled = 0;
+  for (std::size_t i = 0; i < known; i += stride, ++sampled) {
+    measured += static_cast<double>(100 + i % 7);
+    estimated += apriori_weight(contexts[i], {0, 0});
+  }
+  EXPECT_LE(sampled, kRatioSample);
+  const double ratio = measured / estimated;
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double root = apriori_weight(contexts[i], {0, 0});
+    if (i < known) {
+      EXPECT_EQ(w.weight[i], static_cast<double>(100 + i % 7) + kPairWeight) << "pair " << i;
+      EXPECT_DOUBLE_EQ(scale_of(w, view, i), static_cast<double>(100 + i % 7) / root) << "pair " << i;
+    } else {
+      EXPECT_DOUBLE_EQ(w.scale[i], ratio) << "pair " << i;
+      EXPECT_DOUBLE_EQ(w.weight[i], ratio * root + kPairWeight) << "pair " << i;
+    }
+    total += w.weight[i];
+  }
+  EXPECT_DOUBLE_EQ(w.total, total);
 }
 
 TEST(Plans, PairTableFindsSortedPairsInOneMerge) {
