@@ -3,7 +3,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -46,7 +45,9 @@ class RunStats {
   std::uint64_t mContacts = 0;
   std::uint64_t mTasks = 0;
   std::size_t mStepsWithContacts = 0;
-  std::map<ObjectPair, std::uint64_t> mPairWork;
+  /// Node tests per pair over the run, sorted by pair (each step's records, sorted too, merged in).
+  std::vector<std::pair<ObjectPair, std::uint64_t>> mPairWork;
+  std::vector<std::pair<ObjectPair, std::uint64_t>> mMerged;  ///< the merge's other buffer
 };
 
 }  // namespace caliber::cli
