@@ -108,6 +108,11 @@ inline constexpr std::size_t kRatioSample = 4096;
 /// (grid_32768, hybrid on 2 threads, 2-core AMD EPYC VM): a merged task of 54,000 whole pairs took
 /// about 87 ns a pair beside its node tests, which took 21 ns each (medians over 8 steps).
 inline constexpr double kPairWeight = 4.0;
+/// The cart is merged to Omega / k, k = cart items / kCartItemsPerTask, between 1 and kCartFiner:
+/// the paper's Omega for carts of up to a thousand items (the paper's scenes), up to 16 times
+/// finer tasks for a cart of many thousands of light pairs.
+inline constexpr std::size_t kCartItemsPerTask = 512;
+inline constexpr std::size_t kCartFiner = 16;
 [[nodiscard]] InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pairs, narrow::PairContexts contexts,
                                              const History& history);
 /// Pair i's scale, its root estimated now if it was not (a pair with history that is split).

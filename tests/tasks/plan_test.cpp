@@ -162,6 +162,25 @@ TEST(Plans, HybridRatioComesFromAnEvenSampleOfThePairsWithHistory) {
     total += w.weight[i];
   }
   EXPECT_DOUBLE_EQ(w.total, total);
+
+  // Thousands of light pairs: the cart is merged into tasks 16 times finer than Omega (a dozen
+  // tasks of Omega would end on a long tail), each pair in exactly one task.
+  EngineOptions options;
+  options.method = Method::hybrid;
+  options.threads = 2;
+  const Plan plan = plan_calibrated(options, pairs, view, history);
+  ASSERT_EQ(plan.split, 0u);
+  EXPECT_EQ(plan.carted, n);
+  const double cart_omega = plan.omega / static_cast<double>(kCartFiner);
+  std::vector<int> seen(n, 0);
+  double heaviest = 0.0;
+  for (std::size_t i = 0; i < n; ++i) heaviest = std::max(heaviest, w.weight[i]);
+  for (const RunTask& t : plan.run) {
+    EXPECT_LT(t.weight, cart_omega + heaviest) << "a task passes the cart's caliber by less than one item";
+    for (const Root& r : t.roots) ++seen[r.pair];
+  }
+  EXPECT_GE(plan.run.size(), static_cast<std::size_t>(w.total / (cart_omega + heaviest)));
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int k) { return k == 1; }));
 }
 
 TEST(Plans, PairTableFindsSortedPairsInOneMerge) {
