@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -45,9 +46,7 @@ class RunStats {
   std::uint64_t mContacts = 0;
   std::uint64_t mTasks = 0;
   std::size_t mStepsWithContacts = 0;
-  /// Node tests per pair over the run, sorted by pair (each step's records, sorted too, merged in).
-  std::vector<std::pair<ObjectPair, std::uint64_t>> mPairWork;
-  std::vector<std::pair<ObjectPair, std::uint64_t>> mMerged;  ///< the merge's other buffer
+  std::map<ObjectPair, std::uint64_t> mPairWork;
 };
 
 }  // namespace caliber::cli
