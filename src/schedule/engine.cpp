@@ -223,7 +223,6 @@ StepResult Engine::step(const Frame& frame) {
   validate_frame(frame);
   StepResult out;
   const auto start = util::Clock::now();
-  const std::size_t n = frame.pairs.size();
   std::vector<QueryResult> results;
   mImpl->timeline.begin(mOptions.timeline);
   // The work is cut for the threads this step really has (the host's arena and limit decide).
@@ -248,8 +247,7 @@ StepResult Engine::step(const Frame& frame) {
   if (mOptions.timeline) record.timeline = mImpl->timeline.collect();
 
   const auto reduce = util::Clock::now();
-  schedule::gather_step(frame.pairs, results, out);
-  for (std::size_t i = 0; i < n && i < run.candidates.size(); ++i) out.pair_records[i].candidates = run.candidates[i];
+  mImpl->executor.execute([&] { schedule::gather_step(frame.pairs, results, run.candidates, out); });
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
                                 [](const Contact& x, const Contact& y) {
                                   return std::tie(x.object_a, x.object_b, x.tri_a, x.tri_b) <

@@ -156,25 +156,32 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   return stage_root_tests;
 }
 
-void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results, StepResult& out) {
-  out.pair_records.clear();
-  out.contacts.clear();
+void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
+                 const std::vector<std::size_t>& candidates, StepResult& out) {
+  const std::size_t n = pairs.size();
   out.limit_reached = false;
   out.stats = QueryStats{};
-  std::size_t total = 0;
-  for (const QueryResult& r : results) total += r.contacts.size();
-  out.contacts.reserve(total);
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
+  // Where each pair's contacts go (a prefix sum), then the records and contacts written in parallel.
+  std::vector<std::size_t> at(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
     const QueryResult& r = results[i];
-    out.pair_records.push_back(PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached});
+    at[i + 1] = at[i] + r.contacts.size();
     out.limit_reached = out.limit_reached || r.limit_reached;
     out.stats.node_tests += r.stats.node_tests;
     out.stats.leaf_tests += r.stats.leaf_tests;
-    CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
-                               [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
-                   "the finalization wrote the pair's object ids");
-    out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
   }
+  out.pair_records.resize(n);
+  out.contacts.resize(at[n]);
+  parallel::parallel_for(0, n, 1024, [&](std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i != last; ++i) {
+      const QueryResult& r = results[i];
+      out.pair_records[i] = PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached, i < candidates.size() ? candidates[i] : 0};
+      CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
+                                 [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
+                     "the finalization wrote the pair's object ids");
+      std::copy(r.contacts.begin(), r.contacts.end(), out.contacts.begin() + static_cast<std::ptrdiff_t>(at[i]));
+    }
+  });
 }
 
 }  // namespace caliber::schedule

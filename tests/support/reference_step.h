@@ -23,7 +23,7 @@ inline StepResult reference_step(const World& world, int k) {
   StepResult out;
   out.step = k;
   out.time = k * world.scene().dt;
-  schedule::gather_step(frame.pairs, results, out);
+  schedule::gather_step(frame.pairs, results, {}, out);
   return out;
 }
 
