@@ -15,4 +15,5 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
+#include "caliber/sweep.h"
 #include "caliber/version.h"

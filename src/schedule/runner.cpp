@@ -175,7 +175,8 @@ void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryRe
   parallel::parallel_for(0, n, 1024, [&](std::size_t first, std::size_t last) {
     for (std::size_t i = first; i != last; ++i) {
       const QueryResult& r = results[i];
-      out.pair_records[i] = PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached, i < candidates.size() ? candidates[i] : 0};
+      out.pair_records[i] =
+          PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached, i < candidates.size() ? candidates[i] : 0};
       CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
                                  [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
                      "the finalization wrote the pair's object ids");

@@ -45,7 +45,9 @@ InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pai
       if (last(i) == 0 || seen++ % stride == 0) estimate.push_back(static_cast<std::uint32_t>(i));
     }
     std::vector<double> root(estimate.size());
-    parallel::parallel_for_each(0, estimate.size(), [&](std::size_t k) { root[k] = apriori_weight(contexts[estimate[k]], {0, 0}); });
+    parallel::parallel_for_each(0, estimate.size(), [&](std::size_t k) {
+      root[k] = apriori_weight(contexts[estimate[k]], {0, 0});
+    });
     double measured = 0.0, estimated = 0.0;
     for (std::size_t k = 0; k < estimate.size(); ++k) {
       if (last(estimate[k]) > 0) {
@@ -178,7 +180,8 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
   // A cart of thousands of light pairs is merged into finer tasks than Omega: the run-time tasks
   // are then near-equal, and a list schedule of a dozen of them ends on a tail of up to one whole
   // task (grid_4096 on 2 threads: one thread idle for 8 % of the traversal).
-  const double cart_omega = plan.omega / static_cast<double>(std::clamp<std::size_t>(cart.size() / kCartItemsPerTask, 1, kCartFiner));
+  const double cart_omega =
+      plan.omega / static_cast<double>(std::clamp<std::size_t>(cart.size() / kCartItemsPerTask, 1, kCartFiner));
   for (RunTask& t : merge_cart(std::move(cart), cart_omega)) plan.run.push_back(std::move(t));
   // Heaviest first, so that the ordered hand-out does not end on a heavy straggler.
   // (An order of indices, then each task moved once: tasks are too large to be moved around a sort.)

@@ -108,10 +108,18 @@ TEST(Calibration, CartMergeEqualsTheDefinitionOnRandomCarts) {
     for (std::size_t k = 0; k < n; ++k) {
       double w = 0.0;
       switch (trial % 4) {
-        case 0: w = static_cast<double>(1 + rng() % 40); break;                               // ties
-        case 1: w = std::ldexp(1.0 + static_cast<double>(rng() % 1000) / 1000.0, static_cast<int>(rng() % 80) - 40); break;
-        case 2: w = 1.0 + static_cast<double>(rng() % 1000000) * 1e-3; break;
-        default: w = static_cast<double>(rng() % 5); break;                                   // zeros: the fallback
+        case 0:
+          w = static_cast<double>(1 + rng() % 40);
+          break;  // ties
+        case 1:
+          w = std::ldexp(1.0 + static_cast<double>(rng() % 1000) / 1000.0, static_cast<int>(rng() % 80) - 40);
+          break;
+        case 2:
+          w = 1.0 + static_cast<double>(rng() % 1000000) * 1e-3;
+          break;
+        default:
+          w = static_cast<double>(rng() % 5);
+          break;  // zeros: the fallback
       }
       const auto pair = static_cast<std::uint32_t>(rng() % (trial % 2 == 0 ? 50 : 200000));
       const narrow::NodePair node{static_cast<std::uint32_t>(rng() % 3 == 0 ? rng() : rng() % 8),
@@ -124,9 +132,9 @@ TEST(Calibration, CartMergeEqualsTheDefinitionOnRandomCarts) {
     std::sort(cart.begin(), cart.end(), [](const Root& x, const Root& y) {
       return std::tie(x.pair, x.node.a, x.node.b) < std::tie(y.pair, y.node.a, y.node.b);
     });
-    cart.erase(std::unique(cart.begin(), cart.end(),
-                           [](const Root& x, const Root& y) { return x.pair == y.pair && x.node == y.node; }),
-               cart.end());
+    cart.erase(
+        std::unique(cart.begin(), cart.end(), [](const Root& x, const Root& y) { return x.pair == y.pair && x.node == y.node; }),
+        cart.end());
     if (trial % 3 != 0) std::shuffle(cart.begin(), cart.end(), rng);  // else in (pair, node) order, as whole pairs come
     for (std::size_t k = 0; k < cart.size(); ++k) cart[k].stage = static_cast<std::int32_t>(k);  // identifies the item
     const double omega = total / static_cast<double>(1 + rng() % 40);

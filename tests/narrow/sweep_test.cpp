@@ -1,0 +1,182 @@
+// The swept query (caliber/sweep.h) on motions that tunnel between their end poses, grazing and
+// already-touching cases, and random motions checked against a dense sampling of time with the
+// exact interference test.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "caliber/error.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "caliber/sweep.h"
+
+namespace caliber {
+namespace {
+
+Pose at(double x, double y, double z, const Eigen::Quaterniond& q = Eigen::Quaterniond::Identity()) {
+  Pose p;
+  p.translation = Eigen::Vector3d(x, y, z);
+  p.rotation = q;
+  return p;
+}
+
+Eigen::Quaterniond about_z(double degrees) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitZ()));
+}
+
+bool intersect(const Model& a, const Pose& pa, const Model& b, const Pose& pb) {
+  QueryRequest r;
+  r.max_pairs = 1;
+  return !query(a, pa, b, pb, r).contacts.empty();
+}
+
+double distance(const Model& a, const Pose& pa, const Model& b, const Pose& pb) {
+  QueryRequest r;
+  r.kind = QueryKind::distance;
+  r.tolerance = kUnbounded;
+  return query(a, pa, b, pb, r).contacts.front().distance;
+}
+
+TEST(Sweep, NeedleThroughAPlateIsCaughtThoughNeitherEndPoseTouches) {
+  // A plate 0.002 thick in the xy plane; a needle 0.2 long along z flies from z = 1 to z = -1 in
+  // one step. Its tip reaches the plate's top (z = 0.001) when its centre is at 0.101: t = 0.4495.
+  const auto plate = build_model(make_plate(1.0, 0.002, 4));
+  const auto needle = build_model(make_box(0.001, 0.001, 0.1, 1));
+  const SweptPose still{Pose{}, Pose{}};
+  const SweptPose flight{at(0.3, 0.2, 1.0), at(0.3, 0.2, -1.0)};
+  ASSERT_FALSE(intersect(*plate, Pose{}, *needle, flight.start));
+  ASSERT_FALSE(intersect(*plate, Pose{}, *needle, flight.end));
+  SweepRequest request;
+  request.tolerance = 1e-6;
+  const SweepResult s = sweep(*plate, still, *needle, flight, request);
+  ASSERT_EQ(s.status, SweepStatus::contact);
+  const double first = (1.0 - 0.101) / 2.0;
+  EXPECT_LE(s.time, first) << "never later than the first contact";
+  EXPECT_GE(s.time, first - 1e-6 / 2.0 - 1e-12) << "within the tolerance of it (the needle moves 2 per unit t)";
+  EXPECT_LE(s.closest.distance, 1e-6);
+  EXPECT_LE(distance(*plate, Pose{}, *needle, flight.at(s.time)), 1e-6);
+}
+
+TEST(Sweep, ATurningRodSweepsOverABoxBetweenItsEndPoses) {
+  // A rod of half-length 1 along x turns by 170 degrees about z; a small box sits at (0, 0.6):
+  // the rod is far from it at both ends (0 and 170 degrees) and passes over it near 90.
+  const auto rod = build_model(make_box(1.0, 0.02, 0.02, 2));
+  const auto box = build_model(make_box(0.05, 0.05, 0.05, 1));
+  const SweptPose turn{Pose{}, at(0, 0, 0, about_z(170.0))};
+  const SweptPose still{at(0.0, 0.6, 0.0), at(0.0, 0.6, 0.0)};
+  ASSERT_FALSE(intersect(*rod, turn.start, *box, still.start));
+  ASSERT_FALSE(intersect(*rod, turn.end, *box, still.start));
+  const SweepResult s = sweep(*rod, turn, *box, still);
+  ASSERT_EQ(s.status, SweepStatus::contact);
+  // No contact before t*, checked on a fine grid; and within the tolerance at t*.
+  for (int k = 0; k < 2000 && k / 2000.0 < s.time; ++k) {
+    EXPECT_FALSE(intersect(*rod, turn.at(k / 2000.0), *box, still.start)) << "t = " << k / 2000.0;
+  }
+  EXPECT_LE(distance(*rod, turn.at(s.time), *box, still.start), 1e-6 * std::sqrt(1.0 + 2 * 0.02 * 0.02) + 1e-12);
+  EXPECT_LT(s.time, 0.5);
+  EXPECT_GT(s.time, 0.3);
+}
+
+TEST(Sweep, TouchingAtTheStartIsContactAtZeroAndMovingApartIsFree) {
+  const auto a = build_model(make_sphere(1.0, 12, 16));
+  const auto b = build_model(make_box(0.3, 0.3, 0.3, 2));
+  const SweepResult touching = sweep(*a, {Pose{}, Pose{}}, *b, {at(0.9, 0, 0), at(3.0, 0, 0)});
+  EXPECT_EQ(touching.status, SweepStatus::contact);
+  EXPECT_EQ(touching.time, 0.0);
+  const SweepResult apart = sweep(*a, {Pose{}, Pose{}}, *b, {at(1.5, 0, 0), at(3.0, 0, 0)});
+  EXPECT_EQ(apart.status, SweepStatus::free);
+  EXPECT_EQ(apart.time, 1.0);
+  const SweepResult still = sweep(*a, {Pose{}, Pose{}}, *b, {at(1.5, 0, 0), at(1.5, 0, 0)});
+  EXPECT_EQ(still.status, SweepStatus::free);
+  EXPECT_EQ(still.queries, 1u);
+}
+
+TEST(Sweep, GrazingPassesAreDecidedByTheTolerance) {
+  // A box passes beside another at a gap of exactly g (faces parallel): contact iff g <= tolerance.
+  const auto a = build_model(make_box(0.5, 0.5, 0.5, 1));
+  const auto b = build_model(make_box(0.5, 0.5, 0.5, 1));
+  for (const double gap : {1e-3, 1e-5}) {
+    const SweptPose pass{at(-3.0, 1.0 + gap, 0.0), at(3.0, 1.0 + gap, 0.0)};
+    SweepRequest request;
+    request.tolerance = 1e-4;
+    const SweepResult s = sweep(*a, {Pose{}, Pose{}}, *b, pass, request);
+    if (gap > request.tolerance) {
+      EXPECT_EQ(s.status, SweepStatus::free) << "gap " << gap;
+    } else {
+      ASSERT_EQ(s.status, SweepStatus::contact) << "gap " << gap;
+      EXPECT_LE(s.time, 2.0 / 6.0) << "the faces start to overlap in x at t = 1/3";
+      EXPECT_LE(s.closest.distance, request.tolerance);
+    }
+  }
+}
+
+TEST(Sweep, RandomMotionsNeverMissASampledContact) {
+  // Random motions of a torus and a sphere (each turning up to 180 degrees and moving up to 4
+  // radii); time sampled at 1/1000: every sampled contact comes at or after t*, none before it,
+  // a "free" sweep has none, and the models are within the tolerance at t*.
+  const auto torus = build_model(make_torus(1.0, 0.3, 16, 10));
+  const auto sphere = build_model(make_sphere(0.4, 8, 12));
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto random_pose = [&](double spread) {
+    Eigen::Quaterniond q(u(rng), u(rng), u(rng), u(rng));
+    if (q.norm() < 1e-3) q = Eigen::Quaterniond::Identity();
+    return at(spread * u(rng), spread * u(rng), spread * u(rng), q.normalized());
+  };
+  int contacts = 0, frees = 0;
+  for (int m = 0; m < 300; ++m) {
+    const SweptPose ma{random_pose(0.5), random_pose(0.5)};
+    const SweptPose mb{random_pose(2.0), random_pose(2.0)};
+    SweepRequest request;
+    request.tolerance = 1e-4;
+    const SweepResult s = sweep(*torus, ma, *sphere, mb, request);
+    ASSERT_NE(s.status, SweepStatus::undecided) << "motion " << m;
+    for (int k = 0; k <= 1000; ++k) {
+      const double t = k / 1000.0;
+      if (!intersect(*torus, ma.at(t), *sphere, mb.at(t))) continue;
+      ASSERT_EQ(s.status, SweepStatus::contact) << "motion " << m << ": a sampled contact at t = " << t << " was missed";
+      ASSERT_LE(s.time, t) << "motion " << m << ": reported after a sampled contact";
+      break;
+    }
+    if (s.status == SweepStatus::contact) {
+      ++contacts;
+      EXPECT_LE(distance(*torus, ma.at(s.time), *sphere, mb.at(s.time)), request.tolerance) << "motion " << m;
+    } else {
+      ++frees;
+    }
+  }
+  EXPECT_GT(contacts, 50);
+  EXPECT_GT(frees, 25);
+}
+
+TEST(Sweep, BadInputIsAnError) {
+  const auto a = build_model(make_sphere(1.0, 8, 8));
+  SweepRequest negative;
+  negative.tolerance = -1.0;
+  EXPECT_THROW(static_cast<void>(sweep(*a, {Pose{}, Pose{}}, *a, {at(3, 0, 0), Pose{}}, negative)), Error);
+  SweepRequest none;
+  none.max_queries = 0;
+  EXPECT_THROW(static_cast<void>(sweep(*a, {Pose{}, Pose{}}, *a, {at(3, 0, 0), Pose{}}, none)), Error);
+  Pose bad = at(std::nan(""), 0, 0);
+  EXPECT_THROW(static_cast<void>(sweep(*a, {Pose{}, bad}, *a, {at(3, 0, 0), Pose{}})), Error);
+}
+
+TEST(Sweep, UndecidedWhenTheQueriesRunOut) {
+  // A grazing pass just outside a tiny tolerance takes many small advances: with a budget of 3
+  // queries the sweep stops undecided, free of contact up to the time it reached.
+  const auto a = build_model(make_box(0.5, 0.5, 0.5, 1));
+  const SweptPose pass{at(-3.0, 1.0 + 1e-5, 0.0), at(3.0, 1.0 + 1e-5, 0.0)};
+  SweepRequest request;
+  request.tolerance = 1e-6;
+  request.max_queries = 3;
+  const SweepResult s = sweep(*a, {Pose{}, Pose{}}, *a, pass, request);
+  ASSERT_EQ(s.status, SweepStatus::undecided);
+  EXPECT_EQ(s.queries, 3u);
+  EXPECT_GT(s.time, 0.0);
+  EXPECT_LT(s.time, 1.0);
+}
+
+}  // namespace
+}  // namespace caliber
