@@ -478,6 +478,51 @@ def _batch_from_state(state):
       "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal, "
       "or with lowest_ids=True the lowest ids at distance 0 (slower).");
 
+  py::class_<caliber::SweepResult>(m, "Sweep", py::module_local(),
+                                   "The answer of sweep: status 'contact', 'free' or 'undecided'; time (contact: the first "
+                                   "time of contact t*; free: 1; undecided: free up to it); at a contact the closest "
+                                   "triangle pair there, its distance and points.")
+      .def_property_readonly("status",
+                             [](const caliber::SweepResult& s) {
+                               return s.status == caliber::SweepStatus::contact ? "contact"
+                                      : s.status == caliber::SweepStatus::free  ? "free"
+                                                                                : "undecided";
+                             })
+      .def_readonly("time", &caliber::SweepResult::time)
+      .def_readonly("queries", &caliber::SweepResult::queries)
+      .def_property_readonly("pair",
+                             [](const caliber::SweepResult& s) -> py::object {
+                               if (s.status != caliber::SweepStatus::contact) return py::none();
+                               return py::make_tuple(s.closest.tri_a, s.closest.tri_b);
+                             })
+      .def_property_readonly("distance",
+                             [](const caliber::SweepResult& s) -> py::object {
+                               if (s.status != caliber::SweepStatus::contact) return py::none();
+                               return py::float_(s.closest.distance);
+                             })
+      .def_property_readonly("points",
+                             [](const caliber::SweepResult& s) -> py::object {
+                               if (s.status != caliber::SweepStatus::contact) return py::none();
+                               const Eigen::Vector3d &a = s.closest.point_a, &b = s.closest.point_b;
+                               return py::make_tuple(py::make_tuple(a.x(), a.y(), a.z()), py::make_tuple(b.x(), b.y(), b.z()));
+                             })
+      .def("__reduce__", [](const caliber::SweepResult&) -> py::object { throw not_picklable("Sweep", "pickle its fields"); });
+  m.def(
+      "sweep",
+      [](const PyModel& a, const caliber::Pose& start_a, const caliber::Pose& end_a, const PyModel& b,
+         const caliber::Pose& start_b, const caliber::Pose& end_b, double tolerance, std::uint64_t max_queries) {
+        caliber::SweepRequest request;
+        request.tolerance = tolerance;
+        request.max_queries = max_queries;
+        py::gil_scoped_release release;
+        return caliber::sweep(*a.model, {start_a, end_a}, *b.model, {start_b, end_b}, request);
+      },
+      py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
+      py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000,
+      "The first time t in [0, 1] at which a, moving from start_a to end_a, and b, from start_b to end_b (translation "
+      "linear, rotation by slerp), come within tolerance (0: 1e-6 of the larger model's radius): never later than the "
+      "first true contact, never a missed contact (docs/queries.md). Returns a Sweep.");
+
   caliber_python::bind_batch(m);
   m.def(
       "query_many",

@@ -389,3 +389,28 @@ def test_every_protocol_pickles_meshes_models_and_poses_and_refuses_the_rest():
         for thing, name in ((caliber.Engine(), "Engine"), (caliber.World(os.path.join(DATA, "scenes", "tetras.json")), "World")):
             with pytest.raises(caliber.Error, match=name + ": cannot be pickled"):
                 pickle.dumps(thing, protocol)
+
+
+def box_model(hx, hy, hz):
+    corners = np.array([[sx * hx, sy * hy, sz * hz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    return caliber.Model(caliber.Mesh(corners, faces))
+
+
+def test_sweep_catches_a_needle_that_tunnels_through_a_plate():
+    plate, needle = box_model(1.0, 1.0, 0.001), box_model(0.001, 0.001, 0.1)
+    start, end = caliber.Pose((0.3, 0.2, 1.0), (1, 0, 0, 0)), caliber.Pose((0.3, 0.2, -1.0), (1, 0, 0, 0))
+    for p in (start, end):
+        assert len(caliber.query(plate, caliber.Pose(), needle, p, max_pairs=1)) == 0
+    s = caliber.sweep(plate, caliber.Pose(), caliber.Pose(), needle, start, end, tolerance=1e-6)
+    assert s.status == "contact"
+    first = (1.0 - 0.101) / 2.0  # the tip (z - 0.1) reaches the plate's top (0.001)
+    assert first - 1e-6 <= s.time <= first
+    assert s.distance <= 1e-6 and s.pair is not None and len(s.points) == 2
+    apart = caliber.sweep(plate, caliber.Pose(), caliber.Pose(), needle, start, caliber.Pose((3.0, 0.2, 1.0), (1, 0, 0, 0)))
+    assert (apart.status, apart.time, apart.pair, apart.distance) == ("free", 1.0, None, None)
+    with pytest.raises(caliber.Error, match="tolerance"):
+        caliber.sweep(plate, caliber.Pose(), caliber.Pose(), needle, start, end, tolerance=-1.0)
+    with pytest.raises(caliber.Error):
+        pickle.dumps(s)
