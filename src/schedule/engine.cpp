@@ -127,6 +127,10 @@ void Engine::find_pairs(Frame& frame, const std::vector<bool>& fixed, const std:
 
 namespace {
 
+/// Below this many counts (threads x pairs) or pairs, a step's bookkeeping runs on the calling
+/// thread: handing it to the engine's threads costs more than it saves.
+constexpr std::size_t kParallelSums = 1u << 14;
+
 /// Empties a record, its vectors keeping their storage (no allocation once they have grown).
 void reset_keeping_storage(ScheduleRecord& r) {
   ScheduleRecord fresh;
@@ -202,13 +206,19 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
       record.calibrate_ms = util::ms_since(planning);
       run.stage_root_tests = schedule::run_plan(run.plan, state, record);
     }
-    // Each thread's node tests, its slots summed in parallel (threads x pairs counts in all).
+    // Each thread's node tests: its slots summed, in parallel when there are many (threads x pairs
+    // counts in all; a task per thread costs more than a few thousand additions).
     const std::vector<schedule::WorkerSlots*> slots = workers.all();
     std::vector<std::uint64_t> tests(slots.size(), 0);
-    parallel::parallel_for_each(0, slots.size(), [&](std::size_t k) {
+    const auto sum = [&](std::size_t k) {
       if (!state.current(*slots[k])) return;
       for (const QueryStats& st : slots[k]->stats) tests[k] += st.node_tests;
-    });
+    };
+    if (slots.size() * n < kParallelSums) {
+      for (std::size_t k = 0; k < slots.size(); ++k) sum(k);
+    } else {
+      parallel::parallel_for_each(0, slots.size(), sum);
+    }
     for (const std::uint64_t t : tests) {
       if (t > 0) record.thread_node_tests.push_back(t);
     }
@@ -247,7 +257,12 @@ StepResult Engine::step(const Frame& frame) {
   if (mOptions.timeline) record.timeline = mImpl->timeline.collect();
 
   const auto reduce = util::Clock::now();
-  mImpl->executor.execute([&] { schedule::gather_step(frame.pairs, results, run.candidates, out); });
+  // (On the engine's threads only when there are pairs enough to share out.)
+  if (frame.pairs.size() < kParallelSums) {
+    schedule::gather_step(frame.pairs, results, run.candidates, out);
+  } else {
+    mImpl->executor.execute([&] { schedule::gather_step(frame.pairs, results, run.candidates, out); });
+  }
   CALIBER_ASSERT(std::is_sorted(out.contacts.begin(), out.contacts.end(),
                                 [](const Contact& x, const Contact& y) {
                                   return std::tie(x.object_a, x.object_b, x.tri_a, x.tri_b) <
