@@ -15,6 +15,7 @@
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
+#include "caliber/sweep.h"
 
 namespace caliber {
 
@@ -27,6 +28,12 @@ struct ObjectPair {
   std::uint32_t b;  ///< object id, > a
   friend bool operator==(const ObjectPair&, const ObjectPair&) = default;
   friend auto operator<=>(const ObjectPair&, const ObjectPair&) = default;
+};
+
+/// One object pair's answer in a sweep of many objects (Engine::sweep).
+struct PairSweep {
+  ObjectPair pair;     ///< the object pair
+  SweepResult result;  ///< caliber::sweep's answer for it
 };
 
 /// The work and result of one object pair in one step.
@@ -168,6 +175,19 @@ class CALIBER_EXPORT Engine {
   /// refitted over that order has grown by a quarter, and its buffers). Throws caliber::Error as
   /// caliber::broad_phase does, and on a bad request.
   void find_pairs(Frame& frame, const std::vector<bool>& fixed = {}, const std::vector<ObjectPair>& ignored = {});
+  /// Continuous collision detection for many objects: object i moves from from[i] to to[i] (a
+  /// SweptPose: translation linear, rotation by slerp). Every pair whose swept boxes overlap (the
+  /// box of the segment its origin runs along, grown by its radius about the origin and by the
+  /// tolerance) is swept with caliber::sweep, the pairs in parallel on the engine's threads.
+  /// Returns the pairs whose sweep is not `free` (contact or undecided), sorted by pair; each
+  /// answer is caliber::sweep's for that pair, whatever the threads, and no pair left out could
+  /// have come within the tolerance. Pairs of two fixed objects and ignored pairs are skipped.
+  /// Throws caliber::Error on counts that do not match, a bad pose (named by its object), a bad
+  /// ignored pair or a bad request, before any work.
+  [[nodiscard]] std::vector<PairSweep> sweep(const std::vector<std::shared_ptr<const Model>>& models,
+                                             const std::vector<Pose>& from, const std::vector<Pose>& to,
+                                             const SweepRequest& request = {}, const std::vector<bool>& fixed = {},
+                                             const std::vector<ObjectPair>& ignored = {});
   /// Drops what the temporal methods and the broad phase remember (after a jump in the motion, or
   /// when object indices start to denote other objects).
   void forget();

@@ -33,6 +33,9 @@ struct SweepRequest {
   std::uint64_t max_queries = 100000;
 };
 
+/// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or max_queries 0.
+CALIBER_EXPORT void validate_sweep_request(const SweepRequest& request);
+
 /// How a sweep ended.
 enum class SweepStatus : std::uint8_t {
   contact,   ///< the models come within the tolerance at `time`, and do not touch before it

@@ -49,6 +49,12 @@ class CALIBER_EXPORT World {
   /// pairs, on the engine's threads, from what it kept of the previous step). Not const on the
   /// engine: one engine per thread.
   [[nodiscard]] Frame frame(int step, Engine& engine) const;
+  /// The pairs that come within the tolerance between step k and step k + 1 (Engine::sweep), each
+  /// object moving from its pose at k to its pose at k + 1 along a SweptPose: the scene's own
+  /// motion for velocity motions (up to half a turn a step) and for keyframes between two keys.
+  /// Pairs of two static objects and ignored pairs are skipped. The times are fractions of the
+  /// step: t* = 0.25 is a quarter of the way from k to k + 1.
+  [[nodiscard]] std::vector<PairSweep> sweep(int step, Engine& engine, const SweepRequest& request = {}) const;
   /// The query request every task runs (with the scene's group compatibility when it has one).
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
 

@@ -13,21 +13,19 @@
 
 namespace caliber {
 namespace broad {
-namespace {
-
-Error bad(const std::string& problem) { return Error(ErrorCode::bad_argument, "broad phase", problem); }
-
-void validate(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses, double reach,
-              const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
+void validate_objects(const char* source, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
+                      const char* pose_name, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
+  const auto bad = [&](const std::string& problem) { return Error(ErrorCode::bad_argument, source, problem); };
   const std::size_t n = models.size();
-  if (poses.size() != n) throw bad(std::to_string(n) + " models but " + std::to_string(poses.size()) + " poses (one per object)");
+  if (poses.size() != n) {
+    throw bad(std::to_string(n) + " models but " + std::to_string(poses.size()) + " " + pose_name + "s (one per object)");
+  }
   if (!fixed.empty() && fixed.size() != n) {
     throw bad(std::to_string(n) + " objects but " + std::to_string(fixed.size()) + " fixed flags (none, or one per object)");
   }
-  if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
   for (std::size_t i = 0; i < n; ++i) {
     if (!models[i]) throw bad("object " + std::to_string(i) + " has no model");
-    validate_pose_named(poses[i], [&] { return "broad phase: pose of object " + std::to_string(i); });
+    validate_pose_named(poses[i], [&] { return std::string(source) + ": " + pose_name + " of object " + std::to_string(i); });
   }
   for (const ObjectPair& p : ignored) {
     if (p.a >= p.b || p.b >= n) {
@@ -37,12 +35,11 @@ void validate(const std::vector<std::shared_ptr<const Model>>& models, const std
   }
 }
 
-}  // namespace
-
 void find_pairs(State& state, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
                 double reach, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored,
                 std::vector<ObjectPair>& out) {
-  validate(models, poses, reach, fixed, ignored);
+  validate_objects("broad phase", models, poses, "pose", fixed, ignored);
+  if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
   state.ignored.clear();
   for (const ObjectPair& p : ignored) state.ignored.push_back(std::uint64_t{p.a} << 32 | p.b);
   std::sort(state.ignored.begin(), state.ignored.end());

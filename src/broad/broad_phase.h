@@ -19,6 +19,12 @@ struct State {
   std::vector<std::uint64_t> ignored;
 };
 
+/// Checks objects for a broad phase or a sweep: as many poses as models, no missing model, each pose
+/// valid (named "<source>: <pose_name> of object i"), `fixed` empty or one per object, ignored pairs
+/// a < b < objects. Throws caliber::Error whose source is `source`.
+void validate_objects(const char* source, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
+                      const char* pose_name, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored);
+
 /// Validates the input (caliber::broad_phase's errors), then sets `out` to the sorted pairs whose
 /// world boxes, grown by reach / 2, overlap, less the pairs of two fixed objects and the ignored
 /// ones. In parallel on the executor the caller runs in (serially outside any).

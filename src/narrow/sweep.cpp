@@ -6,17 +6,10 @@
 #include <cmath>
 
 #include "caliber/error.h"
+#include "narrow/sweep_bounds.h"
 
 namespace caliber {
 namespace {
-
-/// The largest distance of a vertex from the model's origin: how far a point of it can be from
-/// the axis it turns about.
-double radius_about_origin(const Model& model) {
-  double r2 = 0.0;
-  for (const Eigen::Vector3d& v : model.mesh().vertices) r2 = std::max(r2, v.squaredNorm());
-  return std::sqrt(r2);
-}
 
 /// The angle (radians, in [0, pi]) of the shorter rotation from q0 to q1: what slerp turns by.
 double turn_angle(const Eigen::Quaterniond& q0, const Eigen::Quaterniond& q1) {
@@ -31,6 +24,13 @@ double speed_bound(const SweptPose& m, double radius) {
 
 }  // namespace
 
+void validate_sweep_request(const SweepRequest& request) {
+  if (!std::isfinite(request.tolerance) || request.tolerance < 0.0) {
+    throw Error(ErrorCode::bad_value, "sweep", "tolerance must be finite and >= 0");
+  }
+  if (request.max_queries < 1) throw Error(ErrorCode::bad_value, "sweep", "max_queries must be >= 1");
+}
+
 Pose SweptPose::at(double t) const {
   Pose p;
   p.translation = (1.0 - t) * start.translation + t * end.translation;
@@ -44,19 +44,15 @@ SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b, con
   validate_pose(motion_a.end, "sweep: end pose of A");
   validate_pose(motion_b.start, "sweep: start pose of B");
   validate_pose(motion_b.end, "sweep: end pose of B");
-  if (!std::isfinite(request.tolerance) || request.tolerance < 0.0) {
-    throw Error(ErrorCode::bad_value, "sweep", "tolerance must be finite and >= 0");
-  }
-  if (request.max_queries < 1) throw Error(ErrorCode::bad_value, "sweep", "max_queries must be >= 1");
+  validate_sweep_request(request);
 
-  const double ra = radius_about_origin(a), rb = radius_about_origin(b);
-  // The margin for rounding: poses interpolated and distances computed in double precision are off
-  // by a few units in the last place of the scene's size; 1e-9 of it covers them many times over.
+  const double ra = narrow::radius_about_origin(a), rb = narrow::radius_about_origin(b);
   const double size = ra + rb +
                       std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
                                 motion_b.start.translation.norm(), motion_b.end.translation.norm()});
-  const double margin = 1e-9 * size;
-  const double tolerance = std::max(request.tolerance > 0.0 ? request.tolerance : 1e-6 * std::max(ra, rb), 2.0 * margin);
+  const double margin = narrow::kSweepMargin * size;
+  const double tolerance =
+      std::max(request.tolerance > 0.0 ? request.tolerance : narrow::kSweepDefaultTolerance * std::max(ra, rb), 2.0 * margin);
   // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
   const double mu = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
 

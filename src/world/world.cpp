@@ -139,6 +139,10 @@ Frame World::frame(int step, Engine& engine) const {
   return frame;
 }
 
+std::vector<PairSweep> World::sweep(int step, Engine& engine, const SweepRequest& request) const {
+  return engine.sweep(mModels, poses_at(step), poses_at(step + 1), request, mStatic, mIgnored);
+}
+
 StepResult step(const World& world, Engine& engine, int k) {
   const auto start = Clock::now();
   const Frame frame = world.frame(k, engine);

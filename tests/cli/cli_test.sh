@@ -255,6 +255,14 @@ contains bench-from-cut-log "wrote $tmp/bench-cut/report.md"
 grep -q "the log ends before the run did" "$tmp/bench-cut/report.md" && passes=$((passes + 1)) ||
   { echo "FAIL bench-cut-report"; failures=$((failures + 1)); }
 # A budget too small for the whole run: it stops between runs, inside the budget, and says so.
+# run --continuous: each step's motion to the next swept; the pairs that touch between steps.
+check run-continuous 0 "$cli" run "$data/../../scenes/funnel.json" --continuous --steps 6 --threads 2
+contains run-continuous "summary over 5 step intervals"
+contains run-continuous "pairs that touch"
+check run-continuous-json 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --json "$(mktemp -u)"
+contains run-continuous-json "--continuous"
+check run-continuous-tolerance 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --sweep-tolerance -1
+contains run-continuous-tolerance "tolerance"
 # (two_small: its runs take long enough; its meshes are extracted by scripts/fetch_meshes.sh before the tests)
 check bench-budget 0 "$cli" bench "$data/../../scenes/two_small.json" --steps 100 --repeat 3 --threads 1,2 --simulate 4 --no-fcl \
   --no-figures --budget-s 1 --out "$tmp/bench-budget"
