@@ -597,6 +597,34 @@ def _batch_from_state(state):
           "moving a little are cheaper. fixed: one flag per object (pairs of two fixed objects skipped); ignored: pairs "
           "never reported.")
       .def(
+          "sweep",
+          [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& start,
+             const std::vector<caliber::Pose>& end, double tolerance, std::uint64_t max_queries, std::vector<bool> fixed,
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+            std::vector<std::shared_ptr<const caliber::Model>> shared;
+            shared.reserve(models.size());
+            for (const PyModel& m : models) shared.push_back(m.model);
+            std::vector<caliber::ObjectPair> skip;
+            for (const auto& [a, b] : ignored) skip.push_back(caliber::ObjectPair{a, b});
+            caliber::SweepRequest request;
+            request.tolerance = tolerance;
+            request.max_queries = max_queries;
+            std::vector<caliber::PairSweep> swept;
+            {
+              py::gil_scoped_release release;
+              swept = engine.sweep(shared, start, end, request, fixed, skip);
+            }
+            py::list out;
+            for (const caliber::PairSweep& p : swept) out.append(py::make_tuple(py::make_tuple(p.pair.a, p.pair.b), p.result));
+            return out;
+          },
+          py::arg("models"), py::arg("start"), py::arg("end"), py::kw_only(), py::arg("tolerance") = 0.0,
+          py::arg("max_queries") = 100000, py::arg("fixed") = std::vector<bool>{},
+          py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
+          "Continuous collision detection for many objects: object i moves from start[i] to end[i] (translation linear, "
+          "rotation by slerp); every pair whose swept boxes overlap is swept (caliber.sweep), in parallel on this engine's "
+          "threads. Returns [((a, b), Sweep)] for the pairs that are not free, sorted.")
+      .def(
           "step",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs, const std::string& kind,

@@ -414,3 +414,20 @@ def test_sweep_catches_a_needle_that_tunnels_through_a_plate():
         caliber.sweep(plate, caliber.Pose(), caliber.Pose(), needle, start, end, tolerance=-1.0)
     with pytest.raises(caliber.Error):
         pickle.dumps(s)
+
+
+def test_engine_sweep_equals_sweep_on_every_pair():
+    plate, needle = box_model(1.0, 1.0, 0.001), box_model(0.001, 0.001, 0.1)
+    models = [plate, needle, needle, plate]
+    start = [caliber.Pose(), caliber.Pose((0.3, 0.2, 1.0), (1, 0, 0, 0)), caliber.Pose((5.0, 0, 1.0), (1, 0, 0, 0)),
+             caliber.Pose((9.0, 0, 0), (1, 0, 0, 0))]
+    end = [caliber.Pose(), caliber.Pose((0.3, 0.2, -1.0), (1, 0, 0, 0)), caliber.Pose((5.0, 0, 2.0), (1, 0, 0, 0)),
+           caliber.Pose((9.0, 0, 0), (1, 0, 0, 0))]
+    got = caliber.Engine(threads=2).sweep(models, start, end, tolerance=1e-6)
+    assert [pair for pair, _ in got] == [(0, 1)]  # the needle through the plate; the other needle flies off alone
+    want = caliber.sweep(plate, start[0], end[0], needle, start[1], end[1], tolerance=1e-6)
+    (pair, s), = got
+    assert (s.status, s.time, s.pair) == (want.status, want.time, want.pair)
+    assert caliber.Engine().sweep(models, start, end, ignored=[(0, 1)]) == []
+    with pytest.raises(caliber.Error, match="end pose"):
+        caliber.Engine().sweep(models, start, end[:3])
