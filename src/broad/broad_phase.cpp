@@ -35,14 +35,18 @@ void validate_objects(const char* source, const std::vector<std::shared_ptr<cons
   }
 }
 
+void pair_keys(const std::vector<ObjectPair>& pairs, std::vector<std::uint64_t>& keys) {
+  keys.clear();
+  for (const ObjectPair& p : pairs) keys.push_back(std::uint64_t{p.a} << 32 | p.b);
+  std::sort(keys.begin(), keys.end());
+}
+
 void find_pairs(State& state, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
                 double reach, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored,
                 std::vector<ObjectPair>& out) {
   validate_objects("broad phase", models, poses, "pose", fixed, ignored);
   if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
-  state.ignored.clear();
-  for (const ObjectPair& p : ignored) state.ignored.push_back(std::uint64_t{p.a} << 32 | p.b);
-  std::sort(state.ignored.begin(), state.ignored.end());
+  pair_keys(ignored, state.ignored);
   const std::size_t n = models.size();
   const double grow = 0.5 * reach;
   state.boxes.resize(n);

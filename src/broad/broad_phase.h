@@ -25,6 +25,9 @@ struct State {
 void validate_objects(const char* source, const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
                       const char* pose_name, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored);
 
+/// Sets `keys` to the pairs as PairFilter::ignored holds them: (a << 32 | b), sorted.
+void pair_keys(const std::vector<ObjectPair>& pairs, std::vector<std::uint64_t>& keys);
+
 /// Validates the input (caliber::broad_phase's errors), then sets `out` to the sorted pairs whose
 /// world boxes, grown by reach / 2, overlap, less the pairs of two fixed objects and the ignored
 /// ones. In parallel on the executor the caller runs in (serially outside any).

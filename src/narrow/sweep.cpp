@@ -45,14 +45,19 @@ SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b, con
   validate_pose(motion_b.start, "sweep: start pose of B");
   validate_pose(motion_b.end, "sweep: end pose of B");
   validate_sweep_request(request);
+  return narrow::sweep_checked(a, narrow::radius_about_origin(a), motion_a, b, narrow::radius_about_origin(b), motion_b, request);
+}
 
-  const double ra = narrow::radius_about_origin(a), rb = narrow::radius_about_origin(b);
+namespace narrow {
+
+SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, const Model& b, double rb,
+                          const SweptPose& motion_b, const SweepRequest& request) {
   const double size = ra + rb +
                       std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
                                 motion_b.start.translation.norm(), motion_b.end.translation.norm()});
-  const double margin = narrow::kSweepMargin * size;
+  const double margin = kSweepMargin * size;
   const double tolerance =
-      std::max(request.tolerance > 0.0 ? request.tolerance : narrow::kSweepDefaultTolerance * std::max(ra, rb), 2.0 * margin);
+      std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * std::max(ra, rb), 2.0 * margin);
   // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
   const double mu = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
 
@@ -92,5 +97,7 @@ SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b, con
     t += (d - margin) / mu;
   }
 }
+
+}  // namespace narrow
 
 }  // namespace caliber

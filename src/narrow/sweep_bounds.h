@@ -1,12 +1,14 @@
 #pragma once
 /// \file
 /// What bounds a model's motion along a SweptPose: its radius about its origin, and the margin
-/// the swept query takes off its distances for rounding (caliber/sweep.h).
+/// the swept query takes off its distances for rounding (caliber/sweep.h); the swept query once
+/// its input is checked and its radii known.
 
 #include <algorithm>
 #include <cmath>
 
 #include "caliber/model.h"
+#include "caliber/sweep.h"
 
 namespace caliber::narrow {
 
@@ -25,5 +27,10 @@ inline constexpr double kSweepMargin = 1e-9;
 
 /// A sweep's tolerance when the request gives none, as a share of the larger radius.
 inline constexpr double kSweepDefaultTolerance = 1e-6;
+
+/// caliber::sweep on input already checked (poses, request), with the models' radii about their
+/// origins given (radius_about_origin): what a sweep of many pairs calls, each radius found once.
+[[nodiscard]] SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, const Model& b, double rb,
+                                        const SweptPose& motion_b, const SweepRequest& request);
 
 }  // namespace caliber::narrow

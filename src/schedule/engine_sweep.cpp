@@ -46,8 +46,7 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     boxes[i].hi = from[i].translation.cwiseMax(to[i].translation).array() + grow;
   }
   std::vector<std::uint64_t> skipped;
-  for (const ObjectPair& p : ignored) skipped.push_back(std::uint64_t{p.a} << 32 | p.b);
-  std::sort(skipped.begin(), skipped.end());
+  broad::pair_keys(ignored, skipped);
   const broad::PairFilter filter{fixed.empty() ? nullptr : &fixed, skipped.empty() ? nullptr : &skipped};
   std::vector<ObjectPair> pairs;
   std::vector<SweepResult> results;
@@ -55,10 +54,12 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     broad::BoxTree tree;
     tree.pairs(boxes, filter, pairs);
     results.resize(pairs.size());
-    // A pair's sweep is a run of distance queries, one after another: the pairs are the tasks.
+    // A pair's sweep is a run of distance queries, one after another: the pairs are the tasks (the
+    // input checked above, each model's radius found once).
     parallel::parallel_for_each(0, pairs.size(), [&](std::size_t k) {
       const ObjectPair& p = pairs[k];
-      results[k] = caliber::sweep(*models[p.a], {from[p.a], to[p.a]}, *models[p.b], {from[p.b], to[p.b]}, request);
+      results[k] = narrow::sweep_checked(*models[p.a], radius[p.a], {from[p.a], to[p.a]}, *models[p.b], radius[p.b],
+                                         {from[p.b], to[p.b]}, request);
     });
   });
   std::vector<PairSweep> out;
