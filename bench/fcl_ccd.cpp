@@ -18,7 +18,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -31,16 +30,12 @@
 #include "caliber/query.h"
 #include "caliber/sweep.h"
 #include "fcl_support.h"
+#include "sweep_cases.h"
 #include "machine.h"
 
 namespace {
 
 using namespace caliber;
-
-struct Case {
-  std::string name;
-  Mesh a, b;
-};
 
 struct Tally {
   int motions = 0, sampled_contacts = 0, contacts = 0, misses = 0, late = 0;
@@ -111,51 +106,19 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  std::vector<Case> cases;
-  cases.push_back({"plate x needle", make_plate(1.0, 0.002, 8), make_box(0.002, 0.002, 0.2, 2)});
-  cases.push_back({"torus x sphere", make_torus(1.0, 0.25, 48, 24), make_sphere(0.3, 16, 24)});
-  try {
-    cases.push_back({"bunny x blade", load_mesh(dir / "bunny00.off"), load_mesh(dir / "blade.off")});
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_fcl_ccd: %s (scripts/fetch_meshes.sh extracts CGAL's meshes); that case is left out\n", e.what());
-  }
+  std::vector<bench::SweepCase> cases = bench::sweep_cases(dir, only);
   std::string table =
       "| case | library | motions | with a sampled contact | contact reported | misses | late | median ms | total ms |\n"
       "|---|---|---|---|---|---|---|---|---|\n";
-  for (Case& c : cases) {
-    if (!only.empty() && c.name.find(only) == std::string::npos) continue;
-    // Both meshes centred on the origin, B scaled to a third of A's box diagonal.
-    Eigen::Vector3d center;
-    double da = 0.0, db = 0.0;
-    bench::box_center(c.a, center, da);
-    for (auto& v : c.a.vertices) v -= center;
-    bench::box_center(c.b, center, db);
-    for (auto& v : c.b.vertices) v = (v - center) * (c.name == "plate x needle" ? 1.0 : da / (3.0 * db));
-    bench::box_center(c.b, center, db);
+  for (const bench::SweepCase& c : cases) {
     const auto a = build_model(c.a);
     const auto b = build_model(c.b);
     const auto fa = bench::build_fcl(c.a);
     const auto fb = bench::build_fcl(c.b);
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    const auto random_turn = [&] {
-      Eigen::Vector3d axis(u(rng), u(rng), u(rng));
-      if (axis.norm() < 1e-3) axis = Eigen::Vector3d::UnitZ();
-      return Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI * u(rng), axis.normalized()));
-    };
+    bench::SweepMotions next_motion(c, seed);
     Tally ours, theirs;
     for (int m = 0; m < motions; ++m) {
-      // From one side of A to the other, through a random point near its middle.
-      Eigen::Vector3d dir(u(rng), u(rng), u(rng));
-      if (dir.norm() < 1e-3) dir = Eigen::Vector3d::UnitX();
-      dir.normalize();
-      const Eigen::Vector3d through(0.3 * da * u(rng), 0.3 * da * u(rng), 0.3 * da * u(rng));
-      const double reach = 0.5 * da + db;
-      SweptPose motion;
-      motion.start.translation = through + reach * dir;
-      motion.start.rotation = random_turn();
-      motion.end.translation = through - reach * dir;
-      motion.end.rotation = random_turn();
+      const SweptPose motion = next_motion.next();
       const double sampled = first_sampled_contact(*a, *b, motion);
 
       auto start = std::chrono::steady_clock::now();

@@ -180,14 +180,25 @@ class CALIBER_EXPORT Engine {
   /// box of the segment its origin runs along, grown by its radius about the origin and by the
   /// tolerance) is swept with caliber::sweep, the pairs in parallel on the engine's threads.
   /// Returns the pairs whose sweep is not `free` (contact or undecided), sorted by pair; each
-  /// answer is caliber::sweep's for that pair, whatever the threads, and no pair left out could
-  /// have come within the tolerance. Pairs of two fixed objects and ignored pairs are skipped.
+  /// answer is caliber::sweep's for that pair, whatever the method and threads (a heavy sweep's
+  /// queries split as in sweep_many), and no pair left out could have come within the tolerance. Pairs of two fixed objects and ignored pairs are skipped.
   /// Throws caliber::Error on counts that do not match, a bad pose (named by its object), a bad
   /// ignored pair or a bad request, before any work.
   [[nodiscard]] std::vector<PairSweep> sweep(const std::vector<std::shared_ptr<const Model>>& models,
                                              const std::vector<Pose>& from, const std::vector<Pose>& to,
                                              const SweepRequest& request = {}, const std::vector<bool>& fixed = {},
                                              const std::vector<ObjectPair>& ignored = {});
+  /// Continuous collision detection for model A against model B along many motions: entry i
+  /// answers caliber::sweep(a, motions_a[i], b, motions_b[i], request) (status, time, closest pair
+  /// and query count, bit for bit, whatever the method and threads). A side given one motion
+  /// keeps it for every entry; otherwise both sides give the same number. The sweeps run in
+  /// parallel on the engine's threads; when fewer than 8 a thread are left, the next query of a
+  /// sweep whose last was heavy is split by the engine's method as a heavy pair is (its `stats`
+  /// then count the split traversal's node tests, which depend on the cut). Throws
+  /// caliber::Error on counts that do not match, a bad pose (named "motions of B[3].end") or a
+  /// bad request, before any work.
+  [[nodiscard]] std::vector<SweepResult> sweep_many(const Model& a, std::span<const SweptPose> motions_a, const Model& b,
+                                                    std::span<const SweptPose> motions_b, const SweepRequest& request = {});
   /// Drops what the temporal methods and the broad phase remember (after a jump in the motion, or
   /// when object indices start to denote other objects).
   void forget();

@@ -81,7 +81,7 @@ QueryResult query_whole(const PairContext& ctx) {
   std::vector<Candidate>& candidates = t_candidates;
   candidates.clear();
   QueryStats stats;
-  PairLimit limit;
+  PairShared limit;
   limit.max = ctx.request().max_pairs;
   traverse(ctx, NodePair{0, 0}, t_scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
   let_go_if_large();

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "caliber/error.h"
+#include "narrow/finalize.h"
+#include "narrow/pair_context.h"
 #include "narrow/sweep_bounds.h"
 
 namespace caliber {
@@ -50,52 +52,65 @@ SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b, con
 
 namespace narrow {
 
-SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, const Model& b, double rb,
-                          const SweptPose& motion_b, const SweepRequest& request) {
-  const double size = ra + rb +
-                      std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
-                                motion_b.start.translation.norm(), motion_b.end.translation.norm()});
-  const double margin = kSweepMargin * size;
-  const double tolerance =
-      std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * std::max(ra, rb), 2.0 * margin);
-  // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
-  const double mu = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
-
+QueryRequest sweep_distance_request() {
   QueryRequest distance;
   distance.kind = QueryKind::distance;
   distance.tolerance = kUnbounded;
-  SweepResult out;
-  double t = 0.0;
-  while (true) {
-    const QueryResult r = query(a, motion_a.at(t), b, motion_b.at(t), distance);
-    ++out.queries;
-    out.stats.node_tests += r.stats.node_tests;
-    out.stats.leaf_tests += r.stats.leaf_tests;
-    if (r.contacts.empty()) {  // (an empty model: nothing to touch)
-      out.status = SweepStatus::free;
-      out.time = 1.0;
-      return out;
-    }
-    const double d = r.contacts.front().distance;
-    if (d <= tolerance) {
-      out.status = SweepStatus::contact;
-      out.time = t;
-      out.closest = r.contacts.front();
-      return out;
-    }
-    // No contact before t + (d - margin) / mu: every point moves at most mu per unit t.
-    if (mu == 0.0 || t + (d - margin) / mu >= 1.0) {
-      out.status = SweepStatus::free;
-      out.time = 1.0;
-      return out;
-    }
-    if (out.queries >= request.max_queries) {
-      out.status = SweepStatus::undecided;
-      out.time = t + (d - margin) / mu;
-      return out;
-    }
-    t += (d - margin) / mu;
+  return distance;
+}
+
+SweepAdvance::SweepAdvance(double ra, const SweptPose& motion_a, double rb, const SweptPose& motion_b,
+                           const SweepRequest& request)
+    : mMotionA(motion_a), mMotionB(motion_b), mMaxQueries(request.max_queries) {
+  const double size = ra + rb +
+                      std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
+                                motion_b.start.translation.norm(), motion_b.end.translation.norm()});
+  mMargin = kSweepMargin * size;
+  mTolerance = std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * std::max(ra, rb), 2.0 * mMargin);
+  // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
+  mSpeed = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
+  mResult.time = 0.0;
+}
+
+bool SweepAdvance::take(const QueryResult& r) {
+  const double t = mResult.time;
+  ++mResult.queries;
+  mLastTests = r.stats.node_tests;
+  mLast = r.contacts.empty() ? Contact{} : r.contacts.front();
+  if (r.contacts.empty()) mLast.distance = -1.0;
+  mResult.stats.node_tests += r.stats.node_tests;
+  mResult.stats.leaf_tests += r.stats.leaf_tests;
+  if (r.contacts.empty()) {  // (an empty model: nothing to touch)
+    mResult.status = SweepStatus::free;
+    mResult.time = 1.0;
+    return true;
   }
+  const double d = r.contacts.front().distance;
+  if (d <= mTolerance) {
+    mResult.status = SweepStatus::contact;
+    mResult.closest = r.contacts.front();
+    return true;
+  }
+  // No contact before t + (d - margin) / mu: every point moves at most mu per unit t.
+  if (mSpeed == 0.0 || t + (d - mMargin) / mSpeed >= 1.0) {
+    mResult.status = SweepStatus::free;
+    mResult.time = 1.0;
+    return true;
+  }
+  mResult.time = t + (d - mMargin) / mSpeed;
+  if (mResult.queries >= mMaxQueries) {
+    mResult.status = SweepStatus::undecided;
+    return true;
+  }
+  return false;
+}
+
+SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, const Model& b, double rb,
+                          const SweptPose& motion_b, const SweepRequest& request) {
+  const QueryRequest distance = sweep_distance_request();
+  SweepAdvance advance(ra, motion_a, rb, motion_b, request);
+  while (!advance.take(query_whole(PairContext(a, advance.pose_a(), b, advance.pose_b(), distance)))) {}
+  return advance.result();
 }
 
 }  // namespace narrow

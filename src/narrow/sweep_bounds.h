@@ -2,10 +2,11 @@
 /// \file
 /// What bounds a model's motion along a SweptPose: its radius about its origin, and the margin
 /// the swept query takes off its distances for rounding (caliber/sweep.h); the swept query once
-/// its input is checked and its radii known.
+/// its input is checked and its radii known, whole or a distance query at a time (SweepAdvance).
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "caliber/model.h"
 #include "caliber/sweep.h"
@@ -27,6 +28,43 @@ inline constexpr double kSweepMargin = 1e-9;
 
 /// A sweep's tolerance when the request gives none, as a share of the larger radius.
 inline constexpr double kSweepDefaultTolerance = 1e-6;
+
+/// The distance request every query of a sweep makes: the closest pair, at any distance.
+[[nodiscard]] QueryRequest sweep_distance_request();
+
+/// One pair's conservative advancement, a distance query at a time, on input already checked:
+/// the next query is at poses pose_a() and pose_b() (time time()); take() its answer, until
+/// take() says the sweep is over (result()). Whoever makes the queries (one thread, or the
+/// engine's method splitting a heavy one), the same answers give the same sweep.
+class SweepAdvance {
+ public:
+  /// ra, rb: the models' radii about their origins (radius_about_origin).
+  SweepAdvance(double ra, const SweptPose& motion_a, double rb, const SweptPose& motion_b, const SweepRequest& request);
+  [[nodiscard]] Pose pose_a() const { return mMotionA.at(mResult.time); }
+  [[nodiscard]] Pose pose_b() const { return mMotionB.at(mResult.time); }
+  /// Takes the answer of the distance query (sweep_distance_request) at pose_a() and pose_b();
+  /// returns true when that ends the sweep.
+  bool take(const QueryResult& r);
+  /// The answer, once take() has returned true (before: free up to time(), not yet over).
+  [[nodiscard]] const SweepResult& result() const { return mResult; }
+  /// The node tests of the last query taken (how heavy the next one may be).
+  [[nodiscard]] std::uint64_t last_node_tests() const { return mLastTests; }
+  /// The closest triangle pair of the last query taken: at the next poses, its distance bounds
+  /// the next query's answer from above. False before any query.
+  [[nodiscard]] bool last_pair(std::uint32_t& ta, std::uint32_t& tb) const {
+    ta = mLast.tri_a;
+    tb = mLast.tri_b;
+    return mResult.queries > 0 && mLast.distance >= 0.0;
+  }
+
+ private:
+  SweptPose mMotionA, mMotionB;
+  double mMargin, mTolerance, mSpeed;
+  std::uint64_t mMaxQueries;
+  std::uint64_t mLastTests = 0;
+  Contact mLast{};      ///< the last query's closest pair (distance -1: none)
+  SweepResult mResult;  ///< time: the time of the next query until the sweep is over
+};
 
 /// caliber::sweep on input already checked (poses, request), with the models' radii about their
 /// origins given (radius_about_origin): what a sweep of many pairs calls, each radius found once.

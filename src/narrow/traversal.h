@@ -8,6 +8,7 @@
 #include <compare>
 #include <utility>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -126,12 +127,14 @@ template <class Take>
   return count;
 }
 
-/// How many triangle pairs the traversals of one object pair have kept, against
-/// QueryRequest::max_pairs; shared by the pair's traversals (any threads), which stop once it is
-/// exceeded. Which pairs were kept by then depends on the schedule; finalize keeps max_pairs of them.
-struct PairLimit {
+/// What the traversals of one object pair share, whatever threads they run on: how many triangle
+/// pairs they have kept, against QueryRequest::max_pairs (they stop once it is exceeded; which
+/// pairs were kept by then depends on the schedule; finalize keeps max_pairs of them), and for a
+/// distance query the nearest distance any of them has found (each prunes by it: see Nearest).
+struct PairShared {
   std::atomic<std::size_t> kept{0};
   std::size_t max = 0;  ///< 0: no limit
+  std::atomic<double> nearest{std::numeric_limits<double>::infinity()};
 
   /// Counts one more kept pair; true when the limit is now exceeded.
   bool add() { return kept.fetch_add(1, std::memory_order_relaxed) + 1 > max; }
@@ -165,7 +168,7 @@ struct TraversalScratch {
 /// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                                  QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
-                                 PairLimit* limit = nullptr) {
+                                 PairShared* limit = nullptr) {
   // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
   // more than 3 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
@@ -205,6 +208,11 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
 struct Nearest {
   bool found = false;
   Candidate best{};
+  /// The nearest distance found by every traversal of the pair (the pieces of a split pair), or
+  /// null for a traversal alone. Pruning by it gives the same answer: a node is dropped only when
+  /// farther than some pair found (by more than the safety margin), and a pair exactly as close
+  /// is still kept, so the closest pair with the lowest ids is in some piece's answer.
+  std::atomic<double>* shared = nullptr;
 
   /// Keeps c if it is closer than the best by narrow::closer (ties: lower triangle ids), the order
   /// every method agrees on, so the answer does not depend on which pairs a traversal met first.
@@ -212,10 +220,18 @@ struct Nearest {
     if (!found || closer(c, best)) {
       best = c;
       found = true;
+      if (shared != nullptr) {
+        double now = shared->load(std::memory_order_relaxed);
+        while (c.distance < now && !shared->compare_exchange_weak(now, c.distance, std::memory_order_relaxed)) {}
+      }
     }
   }
-  /// The distance beyond which nothing can win: the best so far, or the query's tolerance.
-  [[nodiscard]] double bound(const PairContext& ctx) const { return found ? best.distance : ctx.request().tolerance; }
+  /// The distance beyond which nothing can win: the best so far (this traversal's, or another's
+  /// of the same pair), or the query's tolerance.
+  [[nodiscard]] double bound(const PairContext& ctx) const {
+    const double own = found ? best.distance : ctx.request().tolerance;
+    return shared != nullptr ? std::min(own, shared->load(std::memory_order_relaxed)) : own;
+  }
 };
 
 /// The distance bounds of the children of CD-tree node r (prepared nodes of A and B; a and b its
@@ -338,18 +354,20 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
 }
 
 /// The traversal every schedule runs on its pieces: for a distance query, traverse_nearest (the
-/// piece's closest pair, if any, appended to `out`), otherwise traverse_depth_first (stopping
-/// early at the pair's limit, if one is given).
+/// piece's closest pair, if any, appended to `out`; pruning by the pair's nearest distance so far,
+/// if `shared` is given), otherwise traverse_depth_first (stopping early at the pair's limit, if
+/// `shared` is given).
 inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                      QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
-                     PairLimit* limit = nullptr) {
+                     PairShared* shared = nullptr) {
   if (ctx.request().kind == QueryKind::distance) {
     Nearest nearest;
+    nearest.shared = shared != nullptr ? &shared->nearest : nullptr;
     traverse_nearest(ctx, root, scratch, nearest, stats, root_test, taboo);
     if (nearest.found) out.push_back(nearest.best);
     return;
   }
-  traverse_depth_first(ctx, root, scratch, out, stats, root_test, taboo, limit);
+  traverse_depth_first(ctx, root, scratch, out, stats, root_test, taboo, shared);
 }
 
 }  // namespace caliber::narrow

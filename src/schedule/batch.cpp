@@ -31,24 +31,9 @@ std::size_t entries(std::size_t na, std::size_t nb) {
                   " of B (give both sides the same number, or one pose to a side that does not move)");
 }
 
-/// Below this many entries per thread, a run is cut by the engine's method (a heavy entry split as
-/// a heavy pair is); from it up, each entry is traversed whole by one thread (splitting would only
-/// add work: a split distance traversal's pieces each look for their own nearest pair).
-constexpr std::size_t kEntriesPerThread = 8;
-
 /// Entries traversed whole: at most this many to a task (few enough to balance heavy entries,
 /// enough that a light entry's task costs little beside it).
 constexpr std::size_t kWholeGrain = 4;
-
-/// Stealing: how deep a run of `n` entries is split: as deep as it takes to give each thread
-/// kEntriesPerThread pieces, never deeper than the engine's stealing depth.
-int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
-  int depth = 0;
-  for (std::size_t pieces = n; depth < stealing_depth && pieces < kEntriesPerThread * static_cast<std::size_t>(threads);
-       pieces *= 4)
-    ++depth;
-  return depth;
-}
 
 void validate_poses(std::span<const Pose> poses, const char* side) {
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -88,7 +73,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     };
     // With max_pairs, which pairs an entry keeps depends on the order its traversal met them: one
     // thread traverses each entry whole, in caliber::query's order. So does a run of many entries.
-    if (request.max_pairs != 0 || count >= kEntriesPerThread * static_cast<std::size_t>(options.threads) ||
+    if (request.max_pairs != 0 || count >= schedule::kEntriesPerThread * static_cast<std::size_t>(options.threads) ||
         mOptions.method == Method::sequential) {
       results.assign(count, QueryResult{});
       mImpl->executor.execute([&] {
@@ -97,7 +82,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
         });
       });
     } else {
-      options.stealing_depth = stealing_cutoff(count, options.threads, mOptions.stealing_depth);
+      options.stealing_depth = schedule::stealing_cutoff(count, options.threads, mOptions.stealing_depth);
       const std::vector<ObjectPair> chunk_pairs(count, ObjectPair{0, 1});  // the object ids every contact carries
       ScheduleRecord record;
       const auto make = [&](std::size_t i, void* where) { new (where) narrow::PairContext(context(i)); };

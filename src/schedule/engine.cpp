@@ -178,15 +178,19 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
 schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method method, const std::vector<ObjectPair>& pairs,
                                            const QueryRequest& request, const tasks::History& plan_history,
                                            const std::function<void(std::size_t, void*)>& make, std::vector<QueryResult>& results,
-                                           ScheduleRecord& record) {
+                                           ScheduleRecord& record, std::span<const double> nearest) {
   const std::size_t n = pairs.size();
   results.assign(n, QueryResult{});
   schedule::StepState state{{}, workers, timeline, results, options.threads > 1, nullptr, {}, pairs.data(), ++runs};
-  std::unique_ptr<narrow::PairLimit[]> limits;
-  if (request.max_pairs != 0) {  // (a distance traversal keeps one pair and ignores it)
-    limits = std::make_unique<narrow::PairLimit[]>(n);
-    for (std::size_t i = 0; i < n; ++i) limits[i].max = request.max_pairs;
-    state.limits = limits.get();
+  // A limit's count, or a distance query's nearest so far, shared by the pieces of a split pair.
+  std::unique_ptr<narrow::PairShared[]> shared;
+  if (request.max_pairs != 0 || request.kind == QueryKind::distance) {
+    shared = std::make_unique<narrow::PairShared[]>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      shared[i].max = request.max_pairs;
+      if (!nearest.empty()) shared[i].nearest.store(nearest[i], std::memory_order_relaxed);
+    }
+    state.shared = shared.get();
   }
   schedule::PairsRun run;
   executor.execute([&] {

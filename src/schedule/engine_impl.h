@@ -1,14 +1,17 @@
 #pragma once
 /// \file
-/// The engine's state between calls (Engine::Impl) and the pieces its two entry points share:
+/// The engine's state between calls (Engine::Impl) and the pieces its entry points share:
 /// Engine::step (schedule/engine.cpp) runs a frame's pairs, Engine::query_many
-/// (schedule/batch.cpp) a batch's poses, both through run_pairs.
+/// (schedule/batch.cpp) a batch's poses, both through run_pairs; Engine::sweep and
+/// Engine::sweep_many (schedule/engine_sweep.cpp) run sweeps through run_sweeps, which splits a
+/// heavy sweep's distance queries through run_pairs.
 
 #include <atomic>
 #include <cstddef>
 #include <functional>
 #include <memory>
 #include <new>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -18,6 +21,7 @@
 #include "caliber/error.h"
 #include "caliber/profile.h"
 #include "narrow/pair_context.h"
+#include "narrow/sweep_bounds.h"
 #include "parallel/executor.h"
 #include "schedule/workers.h"
 #include "tasks/plan.h"
@@ -86,6 +90,34 @@ struct PairsRun {
   std::vector<std::size_t> candidates;  ///< per pair: the candidates its finalization took in
 };
 
+/// Below this many entries (a batch's poses, a sweep's pairs) per thread, the engine's method cuts
+/// the work (a heavy entry split as a heavy pair is); from it up, each entry runs whole on one
+/// thread (splitting would only add work: a split distance traversal's pieces each look for their
+/// own nearest pair).
+inline constexpr std::size_t kEntriesPerThread = 8;
+
+/// Stealing: how deep a run of `n` entries is split: as deep as it takes to give each thread
+/// kEntriesPerThread pieces, never deeper than the engine's stealing depth.
+inline int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
+  int depth = 0;
+  for (std::size_t pieces = n; depth < stealing_depth && pieces < kEntriesPerThread * static_cast<std::size_t>(threads);
+       pieces *= 4)
+    ++depth;
+  return depth;
+}
+
+/// Distance queries of sweeps that went through the method (split across threads), counted over
+/// the process: what the tests read to know that path ran (its answers are the same either way).
+inline std::atomic<std::uint64_t> g_split_sweep_queries{0};
+
+/// A sweep the engine runs: its two models and its advancement (done once it is over).
+struct SweepJob {
+  const Model* a;
+  const Model* b;
+  narrow::SweepAdvance advance;
+  bool done = false;
+};
+
 }  // namespace caliber::schedule
 
 namespace caliber {
@@ -111,13 +143,23 @@ struct Engine::Impl {
   /// Runs `method` over the pairs whose contexts `make` builds (schedule::ContextStore::build), on
   /// the engine's executor: fills results (one per pair; `pairs` are the object ids each pair's
   /// contacts carry), `record`, and with max_pairs the pairs' limits. A calibrated method plans with
-  /// `history` (keyed by `pairs`). Leaves the workers' slots for the caller's bookkeeping.
-  /// (Hidden: a member of the exported Engine's nested type would otherwise be exported.)
+  /// `history` (keyed by `pairs`). A distance query's pieces prune from the start by `nearest[i]`
+  /// when given: a distance that some triangle pair of pair i has (PairContext::leaf_distance at
+  /// these poses), which cannot change the answer. Leaves the workers' slots for the caller's
+  /// bookkeeping. (Hidden: a member of the exported Engine's nested type would otherwise be
+  /// exported.)
   [[gnu::visibility("hidden")]] schedule::PairsRun run_pairs(const EngineOptions& options, Method method,
                                                              const std::vector<ObjectPair>& pairs, const QueryRequest& request,
                                                              const tasks::History& history,
                                                              const std::function<void(std::size_t, void*)>& make,
-                                                             std::vector<QueryResult>& results, ScheduleRecord& record);
+                                                             std::vector<QueryResult>& results, ScheduleRecord& record,
+                                                             std::span<const double> nearest = {});
+  /// Runs the sweeps to their ends on the engine's executor, in parallel over sweeps; when fewer
+  /// than kEntriesPerThread a thread are left, a sweep whose last query was heavy makes its next
+  /// one through run_pairs with `method` (split as a heavy pair is). Every query is
+  /// caliber::query's answer, so every sweep is caliber::sweep's whatever the method and threads.
+  [[gnu::visibility("hidden")]] void run_sweeps(const EngineOptions& options, Method method,
+                                                std::vector<schedule::SweepJob>& jobs);
 };
 
 }  // namespace caliber

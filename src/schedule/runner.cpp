@@ -129,7 +129,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
         const narrow::TabooView taboo =
             root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()} : narrow::TabooView{};
         narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats, root.root_test(), taboo,
-                         state.limit(root.pair));
+                         state.shared_of(root.pair));
         tests += stats.node_tests - before;
         if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
         if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;

@@ -14,7 +14,7 @@ namespace {
 void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::NodePair n, bool tested) {
   const std::uint64_t before = w.stats[pair].node_tests;
   narrow::traverse(state.contexts[pair], n, w.scratch, w.candidates[pair], w.stats[pair],
-                   tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.limit(pair));
+                   tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.shared_of(pair));
   w.pieces.push_back(w.stats[pair].node_tests - before);
 }
 

@@ -92,15 +92,16 @@ struct StepState {
   Timeline& timeline;
   std::vector<QueryResult>& results;
   bool parallel_finalize = true;  ///< let one heavy pair's finalization use several threads
-  /// Per pair: its kept pairs against QueryRequest::max_pairs; null when there is no limit.
-  narrow::PairLimit* limits = nullptr;
+  /// Per pair: what its traversals share (kept pairs against QueryRequest::max_pairs, a distance
+  /// query's nearest distance so far); null when there is neither a limit nor a distance query.
+  narrow::PairShared* shared = nullptr;
   /// Per pair: the candidates its finalization took in (sized by the runner, filled by the
   /// finalization).
   std::vector<std::size_t> candidates;
   /// The frame's object pairs (the ids each pair's contacts carry).
   const ObjectPair* pairs = nullptr;
-  /// The pair's limit for a traversal, or null.
-  [[nodiscard]] narrow::PairLimit* limit(std::size_t pair) const { return limits != nullptr ? &limits[pair] : nullptr; }
+  /// What the pair's traversals share, or null.
+  [[nodiscard]] narrow::PairShared* shared_of(std::size_t pair) const { return shared != nullptr ? &shared[pair] : nullptr; }
   /// This run's number (Engine::Impl counts them): a worker's slots are reset by its own thread
   /// when it first works in a run (in parallel, not one thread for all of them), and slots of
   /// another run are stale.
