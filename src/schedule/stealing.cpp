@@ -28,6 +28,14 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
   int count = 0;
   {
     WorkerSlots& w = local_slots(state);
+    // A distance query's node farther than a pair some piece has found holds nothing that can win
+    // (traverse_nearest's rule: beyond the reach of the nearest distance): dropped here, before it
+    // is split or traversed. The children above the cut-off pass a test against the query's own
+    // tolerance only, which for an unbounded distance query lets every one through.
+    if (narrow::PairShared* shared = state.shared_of(pair); shared != nullptr && ctx.request().kind == QueryKind::distance) {
+      const double reach = ctx.reach_for(std::min(ctx.request().tolerance, shared->nearest.load(std::memory_order_relaxed)));
+      if (reach < kUnbounded && ctx.gap(ctx.near_a(n.a), ctx.near_b(n.b), reach) > reach) return;
+    }
     if (depth >= cutoff) {
       state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested); });
       return;
