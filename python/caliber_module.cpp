@@ -23,6 +23,7 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "batch.h"
+#include "sweeps.h"
 #include "half_built.h"
 
 namespace py = pybind11;
@@ -293,6 +294,41 @@ caliber_python::PyBatch query_many(caliber::Engine& engine, const PyModel& a, co
   return batch;
 }
 
+/// A side's motions from its start and end poses (each as SidePoses reads them), the same count.
+std::vector<caliber::SweptPose> motions_of(const caliber_python::SidePoses& start, const caliber_python::SidePoses& end,
+                                           const char* side) {
+  if (start.poses.size() != end.poses.size()) {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, std::string("end_") + side,
+                         std::to_string(end.poses.size()) + " poses but start_" + side + " has " +
+                             std::to_string(start.poses.size()) + " (a side's start and end give one pose per motion)");
+  }
+  std::vector<caliber::SweptPose> out(start.poses.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {start.poses[i], end.poses[i]};
+  return out;
+}
+
+caliber_python::PySweeps sweep_many(caliber::Engine& engine, const PyModel& a, const py::object& start_a, const py::object& end_a,
+                                    const PyModel& b, const py::object& start_b, const py::object& end_b, double tolerance,
+                                    std::uint64_t max_queries, const std::string& order) {
+  const caliber::QuaternionOrder o = caliber_python::parse_order(order);
+  const std::vector<caliber::SweptPose> ma = motions_of({start_a, o, "start_a"}, {end_a, o, "end_a"}, "a");
+  const std::vector<caliber::SweptPose> mb = motions_of({start_b, o, "start_b"}, {end_b, o, "end_b"}, "b");
+  caliber::SweepRequest request;
+  request.tolerance = tolerance;
+  request.max_queries = max_queries;
+  std::vector<caliber::SweepResult> results;
+  double ms = 0.0;
+  {
+    py::gil_scoped_release release;
+    const auto start = std::chrono::steady_clock::now();
+    results = engine.sweep_many(*a.model, ma, *b.model, mb, request);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  caliber_python::PySweeps sweeps(results);
+  sweeps.sweep_ms = ms;
+  return sweeps;
+}
+
 }  // namespace
 
 CALIBER_REFUSE_HALF_BUILT(caliber::Mesh, "Mesh")
@@ -302,6 +338,7 @@ CALIBER_REFUSE_HALF_BUILT(PyResult, "Result")
 CALIBER_REFUSE_HALF_BUILT(caliber::Engine, "Engine")
 CALIBER_REFUSE_HALF_BUILT(caliber::World, "World")
 CALIBER_REFUSE_HALF_BUILT(caliber_python::PyBatch, "Batch")
+CALIBER_REFUSE_HALF_BUILT(caliber_python::PySweeps, "Sweeps")
 
 PYBIND11_MODULE(caliber, m) {
   m.doc() = "caliber: exact collision detection between rigid triangle meshes, parallelized by task calibration";
@@ -522,6 +559,20 @@ def _batch_from_state(state):
       "The first time t in [0, 1] at which a, moving from start_a to end_a, and b, from start_b to end_b (translation "
       "linear, rotation by slerp), come within tolerance (0: 1e-6 of the larger model's radius): never later than the "
       "first true contact, never a missed contact (docs/queries.md). Returns a Sweep.");
+  caliber_python::bind_sweeps(m, [] { return not_picklable("Sweeps", "pickle its arrays"); });
+  m.def(
+      "sweep_many",
+      [](const PyModel& a, const py::object& start_a, const py::object& end_a, const PyModel& b, const py::object& start_b,
+         const py::object& end_b, double tolerance, std::uint64_t max_queries, const std::string& order, int threads) {
+        caliber::EngineOptions options;
+        options.threads = threads;
+        caliber::Engine engine(options);
+        return sweep_many(engine, a, start_a, end_a, b, start_b, end_b, tolerance, max_queries, order);
+      },
+      py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
+      py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000, py::arg("order") = "wxyz", py::arg("threads") = 0,
+      "Engine(threads=threads).sweep_many(...): the swept query along many motions, in parallel, the GIL released once. "
+      "Returns Sweeps.");
 
   caliber_python::bind_batch(m);
   m.def(
@@ -572,6 +623,20 @@ def _batch_from_state(state):
           "...) bit for bit. Each side is one Pose (kept for every entry), a list of Poses, or an array of N x 4 x 4 "
           "matrices or N x 7 rows (translation, then the quaternion in `order`: 'wxyz' or 'xyzw'), float32 or float64. "
           "Returns a Batch.")
+      .def(
+          "sweep_many",
+          [](caliber::Engine& engine, const PyModel& a, const py::object& start_a, const py::object& end_a, const PyModel& b,
+             const py::object& start_b, const py::object& end_b, double tolerance, std::uint64_t max_queries,
+             const std::string& order) {
+            return sweep_many(engine, a, start_a, end_a, b, start_b, end_b, tolerance, max_queries, order);
+          },
+          py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
+          py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000, py::arg("order") = "wxyz",
+          "The swept query along many motions, on this engine's threads: row i is sweep(a, start_a[i], end_a[i], b, "
+          "start_b[i], end_b[i], ...) bit for bit. Each of the four is one Pose, a list of Poses, or an array of N x 4 x 4 "
+          "matrices or N x 7 rows (translation, then the quaternion in `order`); a side's start and end give the same "
+          "number, and a side of one motion keeps it for every row. Heavy sweeps' queries are split across threads when "
+          "few are left. Returns Sweeps.")
       .def(
           "find_pairs",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,

@@ -431,3 +431,65 @@ def test_engine_sweep_equals_sweep_on_every_pair():
     assert caliber.Engine().sweep(models, start, end, ignored=[(0, 1)]) == []
     with pytest.raises(caliber.Error, match="end pose"):
         caliber.Engine().sweep(models, start, end[:3])
+
+
+def random_passes(n, seed):
+    """n motions of B from one side of A to the other, as N x 7 rows (translation, quaternion wxyz)."""
+    rng = np.random.default_rng(seed)
+    side = rng.normal(size=(n, 3))
+    side /= np.linalg.norm(side, axis=1, keepdims=True)
+    turn = rng.normal(size=(n, 4))
+    turn /= np.linalg.norm(turn, axis=1, keepdims=True)
+    off = rng.uniform(-1.5, 1.5, size=(n, 3))  # through A's middle, or beside it
+    start = np.hstack([2.5 * side + off, turn])
+    end = np.hstack([-2.5 * side + off, np.tile([1.0, 0, 0, 0], (n, 1))])
+    return start, end
+
+
+@pytest.mark.parametrize("method,threads", [("sequential", 1), ("stealing", 2), ("hybrid", 2), ("exploitation", 3)])
+def test_sweep_many_equals_sweep_row_for_row(method, threads):
+    slab = box_model(1.0, 1.0, 0.05)  # a thin slab the needles fly through or past
+    needle = box_model(0.01, 0.01, 0.6)
+    start, end = random_passes(30, 5)
+    engine = caliber.Engine(method, threads=threads)
+    got = engine.sweep_many(slab, caliber.Pose(), caliber.Pose(), needle, start, end, tolerance=1e-6)
+    assert len(got) == 30 and got.time.shape == (30,) and got.pairs.shape == (30, 2) and got.points_a.shape == (30, 3)
+    assert got.contact.sum() > 5 and (~got.contact).sum() > 0, "the motions should both meet and miss"
+    for i in range(30):
+        s = caliber.sweep(slab, caliber.Pose(), caliber.Pose(), needle, caliber.Pose(start[i, :3], start[i, 3:]),
+                          caliber.Pose(end[i, :3], end[i, 3:]), tolerance=1e-6)
+        assert got.time[i] == s.time and got.queries[i] == s.queries
+        assert bool(got.contact[i]) == (s.status == "contact") and bool(got.undecided[i]) == (s.status == "undecided")
+        if s.status == "contact":
+            assert tuple(got.pairs[i]) == s.pair and got.distance[i] == s.distance
+            assert (tuple(got.points_a[i]), tuple(got.points_b[i])) == s.points
+        else:
+            assert tuple(got.pairs[i]) == (-1, -1) and got.distance[i] == np.inf and np.isnan(got.points_a[i]).all()
+    # The module function, scipy's quaternion order, and 4 x 4 matrices give the same rows.
+    xyzw = lambda rows: np.hstack([rows[:, :3], rows[:, 4:], rows[:, 3:4]])
+    again = caliber.sweep_many(slab, caliber.Pose(), caliber.Pose(), needle, xyzw(start), xyzw(end), tolerance=1e-6,
+                               order="xyzw", threads=threads)
+    assert (again.time == got.time).all() and (again.pairs == got.pairs).all()
+    matrices = np.array([caliber.Pose(r[:3], r[3:]).matrix() for r in start])
+    m = caliber.sweep_many(slab, caliber.Pose(), caliber.Pose(), needle, matrices, end, tolerance=1e-6)
+    assert (m.contact == got.contact).all()
+
+
+def test_sweep_many_refuses_bad_motions():
+    plate, needle = box_model(1.0, 1.0, 0.001), box_model(0.001, 0.001, 0.1)
+    start, end = random_passes(4, 1)
+    with pytest.raises(caliber.Error, match="end_b: 3 poses but start_b has 4"):
+        caliber.sweep_many(plate, caliber.Pose(), caliber.Pose(), needle, start, end[:3])
+    with pytest.raises(caliber.Error, match="motions"):
+        caliber.sweep_many(plate, [caliber.Pose()] * 2, [caliber.Pose()] * 2, needle, start, end)
+    bad = end.copy()
+    bad[2, 0] = np.nan
+    with pytest.raises(caliber.Error, match=r"end_b\[2\]"):
+        caliber.sweep_many(plate, caliber.Pose(), caliber.Pose(), needle, start, bad)
+    with pytest.raises(caliber.Error, match="max_queries"):
+        caliber.sweep_many(plate, caliber.Pose(), caliber.Pose(), needle, start, end, max_queries=0)
+    got = caliber.sweep_many(plate, caliber.Pose(), caliber.Pose(), needle, start, end)
+    with pytest.raises(caliber.Error, match="Sweeps"):
+        pickle.dumps(got)
+    with pytest.raises(caliber.Error):
+        caliber.Sweeps.__new__(caliber.Sweeps).time
