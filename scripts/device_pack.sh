@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Packs what another machine needs to run caliber without our Debian packages (for example a
 # 16-core Intel Xeon machine running Ubuntu 24.04, whose glibc is newer than Debian 12's), into
-# .devicepack/ (git-ignored): the Release binary, the benchmarks bench_batch and bench_broad_phase,
+# .devicepack/ (git-ignored): the Release binary, the benchmarks bench_batch, bench_broad_phase and
+# bench_sweep_many,
 # every shared library they load except the C library's own, the four scenes and the meshes they
-# read, the meshes of the many-part scenes and of bench_batch, and run.sh, the one command to run
+# read, the meshes of the many-part scenes, of bench_batch and of bench_sweep_many, and run.sh, the one command to run
 # there:
 #
 #   scripts/device_pack.sh            # here: build (Release) and pack; prints the pack's size
@@ -12,6 +13,7 @@
 #                                     # under $OUT when ARGS name $OUT
 #   bash .devicepack/run.sh bench_batch ARGS...        # the packed benchmarks, likewise
 #   bash .devicepack/run.sh bench_broad_phase ARGS...
+#   bash .devicepack/run.sh bench_sweep_many ARGS...
 #
 # For example, a bench that cannot lose its results when a time limit (here 10 minutes) cuts it:
 #
@@ -31,7 +33,7 @@ limit_mib=64
 
 rm -rf "$pack"
 mkdir -p "$pack/bin" "$pack/lib" "$pack/scenes" "$pack/data/meshes"
-binaries=(caliber bench_batch bench_broad_phase)
+binaries=(caliber bench_batch bench_broad_phase bench_sweep_many)
 for binary in "${binaries[@]}"; do
   cp "$root/build/$binary" "$pack/bin/"
   strip "$pack/bin/$binary"
@@ -70,20 +72,20 @@ for scene in sorted(pathlib.Path(sys.argv[1]).glob("*.json")):
 PY
 # The many-part scenes' mesh (there, `python3 scenes/generate.py --grid N --out-dir
 # .devicepack/data/scenes --mesh .devicepack/data/meshes/eight.off` writes the scenes beside it)
-# and bench_batch's two (it reads data/meshes from the pack's folder).
-for mesh in eight.off bunny00.off turbine.off; do cp "$root/data/meshes/$mesh" "$pack/data/meshes/"; done
+# bench_batch's two and bench_sweep_many's blade (they read data/meshes from the pack's folder).
+for mesh in eight.off bunny00.off turbine.off blade.off; do cp "$root/data/meshes/$mesh" "$pack/data/meshes/"; done
 
 cat > "$pack/run.sh" <<'RUN'
 #!/usr/bin/env bash
 # Runs the packed caliber with the packed libraries (see scripts/device_pack.sh). Scenes are under
-# .devicepack/scenes; `bench` without scenes runs those four. `run.sh bench_batch ...` and
-# `run.sh bench_broad_phase ...` run the packed benchmarks.
+# .devicepack/scenes; `bench` without scenes runs those four. `run.sh bench_batch ...`,
+# `run.sh bench_broad_phase ...` and `run.sh bench_sweep_many ...` run the packed benchmarks.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cd "$here"
 case "${1:-}" in
-  bench_batch|bench_broad_phase) binary="$1"; shift; exec "$here/bin/$binary" "$@" ;;
+  bench_batch|bench_broad_phase|bench_sweep_many) binary="$1"; shift; exec "$here/bin/$binary" "$@" ;;
 esac
 if [ "${1:-}" = bench ]; then
   named=0
