@@ -1,8 +1,6 @@
 // caliber run: a scene over its time steps, with a per-step summary, a final summary (the paper's
 // Table 1 characteristics), an optional JSON report and an optional JSON-lines contact log.
 
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <new>
@@ -20,9 +18,11 @@
 #include "caliber/world.h"
 #include "commands.h"
 #include "export_files.h"
+#include "interrupt.h"
 #include "json_output.h"
 #include "output_file.h"
 #include "progress.h"
+#include "run_continuous.h"
 #include "run_stats.h"
 #include "timing.h"
 
@@ -117,79 +117,17 @@ std::string pair_name(const World& world, const ObjectPair& t) {
   return world.scene().objects[t.a].name + " / " + world.scene().objects[t.b].name;
 }
 
-/// Set by SIGINT during a run: the run stops after the step in progress and writes what it measured.
-std::atomic<bool> gInterrupted{false};
-
-extern "C" void on_interrupt(int) { gInterrupted.store(true); }
-
-/// SIGINT handled for the lifetime of the object (the previous handler restored after).
-struct InterruptGuard {
-  InterruptGuard() {
-    gInterrupted.store(false);
-    previous = std::signal(SIGINT, on_interrupt);
-  }
-  ~InterruptGuard() { std::signal(SIGINT, previous); }
-  void (*previous)(int) = SIG_DFL;
-};
-
-/// `run --continuous`: each step's motion to the next swept (World::sweep), the pairs that touch
-/// between steps reported with when.
-int run_continuous(const RunOptions& opt, Scene scene) {
-  if (!opt.json.empty() || !opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
-    throw Error(ErrorCode::bad_argument, "--continuous",
-                "reports the pairs that touch between steps: it takes none of --json, --contacts, --export, --max-pairs");
-  }
-  EngineOptions engine_options;
-  engine_options.threads = opt.threads;
-  SweepRequest request;
-  request.tolerance = opt.sweep_tolerance;
-  validate_sweep_request(request);
-  const World world(std::move(scene));
-  Engine engine(engine_options);
-  const Scene& sc = world.scene();
-  std::printf("scene %s: %zu objects, %d steps of %g s: sweeping each step's motion to the next on %d thread(s)\n",
-              sc.name.c_str(), world.object_count(), sc.steps, sc.dt, engine.threads());
-  const int intervals = std::max(sc.steps - 1, 0);
-  const Progress progress(static_cast<std::size_t>(intervals));
-  const InterruptGuard interrupt;
-  std::size_t touched = 0, undecided = 0;
-  int done = 0;
-  double first = -1.0;
-  for (int k = 0; k < intervals && !gInterrupted.load(); ++k, ++done) {
-    const auto start = Clock::now();
-    const std::vector<PairSweep> pairs = world.sweep(k, engine, request);
-    const double ms = ms_since(start);
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      const PairSweep& p = pairs[i];
-      const bool contact = p.result.status == SweepStatus::contact;
-      (contact ? touched : undecided) += 1;
-      if (contact && first < 0.0) first = k + p.result.time;
-      if (i < 20) {
-        std::printf("  step %d -> %d: %s %s t = %.6f s (%.6f of the step)", k, k + 1, pair_name(world, p.pair).c_str(),
-                    contact ? "touch at" : "undecided: free up to", (k + p.result.time) * sc.dt, p.result.time);
-        if (contact) std::printf(", triangles %u and %u", p.result.closest.tri_a, p.result.closest.tri_b);
-        std::printf("\n");
-      } else if (i == 20) {
-        std::printf("  step %d -> %d: and %zu more pairs\n", k, k + 1, pairs.size() - 20);
-      }
-    }
-    std::fflush(stdout);  // the pairs before the progress line (stderr)
-    char line[160];
-    std::snprintf(line, sizeof line, "step %d -> %d: %zu pairs touch, %.2f ms", k, k + 1, pairs.size(), ms);
-    progress.update(static_cast<std::size_t>(k + 1), line);
-  }
-  std::printf("\nsummary over %d step intervals\n", done);
-  std::printf("  pairs that touch    %zu (undecided: %zu)\n", touched, undecided);
-  if (first >= 0.0) std::printf("  first contact      at step %.6f (t = %.6f s)\n", first, first * sc.dt);
-  check_stdout();
-  return gInterrupted.load() ? 130 : 0;
-}
-
 int run_scene(const RunOptions& opt) {
   Scene scene = load_scene(opt.scene);
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
   if (opt.steps > 0) scene.steps = opt.steps;
-  if (opt.continuous) return run_continuous(opt, std::move(scene));
+  if (opt.continuous) {
+    if (!opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
+      throw Error(ErrorCode::bad_argument, "--continuous",
+                  "reports the pairs that touch between steps: it takes none of --contacts, --export, --max-pairs");
+    }
+    return run_continuous({opt.scene, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
+  }
   if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
   for (const int p : opt.simulate) {
     if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");

@@ -259,8 +259,28 @@ grep -q "the log ends before the run did" "$tmp/bench-cut/report.md" && passes=$
 check run-continuous 0 "$cli" run "$data/../../scenes/funnel.json" --continuous --steps 6 --threads 2
 contains run-continuous "summary over 5 step intervals"
 contains run-continuous "pairs that touch"
-check run-continuous-json 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --json "$(mktemp -u)"
-contains run-continuous-json "--continuous"
+# --json: the report of every interval, the same pairs and times whatever the threads.
+ctmp=$(mktemp -d)
+check run-continuous-json 0 "$cli" run "$data/../../scenes/funnel.json" --continuous --steps 6 --threads 1 --json "$ctmp/one.json"
+check run-continuous-json 0 "$cli" run "$data/../../scenes/funnel.json" --continuous --steps 6 --threads 2 --json "$ctmp/two.json"
+python3 - "$ctmp/one.json" "$ctmp/two.json" <<'PY' || { echo "FAIL run-continuous-json"; failures=$((failures + 1)); }
+import json, sys
+one, two = (json.load(open(f)) for f in sys.argv[1:])
+strip = lambda r: [[p for p in i["pairs"]] for i in r["intervals"]]
+assert strip(one) == strip(two), "the threads changed a sweep"
+assert [i["step"] for i in one["intervals"]] == list(range(5)) and one["summary"]["intervals"] == 5
+pairs = [p for i in one["intervals"] for p in i["pairs"]]
+assert pairs and one["summary"]["pairs_touching"] == sum(p["status"] == "contact" for p in pairs)
+for p in pairs:
+    assert p["a"] < p["b"] and 0.0 <= p["time"] <= 1.0 and p["queries"] >= 1, p
+    assert p["status"] != "contact" or (p["distance"] >= 0.0 and len(p["point_a"]) == 3), p
+assert one["summary"]["first_contact_step"] == min(i["step"] + p["time"] for i in one["intervals"] for p in i["pairs"])
+PY
+check run-continuous-json-scene 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --json "$data/../../scenes/funnel.json"
+contains run-continuous-json-scene "--json"
+rm -rf "$ctmp"
+check run-continuous-contacts 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --contacts "$(mktemp -u)"
+contains run-continuous-contacts "--continuous"
 check run-continuous-tolerance 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --sweep-tolerance -1
 contains run-continuous-tolerance "tolerance"
 # (two_small: its runs take long enough; its meshes are extracted by scripts/fetch_meshes.sh before the tests)

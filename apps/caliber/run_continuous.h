@@ -1,0 +1,22 @@
+#pragma once
+// caliber run --continuous: each step's motion to the next swept, the pairs that touch between
+// steps printed with when, and optionally written to a JSON report.
+
+#include <string>
+
+#include "caliber/scene.h"
+
+namespace caliber::cli {
+
+struct ContinuousOptions {
+  std::string scene_file;  ///< the scene's path as given (kept apart from the report)
+  int threads = 0;         ///< EngineOptions::threads
+  double tolerance = 0.0;  ///< SweepRequest::tolerance
+  std::string json;        ///< the report's path, or empty
+};
+
+/// Runs the scene's step intervals through World::sweep; returns the exit code (130 when
+/// interrupted). Throws caliber::Error on a bad tolerance or report path, before any work.
+int run_continuous(const ContinuousOptions& opt, Scene scene);
+
+}  // namespace caliber::cli
