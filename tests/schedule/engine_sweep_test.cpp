@@ -49,7 +49,7 @@ Objects flying_parts(std::size_t n, unsigned seed) {
   return o;
 }
 
-TEST(EngineSweep, EveryPairThatTouchesAsCaliberSweepFindsIt) {
+TEST(EngineSweep, EveryPairThatTouchesAsCaliberSweepFindsItWhateverTheMethodAndThreads) {
   const Objects o = flying_parts(24, 7);
   SweepRequest request;
   request.tolerance = 1e-5;
@@ -61,18 +61,22 @@ TEST(EngineSweep, EveryPairThatTouchesAsCaliberSweepFindsIt) {
     }
   }
   ASSERT_GT(brute.size(), 10u) << "the scene should make pairs meet";
-  for (const int threads : {1, 2, 3}) {
-    EngineOptions options;
-    options.threads = threads;
-    Engine engine(options);
-    const std::vector<PairSweep> got = engine.sweep(o.models, o.from, o.to, request);
-    ASSERT_EQ(got.size(), brute.size()) << threads << " threads";
-    for (std::size_t k = 0; k < got.size(); ++k) {
-      EXPECT_EQ(got[k].pair, brute[k].pair) << threads << " threads, pair " << k;
-      EXPECT_EQ(got[k].result.status, brute[k].result.status);
-      EXPECT_EQ(got[k].result.time, brute[k].result.time) << "bit for bit";
-      EXPECT_EQ(got[k].result.closest.tri_a, brute[k].result.closest.tri_a);
-      EXPECT_EQ(got[k].result.closest.tri_b, brute[k].result.closest.tri_b);
+  for (const Method method : {Method::stealing, Method::sequential, Method::hybrid, Method::apriori}) {
+    for (const int threads : {1, 2, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      Engine engine(options);
+      const std::vector<PairSweep> got = engine.sweep(o.models, o.from, o.to, request);
+      const std::string where = std::string(to_string(method)) + ", " + std::to_string(threads) + " threads";
+      ASSERT_EQ(got.size(), brute.size()) << where;
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].pair, brute[k].pair) << where << ", pair " << k;
+        EXPECT_EQ(got[k].result.status, brute[k].result.status) << where;
+        EXPECT_EQ(got[k].result.time, brute[k].result.time) << where << ": bit for bit";
+        EXPECT_EQ(got[k].result.closest.tri_a, brute[k].result.closest.tri_a) << where;
+        EXPECT_EQ(got[k].result.closest.tri_b, brute[k].result.closest.tri_b) << where;
+      }
     }
   }
 }
