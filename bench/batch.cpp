@@ -1,6 +1,7 @@
 // Batch queries against FCL 0.7's loop: a link (CGAL's turbine, scaled) swept along a path through
 // the bunny, N poses, about half of them colliding. Per query kind (first hit, every intersecting
-// pair, minimum distance) and per subset (free poses, colliding poses): microseconds per pose of
+// pair, minimum distance) and per subset (free poses, colliding poses, and the whole batch in the
+// path's order): microseconds per pose of
 // FCL's loop (fcl::collide / fcl::distance, OBBRSS), a loop of caliber::query, and
 // Engine::query_many on 1 and 2 threads (or those --threads names). Interleaved rounds, medians; the entries of every batch
 // are checked against the single queries (same pairs and distances, bit for bit).
@@ -217,7 +218,7 @@ int main(int argc, char** argv) {
                          }});
     }
     for (const auto& [subset, poses] :
-         {std::pair<std::string, const std::vector<Pose>*>{"free", &free}, {"colliding", &colliding}}) {
+         {std::pair<std::string, const std::vector<Pose>*>{"free", &free}, {"colliding", &colliding}, {"all", &all}}) {
       if (poses->empty()) continue;
       // Every batch's entries are the single queries', bit for bit.
       const BatchResult check = engines.back()->query_many(*a, identity, *b, *poses, request);
