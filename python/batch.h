@@ -90,7 +90,10 @@ struct PyBatch {
   PyBatch() = default;
 
   explicit PyBatch(const caliber::BatchResult& b) {
-    allocate(static_cast<py::ssize_t>(b.size()), static_cast<py::ssize_t>(b.contacts.size()));
+    // Interference reports ids only: its points, normals, distances and depths are zeros, made by
+    // numpy.zeros (pages the system hands out zeroed) instead of copied row by row.
+    const bool ids_only = b.kind == caliber::QueryKind::interference;
+    allocate(static_cast<py::ssize_t>(b.size()), static_cast<py::ssize_t>(b.contacts.size()), ids_only);
     std::int64_t* const off = offsets.mutable_data();
     bool* const lr = limit_reached.mutable_data();
     std::uint32_t* const tri = pairs.mutable_data();
@@ -104,6 +107,7 @@ struct PyBatch {
         const caliber::Contact& c = b.contacts[r];
         tri[2 * r] = c.tri_a;
         tri[2 * r + 1] = c.tri_b;
+        if (ids_only) continue;
         for (std::size_t d = 0; d < 3; ++d) {
           pa[3 * r + d] = c.point_a[static_cast<Eigen::Index>(d)];
           pb[3 * r + d] = c.point_b[static_cast<Eigen::Index>(d)];
@@ -195,13 +199,24 @@ struct PyBatch {
   }
 
  private:
-  void allocate(py::ssize_t n, py::ssize_t k) {
+  /// The arrays for n entries and k rows; with `zero_rows`, the rows' points, normals, distances
+  /// and depths are zeros (numpy.zeros), else left to be written.
+  void allocate(py::ssize_t n, py::ssize_t k, bool zero_rows = false) {
     offsets = py::array_t<std::int64_t>(n + 1);
     hit = py::array_t<bool>(n);
     limit_reached = py::array_t<bool>(n);
     distance = py::array_t<double>(n);
     pairs = py::array_t<std::uint32_t>({k, py::ssize_t{2}});
     entries = py::array_t<std::int64_t>(k);
+    if (zero_rows) {
+      const py::object zeros = py::module_::import("numpy").attr("zeros");
+      points_a = zeros(py::make_tuple(k, 3));
+      points_b = zeros(py::make_tuple(k, 3));
+      normals = zeros(py::make_tuple(k, 3));
+      distances = zeros(k);
+      depths = zeros(k);
+      return;
+    }
     points_a = py::array_t<double>({k, py::ssize_t{3}});
     points_b = py::array_t<double>({k, py::ssize_t{3}});
     normals = py::array_t<double>({k, py::ssize_t{3}});
