@@ -3,9 +3,20 @@
 #include "util/printable.h"
 
 namespace caliber::cli {
-namespace {
-nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
-}  // namespace
+
+nlohmann::json json_vector(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+void write_scene_header(JsonObjectWriter& report, const World& world) {
+  const Scene& sc = world.scene();
+  nlohmann::json objects = nlohmann::json::array();
+  for (std::size_t i = 0; i < world.object_count(); ++i) {
+    objects.push_back({{"id", i}, {"name", json_text(sc.objects[i].name)}, {"mesh", json_text(sc.objects[i].mesh.string())}});
+  }
+  report.member("schema_version", kSchemaVersion);
+  report.member("scene", json_text(sc.name));
+  report.member("file", json_text(sc.file.string()));
+  report.member("objects", objects);
+}
 
 nlohmann::json to_json(const QueryResult& result) {
   nlohmann::json out;
@@ -17,9 +28,9 @@ nlohmann::json to_json(const QueryResult& result) {
   for (const Contact& c : result.kind == QueryKind::interference ? std::vector<Contact>{} : result.contacts) {
     contacts.push_back({{"tri_a", c.tri_a},
                         {"tri_b", c.tri_b},
-                        {"point_a", vec(c.point_a)},
-                        {"point_b", vec(c.point_b)},
-                        {"normal", vec(c.normal)},
+                        {"point_a", json_vector(c.point_a)},
+                        {"point_b", json_vector(c.point_b)},
+                        {"normal", json_vector(c.normal)},
                         {"distance", c.distance},
                         {"depth", c.depth}});
   }

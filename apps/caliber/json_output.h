@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "caliber/query.h"
+#include "caliber/world.h"
 
 namespace caliber::cli {
 
@@ -45,5 +46,12 @@ class JsonObjectWriter {
   std::string (*mFilter)(const std::string&);
   bool mFirstMember = true, mFirstItem = true;
 };
+
+/// The members a run's report starts with: schema_version, scene, file, and objects (one
+/// {"id", "name", "mesh"} per scene object).
+void write_scene_header(JsonObjectWriter& report, const World& world);
+
+/// [x, y, z]
+[[nodiscard]] nlohmann::json json_vector(const Eigen::Vector3d& v);
 
 }  // namespace caliber::cli

@@ -47,8 +47,6 @@ struct RunOptions {
   double sweep_tolerance = 0.0;
 };
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
-
 nlohmann::json step_record(const StepResult& s) {
   nlohmann::json tasks = nlohmann::json::array();
   for (const PairRecord& t : s.pair_records) {
@@ -102,9 +100,9 @@ nlohmann::json contacts_line(const World& world, const StepResult& s) {
                         {"tri_a", c.tri_a},
                         {"tri_b", c.tri_b}};
     if (points) {
-      j["point_a"] = vec(c.point_a);
-      j["point_b"] = vec(c.point_b);
-      j["normal"] = vec(c.normal);
+      j["point_a"] = json_vector(c.point_a);
+      j["point_b"] = json_vector(c.point_b);
+      j["normal"] = json_vector(c.normal);
       j["distance"] = c.distance;
       j["depth"] = c.depth;
     }
@@ -167,14 +165,7 @@ int run_scene(const RunOptions& opt) {
   std::optional<JsonObjectWriter> report;
   if (json_out) {
     report.emplace(json_out->stream());
-    nlohmann::json objects = nlohmann::json::array();
-    for (std::size_t i = 0; i < world.object_count(); ++i) {
-      objects.push_back({{"id", i}, {"name", json_text(sc.objects[i].name)}, {"mesh", json_text(sc.objects[i].mesh.string())}});
-    }
-    report->member("schema_version", kSchemaVersion);
-    report->member("scene", json_text(sc.name));
-    report->member("file", json_text(sc.file.string()));
-    report->member("objects", objects);
+    write_scene_header(*report, world);
     report->member(
         "query",
         {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}});

@@ -25,8 +25,6 @@
 namespace caliber::cli {
 namespace {
 
-nlohmann::json vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
-
 /// One pair's sweep in the report: when it touches (as a share of the step and in seconds from the
 /// start), and at a contact the closest triangles and their points (world coordinates).
 nlohmann::json pair_record(const World& world, int k, const PairSweep& p) {
@@ -43,8 +41,8 @@ nlohmann::json pair_record(const World& world, int k, const PairSweep& p) {
   if (contact) {
     j["tri_a"] = p.result.closest.tri_a;
     j["tri_b"] = p.result.closest.tri_b;
-    j["point_a"] = vec(p.result.closest.point_a);
-    j["point_b"] = vec(p.result.closest.point_b);
+    j["point_a"] = json_vector(p.result.closest.point_a);
+    j["point_b"] = json_vector(p.result.closest.point_b);
     j["distance"] = p.result.closest.distance;
   }
   return j;
@@ -89,14 +87,7 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
   std::optional<JsonObjectWriter> report;
   if (json_out) {
     report.emplace(json_out->stream());
-    nlohmann::json objects = nlohmann::json::array();
-    for (std::size_t i = 0; i < world.object_count(); ++i) {
-      objects.push_back({{"id", i}, {"name", json_text(sc.objects[i].name)}, {"mesh", json_text(sc.objects[i].mesh.string())}});
-    }
-    report->member("schema_version", kSchemaVersion);
-    report->member("scene", json_text(sc.name));
-    report->member("file", json_text(sc.file.string()));
-    report->member("objects", objects);
+    write_scene_header(*report, world);
     report->member("continuous", {{"tolerance", opt.tolerance}, {"max_queries", request.max_queries}});
     report->member("dt", sc.dt);
     report->member("threads", engine.threads());
