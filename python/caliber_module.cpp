@@ -313,6 +313,11 @@ caliber_python::PySweeps sweep_many(caliber::Engine& engine, const PyModel& a, c
   const caliber::QuaternionOrder o = caliber_python::parse_order(order);
   const std::vector<caliber::SweptPose> ma = motions_of({start_a, o, "start_a"}, {end_a, o, "end_a"}, "a");
   const std::vector<caliber::SweptPose> mb = motions_of({start_b, o, "start_b"}, {end_b, o, "end_b"}, "b");
+  if (ma.size() != mb.size() && ma.size() != 1 && mb.size() != 1) {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "start_b",
+                         std::to_string(mb.size()) + " motions but start_a gives " + std::to_string(ma.size()) +
+                             " (give both sides the same number, or one motion to a side that moves the same in every row)");
+  }
   caliber::SweepRequest request;
   request.tolerance = tolerance;
   request.max_queries = max_queries;
@@ -571,7 +576,7 @@ def _batch_from_state(state):
       },
       py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
       py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000, py::arg("order") = "wxyz", py::arg("threads") = 0,
-      "Engine(threads=threads).sweep_many(...): the swept query along many motions, in parallel, the GIL released once. "
+      "Engine(threads=threads).sweep_many(...): the swept query along many motions, in parallel, without the GIL. "
       "Returns Sweeps.");
 
   caliber_python::bind_batch(m);

@@ -124,7 +124,7 @@ int run_scene(const RunOptions& opt) {
       throw Error(ErrorCode::bad_argument, "--continuous",
                   "reports the pairs that touch between steps: it takes none of --contacts, --export, --max-pairs");
     }
-    return run_continuous({opt.scene, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
+    return run_continuous({opt.scene, opt.method, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
   }
   if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
   for (const int p : opt.simulate) {

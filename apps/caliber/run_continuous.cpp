@@ -77,12 +77,14 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     json_out = std::make_unique<OutputFile>(opt.json, "--json");
   }
   EngineOptions engine_options;
+  engine_options.method = parse_method(opt.method);
   engine_options.threads = opt.threads;
   const World world(std::move(scene));
   Engine engine(engine_options);
   const Scene& sc = world.scene();
-  std::printf("scene %s: %zu objects, %d steps of %g s: sweeping each step's motion to the next on %d thread(s)\n",
-              sc.name.c_str(), world.object_count(), sc.steps, sc.dt, engine.threads());
+  std::printf("scene %s: %zu objects, %d steps of %g s: sweeping each step's motion to the next, method %s on %d thread(s)\n",
+              sc.name.c_str(), world.object_count(), sc.steps, sc.dt, std::string(to_string(engine.options().method)).c_str(),
+              engine.threads());
   // Streamed like run's report: the header, each interval as it ends, then the summary.
   std::optional<JsonObjectWriter> report;
   if (json_out) {
@@ -90,6 +92,7 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     write_scene_header(*report, world);
     report->member("continuous", {{"tolerance", opt.tolerance}, {"max_queries", request.max_queries}});
     report->member("dt", sc.dt);
+    report->member("method", std::string(to_string(engine.options().method)));
     report->member("threads", engine.threads());
     report->open_array("intervals");
   }
@@ -114,7 +117,7 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     print_pairs(world, k, pairs);
     std::fflush(stdout);  // the pairs before the progress line (stderr)
     char line[160];
-    std::snprintf(line, sizeof line, "step %d -> %d: %zu pairs touch, %.2f ms", k, k + 1, pairs.size(), ms);
+    std::snprintf(line, sizeof line, "step %d -> %d: %zu pairs not free, %.2f ms", k, k + 1, pairs.size(), ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
   const bool interrupted = gInterrupted.load();

@@ -10,6 +10,7 @@ namespace caliber::cli {
 
 struct ContinuousOptions {
   std::string scene_file;  ///< the scene's path as given (kept apart from the report)
+  std::string method;      ///< EngineOptions::method (how a heavy sweep\'s queries are split)
   int threads = 0;         ///< EngineOptions::threads
   double tolerance = 0.0;  ///< SweepRequest::tolerance
   std::string json;        ///< the report's path, or empty

@@ -181,7 +181,8 @@ class CALIBER_EXPORT Engine {
   /// tolerance) is swept with caliber::sweep, the pairs in parallel on the engine's threads.
   /// Returns the pairs whose sweep is not `free` (contact or undecided), sorted by pair; each
   /// answer is caliber::sweep's for that pair, whatever the method and threads (a heavy sweep's
-  /// queries split as in sweep_many), and no pair left out could have come within the tolerance. Pairs of two fixed objects and ignored pairs are skipped.
+  /// queries split as in sweep_many, its `stats` then counting the pieces' node tests), and no pair
+  /// left out could have come within the tolerance. Pairs of two fixed objects and ignored pairs are skipped.
   /// Throws caliber::Error on counts that do not match, a bad pose (named by its object), a bad
   /// ignored pair or a bad request, before any work.
   [[nodiscard]] std::vector<PairSweep> sweep(const std::vector<std::shared_ptr<const Model>>& models,

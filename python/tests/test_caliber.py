@@ -480,7 +480,7 @@ def test_sweep_many_refuses_bad_motions():
     start, end = random_passes(4, 1)
     with pytest.raises(caliber.Error, match="end_b: 3 poses but start_b has 4"):
         caliber.sweep_many(plate, caliber.Pose(), caliber.Pose(), needle, start, end[:3])
-    with pytest.raises(caliber.Error, match="motions"):
+    with pytest.raises(caliber.Error, match="start_b: 4 motions but start_a gives 2"):
         caliber.sweep_many(plate, [caliber.Pose()] * 2, [caliber.Pose()] * 2, needle, start, end)
     bad = end.copy()
     bad[2, 0] = np.nan

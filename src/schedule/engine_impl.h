@@ -92,8 +92,9 @@ struct PairsRun {
 
 /// Below this many entries (a batch's poses, a sweep's pairs) per thread, the engine's method cuts
 /// the work (a heavy entry split as a heavy pair is); from it up, each entry runs whole on one
-/// thread (splitting would only add work: a split distance traversal's pieces each look for their
-/// own nearest pair).
+/// thread (there are enough entries to share out, and splitting adds work: a split traversal's
+/// pieces each start from their own root, and a distance query's prune only by what some piece has
+/// found so far).
 inline constexpr std::size_t kEntriesPerThread = 8;
 
 /// Stealing: how deep a run of `n` entries is split: as deep as it takes to give each thread

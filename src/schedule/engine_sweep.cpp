@@ -34,6 +34,7 @@ constexpr std::uint64_t kSplitNodeTests = 16384;
 void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::SweepJob>& jobs) {
   const QueryRequest distance = narrow::sweep_distance_request();
   const int threads = executor.threads();
+  timeline.begin(false);  // (a split query's spans are not recorded)
   // Exploitation runs a pair whole, as the loop over sweeps does: only the other methods cut one.
   const bool can_split = threads > 1 && method != Method::sequential && method != Method::exploitation;
   std::vector<std::size_t> active(jobs.size()), whole, split;

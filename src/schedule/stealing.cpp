@@ -21,7 +21,8 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
 /// Above the cut-off depth, visits CD-tree node n of pair `pair` (it passed its test, made by its
 /// parent's visit or before the first call) and spawns one task per child that passes; from the
 /// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
-/// exactly those of a single depth-first traversal of the tree.
+/// exactly those of a single depth-first traversal of the tree (for a distance query, those of its
+/// pieces, which depend on what the others have found by then).
 void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested) {
   const narrow::PairContext& ctx = state.contexts[pair];
   narrow::NodePair kids[4];
