@@ -294,6 +294,13 @@ caliber_python::PyBatch query_many(caliber::Engine& engine, const PyModel& a, co
   return batch;
 }
 
+caliber::SweepRequest sweep_request(double tolerance, std::uint64_t max_queries) {
+  caliber::SweepRequest request;
+  request.tolerance = tolerance;
+  request.max_queries = max_queries;
+  return request;
+}
+
 /// A side's motions from its start and end poses (each as SidePoses reads them), the same count.
 std::vector<caliber::SweptPose> motions_of(const caliber_python::SidePoses& start, const caliber_python::SidePoses& end,
                                            const char* side) {
@@ -318,9 +325,7 @@ caliber_python::PySweeps sweep_many(caliber::Engine& engine, const PyModel& a, c
                          std::to_string(mb.size()) + " motions but start_a gives " + std::to_string(ma.size()) +
                              " (give both sides the same number, or one motion to a side that moves the same in every row)");
   }
-  caliber::SweepRequest request;
-  request.tolerance = tolerance;
-  request.max_queries = max_queries;
+  const caliber::SweepRequest request = sweep_request(tolerance, max_queries);
   std::vector<caliber::SweepResult> results;
   double ms = 0.0;
   {
@@ -553,9 +558,7 @@ def _batch_from_state(state):
       "sweep",
       [](const PyModel& a, const caliber::Pose& start_a, const caliber::Pose& end_a, const PyModel& b,
          const caliber::Pose& start_b, const caliber::Pose& end_b, double tolerance, std::uint64_t max_queries) {
-        caliber::SweepRequest request;
-        request.tolerance = tolerance;
-        request.max_queries = max_queries;
+        const caliber::SweepRequest request = sweep_request(tolerance, max_queries);
         py::gil_scoped_release release;
         return caliber::sweep(*a.model, {start_a, end_a}, *b.model, {start_b, end_b}, request);
       },
@@ -676,9 +679,7 @@ def _batch_from_state(state):
             for (const PyModel& m : models) shared.push_back(m.model);
             std::vector<caliber::ObjectPair> skip;
             for (const auto& [a, b] : ignored) skip.push_back(caliber::ObjectPair{a, b});
-            caliber::SweepRequest request;
-            request.tolerance = tolerance;
-            request.max_queries = max_queries;
+            const caliber::SweepRequest request = sweep_request(tolerance, max_queries);
             std::vector<caliber::PairSweep> swept;
             {
               py::gil_scoped_release release;

@@ -66,7 +66,7 @@ SweepAdvance::SweepAdvance(double ra, const SweptPose& motion_a, double rb, cons
                       std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
                                 motion_b.start.translation.norm(), motion_b.end.translation.norm()});
   mMargin = kSweepMargin * size;
-  mTolerance = std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * std::max(ra, rb), 2.0 * mMargin);
+  mTolerance = sweep_tolerance(request, std::max(ra, rb), mMargin);
   // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
   mSpeed = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
   mResult.time = 0.0;
@@ -76,15 +76,16 @@ bool SweepAdvance::take(const QueryResult& r) {
   const double t = mResult.time;
   ++mResult.queries;
   mLastTests = r.stats.node_tests;
-  mLast = r.contacts.empty() ? Contact{} : r.contacts.front();
-  if (r.contacts.empty()) mLast.distance = -1.0;
   mResult.stats.node_tests += r.stats.node_tests;
   mResult.stats.leaf_tests += r.stats.leaf_tests;
-  if (r.contacts.empty()) {  // (an empty model: nothing to touch)
+  mHasLast = !r.contacts.empty();
+  if (!mHasLast) {  // (an empty model: nothing to touch)
     mResult.status = SweepStatus::free;
     mResult.time = 1.0;
     return true;
   }
+  mLastA = r.contacts.front().tri_a;
+  mLastB = r.contacts.front().tri_b;
   const double d = r.contacts.front().distance;
   if (d <= mTolerance) {
     mResult.status = SweepStatus::contact;

@@ -29,6 +29,13 @@ inline constexpr double kSweepMargin = 1e-9;
 /// A sweep's tolerance when the request gives none, as a share of the larger radius.
 inline constexpr double kSweepDefaultTolerance = 1e-6;
 
+/// The distance at which a sweep counts models as touching: the request's tolerance, or
+/// kSweepDefaultTolerance of `radius` (the larger model's), and never below twice the rounding
+/// margin.
+inline double sweep_tolerance(const SweepRequest& request, double radius, double margin) {
+  return std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * radius, 2.0 * margin);
+}
+
 /// The distance request every query of a sweep makes: the closest pair, at any distance.
 [[nodiscard]] QueryRequest sweep_distance_request();
 
@@ -52,9 +59,9 @@ class SweepAdvance {
   /// The closest triangle pair of the last query taken: at the next poses, its distance bounds
   /// the next query's answer from above. False before any query.
   [[nodiscard]] bool last_pair(std::uint32_t& ta, std::uint32_t& tb) const {
-    ta = mLast.tri_a;
-    tb = mLast.tri_b;
-    return mResult.queries > 0 && mLast.distance >= 0.0;
+    ta = mLastA;
+    tb = mLastB;
+    return mHasLast;
   }
 
  private:
@@ -62,7 +69,8 @@ class SweepAdvance {
   double mMargin, mTolerance, mSpeed;
   std::uint64_t mMaxQueries;
   std::uint64_t mLastTests = 0;
-  Contact mLast{};      ///< the last query's closest pair (distance -1: none)
+  std::uint32_t mLastA = 0, mLastB = 0;  ///< the last query's closest pair, when mHasLast
+  bool mHasLast = false;
   SweepResult mResult;  ///< time: the time of the next query until the sweep is over
 };
 

@@ -21,16 +21,6 @@ namespace {
 /// wait for its last entries, is a small part of it.
 constexpr std::size_t kChunk = 8192;
 
-/// The number of entries of a batch whose sides give `na` and `nb` poses; throws on counts that
-/// do not match.
-std::size_t entries(std::size_t na, std::size_t nb) {
-  if (na == nb || nb == 1) return na;
-  if (na == 1) return nb;
-  throw Error(ErrorCode::bad_argument, "poses",
-              std::to_string(na) + " poses of A but " + std::to_string(nb) +
-                  " of B (give both sides the same number, or one pose to a side that does not move)");
-}
-
 /// Entries traversed whole: at most this many to a task (few enough to balance heavy entries,
 /// enough that a light entry's task costs little beside it).
 constexpr std::size_t kWholeGrain = 4;
@@ -50,7 +40,8 @@ void validate_poses(std::span<const Pose> poses, const char* side) {
 BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, const Model& b, std::span<const Pose> poses_b,
                                const QueryRequest& request) {
   const schedule::OneCallAtATime hold(mImpl->busy, "query_many");
-  const std::size_t n = entries(poses_a.size(), poses_b.size());
+  const std::size_t n =
+      schedule::entry_count(poses_a.size(), poses_b.size(), "poses", "or one pose to a side that does not move");
   validate_poses(poses_a, "A");
   validate_poses(poses_b, "B");
   validate_request(request);

@@ -111,6 +111,17 @@ inline int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
 /// the process: what the tests read to know that path ran (its answers are the same either way).
 inline std::atomic<std::uint64_t> g_split_sweep_queries{0};
 
+/// The number of entries of a call whose sides give `na` and `nb` items (a batch's poses, a sweep's
+/// motions): both the same, or one side one item kept for every entry. Throws caliber::Error
+/// (source `items`) naming the counts, `hint` saying what to give instead.
+inline std::size_t entry_count(std::size_t na, std::size_t nb, const char* items, const char* hint) {
+  if (na == nb || nb == 1) return na;
+  if (na == 1) return nb;
+  throw Error(ErrorCode::bad_argument, items,
+              std::to_string(na) + " " + items + " of A but " + std::to_string(nb) + " of B (give both sides the same number, " +
+                  hint + ")");
+}
+
 /// A sweep the engine runs: its two models and its advancement (done once it is over).
 struct SweepJob {
   const Model* a;

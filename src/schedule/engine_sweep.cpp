@@ -115,8 +115,7 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     reach = std::max({reach, from[i].translation.norm(), to[i].translation.norm()});
   }
   const double margin = narrow::kSweepMargin * (2.0 * largest + reach);
-  const double tolerance =
-      std::max(request.tolerance > 0.0 ? request.tolerance : narrow::kSweepDefaultTolerance * largest, 2.0 * margin);
+  const double tolerance = narrow::sweep_tolerance(request, largest, margin);
   std::vector<broad::WorldBox> boxes(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double grow = radius[i] + 0.5 * tolerance + margin;
@@ -149,12 +148,7 @@ std::vector<SweepResult> Engine::sweep_many(const Model& a, std::span<const Swep
                                             std::span<const SweptPose> motions_b, const SweepRequest& request) {
   const schedule::OneCallAtATime hold(mImpl->busy, "sweep_many");
   const std::size_t na = motions_a.size(), nb = motions_b.size();
-  if (na != nb && na != 1 && nb != 1) {
-    throw Error(ErrorCode::bad_argument, "motions",
-                std::to_string(na) + " motions of A but " + std::to_string(nb) +
-                    " of B (give both sides the same number, or one motion to a side that moves the same in every entry)");
-  }
-  const std::size_t n = na == 1 ? nb : na;
+  const std::size_t n = schedule::entry_count(na, nb, "motions", "or one motion to a side that moves the same in every entry");
   const auto check = [](std::span<const SweptPose> motions, const char* side) {
     for (std::size_t i = 0; i < motions.size(); ++i) {
       const auto name = [&](const char* end) { return std::string("motions of ") + side + "[" + std::to_string(i) + "]." + end; };
