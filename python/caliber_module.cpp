@@ -23,6 +23,7 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "batch.h"
+#include "fast_call.h"
 #include "sweeps.h"
 #include "half_built.h"
 
@@ -339,6 +340,63 @@ caliber_python::PySweeps sweep_many(caliber::Engine& engine, const PyModel& a, c
   return sweeps;
 }
 
+/// caliber.query.
+PyResult run_query(const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b,
+                   const std::string& kind, std::optional<double> tolerance, double angle, std::size_t max_pairs,
+                   bool lowest_ids) {
+  const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
+  caliber::QueryResult q;
+  {
+    py::gil_scoped_release release;
+    q = caliber::query(*a.model, pose_a, *b.model, pose_b, request);
+  }
+  return query_result(std::move(q));
+}
+
+/// The pybind11 function caliber.query (run_query), which query_fastcall calls for what it does
+/// not take (fast_call.h).
+PyObject* g_query = nullptr;
+
+/// caliber.query called by vectorcall: run_query on arguments of the common types, read here.
+PyObject* query_fastcall(PyObject*, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
+  namespace fast = caliber_python::fast;
+  static constexpr std::array<const char*, 9> kNames{"a",         "pose_a", "b",         "pose_b",    "kind",
+                                                     "tolerance", "angle",  "max_pairs", "lowest_ids"};
+  std::array<PyObject*, 9> v{};
+  try {
+    if (fast::gather(args, nargs, kwnames, kNames, 8, v) && v[0] != nullptr && v[1] != nullptr && v[2] != nullptr &&
+        v[3] != nullptr) {
+      const PyModel* a = fast::as_bound<PyModel>(v[0]);
+      const PyModel* b = fast::as_bound<PyModel>(v[2]);
+      const caliber::Pose* pose_a = fast::as_bound<caliber::Pose>(v[1]);
+      const caliber::Pose* pose_b = fast::as_bound<caliber::Pose>(v[3]);
+      std::string_view kind = "interference";
+      std::optional<double> tolerance;
+      double angle = 30.0;
+      std::size_t max_pairs = 0;
+      bool lowest_ids = false;
+      if (a != nullptr && b != nullptr && pose_a != nullptr && pose_b != nullptr && a->model && b->model &&
+          (v[4] == nullptr || fast::as_string(v[4], kind)) && (v[5] == nullptr || fast::as_optional_double(v[5], tolerance)) &&
+          (v[6] == nullptr || fast::as_double(v[6], angle)) && (v[7] == nullptr || fast::as_size(v[7], max_pairs)) &&
+          (v[8] == nullptr || fast::as_bool(v[8], lowest_ids))) {
+        return py::cast(run_query(*a, *pose_a, *b, *pose_b, std::string(kind), tolerance, angle, max_pairs, lowest_ids))
+            .release()
+            .ptr();
+      }
+    }
+  } catch (...) {  // raised again, with its message, by the pybind11 function below
+  }
+  return PyObject_Vectorcall(g_query, args, static_cast<std::size_t>(nargs), kwnames);
+}
+
+PyMethodDef g_query_def{
+    "query", reinterpret_cast<PyCFunction>(reinterpret_cast<void (*)()>(&query_fastcall)), METH_FASTCALL | METH_KEYWORDS,
+    "query(a, pose_a, b, pose_b, kind='interference', tolerance=None, angle=30.0, max_pairs=0, *, lowest_ids=False)\n--\n\n"
+    "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
+    "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
+    "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal, "
+    "or with lowest_ids=True the lowest ids at distance 0 (slower). Returns a caliber.Result."};
+
 }  // namespace
 
 CALIBER_REFUSE_HALF_BUILT(caliber::Mesh, "Mesh")
@@ -505,25 +563,10 @@ def _batch_from_state(state):
       .def("__len__", [](const PyResult& r) { return r.rows; })
       .def("__reduce__", [](const PyResult&) -> py::object { throw not_picklable("Result", "pickle its arrays"); });
 
-  m.def(
-      "query",
-      [](const PyModel& a, const caliber::Pose& pose_a, const PyModel& b, const caliber::Pose& pose_b, const std::string& kind,
-         std::optional<double> tolerance, double angle, std::size_t max_pairs, bool lowest_ids) {
-        const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
-        caliber::QueryResult q;
-        {
-          py::gil_scoped_release release;
-          q = caliber::query(*a.model, pose_a, *b.model, pose_b, request);
-        }
-        return query_result(std::move(q));
-      },
-      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference",
-      py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
-      py::arg("lowest_ids") = false,
-      "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
-      "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
-      "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal, "
-      "or with lowest_ids=True the lowest ids at distance 0 (slower).");
+  m.def("query", &run_query, py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"), py::arg("kind") = "interference",
+        py::arg("tolerance") = py::none(), py::arg("angle") = 30.0, py::arg("max_pairs") = 0, py::kw_only(),
+        py::arg("lowest_ids") = false);
+  g_query = caliber_python::fast::stand_in(m, g_query_def);
 
   py::class_<caliber::SweepResult>(m, "Sweep", py::module_local(),
                                    "The answer of sweep: status 'contact', 'free' or 'undecided'; time (contact: the first "

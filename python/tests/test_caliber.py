@@ -1,6 +1,7 @@
 """The Python bindings: the same pairs and contacts as the C++ API (through the caliber CLI's JSON,
 which prints every double exactly), bit for bit; meshes from arrays; poses from matrices; the
 engine over in-memory frames and scenes; pickled models; errors as caliber.Error."""
+import inspect
 import json
 import os
 import pathlib
@@ -47,6 +48,48 @@ def test_query_equals_the_cpp_api_bit_for_bit(kind):
         assert r.points_b[i].tolist() == c["point_b"]
         assert r.normals[i].tolist() == c["normal"]
         assert r.distances[i] == c["distance"]
+
+
+def test_query_takes_its_arguments_in_every_form_alike():
+    # Python floats, ints, bools and str are read by the vectorcall path, numpy scalars by
+    # pybind11's; by position or by name, in any order: one answer.
+    a, b = caliber.Model.load(TETRA), caliber.Model.load(FAN)
+    ident, pb = caliber.Pose(), pose(POSE)
+    # Each argument read changes the answer: the tolerance (8 pairs within 0.05, 16 within 0.3),
+    # the angle (2 contacts at 90 degrees, 1 at 30).
+    assert len(caliber.query(a, ident, b, pb, "proximity", 0.05)) != len(caliber.query(a, ident, b, pb, "proximity", 0.3))
+    assert len(caliber.query(a, ident, b, pb, "contact", 0.3, 90.0)) != len(caliber.query(a, ident, b, pb, "contact", 0.3))
+    for kind, tolerance, angle in [("proximity", 0.05, 30.0), ("contact", 0.3, 90.0), ("distance", None, 30.0)]:
+        want = caliber.query(a, ident, b, pb, kind=kind, tolerance=tolerance, angle=angle)
+        assert len(want) > 0
+        forms = [
+            caliber.query(a, ident, b, pb, kind, tolerance, angle, 0),
+            caliber.query(b=b, pose_b=pb, a=a, angle=angle, pose_a=ident, tolerance=tolerance, kind=kind, lowest_ids=False),
+            caliber.query(a, ident, b, pb, np.str_(kind), None if tolerance is None else np.float32(tolerance),
+                          np.float64(angle), np.int64(0), lowest_ids=np.bool_(False)),
+        ]
+        for got in forms:
+            for name in ["pairs", "points_a", "points_b", "normals", "distances", "depths"]:
+                assert getattr(got, name).tobytes() == getattr(want, name).tobytes(), (kind, name)
+            assert (got.node_tests, got.leaf_tests) == (want.node_tests, want.leaf_tests)
+    assert len(caliber.query(a, ident, b, pb, "proximity", 1)) == len(caliber.query(a, ident, b, pb, "proximity", 1.0))
+    assert caliber.query(a, ident, b, pb, max_pairs=1).limit_reached
+    # Calls it does not take are answered by pybind11's checks, as before.
+    with pytest.raises(TypeError, match="incompatible function arguments"):
+        caliber.query(a, ident, b)
+    with pytest.raises(TypeError, match="incompatible function arguments"):
+        caliber.query(a, ident, b, pb, tolerence=0.1)
+    with pytest.raises(TypeError, match="incompatible function arguments"):
+        caliber.query(a, ident, b, pb, "distance", 0.1, 30.0, 0, True)  # lowest_ids is keyword-only
+    with pytest.raises(TypeError, match="incompatible function arguments"):
+        caliber.query(a, ident, b, pb, max_pairs=-1)
+    with pytest.raises(caliber.Error, match="unknown query kind 'nope'"):
+        caliber.query(a, ident, b, pb, kind="nope")
+    with pytest.raises(caliber.Error, match="tolerance: must be a finite number >= 0"):
+        caliber.query(a, ident, b, pb, tolerance=float("nan"))
+    assert str(inspect.signature(caliber.query)) == (
+        "(a, pose_a, b, pose_b, kind='interference', tolerance=None, angle=30.0, max_pairs=0, *, lowest_ids=False)")
+    assert pickle.loads(pickle.dumps(caliber.query)) is caliber.query
 
 
 @pytest.mark.parametrize("where", [(1.5, 0.2, 0.1), (0.2, 0.2, 0.2)])
