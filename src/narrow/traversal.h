@@ -15,6 +15,7 @@
 #include "caliber/query.h"
 #include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
+#include "narrow/visit_order.h"
 #include "util/assert.h"
 #include "util/gap_buckets.h"
 
@@ -161,27 +162,6 @@ struct TraversalScratch {
     return stack.capacity() * sizeof(NodePair) + waiting.footprint() + near_a.footprint() + near_b.footprint();
   }
 };
-
-/// Pushes the `count` children of a visit (passed, 0..4 of them) onto a depth-first stack at `top`
-/// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
-/// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
-/// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
-/// colliding poses: 324 node tests to 131), which pair it meets first being the traversal's
-/// choice (QueryRequest::max_pairs). A traversal that visits every node keeps cd_children order.
-inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
-  double apart[4];
-  for (int k = 0; k < count; ++k) apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b);
-  // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
-  // insertion sort of at most four.
-  for (int i = 1; i < count; ++i) {
-    for (int j = i; j > 0 && apart[j] >= apart[j - 1]; --j) {
-      std::swap(apart[j], apart[j - 1]);
-      std::swap(passed[j], passed[j - 1]);
-    }
-  }
-  for (int k = 0; k < count; ++k) *top++ = passed[k];
-  return top;
-}
 
 /// Depth-first traversal of the CD subtree rooted at `root`: tests root as `root_test` says (not
 /// when RootTest::done: it was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
@@ -359,20 +339,28 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       continue;
     }
     Waiting kids[4];
-    int count = 0, nearest_kid = -1;
+    int count = 0, nearest_kid = -1, touching = 0;
     const auto wait = [&](double child_gap, Reached child) {
       if (child_gap > reach) return;
       if (nearest_kid < 0 || child_gap < kids[nearest_kid].key) nearest_kid = count;
+      touching += child_gap == 0.0 ? 1 : 0;
       kids[count++] = Waiting{child_gap, child};
     };
     near_children(ctx, scratch, r, a, b, reach, stats, taboo, wait);
+    // Children at gap 0 (touching, as far as the bounds tell), when the traversal stops at contact
+    // and there are several: the one whose spheres overlap the most (PairContext::sphere_apart)
+    // counts as the nearest, and the others wait so that the next most overlapping is popped first
+    // (a bucket is last in, first out): the traversal meets a contact sooner.
+    int order[4] = {0, 1, 2, 3};
+    if (stop_at_contact && touching > 1) touching_first(ctx, kids, count, order, nearest_kid);
     // The nearest child is visited next without going through the queue when no waiting node is
     // in a nearer bucket (popping could give it next); the others wait.
     if (nearest_kid >= 0 && (queue.empty() || queue.bucket_of(kids[nearest_kid].key) <= queue.min_bucket())) {
       next = kids[nearest_kid];
       have_next = true;
     }
-    for (int k = 0; k < count; ++k) {
+    for (int i = 0; i < count; ++i) {
+      const int k = order[i];
       if (have_next && k == nearest_kid) continue;
       queue.push(kids[k].key, kids[k].value);
     }

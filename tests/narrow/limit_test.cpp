@@ -1,7 +1,6 @@
 // QueryRequest::max_pairs: a query that finds more pairs stops early, says so, and reports only
 // pairs of the full answer (with the full answer's bits); one that finds no more is unchanged. On
-// the engine, every method and thread count keeps to the limit (which pairs may differ). A limited
-// traversal enters the children whose spheres overlap the most first.
+// the engine, every method and thread count keeps to the limit (which pairs may differ).
 
 #include <algorithm>
 #include <map>
@@ -14,8 +13,6 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
-#include "narrow/cd_tree.h"
-#include "narrow/traversal.h"
 #include "support/random_poses.h"
 #include "support/torus_sphere.h"
 
@@ -136,44 +133,6 @@ TEST(MaxPairs, DistanceIgnoresIt) {
   const QueryResult limited = query(*shapes().torus, Pose{}, *shapes().sphere, pb, request);
   test::expect_identical(limited, plain, "distance");
   EXPECT_FALSE(limited.limit_reached);
-}
-
-TEST(MaxPairs, NearestSpheresArePoppedFirst) {
-  std::mt19937_64 rng(4);
-  int checked = 0, reordered = 0;
-  for (int i = 0; i < 20; ++i) {
-    const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
-                                  QueryRequest{});
-    // The CD tree's first levels, breadth first: each node's children pushed as a limited
-    // traversal pushes them, then popped.
-    std::vector<narrow::NodePair> level{{0, 0}};
-    for (int depth = 0; depth < 6; ++depth) {
-      std::vector<narrow::NodePair> next;
-      for (const narrow::NodePair n : level) {
-        narrow::NodePair kids[4], passed[4], stack[4];
-        const int count = narrow::cd_children(ctx, n, kids);
-        std::copy(kids, kids + count, passed);
-        narrow::NodePair* const top = narrow::push_nearest_first(ctx, passed, count, stack);
-        ASSERT_EQ(top - stack, count);
-        std::vector<narrow::NodePair> popped(std::make_reverse_iterator(top), std::make_reverse_iterator(stack));
-        for (int k = 0; k < count; ++k) {
-          ASSERT_EQ(std::count(popped.begin(), popped.end(), kids[k]), 1) << "every child pushed once";
-        }
-        for (int k = 1; k < count; ++k) {
-          const double before = ctx.sphere_apart(popped[k - 1].a, popped[k - 1].b);
-          const double after = ctx.sphere_apart(popped[k].a, popped[k].b);
-          ASSERT_LE(before, after) << "pose " << i << ": the nearer spheres first";
-          if (before == after) EXPECT_LT(popped[k - 1], popped[k]) << "ties in cd_children order";
-        }
-        reordered += std::equal(kids, kids + count, popped.begin()) ? 0 : 1;
-        ++checked;
-        next.insert(next.end(), kids, kids + count);
-      }
-      level = std::move(next);
-    }
-  }
-  EXPECT_GT(checked, 1000);
-  EXPECT_GT(reordered, checked / 10) << "the order differs from cd_children's where spheres say so";
 }
 
 }  // namespace

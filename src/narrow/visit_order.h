@@ -1,0 +1,62 @@
+#pragma once
+/// \file
+/// The order in which a traversal that stops early takes a visit's children: the depth-first
+/// traversal with a limit (QueryRequest::max_pairs) and the distance traversal at contact enter
+/// first the child pairs whose spheres overlap the most relative to their size
+/// (PairContext::sphere_apart), so that they meet a touching pair after fewer tests. Which pair
+/// they meet first is theirs to choose (documented so); a traversal that visits every node keeps
+/// cd_children order.
+
+#include <utility>
+
+#include "narrow/cd_tree.h"
+#include "narrow/pair_context.h"
+
+namespace caliber::narrow {
+
+/// Pushes the `count` children of a visit (passed, 0..4 of them) onto a depth-first stack at `top`
+/// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
+/// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
+/// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
+/// colliding poses: 324 node tests to 131), which pair it meets first being the traversal's
+/// choice (QueryRequest::max_pairs). A traversal that visits every node keeps cd_children order.
+inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
+  double apart[4];
+  for (int k = 0; k < count; ++k) apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b);
+  // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
+  // insertion sort of at most four.
+  for (int i = 1; i < count; ++i) {
+    for (int j = i; j > 0 && apart[j] >= apart[j - 1]; --j) {
+      std::swap(apart[j], apart[j - 1]);
+      std::swap(passed[j], passed[j - 1]);
+    }
+  }
+  for (int k = 0; k < count; ++k) *top++ = passed[k];
+  return top;
+}
+
+/// The order in which the distance traversal takes a visit's `count` children (kids) when several
+/// are at gap 0 and it stops at contact: `nearest` becomes the one at gap 0 whose spheres overlap
+/// the most relative to their size (PairContext::sphere_apart; ties to the first in cd_children
+/// order), and `order` lists the children to push: those at a positive gap in cd_children order,
+/// then those at gap 0 from the least overlapping to the most (popped in reverse).
+template <class Waiting>
+void touching_first(const PairContext& ctx, const Waiting kids[4], int count, int order[4], int& nearest) {
+  double apart[4];
+  int n = 0;
+  for (int k = 0; k < count; ++k) {
+    if (kids[k].key != 0.0) order[n++] = k;
+  }
+  const int first_touching = n;
+  for (int k = 0; k < count; ++k) {
+    if (kids[k].key != 0.0) continue;
+    apart[k] = ctx.sphere_apart(kids[k].value.a->index, kids[k].value.b->index);
+    // Insertion from the back: the most overlapping last, equals in reverse cd_children order.
+    int j = n++;
+    for (; j > first_touching && apart[order[j - 1]] <= apart[k]; --j) order[j] = order[j - 1];
+    order[j] = k;
+  }
+  nearest = order[count - 1];
+}
+
+}  // namespace caliber::narrow

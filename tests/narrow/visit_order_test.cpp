@@ -1,0 +1,131 @@
+// The order in which a traversal that stops early takes a visit's children: the depth-first one
+// with max_pairs (push_nearest_first), the distance one at contact (touching_first). Both by
+// PairContext::sphere_apart, ties in cd_children order. (Which pair such a traversal meets first
+// is its own choice; the answers' tests are elsewhere.)
+
+#include <algorithm>
+#include <iterator>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/model.h"
+#include "caliber/query.h"
+#include "narrow/cd_tree.h"
+#include "narrow/traversal.h"
+#include "support/random_poses.h"
+#include "support/torus_sphere.h"
+
+namespace caliber {
+namespace {
+
+const test::TorusSphere& shapes() { return test::torus_sphere(); }
+
+/// Every CD node of the first `levels` levels of the pair's tree, breadth first.
+std::vector<narrow::NodePair> top_of_tree(const narrow::PairContext& ctx, int levels) {
+  std::vector<narrow::NodePair> all, level{{0, 0}};
+  for (int depth = 0; depth < levels; ++depth) {
+    std::vector<narrow::NodePair> next;
+    for (const narrow::NodePair n : level) {
+      narrow::NodePair kids[4];
+      next.insert(next.end(), kids, kids + narrow::cd_children(ctx, n, kids));
+    }
+    all.insert(all.end(), level.begin(), level.end());
+    level = std::move(next);
+  }
+  return all;
+}
+
+TEST(VisitOrder, LimitedTraversalPopsTheNearestSpheresFirst) {
+  std::mt19937_64 rng(4);
+  int checked = 0, reordered = 0;
+  for (int i = 0; i < 20; ++i) {
+    const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
+                                  QueryRequest{});
+    for (const narrow::NodePair n : top_of_tree(ctx, 6)) {
+      // The children pushed as a limited traversal pushes them, then popped.
+      narrow::NodePair kids[4], passed[4], stack[4];
+      const int count = narrow::cd_children(ctx, n, kids);
+      std::copy(kids, kids + count, passed);
+      narrow::NodePair* const top = narrow::push_nearest_first(ctx, passed, count, stack);
+      ASSERT_EQ(top - stack, count);
+      const std::vector<narrow::NodePair> popped(std::make_reverse_iterator(top), std::make_reverse_iterator(stack));
+      for (int k = 0; k < count; ++k) ASSERT_EQ(std::count(popped.begin(), popped.end(), kids[k]), 1) << "every child once";
+      for (int k = 1; k < count; ++k) {
+        const double before = ctx.sphere_apart(popped[k - 1].a, popped[k - 1].b);
+        const double after = ctx.sphere_apart(popped[k].a, popped[k].b);
+        ASSERT_LE(before, after) << "pose " << i << ": the nearer spheres first";
+        if (before == after) EXPECT_LT(popped[k - 1], popped[k]) << "ties in cd_children order";
+      }
+      reordered += std::equal(kids, kids + count, popped.begin()) ? 0 : 1;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(reordered, checked / 10) << "the order differs from cd_children's where spheres say so";
+}
+
+TEST(VisitOrder, DistanceAtContactTakesTheMostOverlappingTouchingChildFirst) {
+  using Reached = narrow::TraversalScratch::Reached;
+  using Waiting = util::GapBuckets<Reached>::Entry;
+  std::mt19937_64 rng(5);
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  request.tolerance = kUnbounded;
+  int checked = 0;
+  for (int i = 0; i < 10; ++i) {
+    const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
+                                  request);
+    for (const narrow::NodePair n : top_of_tree(ctx, 5)) {
+      narrow::NodePair kids[4];
+      const int count = narrow::cd_children(ctx, n, kids);
+      if (count < 2) continue;
+      // Every pattern of children at gap 0 (the others at gaps 1, 2, ...), each child's prepared nodes its own.
+      for (int zeros = 0; zeros < (1 << count); ++zeros) {
+        std::vector<narrow::TraversalScratch::NearA> na(static_cast<std::size_t>(count));
+        std::vector<narrow::TraversalScratch::NearB> nb(static_cast<std::size_t>(count));
+        for (int k = 0; k < count; ++k) {
+          static_cast<narrow::NearA&>(na[k]) = ctx.near_a(kids[k].a);
+          static_cast<narrow::NearB&>(nb[k]) = ctx.near_b(kids[k].b);
+        }
+        Waiting waiting[4];
+        for (int k = 0; k < count; ++k) waiting[k] = Waiting{(zeros >> k) & 1 ? 0.0 : 1.0 + k, Reached{&na[k], &nb[k]}};
+        int order[4] = {0, 1, 2, 3}, nearest = -1;
+        narrow::touching_first(ctx, waiting, count, order, nearest);
+        std::vector<int> seen(order, order + count);
+        std::sort(seen.begin(), seen.end());
+        for (int k = 0; k < count; ++k) ASSERT_EQ(seen[k], k) << "every child once";
+        const int positive = count - __builtin_popcount(static_cast<unsigned>(zeros));
+        for (int k = 0; k < count; ++k) {
+          EXPECT_EQ(waiting[order[k]].key == 0.0, k >= positive) << "the children at a positive gap first";
+          if (k > 0 && k < positive) EXPECT_LT(order[k - 1], order[k]) << "in cd_children order";
+          if (k > positive) {
+            const double before = ctx.sphere_apart(kids[order[k - 1]].a, kids[order[k - 1]].b);
+            const double after = ctx.sphere_apart(kids[order[k]].a, kids[order[k]].b);
+            ASSERT_GE(before, after) << "the touching ones from the least overlapping to the most";
+            if (before == after) EXPECT_GT(order[k - 1], order[k]) << "equals popped in cd_children order";
+          }
+        }
+        if (positive < count) EXPECT_EQ(nearest, order[count - 1]) << "the most overlapping is visited next";
+        ++checked;
+      }
+      // Equals: the first child in every place, all at gap 0: the first is visited next, and the
+      // rest wait in reverse, to be popped in cd_children order.
+      narrow::TraversalScratch::NearA a0;
+      narrow::TraversalScratch::NearB b0;
+      static_cast<narrow::NearA&>(a0) = ctx.near_a(kids[0].a);
+      static_cast<narrow::NearB&>(b0) = ctx.near_b(kids[0].b);
+      Waiting equal[4];
+      for (int k = 0; k < count; ++k) equal[k] = Waiting{0.0, Reached{&a0, &b0}};
+      int order[4] = {0, 1, 2, 3}, nearest = -1;
+      narrow::touching_first(ctx, equal, count, order, nearest);
+      EXPECT_EQ(nearest, 0);
+      for (int k = 0; k < count; ++k) EXPECT_EQ(order[k], count - 1 - k);
+    }
+  }
+  EXPECT_GT(checked, 500);
+}
+
+}  // namespace
+}  // namespace caliber
