@@ -136,7 +136,8 @@ class PairContext {
 
   /// How far apart the spheres of node ia of A and node ib of B are, relative to their size:
   /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders a
-  /// traversal that stops early (max_pairs): it enters the children most likely to touch first.
+  /// traversal that stops early (max_pairs, or a distance query at contact): it enters the
+  /// children most likely to touch first (visit_order.h).
   [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
     const BvhNode& na = mA.nodes[ia];
     const BvhNode& nb = mB.nodes[ib];
