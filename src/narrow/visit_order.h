@@ -7,10 +7,12 @@
 /// they meet first is theirs to choose (documented so); a traversal that visits every node keeps
 /// cd_children order.
 
+#include <cstdint>
 #include <utility>
 
 #include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
+#include "util/assert.h"
 
 namespace caliber::narrow {
 
@@ -21,8 +23,25 @@ namespace caliber::narrow {
 /// colliding poses: 324 node tests to 131), which pair it meets first being the traversal's
 /// choice (QueryRequest::max_pairs). A traversal that visits every node keeps cd_children order.
 inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
-  double apart[4];
-  for (int k = 0; k < count; ++k) apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b);
+  if (count < 2) {  // nothing to order
+    if (count == 1) *top++ = passed[0];
+    return top;
+  }
+  // A visit's children share at most two nodes of B: each one's center is moved into A's frame
+  // once.
+  double apart[4], centers[2][3];
+  std::uint32_t moved[2];
+  int known = 0;
+  for (int k = 0; k < count; ++k) {
+    int c = 0;
+    while (c < known && moved[c] != passed[k].b) ++c;
+    if (c == known) {
+      CALIBER_ASSERT(known < 2, "a visit's children share at most two nodes of B");
+      ctx.sphere_center_in_a(passed[k].b, centers[c]);
+      moved[known++] = passed[k].b;
+    }
+    apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b, centers[c]);
+  }
   // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
   // insertion sort of at most four.
   for (int i = 1; i < count; ++i) {
