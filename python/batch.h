@@ -39,7 +39,10 @@ struct SidePoses {
       poses.push_back(given.cast<caliber::Pose>());
       return;
     }
-    if (!py::isinstance<py::array>(given) && py::isinstance<py::sequence>(given) && !py::isinstance<py::str>(given)) {
+    // A list or tuple of Poses; an object with the buffer protocol (a memoryview, bytes) is read as
+    // an array, like a numpy array.
+    if (!py::isinstance<py::array>(given) && PyObject_CheckBuffer(given.ptr()) == 0 && py::isinstance<py::sequence>(given) &&
+        !py::isinstance<py::str>(given)) {
       const auto seq = given.cast<py::sequence>();
       if (seq.size() == 0 || py::isinstance<caliber::Pose>(seq[0])) {
         for (std::size_t i = 0; i < seq.size(); ++i) {
@@ -118,6 +121,7 @@ struct PyBatch {
       }
     }
     derive();
+    freeze();
     node_tests = b.stats.node_tests;
     leaf_tests = b.stats.leaf_tests;
   }
@@ -160,6 +164,7 @@ struct PyBatch {
       b.node_tests = t[8].cast<std::uint64_t>();
       b.leaf_tests = t[9].cast<std::uint64_t>();
       b.derive();
+      b.freeze();
       return b;
     } catch (const py::cast_error&) {
       throw refuse("the counters must be integers >= 0");
@@ -195,10 +200,23 @@ struct PyBatch {
       r += pk;
     }
     b.derive();
+    b.freeze();
     return b;
   }
 
  private:
+  /// Made read-only once written: what Python reads are views of them (Batch's attributes), which
+  /// cannot write to them or change the shapes and offsets that concatenate and pickle rely on.
+  void freeze() {
+    for (py::array* a :
+         {static_cast<py::array*>(&offsets), static_cast<py::array*>(&hit), static_cast<py::array*>(&limit_reached),
+          static_cast<py::array*>(&distance), static_cast<py::array*>(&pairs), static_cast<py::array*>(&entries),
+          static_cast<py::array*>(&points_a), static_cast<py::array*>(&points_b), static_cast<py::array*>(&normals),
+          static_cast<py::array*>(&distances), static_cast<py::array*>(&depths)}) {
+      a->attr("flags").attr("writeable") = false;
+    }
+  }
+
   /// The arrays for n entries and k rows; with `zero_rows`, the rows' points, normals, distances
   /// and depths are zeros (numpy.zeros), else left to be written.
   void allocate(py::ssize_t n, py::ssize_t k, bool zero_rows = false) {
@@ -263,23 +281,31 @@ inline caliber::QuaternionOrder parse_order(const std::string& order) {
   throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
 }
 
-/// Registers caliber.Batch, the answers of Engine.query_many and caliber.query_many.
+/// A read-only view of a Batch's array (a new numpy object, so that changing its shape or dtype
+/// leaves the Batch's own array as it is).
+template <auto Member>
+py::object view_of(const PyBatch& b) {
+  return (b.*Member).attr("view")();
+}
+
+/// Registers caliber.Batch, the answers of Engine.query_many and caliber.query_many. Its arrays
+/// are read-only.
 inline void bind_batch(py::module_& m) {
   py::class_<PyBatch>(m, "Batch",
                       "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
                       "max_pairs cut it; per reported triangle pair, one row like Result's, with the entry it belongs to.")
-      .def_readonly("offsets", &PyBatch::offsets, "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
-      .def_readonly("hit", &PyBatch::hit, "N bools: the entry reported a pair")
-      .def_readonly("limit_reached", &PyBatch::limit_reached, "N bools: the entry found more than max_pairs")
-      .def_readonly("distance", &PyBatch::distance,
-                    "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")
-      .def_readonly("pairs", &PyBatch::pairs, "k x 2 triangle ids")
-      .def_readonly("entries", &PyBatch::entries, "k: the entry of each row")
-      .def_readonly("points_a", &PyBatch::points_a)
-      .def_readonly("points_b", &PyBatch::points_b)
-      .def_readonly("normals", &PyBatch::normals)
-      .def_readonly("distances", &PyBatch::distances)
-      .def_readonly("depths", &PyBatch::depths)
+      .def_property_readonly("offsets", view_of<&PyBatch::offsets>, "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
+      .def_property_readonly("hit", view_of<&PyBatch::hit>, "N bools: the entry reported a pair")
+      .def_property_readonly("limit_reached", view_of<&PyBatch::limit_reached>, "N bools: the entry found more than max_pairs")
+      .def_property_readonly("distance", view_of<&PyBatch::distance>,
+                             "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")
+      .def_property_readonly("pairs", view_of<&PyBatch::pairs>, "k x 2 triangle ids")
+      .def_property_readonly("entries", view_of<&PyBatch::entries>, "k: the entry of each row")
+      .def_property_readonly("points_a", view_of<&PyBatch::points_a>)
+      .def_property_readonly("points_b", view_of<&PyBatch::points_b>)
+      .def_property_readonly("normals", view_of<&PyBatch::normals>)
+      .def_property_readonly("distances", view_of<&PyBatch::distances>)
+      .def_property_readonly("depths", view_of<&PyBatch::depths>)
       .def_readonly("node_tests", &PyBatch::node_tests)
       .def_readonly("leaf_tests", &PyBatch::leaf_tests)
       .def_readonly("batch_ms", &PyBatch::batch_ms,

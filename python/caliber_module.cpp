@@ -23,6 +23,7 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "batch.h"
+#include "bounded_errors.h"
 #include "fast_call.h"
 #include "sweeps.h"
 #include "half_built.h"
@@ -386,7 +387,9 @@ PyObject* query_fastcall(PyObject*, PyObject* const* args, Py_ssize_t nargs, PyO
     }
   } catch (...) {  // raised again, with its message, by the pybind11 function below
   }
-  return PyObject_Vectorcall(g_query, args, static_cast<std::size_t>(nargs), kwnames);
+  PyObject* result = PyObject_Vectorcall(g_query, args, static_cast<std::size_t>(nargs), kwnames);
+  if (result == nullptr) caliber_python::bound_type_error(args, nargs, kwnames);
+  return result;
 }
 
 PyMethodDef g_query_def{
@@ -819,4 +822,7 @@ def _batch_from_state(state):
   caliber_python::refuse_second<caliber::Pose>(m.attr("Pose"), "__init__", "Pose");
   caliber_python::refuse_second<caliber::Engine>(m.attr("Engine"), "__init__", "Engine");
   caliber_python::refuse_second<caliber::World>(m.attr("World"), "__init__", "World");
+  // Last: every public function and method, as now bound, raises TypeErrors of bounded length
+  // (caliber.query bounds its own, above).
+  caliber_python::bound_type_errors(m, {"query"});
 }

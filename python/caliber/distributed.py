@@ -42,7 +42,11 @@ def _side(poses, name):
         if len(poses) == 1:
             return 1, lambda lo, hi: poses
         return len(poses), lambda lo, hi: list(poses[lo:hi])
-    values = np.asarray(poses)
+    try:
+        values = np.asarray(poses)
+    except (ValueError, TypeError) as e:  # ragged lists, objects numpy cannot read
+        raise caliber.Error(f"{name}: must be a caliber.Pose, a list of them, or an array of N x 4 x 4 matrices or N x 7 "
+                            f"rows ({str(e).splitlines()[0][:200]})") from None
     if values.shape in ((4, 4), (7,)):
         return 1, lambda lo, hi: values
     if (values.ndim == 3 and values.shape[1:] == (4, 4)) or (values.ndim == 2 and values.shape[1] == 7):

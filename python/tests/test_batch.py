@@ -79,7 +79,7 @@ def test_every_pose_format_gives_the_same_batch():
     matrices = np.stack([p.matrix() for p in poses])
     xyzw = np.concatenate([values[:, :3], values[:, 4:], values[:, 3:4]], axis=1)
     want = caliber.query_many(TETRA, caliber.Pose(), FAN, poses, kind="proximity", tolerance=0.05)
-    for given, order in ((values, "wxyz"), (xyzw, "xyzw"), (values.tolist(), "wxyz")):
+    for given, order in ((values, "wxyz"), (xyzw, "xyzw"), (values.tolist(), "wxyz"), (memoryview(values), "wxyz")):
         got = caliber.query_many(TETRA, caliber.Pose(), FAN, given, kind="proximity", tolerance=0.05, order=order)
         assert got.pairs.tolist() == want.pairs.tolist() and got.distances.tobytes() == want.distances.tobytes()
     # Matrices give each pose through its rotation matrix: the same pairs (the last bits of a point
@@ -120,6 +120,11 @@ def test_bad_batches_are_caliber_errors_naming_the_row():
         caliber.query_many(TETRA, caliber.Pose(), FAN, [caliber.Pose(), "x"])
     with pytest.raises(caliber.Error, match="poses_b: must be a caliber.Pose, a list of them"):
         caliber.query_many(TETRA, caliber.Pose(), FAN, "poses")
+    # Buffers are read as arrays, whatever their length: an empty one is not 0 poses.
+    with pytest.raises(caliber.Error, match="poses_b: must be a caliber.Pose, a list of them"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, b"")
+    with pytest.raises(caliber.Error, match="poses_b: an array of poses must be 4 x 4"):
+        caliber.query_many(TETRA, caliber.Pose(), FAN, memoryview(np.zeros((0, 3))))
     with pytest.raises(caliber.Error, match="order: must be 'wxyz' or 'xyzw'"):
         caliber.query_many(TETRA, caliber.Pose(), FAN, rows(2, 1), order="zyxw")
     with pytest.raises(caliber.Error, match="Batch: was never built"):
@@ -168,3 +173,42 @@ def test_tampered_batch_states_are_refused():
     refused(lambda s: s.__setitem__(1, s[1][:-1]), "limit_reached does not have the shape")
     refused(lambda s: s.__setitem__(3, "points"), "points_a")
     refused(lambda s: s.__setitem__(8, -1), "the counters must be integers")
+
+
+def test_a_batch_cannot_be_changed_through_its_arrays():
+    whole = caliber.query_many(TETRA, caliber.Pose(), FAN, rows(20, 4), kind="proximity", tolerance=0.05)
+    assert len(whole.pairs) > 0
+    before = {name: getattr(whole, name).tobytes() for name in FIELDS}
+    for name in FIELDS:
+        view = getattr(whole, name)
+        with pytest.raises(ValueError, match="read-only"):
+            view[...] = 0
+        with pytest.raises(ValueError):
+            view.flags.writeable = True
+        # The view's shape and dtype are its own: the batch's arrays keep theirs.
+        view.shape = (-1,)
+        view.dtype = np.uint8
+    for name in FIELDS:
+        assert getattr(whole, name).tobytes() == before[name], name
+    joined = caliber.Batch.concatenate([whole, whole])
+    assert joined.offsets.tolist() == whole.offsets.tolist() + (whole.offsets[1:] + whole.offsets[-1]).tolist()
+    assert joined.pairs.tolist() == whole.pairs.tolist() * 2
+
+
+def test_type_errors_are_one_line_of_bounded_length():
+    poses = rows(100000, 1).tolist()
+    calls = [
+        (lambda: caliber.query_many(TETRA, caliber.Pose(), FAN, poses, max_pairs=-1), ["list of length 100000", "max_pairs=-1"]),
+        (lambda: caliber.Engine(threads=1).query_many(TETRA, caliber.Pose(), FAN, np.asarray(poses), kind=None),
+         ["numpy.ndarray of length 100000", "kind=None"]),
+        (lambda: caliber.query(TETRA, [0.0] * 100000, FAN, caliber.Pose()), ["list of length 100000"]),
+        (lambda: caliber.Engine(threads="x" * 100000), ["str of length 100000"]),
+        (lambda: caliber.Batch.concatenate([1] * 100000), ["list of length 100000"]),
+    ]
+    for call, shown in calls:
+        with pytest.raises(TypeError, match="incompatible (function|constructor) arguments") as raised:
+            call()
+        text = str(raised.value)
+        assert "\n" not in text and len(text) < 2000, text[:200]
+        for part in shown:
+            assert part in text, (part, text)

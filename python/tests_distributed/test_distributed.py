@@ -91,6 +91,8 @@ def test_bad_sweeps_are_errors_naming_the_row(client):
         caliber.distributed.query_many(client, TETRA, caliber.Pose(), FAN, values, chunk=0)
     with pytest.raises(caliber.Error, match="poses_b"):
         caliber.distributed.query_many(client, TETRA, caliber.Pose(), FAN, np.zeros((5, 6)))
+    with pytest.raises(caliber.Error, match="^poses_a: must be a caliber.Pose"):  # ragged rows
+        caliber.distributed.query_many(client, TETRA, [[0, 0, 0, 1, 0, 0, 0], [0, 0, 1]], FAN, caliber.Pose())
 
 
 def torus(rings, sides):
