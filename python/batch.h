@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "caliber/batch.h"
+#include "readonly.h"
 #include "caliber/error.h"
 #include "caliber/pose.h"
 
@@ -205,16 +206,11 @@ struct PyBatch {
   }
 
  private:
-  /// Made read-only once written: what Python reads are views of them (Batch's attributes), which
-  /// cannot write to them or change the shapes and offsets that concatenate and pickle rely on.
+  /// Made read-only once written (readonly.h): what Python reads are views of them, which cannot
+  /// write to them or change the shapes and offsets that concatenate and pickle rely on.
   void freeze() {
-    for (py::array* a :
-         {static_cast<py::array*>(&offsets), static_cast<py::array*>(&hit), static_cast<py::array*>(&limit_reached),
-          static_cast<py::array*>(&distance), static_cast<py::array*>(&pairs), static_cast<py::array*>(&entries),
-          static_cast<py::array*>(&points_a), static_cast<py::array*>(&points_b), static_cast<py::array*>(&normals),
-          static_cast<py::array*>(&distances), static_cast<py::array*>(&depths)}) {
-      a->attr("flags").attr("writeable") = false;
-    }
+    caliber_python::freeze(
+        {&offsets, &hit, &limit_reached, &distance, &pairs, &entries, &points_a, &points_b, &normals, &distances, &depths});
   }
 
   /// The arrays for n entries and k rows; with `zero_rows`, the rows' points, normals, distances
@@ -281,31 +277,26 @@ inline caliber::QuaternionOrder parse_order(const std::string& order) {
   throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
 }
 
-/// A read-only view of a Batch's array (a new numpy object, so that changing its shape or dtype
-/// leaves the Batch's own array as it is).
-template <auto Member>
-py::object view_of(const PyBatch& b) {
-  return (b.*Member).attr("view")();
-}
-
 /// Registers caliber.Batch, the answers of Engine.query_many and caliber.query_many. Its arrays
 /// are read-only.
 inline void bind_batch(py::module_& m) {
   py::class_<PyBatch>(m, "Batch",
                       "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
                       "max_pairs cut it; per reported triangle pair, one row like Result's, with the entry it belongs to.")
-      .def_property_readonly("offsets", view_of<&PyBatch::offsets>, "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
-      .def_property_readonly("hit", view_of<&PyBatch::hit>, "N bools: the entry reported a pair")
-      .def_property_readonly("limit_reached", view_of<&PyBatch::limit_reached>, "N bools: the entry found more than max_pairs")
-      .def_property_readonly("distance", view_of<&PyBatch::distance>,
+      .def_property_readonly("offsets", view_of<PyBatch, &PyBatch::offsets>,
+                             "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
+      .def_property_readonly("hit", view_of<PyBatch, &PyBatch::hit>, "N bools: the entry reported a pair")
+      .def_property_readonly("limit_reached", view_of<PyBatch, &PyBatch::limit_reached>,
+                             "N bools: the entry found more than max_pairs")
+      .def_property_readonly("distance", view_of<PyBatch, &PyBatch::distance>,
                              "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")
-      .def_property_readonly("pairs", view_of<&PyBatch::pairs>, "k x 2 triangle ids")
-      .def_property_readonly("entries", view_of<&PyBatch::entries>, "k: the entry of each row")
-      .def_property_readonly("points_a", view_of<&PyBatch::points_a>)
-      .def_property_readonly("points_b", view_of<&PyBatch::points_b>)
-      .def_property_readonly("normals", view_of<&PyBatch::normals>)
-      .def_property_readonly("distances", view_of<&PyBatch::distances>)
-      .def_property_readonly("depths", view_of<&PyBatch::depths>)
+      .def_property_readonly("pairs", view_of<PyBatch, &PyBatch::pairs>, "k x 2 triangle ids")
+      .def_property_readonly("entries", view_of<PyBatch, &PyBatch::entries>, "k: the entry of each row")
+      .def_property_readonly("points_a", view_of<PyBatch, &PyBatch::points_a>)
+      .def_property_readonly("points_b", view_of<PyBatch, &PyBatch::points_b>)
+      .def_property_readonly("normals", view_of<PyBatch, &PyBatch::normals>)
+      .def_property_readonly("distances", view_of<PyBatch, &PyBatch::distances>)
+      .def_property_readonly("depths", view_of<PyBatch, &PyBatch::depths>)
       .def_readonly("node_tests", &PyBatch::node_tests)
       .def_readonly("leaf_tests", &PyBatch::leaf_tests)
       .def_readonly("batch_ms", &PyBatch::batch_ms,

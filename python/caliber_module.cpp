@@ -47,7 +47,76 @@ std::string file_path(const py::object& path) {
         caliber::ErrorCode::bad_argument, "path",
         "must be a str, bytes or os.PathLike, not " + py::str(path.get_type().attr("__name__")).cast<std::string>());
   }
-  return encoded.cast<std::string>();
+  std::string bytes = encoded.cast<std::string>();
+  // The file is opened by a C string, which would end at the NUL: another file.
+  if (bytes.find('\0') != std::string::npos) throw caliber::Error(caliber::ErrorCode::bad_argument, "path", "holds a NUL byte");
+  return bytes;
+}
+
+/// N real numbers (`name`: a translation, a quaternion): a list or tuple of Python floats and ints
+/// read directly, anything else through numpy, whose dtype must be real (a complex number's
+/// imaginary part, a bool or a digit string is refused, not converted).
+template <std::size_t N>
+std::array<double, N> reals(const py::object& given, const char* name) {
+  std::array<double, N> out{};
+  if ((PyList_Check(given.ptr()) != 0 || PyTuple_Check(given.ptr()) != 0) && py::len(given) == N) {
+    bool plain = true;
+    for (std::size_t i = 0; i < N && plain; ++i) {
+      PyObject* item = PySequence_Fast_GET_ITEM(given.ptr(), static_cast<Py_ssize_t>(i));
+      if (PyFloat_Check(item) != 0) {
+        out[i] = PyFloat_AS_DOUBLE(item);
+      } else if (PyLong_Check(item) != 0 && PyBool_Check(item) == 0) {
+        out[i] = PyLong_AsDouble(item);
+        if (out[i] == -1.0 && PyErr_Occurred() != nullptr) {
+          PyErr_Clear();
+          plain = false;
+        }
+      } else {
+        plain = false;
+      }
+    }
+    if (plain) return out;
+  }
+  const py::array a = py::array::ensure(given);
+  const char kind = a ? a.dtype().kind() : 'O';
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    const std::string type =
+        a ? "dtype " + std::string(py::str(a.dtype())) : std::string(py::str(given.get_type().attr("__name__")));
+    throw caliber::Error(caliber::ErrorCode::bad_argument, name, "must be " + std::to_string(N) + " real numbers, not " + type);
+  }
+  if (a.ndim() != 1 || a.shape(0) != static_cast<py::ssize_t>(N)) {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, name,
+                         "must be " + std::to_string(N) + " numbers, not an array of " + std::to_string(a.size()) + " in " +
+                             std::to_string(a.ndim()) + " dimensions");
+  }
+  const py::array_t<double, py::array::c_style | py::array::forcecast> values(a);
+  std::copy_n(values.data(), N, out.begin());
+  return out;
+}
+
+/// One flag per object (`fixed`): each True or False (a numpy bool too), or the ints 0 and 1; an
+/// empty list for none. Anything else is refused, not converted by truth value.
+std::vector<bool> flags_of(const py::object& given, const char* name) {
+  if (given.is_none()) return {};
+  if (py::isinstance<py::str>(given) || !py::isinstance<py::sequence>(given)) {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, name, "must be a list of True or False, one per object");
+  }
+  const auto seq = py::reinterpret_borrow<py::sequence>(given);
+  std::vector<bool> out;
+  out.reserve(seq.size());
+  const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
+  for (std::size_t i = 0; i < seq.size(); ++i) {
+    const py::object item = seq[i];
+    if (PyBool_Check(item.ptr()) != 0 || py::isinstance(item, numpy_bool)) {
+      out.push_back(PyObject_IsTrue(item.ptr()) == 1);
+    } else if (PyLong_CheckExact(item.ptr()) != 0 && (item.equal(py::int_(0)) || item.equal(py::int_(1)))) {
+      out.push_back(item.equal(py::int_(1)));
+    } else {
+      throw caliber::Error(caliber::ErrorCode::bad_argument, std::string(name) + "[" + std::to_string(i) + "]",
+                           "must be True or False, not " + py::str(item.get_type().attr("__name__")).cast<std::string>());
+    }
+  }
+  return out;
 }
 
 /// A built model, shared (the C++ side holds it as shared_ptr<const Model>).
@@ -192,6 +261,11 @@ PyResult query_result(caliber::QueryResult&& q) {
 }
 
 caliber::Pose pose_from_matrix(const py::array& m) {
+  const char kind = m.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "matrix",
+                         "must hold real numbers, not dtype " + std::string(py::str(m.dtype())));
+  }
   const double tolerance = caliber_python::rotation_tolerance(m);
   const py::array_t<double, py::array::c_style | py::array::forcecast> d(m);
   if (d.ndim() != 2 || d.shape(0) != 4 || d.shape(1) != 4)
@@ -410,6 +484,7 @@ CALIBER_REFUSE_HALF_BUILT(caliber::Engine, "Engine")
 CALIBER_REFUSE_HALF_BUILT(caliber::World, "World")
 CALIBER_REFUSE_HALF_BUILT(caliber_python::PyBatch, "Batch")
 CALIBER_REFUSE_HALF_BUILT(caliber_python::PySweeps, "Sweeps")
+CALIBER_REFUSE_HALF_BUILT(caliber::SweepResult, "Sweep")
 
 PYBIND11_MODULE(caliber, m) {
   m.doc() = "caliber: exact collision detection between rigid triangle meshes, parallelized by task calibration";
@@ -466,21 +541,23 @@ PYBIND11_MODULE(caliber, m) {
       .def("__reduce__", [](const PyModel& p) { return rebuilt_by("_model_from_state", py::make_tuple(model_state(p))); });
 
   py::class_<caliber::Pose>(m, "Pose", py::module_local(), "A rigid transform: x_world = R x + t.")
-      .def(py::init([](std::array<double, 3> t, std::array<double, 4> q, const std::string& order) {
-             q = quaternion_wxyz(q, order);
+      .def(py::init([](const py::object& translation, const py::object& quaternion, const std::string& order) {
+             const std::array<double, 3> t = reals<3>(translation, "translation");
+             const std::array<double, 4> q = quaternion_wxyz(reals<4>(quaternion, "quaternion"), order);
              return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3]);
            }),
-           py::arg("translation") = std::array<double, 3>{0, 0, 0}, py::arg("quaternion") = std::array<double, 4>{1, 0, 0, 0},
+           py::arg("translation") = py::make_tuple(0.0, 0.0, 0.0), py::arg("quaternion") = py::make_tuple(1.0, 0.0, 0.0, 0.0),
            py::kw_only(), py::arg("order") = "wxyz",
            "translation (x, y, z), quaternion normalized, in `order`: 'wxyz' (the default, Eigen's) or 'xyzw' (scipy's "
            "Rotation.as_quat() and ROS's)")
       .def_static(
           "from_quaternion",
-          [](std::array<double, 4> q, const std::string& order, std::array<double, 3> t) {
-            q = quaternion_wxyz(q, order);
+          [](const py::object& quaternion, const std::string& order, const py::object& translation) {
+            const std::array<double, 4> q = quaternion_wxyz(reals<4>(quaternion, "quaternion"), order);
+            const std::array<double, 3> t = reals<3>(translation, "translation");
             return caliber::Pose::from_values(t[0], t[1], t[2], q[0], q[1], q[2], q[3], "quaternion");
           },
-          py::arg("quaternion"), py::arg("order"), py::arg("translation") = std::array<double, 3>{0, 0, 0},
+          py::arg("quaternion"), py::arg("order"), py::arg("translation") = py::make_tuple(0.0, 0.0, 0.0),
           "from a quaternion in an explicit order, 'wxyz' or 'xyzw' (scipy's and ROS's), and a translation")
       .def_static("from_matrix", &pose_from_matrix, py::arg("matrix"),
                   "from a 4 x 4 rigid transform; its rotation must be orthonormal within 1e-9 (float64) or 1e-6 (float32)")
@@ -694,8 +771,9 @@ def _batch_from_state(state):
       .def(
           "find_pairs",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses,
-             const std::string& kind, std::optional<double> tolerance, std::vector<bool> fixed,
+             const std::string& kind, std::optional<double> tolerance, const py::object& fixed_flags,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+            const std::vector<bool> fixed = flags_of(fixed_flags, "fixed");
             caliber::Frame frame = make_frame(models, poses, {}, make_request(kind, tolerance, 30.0, 0, false));
             std::vector<caliber::ObjectPair> skip;
             for (const auto& [a, b] : ignored) skip.push_back(caliber::ObjectPair{a, b});
@@ -709,7 +787,7 @@ def _batch_from_state(state):
             return out;
           },
           py::arg("models"), py::arg("poses"), py::arg("kind") = "interference", py::arg("tolerance") = py::none(), py::kw_only(),
-          py::arg("fixed") = std::vector<bool>{}, py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
+          py::arg("fixed") = py::list(), py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
           "The broad phase on this engine's threads: the object pairs (a < b, sorted) whose world boxes overlap within "
           "the query's reach (its tolerance for kind 'distance' or 'contact'), what step() takes. The same pairs as "
           "broad_phase(); the engine keeps its tree of boxes from call to call (refitted), so calls on the same objects "
@@ -718,8 +796,9 @@ def _batch_from_state(state):
       .def(
           "sweep",
           [](caliber::Engine& engine, const std::vector<PyModel>& models, const std::vector<caliber::Pose>& start,
-             const std::vector<caliber::Pose>& end, double tolerance, std::uint64_t max_queries, std::vector<bool> fixed,
+             const std::vector<caliber::Pose>& end, double tolerance, std::uint64_t max_queries, const py::object& fixed_flags,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+            const std::vector<bool> fixed = flags_of(fixed_flags, "fixed");
             std::vector<std::shared_ptr<const caliber::Model>> shared;
             shared.reserve(models.size());
             for (const PyModel& m : models) shared.push_back(m.model);
@@ -736,7 +815,7 @@ def _batch_from_state(state):
             return out;
           },
           py::arg("models"), py::arg("start"), py::arg("end"), py::kw_only(), py::arg("tolerance") = 0.0,
-          py::arg("max_queries") = 100000, py::arg("fixed") = std::vector<bool>{},
+          py::arg("max_queries") = 100000, py::arg("fixed") = py::list(),
           py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
           "Continuous collision detection for many objects: object i moves from start[i] to end[i] (translation linear, "
           "rotation by slerp); every pair whose swept boxes overlap is swept (caliber.sweep), in parallel on this engine's "
@@ -765,8 +844,9 @@ def _batch_from_state(state):
 
   m.def(
       "broad_phase",
-      [](const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses, double reach, std::vector<bool> fixed,
+      [](const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses, double reach, const py::object& fixed_flags,
          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& ignored) {
+        const std::vector<bool> fixed = flags_of(fixed_flags, "fixed");
         std::vector<std::shared_ptr<const caliber::Model>> shared;
         for (const PyModel& m : models) shared.push_back(m.model);
         std::vector<caliber::ObjectPair> skip;
@@ -781,7 +861,7 @@ def _batch_from_state(state):
         for (const caliber::ObjectPair& p : pairs) out.emplace_back(p.a, p.b);
         return out;
       },
-      py::arg("models"), py::arg("poses"), py::arg("reach") = 0.0, py::arg("fixed") = std::vector<bool>{},
+      py::arg("models"), py::arg("poses"), py::arg("reach") = 0.0, py::arg("fixed") = py::list(),
       py::arg("ignored") = std::vector<std::pair<std::uint32_t, std::uint32_t>>{},
       "The object pairs (a < b, sorted) whose world boxes, grown by reach / 2, overlap: what Engine.step takes. fixed: "
       "one flag per object (pairs of two fixed objects are skipped); ignored: pairs never tested.");
@@ -808,7 +888,9 @@ def _batch_from_state(state):
               py::gil_scoped_release release;
               s = caliber::step(world, engine, k);
             }
-            return to_result(std::move(s.contacts), s.stats);
+            PyResult r = to_result(std::move(s.contacts), s.stats);
+            r.limit_reached = s.limit_reached;
+            return r;
           },
           py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.")
       .def("__reduce__", [](const caliber::World&) -> py::object {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "caliber/sweep.h"
+#include "readonly.h"
 
 namespace caliber_python {
 
@@ -42,7 +43,16 @@ struct PySweeps {
     double *const pa = points_a.mutable_data(), *const pb = points_b.mutable_data();
     std::int64_t* const tri = pairs.mutable_data();
     std::uint64_t* const q = queries.mutable_data();
-    py::gil_scoped_release release;
+    {
+      py::gil_scoped_release release;
+      fill(results, c, u, t, d, pa, pb, tri, q);
+    }
+    freeze({&contact, &undecided, &time, &pairs, &distance, &points_a, &points_b, &queries});  // readonly.h
+  }
+
+ private:
+  void fill(const std::vector<caliber::SweepResult>& results, bool* c, bool* u, double* t, double* d, double* pa, double* pb,
+            std::int64_t* tri, std::uint64_t* q) {
     constexpr double nan = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < results.size(); ++i) {
       const caliber::SweepResult& r = results[i];
@@ -64,20 +74,26 @@ struct PySweeps {
   }
 };
 
-/// Registers caliber.Sweeps; `refuse_pickle` throws the module's not-picklable error.
+/// Registers caliber.Sweeps (its arrays read-only views); `refuse_pickle` throws the module's not-picklable error.
 template <class Refuse>
 void bind_sweeps(py::module_& m, Refuse&& refuse_pickle) {
   py::class_<PySweeps>(m, "Sweeps",
                        "The answers of sweep_many, a row per motion: contact, undecided, time (t* at a contact, 1 when "
                        "free), and at a contact the closest triangle pair, its distance and points.")
-      .def_readonly("contact", &PySweeps::contact, "N bools: the models come within the tolerance at time")
-      .def_readonly("undecided", &PySweeps::undecided, "N bools: max_queries ran out; free up to time, unknown after")
-      .def_readonly("time", &PySweeps::time, "N: the first time of contact t*; 1 when free; how far it got when undecided")
-      .def_readonly("pairs", &PySweeps::pairs, "N x 2 triangle ids of the closest pair at t* (-1 when no contact)")
-      .def_readonly("distance", &PySweeps::distance, "N: that pair's distance (inf when no contact)")
-      .def_readonly("points_a", &PySweeps::points_a, "N x 3: its point on a at t*, world coordinates (nan when no contact)")
-      .def_readonly("points_b", &PySweeps::points_b, "N x 3: its point on b at t* (nan when no contact)")
-      .def_readonly("queries", &PySweeps::queries, "N: the distance queries each sweep made")
+      .def_property_readonly("contact", view_of<PySweeps, &PySweeps::contact>,
+                             "N bools: the models come within the tolerance at time")
+      .def_property_readonly("undecided", view_of<PySweeps, &PySweeps::undecided>,
+                             "N bools: max_queries ran out; free up to time, unknown after")
+      .def_property_readonly("time", view_of<PySweeps, &PySweeps::time>,
+                             "N: the first time of contact t*; 1 when free; how far it got when undecided")
+      .def_property_readonly("pairs", view_of<PySweeps, &PySweeps::pairs>,
+                             "N x 2 triangle ids of the closest pair at t* (-1 when no contact)")
+      .def_property_readonly("distance", view_of<PySweeps, &PySweeps::distance>, "N: that pair's distance (inf when no contact)")
+      .def_property_readonly("points_a", view_of<PySweeps, &PySweeps::points_a>,
+                             "N x 3: its point on a at t*, world coordinates (nan when no contact)")
+      .def_property_readonly("points_b", view_of<PySweeps, &PySweeps::points_b>,
+                             "N x 3: its point on b at t* (nan when no contact)")
+      .def_property_readonly("queries", view_of<PySweeps, &PySweeps::queries>, "N: the distance queries each sweep made")
       .def_readonly("node_tests", &PySweeps::node_tests)
       .def_readonly("leaf_tests", &PySweeps::leaf_tests)
       .def_readonly("sweep_ms", &PySweeps::sweep_ms,

@@ -70,7 +70,9 @@ class CALIBER_EXPORT World {
 };
 
 /// Step k of a world on an engine: its frame (poses and the engine's broad phase, timed as
-/// broad_ms), then engine.step; fills the result's step, time and broad_ms.
+/// broad_ms), then engine.step; fills the result's step, time and broad_ms. k is any step: the
+/// poses follow the scene's motions at time k dt, within its `steps` (what `caliber run` runs) or
+/// beyond.
 [[nodiscard]] CALIBER_EXPORT StepResult step(const World& world, Engine& engine, int k);
 
 }  // namespace caliber

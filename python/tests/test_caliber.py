@@ -147,6 +147,27 @@ def test_pose_from_a_float32_matrix_and_quaternion_orders():
         caliber.Pose.from_quaternion((0.0, 0.0, 0.0, 1.0), "zyxw")
 
 
+def test_poses_refuse_numbers_that_are_not_real():
+    # Lists, tuples and arrays of floats and ints are taken; numpy arrays of any real dtype too.
+    assert caliber.Pose([1, 2.5, 3]).translation == [1.0, 2.5, 3.0]
+    assert caliber.Pose(np.array([1, 2, 3], dtype=np.int16), np.array([1, 0, 0, 0], dtype=np.float32)).translation == [1, 2, 3]
+    complex_matrix = np.eye(4, dtype=complex)
+    complex_matrix[0, 3] = 5j  # its imaginary part was dropped: a translation of 0
+    for call, match in [
+        (lambda: caliber.Pose(np.array([1, 2, 3 + 1j])), "translation: must be 3 real numbers, not dtype complex128"),
+        (lambda: caliber.Pose([1, 2, 3j]), "translation: must be 3 real numbers"),
+        (lambda: caliber.Pose((0, 0, 0), [True, False, False, False]), "quaternion: must be 4 real numbers, not dtype bool"),
+        (lambda: caliber.Pose(["1", "2", "3"]), "translation: must be 3 real numbers"),
+        (lambda: caliber.Pose((1, 2)), "translation: must be 3 numbers, not an array of 2"),
+        (lambda: caliber.Pose.from_quaternion((1, 0, 0), "wxyz"), "quaternion: must be 4 numbers"),
+        (lambda: caliber.Pose.from_matrix(complex_matrix), "matrix: must hold real numbers, not dtype complex128"),
+        (lambda: caliber.Pose.from_matrix(np.eye(4, dtype=bool)), "matrix: must hold real numbers, not dtype bool"),
+        (lambda: caliber.Pose.from_matrix(np.eye(4).astype(str)), "matrix: must hold real numbers"),
+    ]:
+        with pytest.raises(caliber.Error, match=match):
+            call()
+
+
 def test_engine_step_max_pairs_bounds_each_pair():
     models = [caliber.Model.load(TETRA), caliber.Model.load(FAN)]
     poses = [caliber.Pose(), pose(POSE)]
@@ -163,6 +184,18 @@ def test_broad_phase_gives_the_pairs_a_step_takes():
     pairs = caliber.broad_phase(models, poses, reach=0.3)
     assert pairs == [(0, 1)]
     assert caliber.broad_phase(models, poses, 0.3, fixed=[True, True, False]) == []
+    assert caliber.broad_phase(models, poses, 0.3, fixed=np.array([True, True, False])) == []
+    assert caliber.broad_phase(models, poses, 0.3, fixed=[1, 1, 0]) == []
+    # Flags are True or False (or 0 and 1), not any object's truth value.
+    for flags, match in [([0.5, 1.0, 0.0], r"fixed\[0\]: must be True or False, not float"),
+                         ([None] * 3, r"fixed\[0\]: must be True or False, not NoneType"),
+                         ([True, 2, False], r"fixed\[1\]: must be True or False, not int"), ("yes", "fixed: must be a list")]:
+        with pytest.raises(caliber.Error, match=match):
+            caliber.broad_phase(models, poses, 0.3, fixed=flags)
+        with pytest.raises(caliber.Error, match=match):
+            caliber.Engine().find_pairs(models, poses, kind="proximity", tolerance=0.3, fixed=flags)
+        with pytest.raises(caliber.Error, match=match):
+            caliber.Engine().sweep(models, poses, poses, fixed=flags)
     assert caliber.broad_phase(models, poses, 0.3, ignored=[(0, 1)]) == []
     got = caliber.Engine().step(models, poses, pairs, kind="proximity", tolerance=0.3)
     want = caliber.query(models[0], poses[0], models[1], poses[1], kind="proximity", tolerance=0.3)
@@ -222,6 +255,22 @@ def test_a_scene_steps_through_the_engine():
     for k in range(world.steps):
         a, b = world.step(engine, k), world.step(seq, k)
         assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.distances, b.distances)
+
+
+def test_a_scene_step_cut_by_max_pairs_says_so(tmp_path):
+    def world(query):
+        scene = tmp_path / f"cut{len(query)}.json"
+        scene.write_text(json.dumps({
+            "steps": 3, "dt": 0.1, "query": query,
+            "objects": [{"name": "fixed", "mesh": TETRA, "refine": 2},
+                        {"name": "mover", "mesh": TETRA, "refine": 2, "position": [0.2, 0.1, 0.1],
+                         "motion": {"type": "velocity", "linear": [-0.1, 0, 0]}}]}))
+        return caliber.World(scene)
+
+    full = world({"kind": "proximity", "tolerance": 0.05}).step(caliber.Engine(), 0)
+    cut = world({"kind": "proximity", "tolerance": 0.05, "max_pairs": 1}).step(caliber.Engine(), 0)
+    assert len(full) > 1 and not full.limit_reached
+    assert len(cut) == 1 and cut.limit_reached
 
 
 def test_bad_input_is_a_caliber_error_naming_the_file():
@@ -366,6 +415,9 @@ def test_objects_made_without_their_state_refuse_every_use():
         caliber.Model(caliber.Mesh.__new__(caliber.Mesh))
     with pytest.raises(caliber.Error, match="Result: was never built"):
         len(caliber.Result.__new__(caliber.Result))
+    for field in ("status", "time", "queries", "pair", "points", "distance"):
+        with pytest.raises(caliber.Error, match="Sweep: was never built"):
+            getattr(caliber.Sweep.__new__(caliber.Sweep), field)
     # The husk's state can still be given once, as unpickling does; then it is an ordinary model.
     husk.__setstate__(good.__getstate__())
     assert husk.triangles == good.triangles
@@ -418,6 +470,10 @@ def test_paths_that_are_not_utf8_are_named_escaped(tmp_path):
         assert str(error.value).endswith("/caf\\xe9\\x0aname.obj: cannot parse mesh: line 1: '1\\xff\\x00' is not a number")
     with pytest.raises(caliber.Error, match="path: must be a str, bytes or os.PathLike, not int"):
         caliber.Model.load(5)
+    # A NUL byte would end the C string the file is opened by: another file (tetra.off) was read.
+    for load in (caliber.Mesh.load, caliber.Model.load, caliber.World):
+        with pytest.raises(caliber.Error, match="path: holds a NUL byte"):
+            load(TETRA + "\0.bogus")
     assert caliber.Model.load(pathlib.Path(TETRA)).triangles == 4
 
 
@@ -536,3 +592,12 @@ def test_sweep_many_refuses_bad_motions():
         pickle.dumps(got)
     with pytest.raises(caliber.Error):
         caliber.Sweeps.__new__(caliber.Sweeps).time
+    # Its arrays are read-only views: the Sweeps keeps its rows whatever is done to them.
+    before = {name: getattr(got, name).tobytes() for name in ("contact", "undecided", "time", "pairs", "distance", "points_a",
+                                                               "points_b", "queries")}
+    for name in before:
+        view = getattr(got, name)
+        with pytest.raises(ValueError, match="read-only"):
+            view[...] = 0
+        view.shape = (-1,)
+    assert len(got) == 4 and all(getattr(got, name).tobytes() == b for name, b in before.items())

@@ -40,6 +40,9 @@ std::string bounded(const std::string& message) {
 }
 
 void check_file(const std::filesystem::path& path) {
+  // Files are opened by C strings, which would end at a NUL byte: another file.
+  if (path.native().find('\0') != std::string::npos)
+    throw Error(ErrorCode::bad_argument, path.string(), "the path holds a NUL byte");
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) {

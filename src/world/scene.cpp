@@ -299,6 +299,8 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
 }
 
 Scene load_scene(const std::filesystem::path& file) {
+  if (file.native().find('\0') != std::string::npos)
+    throw Error(ErrorCode::bad_argument, file.string(), "the path holds a NUL byte");
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw Error(ErrorCode::file_not_found, file.string(), "no such scene file");
   if (std::filesystem::is_directory(file, ec))

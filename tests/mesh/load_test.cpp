@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "caliber/scene.h"
+
 #include "support/error_message.h"
 
 #include "caliber/error.h"
@@ -159,6 +161,25 @@ TEST(LoadMeshErrors, OtherFormats) {
   expect_error(kData / "bad/nan.obj", ErrorCode::bad_value, "non-finite");
   expect_error(kData / "bad/no_faces.obj", ErrorCode::empty_mesh, "no triangles");
   expect_error(kData / "bad/truncated_ascii.stl", ErrorCode::unreadable, "cannot parse");
+}
+
+TEST(LoadMeshErrors, APathWithANulByteIsRefusedNotCutThere) {
+  // Files are opened by C strings: the path would end at the NUL, and tetra.off would be read.
+  const std::string path = (kData / "tetra.off").string() + std::string("\0.bogus", 7);
+  for (const bool scene : {false, true}) {
+    try {
+      if (scene) {
+        (void)load_scene(path);
+      } else {
+        (void)load_mesh(path);
+      }
+      FAIL() << "a path with a NUL byte was opened";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(e.code(), ErrorCode::bad_argument) << what;
+      EXPECT_NE(what.find("tetra.off\\x00.bogus: the path holds a NUL byte"), std::string::npos) << what;
+    }
+  }
 }
 
 TEST(LoadMeshErrors, TruncatedOff) {
