@@ -86,6 +86,7 @@ struct ScheduleRecord {
 
 /// Makespan, in node tests, of greedy list scheduling: each cost in order goes to the least-loaded
 /// of `cores` virtual cores (the policy of a dynamic parallel loop with grain 1).
+/// (Each of these takes 1 to 65,536 cores: caliber::Error otherwise.)
 [[nodiscard]] CALIBER_EXPORT double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores);
 
 /// The load-balance simulation: the speed-up on `cores` virtual cores that the step's recorded

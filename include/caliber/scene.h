@@ -39,7 +39,7 @@ struct Motion {
 };
 
 /// The pose at time t of an object that starts at `initial` and moves by `motion`.
-/// (Keyframes ignore `initial`: the keys are absolute poses.)
+/// (Keyframes ignore `initial`: the keys are absolute poses; Error when there is none.)
 [[nodiscard]] CALIBER_EXPORT Pose pose_at(const Pose& initial, const Motion& motion, double t);
 
 /// A run of triangles (by id) put in one primitive group.

@@ -27,7 +27,8 @@ struct SweptPose {
 struct SweepRequest {
   /// Distance delta (world units) at which the models count as touching: the sweep reports the
   /// first time it finds them within delta. 0 (default): 1e-6 of the larger model's radius about
-  /// its origin. Must be finite and >= 0.
+  /// its origin. Never below twice the rounding margin (2e-9 of the scene's size, its radii and
+  /// translations): a smaller one is raised to that. Must be finite and >= 0.
   double tolerance = 0.0;
   /// The most distance queries a sweep makes; one that needs more ends `undecided`. Must be >= 1.
   std::uint64_t max_queries = 100000;
@@ -63,7 +64,8 @@ struct SweepResult {
 /// (free). Guaranteed, with a margin of 1e-9 of the scene's size (the models' radii and the
 /// translations) taken off every distance for the rounding of poses and distances: a contact is
 /// never reported later than the first true contact, "free" is never wrong, and at a reported
-/// contact the models are within the tolerance. A sweep that starts within the tolerance reports
+/// contact the models are within the tolerance (as raised to twice the margin, SweepRequest::
+/// tolerance). A sweep that starts within the tolerance reports
 /// contact at 0. Thread-safe on shared models. Throws caliber::Error on a bad pose or request.
 [[nodiscard]] CALIBER_EXPORT SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b,
                                                const SweptPose& motion_b, const SweepRequest& request = {});

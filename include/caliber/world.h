@@ -22,13 +22,20 @@ class CALIBER_EXPORT World {
   /// Loads every mesh once (objects that share file, scale and refinement share one Model) and
   /// builds the models. Throws caliber::Error on bad meshes (naming the object and file).
   explicit World(Scene scene);
+  /// Copies and moves keep the request's group table pointing at their own scene's.
+  World(const World& other);
+  World(World&& other) noexcept;
+  World& operator=(const World& other);
+  World& operator=(World&& other) noexcept;
+  ~World() = default;
 
   /// The scene.
   [[nodiscard]] const Scene& scene() const { return mScene; }
   /// Number of objects.
   [[nodiscard]] std::size_t object_count() const { return mScene.objects.size(); }
-  /// The model of object i (shared between objects with the same mesh).
-  [[nodiscard]] const Model& model(std::size_t i) const { return *mModels[i]; }
+  /// The model of object i (shared between objects with the same mesh); Error for an i past the
+  /// objects.
+  [[nodiscard]] const Model& model(std::size_t i) const;
   /// Number of distinct models built.
   [[nodiscard]] std::size_t distinct_models() const;
   /// Total triangles over the objects.
@@ -37,7 +44,8 @@ class CALIBER_EXPORT World {
   /// The poses of all objects at step k.
   [[nodiscard]] std::vector<Pose> poses_at(int step) const;
   /// World-space box of object i at `pose` (its root box moved by the pose, grown by `grow` and a
-  /// rounding margin), as the broad phase uses it: low corner, high corner.
+  /// rounding margin), as the broad phase uses it: low corner, high corner. Error for an i past
+  /// the objects, a pose validate_pose refuses, or a grow that is not finite and >= 0.
   [[nodiscard]] std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds(std::size_t i, const Pose& pose, double grow) const;
   /// The broad phase (caliber::broad_phase): object pairs whose world boxes, grown by the tolerance,
   /// overlap; pairs of two static objects and ignored pairs are skipped. Sorted.
@@ -59,6 +67,8 @@ class CALIBER_EXPORT World {
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
 
  private:
+  /// mRequest.groups: this world's group table, or null when the scene has none.
+  void point_at_groups() { mRequest.groups = mScene.use_groups ? &mScene.compatibility : nullptr; }
   /// Step k's models, poses and request, without pairs.
   [[nodiscard]] Frame posed_frame(int step) const;
 

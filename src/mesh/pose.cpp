@@ -142,6 +142,9 @@ std::vector<Pose> poses_from_rows(std::size_t values, std::size_t width, std::st
 }  // namespace
 
 std::vector<Pose> poses_from_matrices(std::span<const double> values, double tolerance, std::string_view source) {
+  if (!(tolerance >= 0.0) || !(tolerance < 0.5)) {
+    throw Error(ErrorCode::bad_value, "tolerance", "the rotation's tolerance must be in [0, 0.5)");
+  }
   return poses_from_rows(values.size(), 16, source, [&](std::size_t i, std::string_view name) {
     return Pose::from_matrix(Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(values.data() + 16 * i), tolerance,
                              name);

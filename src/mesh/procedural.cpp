@@ -30,10 +30,16 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw Error(ErrorCode::bad_value, "procedural mesh", what);
 }
 
+/// A generated mesh's vertices stay within 2^27, far below the 32-bit ids' limit (its int loops
+/// cannot overflow) and within memory a test or a scene can ask for.
+bool vertex_count_within(double vertices) { return vertices <= 134217728.0; }
+
 }  // namespace
 
 Mesh make_sphere(double radius, int rings, int segments) {
   require(radius > 0.0 && rings >= 2 && segments >= 3, "sphere needs radius > 0, rings >= 2, segments >= 3");
+  require(std::isfinite(radius) && vertex_count_within(static_cast<double>(rings + 1) * segments),
+          "sphere needs a finite radius and at most 2^27 vertices");
   Mesh mesh;
   mesh.source = "sphere";
   for (int i = 0; i <= rings; ++i) {
@@ -52,6 +58,8 @@ Mesh make_sphere(double radius, int rings, int segments) {
 
 Mesh make_torus(double major, double minor, int rings, int segments) {
   require(major > minor && minor > 0.0 && rings >= 3 && segments >= 3, "torus needs major > minor > 0, rings, segments >= 3");
+  require(std::isfinite(major) && vertex_count_within(static_cast<double>(rings + 1) * segments),
+          "torus needs finite radii and at most 2^27 vertices");
   Mesh mesh;
   mesh.source = "torus";
   for (int i = 0; i <= rings; ++i) {
@@ -68,6 +76,9 @@ Mesh make_torus(double major, double minor, int rings, int segments) {
 
 Mesh make_box(double hx, double hy, double hz, int divisions) {
   require(hx > 0.0 && hy > 0.0 && hz > 0.0 && divisions >= 1, "box needs positive half-extents and divisions >= 1");
+  require(std::isfinite(hx) && std::isfinite(hy) && std::isfinite(hz) &&
+              vertex_count_within(6.0 * (static_cast<double>(divisions) + 1) * (static_cast<double>(divisions) + 1)),
+          "box needs finite half-extents and at most 2^27 vertices");
   Mesh mesh;
   mesh.source = "box";
   const Eigen::Vector3d half(hx, hy, hz);

@@ -44,6 +44,7 @@ Mesh refine_once(const Mesh& in) {
 
 Mesh refine_mesh(const Mesh& mesh, int levels) {
   if (levels < 0 || levels > 8) throw Error(ErrorCode::bad_value, "refine", "levels must be in [0, 8]");
+  validate_mesh(mesh);  // indices and groups are read as given: a hand-built mesh is checked first
   const std::uint64_t triangles = std::uint64_t{mesh.triangles.size()} << (2 * levels);
   if (triangles >= 0x7fffffffu) {
     throw Error(ErrorCode::bad_value, mesh.source,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <functional>
 #include <queue>
+#include <string>
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
@@ -22,6 +23,13 @@ const ScheduleRecord& schedule_of(const StepResult& step) {
                 "the step has no schedule (run it with EngineOptions::profile on)");
   }
   return *step.schedule;
+}
+
+/// The simulations take 1 to 65,536 virtual cores (each one an entry of the list schedule's
+/// queue).
+void check_cores(int cores) {
+  if (cores < 1 || cores > 65536)
+    throw Error(ErrorCode::bad_value, "cores", "must be in [1, 65536], not " + std::to_string(cores));
 }
 
 /// Greedy list scheduling of `costs` in order on `cores` cores: the makespan.
@@ -42,7 +50,7 @@ double list_schedule(const std::vector<Cost>& costs, int cores) {
 }  // namespace
 
 double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores) {
-  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+  check_cores(cores);
   return list_schedule(costs, cores);
 }
 
@@ -71,6 +79,7 @@ double stage_makespan(const ScheduleRecord& r, const std::vector<double>& unit, 
 }  // namespace
 
 double simulated_speedup(const StepResult& step, Method method, int cores) {
+  check_cores(cores);
   const ScheduleRecord& r = schedule_of(step);
   const double total = static_cast<double>(step.stats.node_tests);
   if (total <= 0.0 || method == Method::sequential) return 1.0;
@@ -96,7 +105,7 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
 }
 
 double predicted_step_ms(const StepResult& step, Method method, int cores) {
-  if (cores < 1) throw Error(ErrorCode::bad_value, "cores", "must be >= 1");
+  check_cores(cores);
   const ScheduleRecord& r = schedule_of(step);
   if (r.timeline.empty()) {
     throw Error(ErrorCode::bad_argument, "predicted_step_ms", "the step has no timeline (EngineOptions::timeline)");

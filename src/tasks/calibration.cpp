@@ -281,8 +281,16 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
 
 std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std::vector<TrianglePair>& reported) {
   std::vector<SummaryNode> summary;
-  if (reported.empty()) return summary;
-  std::vector<TrianglePair> items = reported;
+  // The pairs reported last step, by triangle ids of last step's models: a frame may have given the
+  // pair other models since (without Engine::forget), so ids past these models' triangles are left
+  // out. The summary only weighs the split; no answer depends on it.
+  std::vector<TrianglePair> items;
+  items.reserve(reported.size());
+  const std::size_t triangles_a = ctx.a().leaf_position.size(), triangles_b = ctx.b().leaf_position.size();
+  for (const TrianglePair& p : reported) {
+    if (p.tri_a < triangles_a && p.tri_b < triangles_b) items.push_back(p);
+  }
+  if (items.empty()) return summary;
   summary.reserve(2 * items.size() + 1);
   summary.resize(1);
   fill_summary(ctx, 0, narrow::NodePair{0, 0}, false, items.data(), items.data() + items.size(), summary);

@@ -331,6 +331,7 @@ Pose pose_at(const Pose& initial, const Motion& motion, double t) {
     }
     case Motion::Type::keyframes: {
       const auto& keys = motion.keys;
+      if (keys.empty()) throw Error(ErrorCode::bad_value, "motion", "a keyframe motion needs at least one key");
       Pose p;
       if (t <= keys.front().time || keys.size() == 1) {
         p.translation = keys.front().position;

@@ -3,8 +3,11 @@
 #include "caliber/world.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <new>
+#include <string>
 #include <tuple>
 
 #include "caliber/broad_phase.h"
@@ -21,12 +24,78 @@ using broad::WorldBox;
 using util::Clock;
 using util::ms_since;
 
+void check_object(std::size_t i, std::size_t objects) {
+  if (i >= objects) {
+    throw Error(ErrorCode::bad_argument, "object",
+                "index " + std::to_string(i) + " is past the world's " + std::to_string(objects) + " objects");
+  }
+}
+
+/// What parse_scene checks of a scene file, for a Scene built by hand: dt, each object's scale,
+/// refinement, pose and motion (a keyframe motion needs keys, at finite increasing times).
+void check_scene(const Scene& scene) {
+  const std::string source = scene.file.empty() ? "scene " + scene.name : scene.file.string();
+  if (!(scene.dt > 0.0) || !std::isfinite(scene.dt)) throw Error(ErrorCode::bad_value, source, "dt must be finite and > 0");
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& o = scene.objects[i];
+    const std::string what = "object '" + o.name + "' (objects[" + std::to_string(i) + "])";
+    if (!std::isfinite(o.scale) || o.scale == 0.0)
+      throw Error(ErrorCode::bad_value, source, what + ": scale must be finite and not 0");
+    if (o.refine < 0 || o.refine > 6) throw Error(ErrorCode::bad_value, source, what + ": refine must be in [0, 6]");
+    validate_pose(o.pose, source + ": " + what + ": pose");
+    const Motion& m = o.motion;
+    if (!m.linear.allFinite() || !m.angular.allFinite()) {
+      throw Error(ErrorCode::bad_value, source, what + ": its velocities must be finite");
+    }
+    if (m.type != Motion::Type::keyframes) continue;
+    if (m.keys.empty()) throw Error(ErrorCode::bad_value, source, what + ": a keyframe motion needs at least one key");
+    for (std::size_t k = 0; k < m.keys.size(); ++k) {
+      const Keyframe& key = m.keys[k];
+      const std::string at = what + ": key " + std::to_string(k);
+      if (!std::isfinite(key.time) || (k > 0 && !(key.time > m.keys[k - 1].time))) {
+        throw Error(ErrorCode::bad_value, source, at + ": key times must be finite and increase");
+      }
+      validate_pose(Pose{key.orientation, key.position}, source + ": " + at);
+    }
+  }
+}
+
 }  // namespace
+
+World::World(const World& other)
+    : mScene(other.mScene), mRequest(other.mRequest), mModels(other.mModels), mStatic(other.mStatic), mIgnored(other.mIgnored) {
+  point_at_groups();
+}
+
+World::World(World&& other) noexcept
+    : mScene(std::move(other.mScene)),
+      mRequest(other.mRequest),
+      mModels(std::move(other.mModels)),
+      mStatic(std::move(other.mStatic)),
+      mIgnored(std::move(other.mIgnored)) {
+  point_at_groups();
+}
+
+World& World::operator=(const World& other) {
+  if (this != &other) *this = World(other);
+  return *this;
+}
+
+World& World::operator=(World&& other) noexcept {
+  mScene = std::move(other.mScene);
+  mRequest = other.mRequest;
+  mModels = std::move(other.mModels);
+  mStatic = std::move(other.mStatic);
+  mIgnored = std::move(other.mIgnored);
+  point_at_groups();
+  return *this;
+}
 
 World::World(Scene scene) : mScene(std::move(scene)) {
   validate_request(mScene.query);
+  check_scene(mScene);
   mRequest = mScene.query;
-  mRequest.groups = mScene.use_groups ? &mScene.compatibility : nullptr;
+  point_at_groups();
   // One model per (file, scale, refinement, groups): objects that share all four share the BVH.
   using Key =
       std::tuple<std::string, double, int, std::uint8_t, std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint8_t>>>;
@@ -110,7 +179,15 @@ std::vector<Pose> World::poses_at(int step) const {
   return poses;
 }
 
+const Model& World::model(std::size_t i) const {
+  check_object(i, mModels.size());
+  return *mModels[i];
+}
+
 std::pair<Eigen::Vector3d, Eigen::Vector3d> World::bounds(std::size_t i, const Pose& pose, double grow) const {
+  check_object(i, mModels.size());
+  validate_pose(pose, "pose");
+  if (!(grow >= 0.0) || !std::isfinite(grow)) throw Error(ErrorCode::bad_value, "grow", "must be finite and >= 0");
   const WorldBox b = world_box(*mModels[i], pose, grow);
   return {b.lo, b.hi};
 }
@@ -140,6 +217,7 @@ Frame World::frame(int step, Engine& engine) const {
 }
 
 std::vector<PairSweep> World::sweep(int step, Engine& engine, const SweepRequest& request) const {
+  if (step == std::numeric_limits<int>::max()) throw Error(ErrorCode::bad_argument, "step", "has no step after it");
   return engine.sweep(mModels, poses_at(step), poses_at(step + 1), request, mStatic, mIgnored);
 }
 

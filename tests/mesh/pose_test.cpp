@@ -1,9 +1,11 @@
 #include <cmath>
 #include <limits>
+#include <vector>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "caliber/batch.h"
 #include "caliber/error.h"
 #include "caliber/mesh.h"
 #include "caliber/pose.h"
@@ -91,6 +93,18 @@ TEST(Pose, ValidateRejectsHandBuiltBadPoses) {
   p.rotation = Eigen::Quaterniond::Identity();
   p.translation.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(validate_pose(p), Error);
+}
+
+TEST(Pose, ABadRotationToleranceIsNamedEvenWithoutMatrices) {
+  for (const std::size_t count : {0u, 16u}) {
+    const std::vector<double> values(count, 0.0);
+    try {
+      (void)poses_from_matrices(values, std::numeric_limits<double>::quiet_NaN(), "poses");
+      FAIL() << "a NaN tolerance was taken";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.source(), "tolerance") << e.what();
+    }
+  }
 }
 
 TEST(Pose, HugeQuaternionsDoNotOverflowIntoAZeroRotation) {

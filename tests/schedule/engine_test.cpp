@@ -185,6 +185,7 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_EQ(list_schedule_makespan({1, 1, 1, 9}, 2), 10.0) << "handout order, not sorted: the 9 lands on a loaded core";
   EXPECT_EQ(list_schedule_makespan({9, 1, 1, 1}, 2), 9.0);
   EXPECT_THROW((void)list_schedule_makespan({1}, 0), Error);
+  EXPECT_THROW((void)list_schedule_makespan({1}, 65537), Error) << "a queue entry per core";
   StepResult step;
   EXPECT_THROW((void)simulated_speedup(step, Method::exploitation, 8), Error) << "a step run without a schedule";
   auto record = std::make_shared<ScheduleRecord>();
@@ -206,6 +207,9 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   record->stage_level_task = {0, 0, 1, 1};
   step.stats.node_tests = 150;
   EXPECT_NEAR(simulated_speedup(step, Method::apriori, 4), 150.0 / (70.0 / 4 + 20.0), 1e-12) << "each span 1 + 2 + 8";
+  for (const int cores : {0, -3, 1 << 30}) {
+    EXPECT_THROW((void)simulated_speedup(step, Method::apriori, cores), Error) << cores << " cores (the stage's schedule)";
+  }
 }
 
 TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
@@ -576,6 +580,51 @@ TEST(EngineFrames, ForgetDropsTheTemporalState) {
   EXPECT_GT(engine.step(frame).schedule->taboo, 0u) << "last step's contacts give sub-task roots";
   engine.forget();
   EXPECT_EQ(engine.step(frame).schedule->taboo, 0u) << "forgotten";
+}
+
+TEST(EngineFrames, APairGivenOtherModelsWithoutForgetGetsThePairwiseAnswer) {
+  // The a posteriori method splits a pair by the triangle pairs it reported last step, by last
+  // step's models' ids. Here the pair's models become two 12-triangle boxes without forget(): the
+  // old ids are past their triangles (they were read past the end of the boxes' tables).
+  EngineOptions options;
+  options.method = Method::aposteriori;
+  options.threads = 2;
+  options.beta = 8;
+  options.profile = true;
+  Engine engine(options);
+  Frame frame = memory_frame(0.9);
+  frame.pairs = {ObjectPair{0, 1}};
+  (void)engine.step(frame);
+  ASSERT_GT(engine.step(frame).schedule->taboo, 0u) << "last step's contacts split the pair";
+  frame.models[0] = build_model(make_box(0.3, 0.3, 0.3, 1));
+  frame.models[1] = build_model(make_box(0.3, 0.3, 0.3, 1));
+  frame.poses[1] = Pose::from_values(-0.61, 0.1, 0.0, 1, 0, 0, 0);  // faces 0.01 apart, within the tolerance
+  const StepResult got = engine.step(frame);
+  const QueryResult want = query(*frame.models[0], frame.poses[0], *frame.models[1], frame.poses[1], frame.request);
+  ASSERT_FALSE(want.contacts.empty());
+  ASSERT_EQ(got.contacts.size(), want.contacts.size());
+  for (std::size_t i = 0; i < want.contacts.size(); ++i) {
+    EXPECT_EQ(got.contacts[i].tri_a, want.contacts[i].tri_a);
+    EXPECT_EQ(got.contacts[i].tri_b, want.contacts[i].tri_b);
+    EXPECT_EQ(got.contacts[i].point_a, want.contacts[i].point_a);
+    EXPECT_EQ(got.contacts[i].distance, want.contacts[i].distance);
+  }
+}
+
+TEST(EngineFrames, AContactQueryOnModelsWithoutAdjacencyIsRefusedBeforeAnyWork) {
+  BuildOptions bare;
+  bare.adjacency = false;
+  Frame frame = memory_frame(0.0);
+  frame.models[1] = build_model(make_sphere(0.5, 12, 16), bare);
+  Engine engine;
+  try {
+    (void)engine.step(frame);
+    FAIL() << "a contact query needs adjacency";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "contact query: models were built without adjacency");
+  }
+  const std::vector<Pose> fixed{Pose{}}, poses{Pose{}, Pose{}};
+  EXPECT_THROW((void)engine.query_many(*frame.models[0], fixed, *frame.models[1], poses, frame.request), Error);
 }
 
 TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {

@@ -1,6 +1,9 @@
 // The world: shared models, broad phase against the all-pairs check, steps against the oracle.
 
 #include <filesystem>
+#include <vector>
+#include <limits>
+#include <functional>
 #include <fstream>
 #include <random>
 
@@ -8,6 +11,7 @@
 
 #include "caliber/error.h"
 #include "caliber/procedural.h"
+#include "caliber/scene.h"
 #include "caliber/world.h"
 #include "support/random_poses.h"
 #include "support/temp_dir.h"
@@ -166,6 +170,66 @@ TEST_F(WorldFiles, GroupsInScenesFilterContacts) {
   EXPECT_FALSE(test::reference_step(World(scene(without)), 0).contacts.empty());
 }
 
+TEST_F(WorldFiles, CopiedAndMovedWorldsKeepTheirOwnGroupTable) {
+  const World world(scene(R"({"query": {"kind": "interference"}, "groups": {"compatible": [[1, 1], [2, 2]]}, "objects": [
+      {"name": "a", "mesh": "cube.off", "group": 1},
+      {"name": "b", "mesh": "cube.off", "position": [0.6, 0.2, 0.1], "group": 2, "motion": {"type": "velocity"}}]})"));
+  ASSERT_EQ(world.request().groups, &world.scene().compatibility);
+  World copy(world);
+  EXPECT_EQ(copy.request().groups, &copy.scene().compatibility) << "not the original's table";
+  const World moved(std::move(copy));
+  EXPECT_EQ(moved.request().groups, &moved.scene().compatibility);
+  // A vector that grows moves its worlds and frees the old storage: each keeps filtering by groups.
+  std::vector<World> worlds;
+  for (int i = 0; i < 9; ++i) worlds.push_back(world);
+  for (const World& w : worlds) {
+    EXPECT_EQ(w.request().groups, &w.scene().compatibility);
+    EXPECT_TRUE(test::reference_step(w, 0).contacts.empty()) << "groups 1 and 2 never touch";
+  }
+  World assigned = world;
+  assigned = worlds.back();
+  EXPECT_EQ(assigned.request().groups, &assigned.scene().compatibility);
+}
+
+TEST_F(WorldFiles, HandBuiltScenesAreCheckedAsSceneFilesAre) {
+  const Scene base = scene(R"({"objects": [{"name": "a", "mesh": "cube.off"},
+      {"name": "b", "mesh": "cube.off", "motion": {"type": "velocity", "linear": [1, 0, 0]}}]})");
+  const auto refused = [&](const std::function<void(Scene&)>& change, const std::string& words) {
+    Scene s = base;
+    change(s);
+    try {
+      const World world(std::move(s));
+      FAIL() << "accepted: " << words;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused([](Scene& s) { s.objects[1].motion.type = Motion::Type::keyframes; },
+          "object 'b' (objects[1]): a keyframe motion needs at least one key");
+  refused(
+      [](Scene& s) {
+        s.objects[1].motion.type = Motion::Type::keyframes;
+        s.objects[1].motion.keys.resize(2);
+      },
+      "key 1: key times must be finite and increase");
+  refused([](Scene& s) { s.objects[1].scale = std::numeric_limits<double>::quiet_NaN(); }, "scale must be finite and not 0");
+  refused([](Scene& s) { s.objects[0].refine = 7; }, "refine must be in [0, 6]");
+  refused([](Scene& s) { s.dt = 0.0; }, "dt must be finite and > 0");
+  refused([](Scene& s) { s.objects[1].motion.linear.x() = std::numeric_limits<double>::infinity(); },
+          "velocities must be finite");
+  refused([](Scene& s) { s.objects[0].pose.translation.y() = std::numeric_limits<double>::quiet_NaN(); },
+          "object 'a' (objects[0]): pose");
+  EXPECT_THROW((void)pose_at(Pose{}, Motion{Motion::Type::keyframes}, 0.0), Error) << "no key to hold";
+  const World world(base);
+  EXPECT_THROW((void)world.model(2), Error);
+  EXPECT_THROW((void)world.bounds(2, Pose{}, 0.0), Error);
+  EXPECT_THROW((void)world.bounds(0, Pose{}, std::numeric_limits<double>::quiet_NaN()), Error);
+  Pose bad;
+  bad.translation.x() = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)world.bounds(0, bad, 0.0), Error);
+  EXPECT_EQ(&world.model(1), &world.model(0)) << "one cube, shared";
+}
+
 TEST_F(WorldFiles, AMeshThatIsNotAMeshFailsClearly) {
   std::ofstream(dir / "self.json") << R"({"objects": [{"mesh": "self.json"}]})";
   try {
@@ -174,6 +238,16 @@ TEST_F(WorldFiles, AMeshThatIsNotAMeshFailsClearly) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("self.json"), std::string::npos) << e.what();
   }
+}
+
+TEST(ProceduralMeshes, InfiniteSizesAndHugeCountsAreErrors) {
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)make_sphere(inf, 8, 8), Error);
+  EXPECT_THROW((void)make_torus(inf, 0.2, 8, 8), Error);
+  EXPECT_THROW((void)make_box(1.0, inf, 1.0, 1), Error);
+  EXPECT_THROW((void)make_sphere(1.0, 100000, 100000), Error) << "10^10 vertices";
+  EXPECT_THROW((void)make_box(1.0, 1.0, 1.0, 100000), Error);
+  EXPECT_EQ(make_sphere(1.0, 8, 8).vertices.size(), 9u * 8u);
 }
 
 TEST(RefineMesh, SplitsEachTriangleIntoFourInPlace) {
@@ -191,6 +265,12 @@ TEST(RefineMesh, SplitsEachTriangleIntoFourInPlace) {
   }
   EXPECT_EQ(fine.vertices[fine.triangles[0][0]], box.vertices[box.triangles[0][0]]) << "corner triangle first";
   EXPECT_THROW((void)refine_mesh(box, -1), Error);
+  Mesh bad = box;
+  bad.triangles[3][1] = 1000;  // a corner past the vertices: refused, not read
+  EXPECT_THROW((void)refine_mesh(bad, 1), Error);
+  bad = box;
+  bad.groups.assign(2, 1);  // fewer groups than triangles
+  EXPECT_THROW((void)refine_mesh(bad, 1), Error);
 }
 
 }  // namespace
