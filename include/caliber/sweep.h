@@ -19,7 +19,8 @@ namespace caliber {
 struct SweptPose {
   Pose start;
   Pose end;
-  /// The pose at time t (t in [0, 1]).
+  /// The pose at time t (t in [0, 1]): translation linear, rotation by slerp. A translation
+  /// component that comes out below 2^-120 in magnitude (caliber's smallest coordinate) is 0.
   [[nodiscard]] CALIBER_EXPORT Pose at(double t) const;
 };
 

@@ -36,6 +36,11 @@ void validate_sweep_request(const SweepRequest& request) {
 Pose SweptPose::at(double t) const {
   Pose p;
   p.translation = (1.0 - t) * start.translation + t * end.translation;
+  // An interpolated component below the smallest non-zero coordinate caliber takes (validate_pose)
+  // is 0: a move of at most sqrt(3) 2^-120, which the sweep's margin covers (kSweepFlush).
+  for (int k = 0; k < 3; ++k) {
+    if (p.translation[k] != 0.0 && std::abs(p.translation[k]) < narrow::kSmallestCoordinate) p.translation[k] = 0.0;
+  }
   p.rotation = start.rotation.slerp(t, end.rotation).normalized();
   return p;
 }
@@ -65,7 +70,7 @@ SweepAdvance::SweepAdvance(double ra, const SweptPose& motion_a, double rb, cons
   const double size = ra + rb +
                       std::max({motion_a.start.translation.norm(), motion_a.end.translation.norm(),
                                 motion_b.start.translation.norm(), motion_b.end.translation.norm()});
-  mMargin = kSweepMargin * size;
+  mMargin = kSweepMargin * size + kSweepFlush;
   mTolerance = sweep_tolerance(request, std::max(ra, rb), mMargin);
   // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
   mSpeed = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);

@@ -114,7 +114,7 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     largest = std::max(largest, radius[i]);
     reach = std::max({reach, from[i].translation.norm(), to[i].translation.norm()});
   }
-  const double margin = narrow::kSweepMargin * (2.0 * largest + reach);
+  const double margin = narrow::kSweepMargin * (2.0 * largest + reach) + narrow::kSweepFlush;
   const double tolerance = narrow::sweep_tolerance(request, largest, margin);
   std::vector<broad::WorldBox> boxes(n);
   for (std::size_t i = 0; i < n; ++i) {

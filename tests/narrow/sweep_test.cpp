@@ -163,6 +163,20 @@ TEST(Sweep, BadInputIsAnError) {
   EXPECT_THROW(static_cast<void>(sweep(*a, {Pose{}, bad}, *a, {at(3, 0, 0), Pose{}})), Error);
 }
 
+TEST(Sweep, AnInterpolatedTranslationBelowTheSmallestCoordinateIsZeroNotAnError) {
+  // B's y goes from 0 to 1e-35 (a valid coordinate): near the start, t * 1e-35 is below 2^-120,
+  // which a pose may not hold. The sweep takes 0 there, within its margin.
+  const auto a = build_model(make_box(0.5, 0.5, 0.5, 1)), b = build_model(make_box(0.5, 0.5, 0.5, 1));
+  const SweptPose still{Pose{}, Pose{}},
+      coming{Pose::from_values(1.01, 0, 0, 1, 0, 0, 0), Pose::from_values(0, 1e-35, 0, 1, 0, 0, 0)};
+  EXPECT_EQ(coming.at(0.01).translation.y(), 0.0);
+  EXPECT_EQ(coming.at(0.5).translation.y(), 0.5e-35);
+  const SweepResult r = sweep(*a, still, *b, coming);
+  ASSERT_EQ(r.status, SweepStatus::contact);
+  EXPECT_LE(r.time, 0.01 / 1.01) << "never later than the first true contact";
+  EXPECT_GT(r.time, 0.0);
+}
+
 TEST(Sweep, UndecidedWhenTheQueriesRunOut) {
   // A grazing pass just outside a tiny tolerance takes many small advances: with a budget of 3
   // queries the sweep stops undecided, free of contact up to the time it reached.
