@@ -25,6 +25,14 @@ int main(int argc, char** argv) {
   const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app), caliber::cli::add_run_command(app),
                                                       caliber::cli::add_refine_command(app), caliber::cli::add_bench_command(app),
                                                       caliber::cli::add_view_command(app)};
+  // An empty value is refused, not read as 0 or as no output file ("--tolerance ''", "--json ''").
+  const CLI::Validator non_empty(
+      [](std::string& value) { return value.empty() ? std::string("must not be empty") : std::string(); }, "", "NONEMPTY");
+  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
+    for (CLI::Option* option : command->get_options([](CLI::Option*) { return true; })) {
+      if (option->get_type_size() != 0 && !option->get_positional()) option->check(non_empty);
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

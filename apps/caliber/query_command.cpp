@@ -209,7 +209,8 @@ Runner add_query_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads,
                   "Engine threads (0: every hardware thread the process may use; 1: this thread alone)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
       ->check(at_least(0))

@@ -1,6 +1,8 @@
 // caliber refine: 1-to-4 midpoint subdivision of a mesh, written as OFF.
 
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <new>
 #include <string>
@@ -20,12 +22,15 @@ Runner add_refine_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("refine", "Subdivide every triangle into 4, K times, and write an OFF file");
   cmd->add_option("IN", opt->in, "Input mesh (OFF, OBJ, STL or PLY)")->required();
-  cmd->add_option("OUT", opt->out, "Output OFF file")->required();
+  cmd->add_option("OUT", opt->out, "Output OFF file (its name ends in .off)")->required();
   cmd->add_option("--levels,-l", opt->levels, "Subdivision levels (each multiplies the triangles by 4)")
       ->capture_default_str()
       ->check(CLI::Range(0, 8));
   return [cmd, opt]() {
     if (!cmd->parsed()) return -1;
+    std::string ext = std::filesystem::path(opt->out).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".off") throw Error(ErrorCode::bad_argument, "OUT", "must name an .off file: refine writes OFF");
     check_distinct_files({{"OUT", opt->out}}, {{"IN", opt->in}});
     OutputFile file(opt->out, "OUT");
     const Mesh in = load_mesh(opt->in);
@@ -39,6 +44,7 @@ Runner add_refine_command(CLI::App& app) {
     file.commit();
     std::printf("%s: %zu triangles -> %s: %zu triangles\n", opt->in.c_str(), in.triangles.size(), opt->out.c_str(),
                 out.triangles.size());
+    check_stdout();
     return 0;
   };
 }

@@ -116,8 +116,13 @@ std::string pair_name(const World& world, const ObjectPair& t) {
 }
 
 int run_scene(const RunOptions& opt) {
+  if (!(opt.sweep_tolerance >= 0.0) || opt.sweep_tolerance > kMaxCoordinate ||
+      (opt.sweep_tolerance != 0.0 && opt.sweep_tolerance < kMinCoordinate)) {
+    throw Error(ErrorCode::bad_value, "--sweep-tolerance", "must be 0 or in [2^-120, 1e15]");
+  }
   Scene scene = load_scene(opt.scene);
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
+  if (opt.steps > 100000000) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
   if (opt.steps > 0) scene.steps = opt.steps;
   if (opt.continuous) {
     if (!opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
@@ -138,6 +143,7 @@ int run_scene(const RunOptions& opt) {
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
+  Engine engine(engine_options);  // its options checked before any output is made
   // Every output is checked, and kept apart from every input, before any work is done.
   NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
   for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
@@ -150,7 +156,6 @@ int run_scene(const RunOptions& opt) {
 
   const auto load_start = Clock::now();
   const World world(std::move(scene));
-  Engine engine(engine_options);
   const double load_ms = ms_since(load_start);
   const Scene& sc = world.scene();
   std::printf("scene %s: %zu objects (%zu distinct models), %zu triangles, %d steps of %g s, %s query (d = %g, angle %g)\n",
@@ -205,8 +210,8 @@ int run_scene(const RunOptions& opt) {
   if (contacts_out) contacts_out->commit();
 
   if (limited_steps > 0) {
-    std::printf("\n%zu of %zu steps reached --max-pairs %zu on some pair: their contacts are partial\n", limited_steps,
-                stats.steps(), opt.max_pairs);
+    std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts are partial\n", limited_steps,
+                stats.steps(), sc.query.max_pairs, opt.max_pairs != 0 ? "--max-pairs" : "the scene's query");
   }
   const auto [heavy, heavy_share] = stats.heaviest_pair();
   const auto [second, second_share] = stats.second_heaviest_pair();

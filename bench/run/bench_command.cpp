@@ -568,6 +568,7 @@ int report_from_log(const BenchOptions& opt) {
   }
   std::filesystem::create_directories(out);
   write_outputs(records, out, opt.figures);
+  check_stdout();
   return 0;
 }
 
@@ -691,6 +692,7 @@ int run_bench(BenchOptions opt) {
     std::fprintf(stderr, "caliber bench: some method returned contacts that differ from sequential's (see above)\n");
     return 1;
   }
+  check_stdout();
   return 0;
 }
 

@@ -136,6 +136,10 @@ std::string record_problem(const Json& r, const Json* header) {
 }  // namespace
 
 std::vector<Json> read_bench_log(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw Error(ErrorCode::file_not_found, file.string(), "no such bench log");
+  // Read whole: a FIFO or a device (/dev/zero) would block or never end.
+  if (!std::filesystem::is_regular_file(file, ec)) throw Error(ErrorCode::unreadable, file.string(), "is not a regular file");
   std::ifstream in(file);
   if (!in) throw Error(ErrorCode::file_not_found, file.string(), "cannot be opened");
   std::vector<std::string> lines;

@@ -166,8 +166,9 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   r.only_keys(q, "query", {"kind", "tolerance", "angle", "max_pairs"});
   QueryRequest query;
   if (q.contains("kind")) {
+    const std::string kind = r.string(q.at("kind"), "query.kind");  // fails naming the file and key itself
     try {
-      query.kind = parse_query_kind(r.string(q.at("kind"), "query.kind"));
+      query.kind = parse_query_kind(kind);
     } catch (const Error& e) {
       r.fail("query.kind", e.what());
     }
@@ -236,6 +237,10 @@ Json::parser_callback_t refuse_duplicate_keys(const std::string& source) {
 
 Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir, const std::string& source) {
   const Reader r(source);
+  // JSON holds no NUL byte; the parser would end the text there and ignore the rest.
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+    throw Error(ErrorCode::unreadable, source, "holds a NUL byte at offset " + std::to_string(nul) + " (not a JSON text)");
+  }
   Json root;
   try {
     root = Json::parse(text, refuse_duplicate_keys(source));
@@ -305,6 +310,8 @@ Scene load_scene(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file, ec)) throw Error(ErrorCode::file_not_found, file.string(), "no such scene file");
   if (std::filesystem::is_directory(file, ec))
     throw Error(ErrorCode::unreadable, file.string(), "is a directory, not a scene file");
+  // Read whole: a FIFO or a device (/dev/zero) would block or never end.
+  if (!std::filesystem::is_regular_file(file, ec)) throw Error(ErrorCode::unreadable, file.string(), "is not a regular file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCode::unreadable, file.string(), "cannot be opened for reading");
   std::stringstream text;

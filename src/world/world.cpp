@@ -164,9 +164,17 @@ std::vector<Pose> World::poses_at(int step) const {
   for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
     const SceneObject& o = mScene.objects[i];
     poses.push_back(pose_at(o.pose, o.motion, t));
-    const bool far = !poses.back().translation.allFinite() || poses.back().translation.cwiseAbs().maxCoeff() > kMaxCoordinate;
-    if (!far && poses.back().rotation.coeffs().allFinite()) continue;
+    const Eigen::Vector3d& at = poses.back().translation;
+    const bool far = !at.allFinite() || at.cwiseAbs().maxCoeff() > kMaxCoordinate;
+    bool tiny = false;
+    for (int k = 0; k < 3; ++k) tiny = tiny || (at[k] != 0.0 && std::abs(at[k]) < kMinCoordinate);
+    if (!far && !tiny && poses.back().rotation.coeffs().allFinite()) continue;
     const std::string key = "objects[" + std::to_string(i) + "].motion";
+    if (tiny && !far) {
+      throw Error(ErrorCode::bad_value, source,
+                  "object '" + o.name + "' (" + key + ") has a translation component below 2^-120 (about 7.5e-37, the smallest " +
+                      "non-zero coordinate caliber takes) at step " + std::to_string(step));
+    }
     if (far) {
       throw Error(ErrorCode::bad_value, source,
                   "object '" + o.name + "' (" + key + ") moves beyond +-1e15 (caliber's limit on coordinates) by step " +

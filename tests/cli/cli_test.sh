@@ -131,7 +131,7 @@ contains max-pairs-roomy '"limit_reached":false'
 check max-pairs-negative 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --max-pairs -1
 mtmp=$(mktemp -d)
 check run-max-pairs 0 "$cli" run "$data/scenes/view_tetras.json" --max-pairs 1 --contacts "$mtmp/c.jsonl" --json "$mtmp/r.json"
-contains run-max-pairs "reached --max-pairs 1 on some pair"
+contains run-max-pairs "reached max_pairs 1 (--max-pairs) on some pair"
 python3 - "$mtmp/c.jsonl" "$mtmp/r.json" <<'PY' || { echo "FAIL run-max-pairs-files"; failures=$((failures + 1)); }
 import json, sys
 lines = [json.loads(l) for l in open(sys.argv[1])]
@@ -481,6 +481,55 @@ assert len(open(sys.argv[2]).read().splitlines()) == r["summary"]["steps"]
 PY
 then passes=$((passes + 1)); else echo "FAIL sigint: exit $rc"; failures=$((failures + 1)); fi
 rm -rf "$r2"
+
+# Special files, empty values and misnamed outputs.
+h=$(mktemp -d)
+mkfifo "$h/fifo.json"
+check scene-fifo 2 timeout 10 "$cli" run "$h/fifo.json"
+contains scene-fifo "fifo.json: is not a regular file"
+check scene-dev-zero 2 timeout 10 "$cli" run /dev/zero
+contains scene-dev-zero "/dev/zero: is not a regular file"
+check log-fifo 2 timeout 10 "$cli" bench --from-log "$h/fifo.json" --out "$h/b"
+contains log-fifo "is not a regular file"
+check empty-output-name 2 "$cli" run "$data/scenes/tetras.json" --json ""
+contains empty-output-name "--json: must not be empty"
+check empty-number 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind distance --tolerance '' --pose-b "2 0 0 1 0 0 0"
+contains empty-number "--tolerance: must not be empty"
+check refine-not-off 2 "$cli" refine "$data/tetra.off" "$h/r.obj"
+contains refine-not-off "OUT: must name an .off file"
+[ -e "$h/r.obj" ] && { echo "FAIL refine-not-off: wrote $h/r.obj"; failures=$((failures + 1)); }
+check refine-full-stdout 2 sh -c '"$0" refine "$1" "$2" > /dev/full' "$cli" "$data/tetra.off" "$h/r.off"
+contains refine-full-stdout "standard output: could not be written"
+python3 - "$h" "$data" <<'PY'
+import json, os, sys
+h, data = sys.argv[1], os.path.abspath(sys.argv[2])
+with open(f"{h}/nul.json", "wb") as f:
+    f.write(json.dumps({"steps": 1, "objects": [{"mesh": f"{data}/tetra.off"}]}).encode() + b"\0{{{junk\n")
+json.dump({"steps": 3, "dt": 0.1, "objects": [{"name": "fixed", "mesh": f"{data}/tetra.off"},
+           {"name": "mover", "mesh": f"{data}/tetra.off", "position": [0, 0.1, 0.1],
+            "motion": {"type": "velocity", "linear": [1e-36, 0, 0]}}]}, open(f"{h}/tiny.json", "w"))
+json.dump({"steps": 3, "dt": 0.1, "query": {"kind": "proximity", "tolerance": 0.05, "max_pairs": 1},
+           "objects": [{"name": "fixed", "mesh": f"{data}/tetra.off", "refine": 2},
+                       {"name": "mover", "mesh": f"{data}/tetra.off", "refine": 2, "position": [0.2, 0.1, 0.1],
+                        "motion": {"type": "velocity", "linear": [-0.1, 0, 0]}}]}, open(f"{h}/cut.json", "w"))
+json.dump({"steps": 3, "query": {"kind": 3}, "objects": [{"mesh": f"{data}/tetra.off"}]}, open(f"{h}/kind.json", "w"))
+PY
+check scene-nul 2 "$cli" run "$h/nul.json"
+contains scene-nul "holds a NUL byte at offset"
+check motion-tiny 2 "$cli" run "$h/tiny.json"
+contains motion-tiny "object 'mover' (objects[1].motion) has a translation component below 2^-120"
+check motion-tiny-continuous 2 "$cli" run "$h/tiny.json" --continuous
+contains motion-tiny-continuous "object 'mover' (objects[1].motion)"
+check scene-max-pairs 0 "$cli" run "$h/cut.json"
+contains scene-max-pairs "reached max_pairs 1 (the scene's query)"
+check scene-kind-once 2 "$cli" run "$h/kind.json"
+contains scene-kind-once "kind.json: 'query.kind': must be a string"
+case "$out" in *"kind.json: 'query.kind': "*"kind.json"*) echo "FAIL scene-kind-once: $out"; failures=$((failures + 1)) ;; esac
+check query-threads-range 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads -5
+check sweep-tolerance-nan 2 "$cli" run "$data/scenes/tetras.json" --sweep-tolerance nan
+check export-bad-threads-no-folder 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e4" --threads 99999
+[ -e "$h/e4" ] && { echo "FAIL export-bad-threads-no-folder: created $h/e4"; failures=$((failures + 1)); }
+rm -rf "$h"
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
