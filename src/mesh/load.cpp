@@ -40,6 +40,7 @@ std::string bounded(const std::string& message) {
 }
 
 void check_file(const std::filesystem::path& path) {
+  if (path.empty()) throw Error(ErrorCode::bad_argument, "mesh path", "is empty");
   // Files are opened by C strings, which would end at a NUL byte: another file.
   if (path.native().find('\0') != std::string::npos)
     throw Error(ErrorCode::bad_argument, path.string(), "the path holds a NUL byte");

@@ -135,9 +135,11 @@ SceneObject read_object(const Reader& r, const Json& j, const std::string& where
   o.mesh = o.mesh.lexically_normal();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(o.mesh, ec)) {
+    const bool there = std::filesystem::exists(o.mesh, ec);
     r.fail(where + ".mesh",
-           "no such mesh file: " + o.mesh.string() + (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
-           ErrorCode::file_not_found);
+           (there ? "not a regular mesh file: " : "no such mesh file: ") + o.mesh.string() +
+               (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
+           there ? ErrorCode::unreadable : ErrorCode::file_not_found);
   }
   o.scale = r.number(j, where, "scale", 1.0);
   if (!(o.scale > 0.0)) r.fail(where + ".scale", "must be > 0");
@@ -304,6 +306,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
 }
 
 Scene load_scene(const std::filesystem::path& file) {
+  if (file.empty()) throw Error(ErrorCode::bad_argument, "scene path", "is empty");
   if (file.native().find('\0') != std::string::npos)
     throw Error(ErrorCode::bad_argument, file.string(), "the path holds a NUL byte");
   std::error_code ec;

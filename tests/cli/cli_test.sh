@@ -525,6 +525,12 @@ contains scene-max-pairs "reached max_pairs 1 (the scene's query)"
 check scene-kind-once 2 "$cli" run "$h/kind.json"
 contains scene-kind-once "kind.json: 'query.kind': must be a string"
 case "$out" in *"kind.json: 'query.kind': "*"kind.json"*) echo "FAIL scene-kind-once: $out"; failures=$((failures + 1)) ;; esac
+mkfifo "$h/pipe.off"
+printf '{"objects": [{"mesh": "pipe.off"}]}' > "$h/pipe.json"
+check scene-mesh-fifo 2 timeout 10 "$cli" run "$h/pipe.json"
+contains scene-mesh-fifo "'objects[0].mesh': not a regular mesh file"
+check query-empty-path 2 "$cli" query "" "$data/tetra.off"
+contains query-empty-path "mesh path: is empty"
 check query-threads-range 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads -5
 check sweep-tolerance-nan 2 "$cli" run "$data/scenes/tetras.json" --sweep-tolerance nan
 check export-bad-threads-no-folder 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e4" --threads 99999
