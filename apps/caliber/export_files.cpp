@@ -127,6 +127,13 @@ void write_bvh(const World& world, const std::vector<Pose>& poses, int k, int de
 
 }  // namespace
 
+Exporter::~Exporter() {
+  if (mCommitted) return;
+  std::error_code ec;
+  for (const std::string& file : mWritten) std::filesystem::remove(file, ec);
+  if (mMadeFolder) std::filesystem::remove(mOptions.dir, ec);  // only if empty
+}
+
 Exporter::Exporter(ExportOptions options, int scene_steps) : mOptions(std::move(options)) {
   for (const int k : mOptions.steps) {
     if (k < 0 || k >= scene_steps) {
@@ -140,6 +147,7 @@ Exporter::Exporter(ExportOptions options, int scene_steps) : mOptions(std::move(
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
     throw Error(ErrorCode::bad_value, mOptions.dir, "--export needs a folder, and this is a file");
   }
+  mMadeFolder = !std::filesystem::exists(dir, ec);
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error(ErrorCode::bad_value, mOptions.dir, "--export: cannot create the folder (" + ec.message() + ")");
 }

@@ -37,9 +37,18 @@ class Exporter {
   /// The files written so far.
   [[nodiscard]] const std::vector<std::string>& written() const { return mWritten; }
 
+  /// Keeps what was written. Without it (a run that fails), the destructor removes the files
+  /// written and the folder if this exporter made it.
+  void commit() { mCommitted = true; }
+  ~Exporter();
+  Exporter(const Exporter&) = delete;
+  Exporter& operator=(const Exporter&) = delete;
+
  private:
   ExportOptions mOptions;
   mutable std::vector<std::string> mWritten;
+  bool mMadeFolder = false;
+  bool mCommitted = false;
 };
 
 }  // namespace caliber::cli

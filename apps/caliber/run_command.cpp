@@ -144,6 +144,12 @@ int run_scene(const RunOptions& opt) {
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
   Engine engine(engine_options);  // its options checked before any output is made
+  const std::vector<int>& listed = opt.exports.steps;
+  for (auto k = listed.begin(); k != listed.end(); ++k) {
+    if (std::find(listed.begin(), k, *k) != k) {
+      throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*k) + " is listed twice");
+    }
+  }
   // Every output is checked, and kept apart from every input, before any work is done.
   NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
   for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
@@ -208,6 +214,7 @@ int run_scene(const RunOptions& opt) {
   if (interrupted)
     std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
   if (contacts_out) contacts_out->commit();
+  if (exporter) exporter->commit();
 
   if (limited_steps > 0) {
     std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts are partial\n", limited_steps,

@@ -613,6 +613,12 @@ int run_bench(BenchOptions opt) {
   for (const std::string& file : opt.scenes) {
     scenes.push_back(load_scene(file));
     if (opt.steps > 0) scenes.back().steps = opt.steps;
+    for (std::size_t i = 0; i + 1 < scenes.size(); ++i) {
+      if (scenes[i].name == scenes.back().name) {
+        throw Error(ErrorCode::bad_argument, file,
+                    "scene '" + scenes.back().name + "' is given twice (each scene's outputs are named by it)");
+      }
+    }
   }
   if (opt.out.empty()) opt.out = "bench/results/" + machine_slug() + "/engine";
   if (std::filesystem::exists(opt.out) && !std::filesystem::is_directory(opt.out)) {
@@ -632,6 +638,9 @@ int run_bench(BenchOptions opt) {
   NamedFiles outputs = bench_outputs(opt.out, names);
   outputs.insert(outputs.begin(), {opt.log.empty() ? "--out's runs.jsonl" : "--log", log_path.string()});
   check_distinct_files(outputs, inputs);
+  if (std::error_code ec; !opt.log.empty() && std::filesystem::is_directory(log_path, ec)) {
+    throw Error(ErrorCode::bad_argument, "--log", "'" + opt.log + "' is a folder, not a log file");  // before --out is made
+  }
   std::filesystem::create_directories(opt.out);
   BenchLog log(log_path);  // opened before the long work: an unwritable log fails now
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

@@ -7,6 +7,9 @@
 #include <string>
 #include <utility>
 
+#include <cerrno>
+#include <cstring>
+
 #include "caliber/error.h"
 #include "timing.h"
 
@@ -15,7 +18,12 @@ namespace caliber::cli {
 using Json = nlohmann::json;
 
 BenchLog::BenchLog(std::filesystem::path file) : mFile(std::move(file)), mOut(mFile, std::ios::trunc) {
-  if (!mOut) throw Error(ErrorCode::unreadable, mFile.string(), "cannot be opened for writing");
+  if (!mOut) {
+    std::error_code ec;
+    const bool folder = std::filesystem::is_directory(mFile, ec);
+    throw Error(ErrorCode::unreadable, mFile.string(),
+                folder ? "is a folder, not a log file" : std::string("cannot be opened for writing: ") + std::strerror(errno));
+  }
 }
 
 void BenchLog::add(Json record) {

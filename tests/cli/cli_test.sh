@@ -531,6 +531,15 @@ check scene-mesh-fifo 2 timeout 10 "$cli" run "$h/pipe.json"
 contains scene-mesh-fifo "'objects[0].mesh': not a regular mesh file"
 check query-empty-path 2 "$cli" query "" "$data/tetra.off"
 contains query-empty-path "mesh path: is empty"
+check motion-tiny-export 2 "$cli" run "$h/tiny.json" --export "$h/e5" --export-steps 0 --json "$h/r5.json"
+[ -e "$h/e5" ] || [ -e "$h/r5.json" ] && { echo "FAIL motion-tiny-export: a failed run left $(ls "$h")"; failures=$((failures + 1)); }
+check export-steps-twice 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e6" --export-steps 0,0
+contains export-steps-twice "--export-steps: step 0 is listed twice"
+check bench-log-folder 2 "$cli" bench "$data/scenes/tetras.json" --out "$h/b1" --log "$h" --steps 2
+contains bench-log-folder "--log: '$h' is a folder, not a log file"
+[ -e "$h/b1" ] && { echo "FAIL bench-log-folder: created $h/b1"; failures=$((failures + 1)); }
+check bench-scene-twice 2 "$cli" bench "$data/scenes/tetras.json" "$data/scenes/tetras.json" --out "$h/b2" --steps 2
+contains bench-scene-twice "scene 'tetras' is given twice"
 check query-threads-range 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads -5
 check sweep-tolerance-nan 2 "$cli" run "$data/scenes/tetras.json" --sweep-tolerance nan
 check export-bad-threads-no-folder 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e4" --threads 99999
