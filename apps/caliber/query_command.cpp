@@ -205,7 +205,7 @@ Runner add_query_command(CLI::App& app) {
   cmd->add_option("--show", opt->show, "How many pairs the summary lists")->capture_default_str()->check(at_least(0));
   cmd->add_option("--method", opt->method,
                   "sequential (default: caliber::query) or an engine method: exploitation, stealing, aposteriori, "
-                  "apriori, hybrid (same pairs; build time then counted in query_ms)")
+                  "apriori, hybrid (same pairs; query_ms times the engine's step)")
       ->capture_default_str();
   cmd->add_option("--threads", opt->threads,
                   "Engine threads (0: every hardware thread the process may use; 1: this thread alone)")
