@@ -129,7 +129,10 @@ struct PyBatch {
 
   /// What pickle keeps: the arrays the others derive from, and the counters.
   [[nodiscard]] py::tuple state() const {
-    return py::make_tuple(offsets, limit_reached, pairs, points_a, points_b, normals, distances, depths, node_tests, leaf_tests);
+    // Copies: the Batch's own arrays never leave it (concatenate trusts their shapes).
+    const auto copy = [](const py::array& a) { return a.attr("copy")(); };
+    return py::make_tuple(copy(offsets), copy(limit_reached), copy(pairs), copy(points_a), copy(points_b), copy(normals),
+                          copy(distances), copy(depths), node_tests, leaf_tests);
   }
 
   /// A Batch from its pickled state, every array checked (dtype converted, shape and offsets

@@ -40,12 +40,18 @@ inline std::string describe(PyObject* o) {
     PyErr_Clear();
     return type;
   }
+  // Cut by characters, not bytes, so that the text stays valid UTF-8.
+  const bool long_repr = PyUnicode_GetLength(repr) > static_cast<Py_ssize_t>(kReprMost);
+  PyObject* shown = long_repr ? PyUnicode_Substring(repr, 0, static_cast<Py_ssize_t>(kReprMost)) : repr;
   Py_ssize_t size = 0;
-  const char* text = PyUnicode_AsUTF8AndSize(repr, &size);
+  const char* text = shown != nullptr ? PyUnicode_AsUTF8AndSize(shown, &size) : nullptr;
   std::string out = text != nullptr ? std::string(text, static_cast<std::size_t>(size)) : type;
   if (text == nullptr) PyErr_Clear();
+  if (long_repr) {
+    Py_XDECREF(shown);
+    out = type + " " + out + "...";
+  }
   Py_DECREF(repr);
-  if (out.size() > kReprMost) out = type + " " + out.substr(0, kReprMost) + "...";
   for (char& c : out) {
     if (c == '\n' || c == '\r') c = ' ';
   }
@@ -72,54 +78,63 @@ inline std::string one_line(const std::string& text) {
   return out;
 }
 
+/// The bounded message for a TypeError whose text is `message` (see bound_type_error).
+inline std::string bounded_message(const std::string& message, PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
+  const std::size_t invoked = message.find("\nInvoked with:");
+  std::string out = one_line(message.substr(0, invoked));
+  if (out.size() > kSignaturesMost) out = out.substr(0, kSignaturesMost) + "...";
+  if (invoked == std::string::npos) return out;
+  out += " Invoked with: ";
+  // A constructor's self (the new object) is left out, as pybind11 leaves it out.
+  const Py_ssize_t first = message.find("incompatible constructor arguments") != std::string::npos ? 1 : 0;
+  bool some = false;
+  for (Py_ssize_t i = first; i < nargs; ++i) {
+    out += (some ? ", " : "") + describe(args[i]);
+    some = true;
+  }
+  const Py_ssize_t named = kwnames != nullptr ? PyTuple_GET_SIZE(kwnames) : 0;
+  for (Py_ssize_t k = 0; k < named; ++k) {
+    const char* name = PyUnicode_AsUTF8(PyTuple_GET_ITEM(kwnames, k));
+    if (name == nullptr) PyErr_Clear();
+    out += (some ? ", " : "") + std::string(name != nullptr ? name : "?") + "=" + describe(args[nargs + k]);
+    some = true;
+  }
+  return out;
+}
+
 /// With a TypeError set whose message is long or spans lines: replaces it with one line, the
 /// message's part before pybind11's "Invoked with:" (at most kSignaturesMost characters), then the
-/// arguments of the call (vectorcall form) described briefly. Any other error is left as it is.
-inline void bound_type_error(PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) {
+/// arguments of the call (vectorcall form) described briefly. Any other error is left as it is,
+/// and so is this one when the bounded message cannot be made (out of memory).
+inline void bound_type_error(PyObject* const* args, Py_ssize_t nargs, PyObject* kwnames) noexcept {
   if (PyErr_Occurred() == nullptr || PyErr_ExceptionMatches(PyExc_TypeError) == 0) return;
   PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
   PyErr_Fetch(&type, &value, &traceback);
   PyErr_NormalizeException(&type, &value, &traceback);
-  std::string message;
-  if (PyObject* text = value != nullptr ? PyObject_Str(value) : nullptr) {
-    Py_ssize_t size = 0;
-    if (const char* utf8 = PyUnicode_AsUTF8AndSize(text, &size)) message.assign(utf8, static_cast<std::size_t>(size));
-    Py_DECREF(text);
+  std::string out;
+  try {
+    std::string message;
+    if (PyObject* text = value != nullptr ? PyObject_Str(value) : nullptr) {
+      Py_ssize_t size = 0;
+      if (const char* utf8 = PyUnicode_AsUTF8AndSize(text, &size)) message.assign(utf8, static_cast<std::size_t>(size));
+      Py_DECREF(text);
+    }
+    PyErr_Clear();
+    if (message.size() > kMessageMost || message.find('\n') != std::string::npos)
+      out = bounded_message(message, args, nargs, kwnames);
+  } catch (...) {
+    out.clear();
   }
   PyErr_Clear();
-  if (message.size() <= kMessageMost && message.find('\n') == std::string::npos) {
+  PyObject* text = out.empty() ? nullptr : PyUnicode_DecodeUTF8(out.data(), static_cast<Py_ssize_t>(out.size()), "replace");
+  PyObject* replacement = text != nullptr ? PyObject_CallOneArg(type, text) : nullptr;
+  Py_XDECREF(text);
+  if (replacement == nullptr) {  // short already, or not made: the original error
+    PyErr_Clear();
     PyErr_Restore(type, value, traceback);
     return;
   }
-  const std::size_t invoked = message.find("\nInvoked with:");
-  std::string out = one_line(message.substr(0, invoked));
-  if (out.size() > kSignaturesMost) out = out.substr(0, kSignaturesMost) + "...";
-  if (invoked != std::string::npos) {
-    out += " Invoked with: ";
-    // A constructor's self (the new object) is left out, as pybind11 leaves it out.
-    const Py_ssize_t first = message.find("incompatible constructor arguments") != std::string::npos ? 1 : 0;
-    bool some = false;
-    for (Py_ssize_t i = first; i < nargs; ++i) {
-      out += (some ? ", " : "") + describe(args[i]);
-      some = true;
-    }
-    const Py_ssize_t named = kwnames != nullptr ? PyTuple_GET_SIZE(kwnames) : 0;
-    for (Py_ssize_t k = 0; k < named; ++k) {
-      const char* name = PyUnicode_AsUTF8(PyTuple_GET_ITEM(kwnames, k));
-      if (name == nullptr) PyErr_Clear();
-      out += (some ? ", " : "") + std::string(name != nullptr ? name : "?") + "=" + describe(args[nargs + k]);
-      some = true;
-    }
-  }
   Py_XDECREF(value);
-  PyObject* text = PyUnicode_FromStringAndSize(out.data(), static_cast<Py_ssize_t>(out.size()));
-  PyObject* replacement = text != nullptr ? PyObject_CallOneArg(type, text) : nullptr;
-  Py_XDECREF(text);
-  if (replacement == nullptr) {  // keep whatever that raised
-    Py_XDECREF(type);
-    Py_XDECREF(traceback);
-    return;
-  }
   PyErr_Restore(type, replacement, traceback);
 }
 

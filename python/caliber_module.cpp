@@ -53,49 +53,52 @@ std::string file_path(const py::object& path) {
   return bytes;
 }
 
-/// N real numbers (`name`: a translation, a quaternion): a list or tuple of Python floats and ints
-/// read directly, anything else through numpy, whose dtype must be real (a complex number's
-/// imaginary part, a bool or a digit string is refused, not converted).
+/// N real numbers (`name`: a translation, a quaternion): a list or tuple of N numbers (Python
+/// floats and ints, numpy reals, anything with __float__), or an array of N real numbers (a row,
+/// a column). Complex numbers, bools and strings are refused, not converted: an imaginary part is
+/// not dropped, True is not 1.
 template <std::size_t N>
 std::array<double, N> reals(const py::object& given, const char* name) {
+  const auto refuse = [&](const std::string& what) {
+    return caliber::Error(caliber::ErrorCode::bad_argument, name, "must be " + std::to_string(N) + " real numbers, not " + what);
+  };
   std::array<double, N> out{};
-  if ((PyList_Check(given.ptr()) != 0 || PyTuple_Check(given.ptr()) != 0) && py::len(given) == N) {
-    bool plain = true;
-    for (std::size_t i = 0; i < N && plain; ++i) {
+  if (PyList_Check(given.ptr()) != 0 || PyTuple_Check(given.ptr()) != 0) {
+    if (py::len(given) != N) throw refuse(std::to_string(py::len(given)) + " items");
+    static const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
+    static const py::object numpy_complex = py::module_::import("numpy").attr("complexfloating");
+    for (std::size_t i = 0; i < N; ++i) {
       PyObject* item = PySequence_Fast_GET_ITEM(given.ptr(), static_cast<Py_ssize_t>(i));
-      if (PyFloat_Check(item) != 0) {
-        out[i] = PyFloat_AS_DOUBLE(item);
-      } else if (PyLong_Check(item) != 0 && PyBool_Check(item) == 0) {
-        out[i] = PyLong_AsDouble(item);
-        if (out[i] == -1.0 && PyErr_Occurred() != nullptr) {
-          PyErr_Clear();
-          plain = false;
-        }
-      } else {
-        plain = false;
+      const py::handle h(item);
+      const std::string type = py::str(h.get_type().attr("__name__"));
+      if (PyBool_Check(item) != 0 || py::isinstance(h, numpy_bool) || PyComplex_Check(item) != 0 ||
+          py::isinstance(h, numpy_complex) || PyUnicode_Check(item) != 0 || PyBytes_Check(item) != 0) {
+        throw refuse("a " + type);
+      }
+      out[i] = PyFloat_AsDouble(item);  // floats, ints, numpy reals, Decimal, Fraction: their __float__
+      if (out[i] == -1.0 && PyErr_Occurred() != nullptr) {
+        PyErr_Clear();
+        throw refuse("a " + type);
       }
     }
-    if (plain) return out;
+    return out;
   }
   const py::array a = py::array::ensure(given);
   const char kind = a ? a.dtype().kind() : 'O';
   if (kind != 'f' && kind != 'i' && kind != 'u') {
-    const std::string type =
-        a ? "dtype " + std::string(py::str(a.dtype())) : std::string(py::str(given.get_type().attr("__name__")));
-    throw caliber::Error(caliber::ErrorCode::bad_argument, name, "must be " + std::to_string(N) + " real numbers, not " + type);
+    throw refuse(a ? "dtype " + std::string(py::str(a.dtype())) : std::string(py::str(given.get_type().attr("__name__"))));
   }
-  if (a.ndim() != 1 || a.shape(0) != static_cast<py::ssize_t>(N)) {
-    throw caliber::Error(caliber::ErrorCode::bad_argument, name,
-                         "must be " + std::to_string(N) + " numbers, not an array of " + std::to_string(a.size()) + " in " +
-                             std::to_string(a.ndim()) + " dimensions");
+  if (a.size() != static_cast<py::ssize_t>(N) || a.ndim() > 2) {
+    throw refuse("an array of " + std::to_string(a.size()) + " in " + std::to_string(a.ndim()) + " dimensions");
   }
   const py::array_t<double, py::array::c_style | py::array::forcecast> values(a);
   std::copy_n(values.data(), N, out.begin());
   return out;
 }
 
-/// One flag per object (`fixed`): each True or False (a numpy bool too), or the ints 0 and 1; an
-/// empty list for none. Anything else is refused, not converted by truth value.
+/// One flag per object (`fixed`): each True or False (a numpy bool too), or an integer 0 or 1
+/// (Python's or numpy's); an empty list for none. Anything else is refused, not converted by its
+/// truth value.
 std::vector<bool> flags_of(const py::object& given, const char* name) {
   if (given.is_none()) return {};
   if (py::isinstance<py::str>(given) || !py::isinstance<py::sequence>(given)) {
@@ -104,12 +107,14 @@ std::vector<bool> flags_of(const py::object& given, const char* name) {
   const auto seq = py::reinterpret_borrow<py::sequence>(given);
   std::vector<bool> out;
   out.reserve(seq.size());
-  const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
+  static const py::object numpy_bool = py::module_::import("numpy").attr("bool_");
+  static const py::object numpy_integer = py::module_::import("numpy").attr("integer");
   for (std::size_t i = 0; i < seq.size(); ++i) {
     const py::object item = seq[i];
     if (PyBool_Check(item.ptr()) != 0 || py::isinstance(item, numpy_bool)) {
       out.push_back(PyObject_IsTrue(item.ptr()) == 1);
-    } else if (PyLong_CheckExact(item.ptr()) != 0 && (item.equal(py::int_(0)) || item.equal(py::int_(1)))) {
+    } else if ((PyLong_Check(item.ptr()) != 0 || py::isinstance(item, numpy_integer)) &&
+               (item.equal(py::int_(0)) || item.equal(py::int_(1)))) {
       out.push_back(item.equal(py::int_(1)));
     } else {
       throw caliber::Error(caliber::ErrorCode::bad_argument, std::string(name) + "[" + std::to_string(i) + "]",

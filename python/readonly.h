@@ -1,12 +1,14 @@
 #pragma once
 // Result objects whose numpy arrays Python reads but cannot change: each array is made read-only
-// once written, and each attribute returns a view of it (a new numpy object, so that changing the
-// view's shape or dtype leaves the object's own array as it is).
+// once written, and each attribute returns a read-only view of it whose base is the object (so
+// that neither the view nor its base reaches the array itself).
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <initializer_list>
+#include <utility>
+#include <vector>
 
 namespace caliber_python {
 
@@ -15,10 +17,17 @@ inline void freeze(std::initializer_list<pybind11::array*> arrays) {
   for (pybind11::array* a : arrays) a->attr("flags").attr("writeable") = false;
 }
 
-/// A view of the array `Member` of an object of class C: what its attribute returns.
+/// A read-only view of the array `Member` of the object `self` (of class C): what its attribute
+/// returns. The view's base is `self`, not the array, so that nothing reached through it can
+/// change the array's dtype, shape or flags; `self` keeps the data alive.
 template <class C, auto Member>
-pybind11::object view_of(const C& object) {
-  return (object.*Member).attr("view")();
+pybind11::object view_of(pybind11::object self) {
+  const C& object = self.cast<const C&>();
+  const pybind11::array& a = object.*Member;
+  const std::vector<pybind11::ssize_t> shape(a.shape(), a.shape() + a.ndim()), strides(a.strides(), a.strides() + a.ndim());
+  pybind11::array view(a.dtype(), shape, strides, a.data(), self);
+  view.attr("flags").attr("writeable") = false;  // and not to be set again: its base is no writeable buffer
+  return view;
 }
 
 }  // namespace caliber_python

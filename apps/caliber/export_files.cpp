@@ -131,7 +131,7 @@ Exporter::~Exporter() {
   if (mCommitted) return;
   std::error_code ec;
   for (const std::string& file : mWritten) std::filesystem::remove(file, ec);
-  if (mMadeFolder) std::filesystem::remove(mOptions.dir, ec);  // only if empty
+  for (const std::filesystem::path& folder : mMadeFolders) std::filesystem::remove(folder, ec);  // only if empty
 }
 
 Exporter::Exporter(ExportOptions options, int scene_steps) : mOptions(std::move(options)) {
@@ -147,7 +147,11 @@ Exporter::Exporter(ExportOptions options, int scene_steps) : mOptions(std::move(
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
     throw Error(ErrorCode::bad_value, mOptions.dir, "--export needs a folder, and this is a file");
   }
-  mMadeFolder = !std::filesystem::exists(dir, ec);
+  // The folders this makes, deepest first (removed, if empty, after a failed run).
+  for (std::filesystem::path p = dir; !p.empty() && !std::filesystem::exists(p, ec); p = p.parent_path()) {
+    mMadeFolders.push_back(p);
+    if (p == p.parent_path()) break;
+  }
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error(ErrorCode::bad_value, mOptions.dir, "--export: cannot create the folder (" + ec.message() + ")");
 }
@@ -173,9 +177,11 @@ std::vector<std::string> export_paths(const ExportOptions& options) {
 void Exporter::write(const World& world, const StepResult& step) const {
   const std::vector<Pose> poses = world.poses_at(step.step);
   const std::string stem = cli::stem(mOptions, step.step);
+  // Each file counted as written as soon as it is (a failure on the next removes it too).
   write_objects(world, poses, step.step, stem + "_objects.ply");
+  mWritten.push_back(stem + "_objects.ply");
   write_contacts(world, step, poses, stem + "_contacts.ply");
-  mWritten.insert(mWritten.end(), {stem + "_objects.ply", stem + "_contacts.ply"});
+  mWritten.push_back(stem + "_contacts.ply");
   if (mOptions.bvh_depth >= 0) {
     write_bvh(world, poses, step.step, mOptions.bvh_depth, stem + "_bvh.ply");
     mWritten.push_back(stem + "_bvh.ply");

@@ -3,6 +3,7 @@
 // each chosen step, PLY files of the posed meshes, of the contacts (points, and normals as
 // segments) and, on request, of every object's BVH boxes down to a depth (docs/exports.md).
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,7 @@ class Exporter {
   [[nodiscard]] const std::vector<std::string>& written() const { return mWritten; }
 
   /// Keeps what was written. Without it (a run that fails), the destructor removes the files
-  /// written and the folder if this exporter made it.
+  /// written and the folders this exporter made.
   void commit() { mCommitted = true; }
   ~Exporter();
   Exporter(const Exporter&) = delete;
@@ -47,7 +48,7 @@ class Exporter {
  private:
   ExportOptions mOptions;
   mutable std::vector<std::string> mWritten;
-  bool mMadeFolder = false;
+  std::vector<std::filesystem::path> mMadeFolders;
   bool mCommitted = false;
 };
 

@@ -188,6 +188,12 @@ def test_a_batch_cannot_be_changed_through_its_arrays():
         # The view's shape and dtype are its own: the batch's arrays keep theirs.
         view.shape = (-1,)
         view.dtype = np.uint8
+    # Nor through a view's base (the Batch itself) or a pickled state (copies).
+    view = whole.distances
+    assert view.base is whole
+    state = whole.__reduce__()[1][0]
+    state[6].dtype = np.int8
+    state[0][...] = 0
     for name in FIELDS:
         assert getattr(whole, name).tobytes() == before[name], name
     joined = caliber.Batch.concatenate([whole, whole])

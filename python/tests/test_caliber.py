@@ -151,15 +151,24 @@ def test_poses_refuse_numbers_that_are_not_real():
     # Lists, tuples and arrays of floats and ints are taken; numpy arrays of any real dtype too.
     assert caliber.Pose([1, 2.5, 3]).translation == [1.0, 2.5, 3.0]
     assert caliber.Pose(np.array([1, 2, 3], dtype=np.int16), np.array([1, 0, 0, 0], dtype=np.float32)).translation == [1, 2, 3]
+    # Numbers with __float__ (numpy scalars, Decimal, Fraction) and a column of a matrix, as before.
+    from decimal import Decimal
+    from fractions import Fraction
+    assert caliber.Pose([np.float32(0.5), Decimal("1.5"), Fraction(1, 4)]).translation == [0.5, 1.5, 0.25]
+    m = caliber.Pose((1.0, 2.0, 3.0)).matrix()
+    assert caliber.Pose(m[:3, 3:]).translation == [1.0, 2.0, 3.0]
     complex_matrix = np.eye(4, dtype=complex)
     complex_matrix[0, 3] = 5j  # its imaginary part was dropped: a translation of 0
     for call, match in [
         (lambda: caliber.Pose(np.array([1, 2, 3 + 1j])), "translation: must be 3 real numbers, not dtype complex128"),
         (lambda: caliber.Pose([1, 2, 3j]), "translation: must be 3 real numbers"),
-        (lambda: caliber.Pose((0, 0, 0), [True, False, False, False]), "quaternion: must be 4 real numbers, not dtype bool"),
+        (lambda: caliber.Pose((0, 0, 0), [True, False, False, False]), "quaternion: must be 4 real numbers, not a bool"),
+        (lambda: caliber.Pose([True, 0, 0]), "translation: must be 3 real numbers, not a bool"),
+        (lambda: caliber.Pose(np.array([True] * 3)), "translation: must be 3 real numbers, not dtype bool"),
         (lambda: caliber.Pose(["1", "2", "3"]), "translation: must be 3 real numbers"),
-        (lambda: caliber.Pose((1, 2)), "translation: must be 3 numbers, not an array of 2"),
-        (lambda: caliber.Pose.from_quaternion((1, 0, 0), "wxyz"), "quaternion: must be 4 numbers"),
+        (lambda: caliber.Pose((1, 2)), "translation: must be 3 real numbers, not 2 items"),
+        (lambda: caliber.Pose(np.zeros((2, 2))), "translation: must be 3 real numbers, not an array of 4"),
+        (lambda: caliber.Pose.from_quaternion((1, 0, 0), "wxyz"), "quaternion: must be 4 real numbers, not 3 items"),
         (lambda: caliber.Pose.from_matrix(complex_matrix), "matrix: must hold real numbers, not dtype complex128"),
         (lambda: caliber.Pose.from_matrix(np.eye(4, dtype=bool)), "matrix: must hold real numbers, not dtype bool"),
         (lambda: caliber.Pose.from_matrix(np.eye(4).astype(str)), "matrix: must hold real numbers"),
@@ -186,6 +195,7 @@ def test_broad_phase_gives_the_pairs_a_step_takes():
     assert caliber.broad_phase(models, poses, 0.3, fixed=[True, True, False]) == []
     assert caliber.broad_phase(models, poses, 0.3, fixed=np.array([True, True, False])) == []
     assert caliber.broad_phase(models, poses, 0.3, fixed=[1, 1, 0]) == []
+    assert caliber.broad_phase(models, poses, 0.3, fixed=np.array([1, 1, 0])) == []
     # Flags are True or False (or 0 and 1), not any object's truth value.
     for flags, match in [([0.5, 1.0, 0.0], r"fixed\[0\]: must be True or False, not float"),
                          ([None] * 3, r"fixed\[0\]: must be True or False, not NoneType"),

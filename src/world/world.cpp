@@ -31,19 +31,26 @@ void check_object(std::size_t i, std::size_t objects) {
   }
 }
 
-/// What parse_scene checks of a scene file, for a Scene built by hand: dt, each object's scale,
-/// refinement, pose and motion (a keyframe motion needs keys, at finite increasing times).
+/// What parse_scene checks of a scene file, for a Scene built by hand: dt > 0, each object's
+/// scale > 0 and refinement, finite numbers in its pose and motion, and a keyframe motion with
+/// keys at finite, increasing times. (Where a motion takes an object is checked at each step,
+/// poses_at.)
 void check_scene(const Scene& scene) {
   const std::string source = scene.file.empty() ? "scene " + scene.name : scene.file.string();
   if (!(scene.dt > 0.0) || !std::isfinite(scene.dt)) throw Error(ErrorCode::bad_value, source, "dt must be finite and > 0");
+  const auto finite = [](const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+    return p.allFinite() && q.coeffs().allFinite() && q.coeffs().squaredNorm() > 0.0;
+  };
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& o = scene.objects[i];
     const std::string what = "object '" + o.name + "' (objects[" + std::to_string(i) + "])";
-    if (!std::isfinite(o.scale) || o.scale == 0.0)
-      throw Error(ErrorCode::bad_value, source, what + ": scale must be finite and not 0");
+    if (!(o.scale > 0.0) || !std::isfinite(o.scale))
+      throw Error(ErrorCode::bad_value, source, what + ": scale must be finite and > 0");
     if (o.refine < 0 || o.refine > 6) throw Error(ErrorCode::bad_value, source, what + ": refine must be in [0, 6]");
-    validate_pose(o.pose, source + ": " + what + ": pose");
     const Motion& m = o.motion;
+    if (m.type != Motion::Type::keyframes && !finite(o.pose.translation, o.pose.rotation)) {
+      throw Error(ErrorCode::bad_value, source, what + ": its pose must be finite, with a non-zero quaternion");
+    }
     if (!m.linear.allFinite() || !m.angular.allFinite()) {
       throw Error(ErrorCode::bad_value, source, what + ": its velocities must be finite");
     }
@@ -55,7 +62,9 @@ void check_scene(const Scene& scene) {
       if (!std::isfinite(key.time) || (k > 0 && !(key.time > m.keys[k - 1].time))) {
         throw Error(ErrorCode::bad_value, source, at + ": key times must be finite and increase");
       }
-      validate_pose(Pose{key.orientation, key.position}, source + ": " + at);
+      if (!finite(key.position, key.orientation)) {
+        throw Error(ErrorCode::bad_value, source, at + ": its pose must be finite, with a non-zero quaternion");
+      }
     }
   }
 }

@@ -212,14 +212,22 @@ TEST_F(WorldFiles, HandBuiltScenesAreCheckedAsSceneFilesAre) {
         s.objects[1].motion.keys.resize(2);
       },
       "key 1: key times must be finite and increase");
-  refused([](Scene& s) { s.objects[1].scale = std::numeric_limits<double>::quiet_NaN(); }, "scale must be finite and not 0");
+  refused([](Scene& s) { s.objects[1].scale = std::numeric_limits<double>::quiet_NaN(); }, "scale must be finite and > 0");
+  refused([](Scene& s) { s.objects[1].scale = -2.0; }, "scale must be finite and > 0");
   refused([](Scene& s) { s.objects[0].refine = 7; }, "refine must be in [0, 6]");
   refused([](Scene& s) { s.dt = 0.0; }, "dt must be finite and > 0");
   refused([](Scene& s) { s.objects[1].motion.linear.x() = std::numeric_limits<double>::infinity(); },
           "velocities must be finite");
   refused([](Scene& s) { s.objects[0].pose.translation.y() = std::numeric_limits<double>::quiet_NaN(); },
-          "object 'a' (objects[0]): pose");
+          "object 'a' (objects[0]): its pose must be finite");
   EXPECT_THROW((void)pose_at(Pose{}, Motion{Motion::Type::keyframes}, 0.0), Error) << "no key to hold";
+  // A key far away that the steps never reach is no error (where a motion takes an object is
+  // checked at each step), as in a scene file.
+  Scene far = base;
+  far.objects[1].motion.type = Motion::Type::keyframes;
+  far.objects[1].motion.keys = {Keyframe{0.0, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()},
+                                Keyframe{1000.0, Eigen::Vector3d(2e15, 0.0, 0.0), Eigen::Quaterniond::Identity()}};
+  EXPECT_NO_THROW((void)World(far));
   const World world(base);
   EXPECT_THROW((void)world.model(2), Error);
   EXPECT_THROW((void)world.bounds(2, Pose{}, 0.0), Error);
