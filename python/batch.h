@@ -122,7 +122,6 @@ struct PyBatch {
       }
     }
     derive();
-    freeze();
     node_tests = b.stats.node_tests;
     leaf_tests = b.stats.leaf_tests;
   }
@@ -168,7 +167,6 @@ struct PyBatch {
       b.node_tests = t[8].cast<std::uint64_t>();
       b.leaf_tests = t[9].cast<std::uint64_t>();
       b.derive();
-      b.freeze();
       return b;
     } catch (const py::cast_error&) {
       throw refuse("the counters must be integers >= 0");
@@ -204,18 +202,10 @@ struct PyBatch {
       r += pk;
     }
     b.derive();
-    b.freeze();
     return b;
   }
 
  private:
-  /// Made read-only once written (readonly.h): what Python reads are views of them, which cannot
-  /// write to them or change the shapes and offsets that concatenate and pickle rely on.
-  void freeze() {
-    caliber_python::freeze(
-        {&offsets, &hit, &limit_reached, &distance, &pairs, &entries, &points_a, &points_b, &normals, &distances, &depths});
-  }
-
   /// The arrays for n entries and k rows; with `zero_rows`, the rows' points, normals, distances
   /// and depths are zeros (numpy.zeros), else left to be written.
   void allocate(py::ssize_t n, py::ssize_t k, bool zero_rows = false) {

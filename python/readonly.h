@@ -1,21 +1,15 @@
 #pragma once
-// Result objects whose numpy arrays Python reads but cannot change: each array is made read-only
-// once written, and each attribute returns a read-only view of it whose base is the object (so
-// that neither the view nor its base reaches the array itself).
+// Result objects whose numpy arrays Python reads but cannot change: each attribute returns a
+// read-only view of the object's array whose base is the object (so that neither the view nor
+// its base reaches the array itself).
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <initializer_list>
 #include <utility>
 #include <vector>
 
 namespace caliber_python {
-
-/// Makes each array read-only (its object's methods write before this, never after).
-inline void freeze(std::initializer_list<pybind11::array*> arrays) {
-  for (pybind11::array* a : arrays) a->attr("flags").attr("writeable") = false;
-}
 
 /// A read-only view of the array `Member` of the object `self` (of class C): what its attribute
 /// returns. The view's base is `self`, not the array, so that nothing reached through it can

@@ -43,16 +43,7 @@ struct PySweeps {
     double *const pa = points_a.mutable_data(), *const pb = points_b.mutable_data();
     std::int64_t* const tri = pairs.mutable_data();
     std::uint64_t* const q = queries.mutable_data();
-    {
-      py::gil_scoped_release release;
-      fill(results, c, u, t, d, pa, pb, tri, q);
-    }
-    freeze({&contact, &undecided, &time, &pairs, &distance, &points_a, &points_b, &queries});  // readonly.h
-  }
-
- private:
-  void fill(const std::vector<caliber::SweepResult>& results, bool* c, bool* u, double* t, double* d, double* pa, double* pb,
-            std::int64_t* tri, std::uint64_t* q) {
+    py::gil_scoped_release release;
     constexpr double nan = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < results.size(); ++i) {
       const caliber::SweepResult& r = results[i];

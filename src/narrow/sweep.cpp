@@ -39,7 +39,7 @@ Pose SweptPose::at(double t) const {
   // An interpolated component below the smallest non-zero coordinate caliber takes (validate_pose)
   // is 0: a move of at most sqrt(3) 2^-120, which the sweep's margin covers (kSweepFlush).
   for (int k = 0; k < 3; ++k) {
-    if (p.translation[k] != 0.0 && std::abs(p.translation[k]) < narrow::kSmallestCoordinate) p.translation[k] = 0.0;
+    if (p.translation[k] != 0.0 && std::abs(p.translation[k]) < kMinCoordinate) p.translation[k] = 0.0;
   }
   p.rotation = start.rotation.slerp(t, end.rotation).normalized();
   return p;

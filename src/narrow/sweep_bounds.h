@@ -26,12 +26,10 @@ inline double radius_about_origin(const Model& model) {
 /// place of that size; 1e-9 of it covers them many times over.
 inline constexpr double kSweepMargin = 1e-9;
 
-/// The smallest non-zero coordinate magnitude caliber takes (kMinCoordinate: 2^-120).
-inline constexpr double kSmallestCoordinate = kMinCoordinate;
 /// What SweptPose::at's flush of tiny components can move the two poses of a pair, in all: each
 /// by at most sqrt(3) 2^-120. Added to the margin (for any scene of a realistic size it does not
 /// change the margin's bits).
-inline constexpr double kSweepFlush = 2.0 * 1.7320508075688773 * kSmallestCoordinate;
+inline constexpr double kSweepFlush = 2.0 * 1.7320508075688773 * kMinCoordinate;
 
 /// A sweep's tolerance when the request gives none, as a share of the larger radius.
 inline constexpr double kSweepDefaultTolerance = 1e-6;

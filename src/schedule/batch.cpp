@@ -45,9 +45,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   validate_poses(poses_a, "A");
   validate_poses(poses_b, "B");
   validate_request(request);
-  if (request.kind == QueryKind::contact && (!a.has_adjacency() || !b.has_adjacency())) {
-    throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");  // before any work
-  }
+  schedule::check_contact_models(request, a, b);
   BatchResult out;
   out.kind = request.kind;
   out.offsets.reserve(n + 1);

@@ -87,11 +87,7 @@ void validate_frame(const Frame& frame) {
     if (k > 0 && !(frame.pairs[k - 1] < p)) {
       throw Error(ErrorCode::bad_argument, "frame", "pairs must be sorted and distinct (pair " + std::to_string(k) + ")");
     }
-    // Before any work, not when the pair's contacts are reduced.
-    if (frame.request.kind == QueryKind::contact &&
-        (!frame.models[p.a]->has_adjacency() || !frame.models[p.b]->has_adjacency())) {
-      throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
-    }
+    schedule::check_contact_models(frame.request, *frame.models[p.a], *frame.models[p.b]);
   }
   validate_request(frame.request);  // a distance query may be unbounded: the frame names its pairs
 }

@@ -24,6 +24,9 @@ using broad::WorldBox;
 using util::Clock;
 using util::ms_since;
 
+/// How messages name a scene: its file, or its name for a scene built in memory.
+std::string source_of(const Scene& scene) { return scene.file.empty() ? "scene " + scene.name : scene.file.string(); }
+
 void check_object(std::size_t i, std::size_t objects) {
   if (i >= objects) {
     throw Error(ErrorCode::bad_argument, "object",
@@ -36,7 +39,7 @@ void check_object(std::size_t i, std::size_t objects) {
 /// keys at finite, increasing times. (Where a motion takes an object is checked at each step,
 /// poses_at.)
 void check_scene(const Scene& scene) {
-  const std::string source = scene.file.empty() ? "scene " + scene.name : scene.file.string();
+  const std::string source = source_of(scene);
   if (!(scene.dt > 0.0) || !std::isfinite(scene.dt)) throw Error(ErrorCode::bad_value, source, "dt must be finite and > 0");
   const auto finite = [](const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
     return p.allFinite() && q.coeffs().allFinite() && q.coeffs().squaredNorm() > 0.0;
@@ -169,7 +172,7 @@ std::vector<Pose> World::poses_at(int step) const {
   poses.reserve(mScene.objects.size());
   const double t = step * mScene.dt;
   // A motion that leaves caliber's range is named by file, object and key.
-  const std::string source = mScene.file.empty() ? "scene " + mScene.name : mScene.file.string();
+  const std::string source = source_of(mScene);
   for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
     const SceneObject& o = mScene.objects[i];
     poses.push_back(pose_at(o.pose, o.motion, t));
