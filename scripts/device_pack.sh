@@ -38,6 +38,16 @@ for binary in "${binaries[@]}"; do
   cp "$root/build/$binary" "$pack/bin/"
   strip "$pack/bin/$binary"
 done
+# A baseline to compare with, interleaved (scripts/device_compare.sh): BASELINE_BUILD names the
+# build folder of an older commit (git worktree add /tmp/old COMMIT; build caliber_cli, bench_batch
+# and bench_sweep_many there); its binaries go to .devicepack/old/ (same libraries).
+if [ -n "${BASELINE_BUILD:-}" ]; then
+  mkdir -p "$pack/old"
+  for binary in caliber bench_batch bench_sweep_many; do
+    cp "$BASELINE_BUILD/$binary" "$pack/old/" && strip "$pack/old/$binary"
+  done
+  cp "$root/scripts/device_compare.sh" "$pack/"
+fi
 
 # Every library the binary loads, but glibc's own (the C library, its companions, the dynamic
 # loader): those come from the other machine's system (glibc is backward compatible, not forward).
