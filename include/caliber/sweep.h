@@ -33,6 +33,9 @@ struct SweepRequest {
   double tolerance = 0.0;
   /// The most distance queries a sweep makes; one that needs more ends `undecided`. Must be >= 1.
   std::uint64_t max_queries = 100000;
+  /// Which primitive groups may touch (not owned; must outlive the call), as in QueryRequest: a
+  /// triangle pair whose groups may not touch is never a contact of the sweep. Null: all may.
+  const GroupCompatibility* groups = nullptr;
 };
 
 /// Throws caliber::Error (bad_value) on a negative or non-finite tolerance or max_queries 0.

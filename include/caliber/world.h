@@ -57,11 +57,16 @@ class CALIBER_EXPORT World {
   /// pairs, on the engine's threads, from what it kept of the previous step). Not const on the
   /// engine: one engine per thread.
   [[nodiscard]] Frame frame(int step, Engine& engine) const;
-  /// The pairs that come within the tolerance between step k and step k + 1 (Engine::sweep), each
-  /// object moving from its pose at k to its pose at k + 1 along a SweptPose: the scene's own
-  /// motion for velocity motions (up to half a turn a step) and for keyframes between two keys.
-  /// Pairs of two static objects and ignored pairs are skipped. The times are fractions of the
-  /// step: t* = 0.25 is a quarter of the way from k to k + 1.
+  /// The pairs that come within the tolerance between step k and step k + 1, each object moving
+  /// along the scene's own motion: the step is cut into pieces, each swept by Engine::sweep along
+  /// SweptPoses, so that no object turns more than a quarter turn in a piece (a velocity motion's
+  /// turn is then the slerp's) and every keyframe inside the step ends a piece (between two keys a
+  /// keyframe motion is the slerp's). A pair's answer is that of the first piece in which it is
+  /// not free (its queries and stats count that piece's). The scene's groups apply unless the
+  /// request names its own. Pairs of two static objects and ignored pairs are skipped. The times
+  /// are fractions of the step: t* = 0.25 is a quarter of the way from k to k + 1. Throws
+  /// caliber::Error naming the object when a velocity motion turns more than 4,096 quarter turns
+  /// in a step.
   [[nodiscard]] std::vector<PairSweep> sweep(int step, Engine& engine, const SweepRequest& request = {}) const;
   /// The query request every task runs (with the scene's group compatibility when it has one).
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
@@ -71,6 +76,11 @@ class CALIBER_EXPORT World {
   void point_at_groups() { mRequest.groups = mScene.use_groups ? &mScene.compatibility : nullptr; }
   /// Step k's models, poses and request, without pairs.
   [[nodiscard]] Frame posed_frame(int step) const;
+  /// The poses of all objects at time t (seconds), inside step `step` (named in errors).
+  [[nodiscard]] std::vector<Pose> poses_at_time(double t, int step) const;
+  /// The times (seconds) at which step k's motion is cut for the swept query, from k dt to
+  /// (k + 1) dt: pieces in which no object turns more than a quarter turn, cut at every key inside.
+  [[nodiscard]] std::vector<double> sweep_times(int step) const;
 
   Scene mScene;
   QueryRequest mRequest;

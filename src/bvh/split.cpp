@@ -166,11 +166,14 @@ std::vector<SplitItem> split_items(const Mesh& mesh) {
   // Coordinates relative to the vertices' box, over its largest extent, before they are rounded to
   // floats: scaling a mesh by a power of two scales the differences and the extent alike, so the
   // items, and the tree, are the same bit for bit (tests/narrow/scale_test.cpp: the same prunes).
+  // The box of the vertices the triangles use: a stray vertex far away would coarsen every item.
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
-  if (!mesh.vertices.empty()) lo = hi = mesh.vertices[0];
-  for (const Eigen::Vector3d& v : mesh.vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
+  if (!mesh.triangles.empty()) lo = hi = mesh.vertices[mesh.triangles[0][0]];
+  for (const auto& tri : mesh.triangles) {
+    for (const std::uint32_t v : tri) {
+      lo = lo.cwiseMin(mesh.vertices[v]);
+      hi = hi.cwiseMax(mesh.vertices[v]);
+    }
   }
   const double largest = (hi - lo).maxCoeff();
   const double extent = largest > 0.0 ? largest : 1.0;

@@ -57,8 +57,9 @@ SweepResult sweep(const Model& a, const SweptPose& motion_a, const Model& b, con
 
 namespace narrow {
 
-QueryRequest sweep_distance_request() {
+QueryRequest sweep_distance_request(const GroupCompatibility* groups) {
   QueryRequest distance;
+  distance.groups = groups;
   distance.kind = QueryKind::distance;
   distance.tolerance = kUnbounded;
   return distance;
@@ -113,7 +114,7 @@ bool SweepAdvance::take(const QueryResult& r) {
 
 SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, const Model& b, double rb,
                           const SweptPose& motion_b, const SweepRequest& request) {
-  const QueryRequest distance = sweep_distance_request();
+  const QueryRequest distance = sweep_distance_request(request.groups);
   SweepAdvance advance(ra, motion_a, rb, motion_b, request);
   while (!advance.take(query_whole(PairContext(a, advance.pose_a(), b, advance.pose_b(), distance)))) {}
   return advance.result();

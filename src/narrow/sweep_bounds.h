@@ -13,11 +13,16 @@
 
 namespace caliber::narrow {
 
-/// The largest distance of a vertex from the model's origin: how far a point of it can be from
-/// the axis it turns about.
+/// The largest distance from the model's origin of a vertex its triangles use: how far a point of
+/// it can be from the axis it turns about. (A vertex no triangle uses is no part of the model: it
+/// moves nothing, and a stray one far away must not inflate the speed bound, the default
+/// tolerance or the swept boxes.)
 inline double radius_about_origin(const Model& model) {
+  const Mesh& mesh = model.mesh();
   double r2 = 0.0;
-  for (const Eigen::Vector3d& v : model.mesh().vertices) r2 = std::max(r2, v.squaredNorm());
+  for (const auto& tri : mesh.triangles) {
+    for (const std::uint32_t v : tri) r2 = std::max(r2, mesh.vertices[v].squaredNorm());
+  }
   return std::sqrt(r2);
 }
 
@@ -41,8 +46,9 @@ inline double sweep_tolerance(const SweepRequest& request, double radius, double
   return std::max(request.tolerance > 0.0 ? request.tolerance : kSweepDefaultTolerance * radius, 2.0 * margin);
 }
 
-/// The distance request every query of a sweep makes: the closest pair, at any distance.
-[[nodiscard]] QueryRequest sweep_distance_request();
+/// The distance request every query of a sweep makes: the closest pair, at any distance, among
+/// the triangle pairs whose groups may touch (`groups`: SweepRequest::groups).
+[[nodiscard]] QueryRequest sweep_distance_request(const GroupCompatibility* groups);
 
 /// One pair's conservative advancement, a distance query at a time, on input already checked:
 /// the next query is at poses pose_a() and pose_b() (time time()); take() its answer, until

@@ -178,8 +178,9 @@ struct Engine::Impl {
   /// than kEntriesPerThread a thread are left, a sweep whose last query was heavy makes its next
   /// one through run_pairs with `method` (split as a heavy pair is). Every query is
   /// caliber::query's answer, so every sweep is caliber::sweep's whatever the method and threads.
+  /// `groups`: the sweeps' SweepRequest::groups.
   [[gnu::visibility("hidden")]] void run_sweeps(const EngineOptions& options, Method method,
-                                                std::vector<schedule::SweepJob>& jobs);
+                                                std::vector<schedule::SweepJob>& jobs, const GroupCompatibility* groups);
 };
 
 }  // namespace caliber

@@ -31,8 +31,9 @@ constexpr std::uint64_t kSplitNodeTests = 16384;
 
 }  // namespace
 
-void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::SweepJob>& jobs) {
-  const QueryRequest distance = narrow::sweep_distance_request();
+void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::SweepJob>& jobs,
+                              const GroupCompatibility* groups) {
+  const QueryRequest distance = narrow::sweep_distance_request(groups);
   const int threads = executor.threads();
   timeline.begin(false);  // (a split query's spans are not recorded)
   // Exploitation runs a pair whole, as the loop over sweeps does: only the other methods cut one.
@@ -136,7 +137,7 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     jobs.push_back({models[p.a].get(), models[p.b].get(),
                     narrow::SweepAdvance(radius[p.a], {from[p.a], to[p.a]}, radius[p.b], {from[p.b], to[p.b]}, request)});
   }
-  mImpl->run_sweeps(mOptions, mOptions.method, jobs);
+  mImpl->run_sweeps(mOptions, mOptions.method, jobs, request.groups);
   std::vector<PairSweep> out;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (jobs[k].advance.result().status != SweepStatus::free) out.push_back(PairSweep{pairs[k], jobs[k].advance.result()});
@@ -165,7 +166,7 @@ std::vector<SweepResult> Engine::sweep_many(const Model& a, std::span<const Swep
   for (std::size_t i = 0; i < n; ++i) {
     jobs.push_back({&a, &b, narrow::SweepAdvance(ra, motions_a[na == 1 ? 0 : i], rb, motions_b[nb == 1 ? 0 : i], request)});
   }
-  mImpl->run_sweeps(mOptions, mOptions.method, jobs);
+  mImpl->run_sweeps(mOptions, mOptions.method, jobs, request.groups);
   std::vector<SweepResult> out;
   out.reserve(n);
   for (const schedule::SweepJob& job : jobs) out.push_back(job.advance.result());

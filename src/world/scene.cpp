@@ -1,5 +1,6 @@
 // Scene files: strict JSON reading with errors that name the file and the key.
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -353,8 +354,9 @@ Pose pose_at(const Pose& initial, const Motion& motion, double t) {
         p.rotation = keys.back().orientation;
         return p;
       }
-      std::size_t i = 1;
-      while (keys[i].time < t) ++i;
+      // The first key at or after t (binary search: a baked animation has one key a frame).
+      const std::size_t i = static_cast<std::size_t>(
+          std::lower_bound(keys.begin(), keys.end(), t, [](const Keyframe& k, double at) { return k.time < at; }) - keys.begin());
       const Keyframe& k0 = keys[i - 1];
       const Keyframe& k1 = keys[i];
       const double s = (t - k0.time) / (k1.time - k0.time);

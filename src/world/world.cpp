@@ -167,10 +167,11 @@ std::size_t World::triangle_count() const {
   return n;
 }
 
-std::vector<Pose> World::poses_at(int step) const {
+std::vector<Pose> World::poses_at(int step) const { return poses_at_time(step * mScene.dt, step); }
+
+std::vector<Pose> World::poses_at_time(double t, int step) const {
   std::vector<Pose> poses;
   poses.reserve(mScene.objects.size());
-  const double t = step * mScene.dt;
   // A motion that leaves caliber's range is named by file, object and key.
   const std::string source = source_of(mScene);
   for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
@@ -234,11 +235,6 @@ Frame World::frame(int step, Engine& engine) const {
   Frame frame = posed_frame(step);
   engine.find_pairs(frame, mStatic, mIgnored);
   return frame;
-}
-
-std::vector<PairSweep> World::sweep(int step, Engine& engine, const SweepRequest& request) const {
-  if (step == std::numeric_limits<int>::max()) throw Error(ErrorCode::bad_argument, "step", "has no step after it");
-  return engine.sweep(mModels, poses_at(step), poses_at(step + 1), request, mStatic, mIgnored);
 }
 
 StepResult step(const World& world, Engine& engine, int k) {
