@@ -82,7 +82,8 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     }
     std::size_t total = out.contacts.size();
     for (const QueryResult& r : results) total += r.contacts.size();
-    out.contacts.reserve(total);
+    // Geometric growth: reserving the exact new size at every chunk copied every contact so far.
+    if (total > out.contacts.capacity()) out.contacts.reserve(std::max(total, 2 * out.contacts.capacity()));
     for (const QueryResult& r : results) {
       out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
       out.offsets.push_back(out.contacts.size());

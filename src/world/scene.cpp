@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -189,52 +190,64 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   return query;
 }
 
-/// A parser callback that refuses a key given twice in one object (JSON parsers keep one of the
-/// two values, silently), naming its path ("objects[1].motion.type").
-Json::parser_callback_t refuse_duplicate_keys(const std::string& source) {
+/// A SAX pass that refuses a key given twice in one object (JSON parsers keep one of the two
+/// values, silently), naming its path ("objects[1].motion.type"), and turns a syntax error into
+/// caliber's. (A parser callback could do it while parsing, but nlohmann's callback parser scans
+/// the enclosing array at every object's end: quadratic in a scene of 40,000 objects.)
+class DuplicateKeys final : public nlohmann::json_sax<Json> {
+ public:
+  explicit DuplicateKeys(std::string source) : mSource(std::move(source)) {}
+  bool null() override { return element_done(); }
+  bool boolean(bool) override { return element_done(); }
+  bool number_integer(number_integer_t) override { return element_done(); }
+  bool number_unsigned(number_unsigned_t) override { return element_done(); }
+  bool number_float(number_float_t, const string_t&) override { return element_done(); }
+  bool string(string_t&) override { return element_done(); }
+  bool binary(binary_t&) override { return element_done(); }
+  bool start_object(std::size_t) override { return push(true); }
+  bool start_array(std::size_t) override { return push(false); }
+  bool end_object() override { return pop(); }
+  bool end_array() override { return pop(); }
+  bool key(string_t& key) override {
+    if (!mStack.back().keys.insert(key).second) {
+      std::string path;
+      for (std::size_t i = 0; i + 1 < mStack.size(); ++i) {
+        path += mStack[i].object ? (path.empty() ? "" : ".") + mStack[i].key : "[" + std::to_string(mStack[i].index) + "]";
+      }
+      path += (path.empty() ? "" : ".") + key;
+      throw Error(ErrorCode::unreadable, mSource,
+                  "'" + path + "': the key is given twice in one object (which value was meant?)");
+    }
+    mStack.back().key = key;
+    return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
+    throw Error(ErrorCode::unreadable, mSource, std::string("not valid JSON: ") + e.what());
+  }
+
+ private:
   struct Level {
     bool object = false;
     std::set<std::string> keys;
     std::string key;
     std::size_t index = 0;
   };
-  auto levels = std::make_shared<std::vector<Level>>();
-  return [levels, source](int, Json::parse_event_t event, Json& parsed) {
-    auto& stack = *levels;
-    const auto element_done = [&] {
-      if (!stack.empty() && !stack.back().object) ++stack.back().index;
-    };
-    switch (event) {
-      case Json::parse_event_t::object_start:
-      case Json::parse_event_t::array_start:
-        stack.push_back(Level{event == Json::parse_event_t::object_start, {}, {}, 0});
-        break;
-      case Json::parse_event_t::key: {
-        const std::string key = parsed.get<std::string>();
-        if (!stack.back().keys.insert(key).second) {
-          std::string path;
-          for (std::size_t i = 0; i + 1 < stack.size(); ++i) {
-            path += stack[i].object ? (path.empty() ? "" : ".") + stack[i].key : "[" + std::to_string(stack[i].index) + "]";
-          }
-          path += (path.empty() ? "" : ".") + key;
-          throw Error(ErrorCode::unreadable, source,
-                      "'" + path + "': the key is given twice in one object (which value was meant?)");
-        }
-        stack.back().key = key;
-        break;
-      }
-      case Json::parse_event_t::object_end:
-      case Json::parse_event_t::array_end:
-        stack.pop_back();
-        element_done();
-        break;
-      case Json::parse_event_t::value:
-        element_done();
-        break;
-    }
+  bool element_done() {
+    if (!mStack.empty() && !mStack.back().object) ++mStack.back().index;
     return true;
-  };
-}
+  }
+  bool push(bool object) {
+    mStack.push_back(Level{object, {}, {}, 0});
+    return true;
+  }
+  bool pop() {
+    mStack.pop_back();
+    return element_done();
+  }
+
+  std::string mSource;
+  std::vector<Level> mStack;
+};
 
 }  // namespace
 
@@ -246,7 +259,9 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
   }
   Json root;
   try {
-    root = Json::parse(text, refuse_duplicate_keys(source));
+    DuplicateKeys check(source);
+    Json::sax_parse(text, &check);
+    root = Json::parse(text);
   } catch (const Json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     throw Error(ErrorCode::unreadable, source, std::string("not valid JSON: ") + e.what());
   }
@@ -261,18 +276,19 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
 
   const Json& objects = r.required(root, "", "objects");
   if (!objects.is_array() || objects.empty()) r.fail("objects", "must be a non-empty array");
-  std::set<std::string> names;
+  std::map<std::string, int> ids;  // name -> object id: `ignore` names are looked up, not scanned for
   for (std::size_t i = 0; i < objects.size(); ++i) {
     SceneObject o = read_object(r, objects[i], "objects[" + std::to_string(i) + "]", base_dir, i);
-    if (!names.insert(o.name).second) r.fail("objects[" + std::to_string(i) + "].name", "duplicate name '" + o.name + "'");
+    if (!ids.emplace(o.name, static_cast<int>(i)).second) {
+      r.fail("objects[" + std::to_string(i) + "].name", "duplicate name '" + o.name + "'");
+    }
     scene.objects.push_back(std::move(o));
   }
   const auto find = [&](const Json& name, const std::string& key) {
     const std::string n = r.string(name, key);
-    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-      if (scene.objects[i].name == n) return static_cast<int>(i);
-    }
-    r.fail(key, "no object named '" + n + "'");
+    const auto it = ids.find(n);
+    if (it == ids.end()) r.fail(key, "no object named '" + n + "'");
+    return it->second;
   };
 
   if (root.contains("groups")) {

@@ -205,5 +205,25 @@ TEST_F(WorldSweep, ATurnTooFastToFollowIsAnErrorNamingTheObject) {
   }
 }
 
+TEST(KeyframeLookup, ThePoseBetweenAnyTwoOfManyKeysIsTheirInterpolation) {
+  Motion m;
+  m.type = Motion::Type::keyframes;
+  for (int i = 0; i < 1000; ++i) {
+    Keyframe k;
+    k.time = 0.5 * i;
+    k.position = Eigen::Vector3d(i * i, -i, 0.25 * i);
+    m.keys.push_back(k);
+  }
+  for (int i = 0; i + 1 < 1000; i += 37) {
+    for (const double s : {0.0, 0.25, 0.5, 1.0}) {
+      const double t = 0.5 * i + 0.5 * s;
+      const Eigen::Vector3d want = (1.0 - s) * m.keys[i].position + s * m.keys[i + 1].position;
+      EXPECT_LT((pose_at(Pose{}, m, t).translation - want).norm(), 1e-9) << "t = " << t;
+    }
+  }
+  EXPECT_EQ(pose_at(Pose{}, m, -1.0).translation, m.keys.front().position);
+  EXPECT_EQ(pose_at(Pose{}, m, 1e9).translation, m.keys.back().position);
+}
+
 }  // namespace
 }  // namespace caliber
