@@ -18,9 +18,9 @@ TETRA = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float),
 
 
 def per_entry_us(a, b, n, kind, offset, repeat):
-    poses = np.zeros((n, 7))
-    poses[:, 0] = 1.0  # w x y z, then the translation
-    poses[:, 4] = offset
+    poses = np.zeros((n, 7))  # rows: the translation, then the quaternion w x y z
+    poses[:, 0] = offset
+    poses[:, 3] = 1.0
     best = []
     for _ in range(repeat):
         start = time.perf_counter()

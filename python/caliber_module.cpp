@@ -25,6 +25,7 @@
 #include "batch.h"
 #include "bounded_errors.h"
 #include "fast_call.h"
+#include "interrupts.h"
 #include "sweeps.h"
 #include "half_built.h"
 
@@ -702,7 +703,7 @@ def _batch_from_state(state):
          const py::object& end_b, double tolerance, std::uint64_t max_queries, const std::string& order, int threads) {
         caliber::EngineOptions options;
         options.threads = threads;
-        caliber::Engine engine(options);
+        caliber::Engine engine(caliber_python::interruptible(options));
         return sweep_many(engine, a, start_a, end_a, b, start_b, end_b, tolerance, max_queries, order);
       },
       py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
@@ -719,7 +720,7 @@ def _batch_from_state(state):
         const caliber::QueryRequest request = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
         caliber::EngineOptions options;
         options.threads = threads;
-        caliber::Engine engine(options);
+        caliber::Engine engine(caliber_python::interruptible(options));
         return query_many(engine, a, poses_a, b, poses_b, request, order);
       },
       py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), py::arg("kind") = "interference",
@@ -734,7 +735,7 @@ def _batch_from_state(state):
              caliber::EngineOptions options;
              options.method = caliber::parse_method(method);
              options.threads = threads;
-             return std::make_unique<caliber::Engine>(options);
+             return std::make_unique<caliber::Engine>(caliber_python::interruptible(options));
            }),
            py::arg("method") = std::string(caliber::to_string(caliber::kDefaultMethod)), py::arg("threads") = 0,
            "method: sequential, exploitation, stealing (the default), aposteriori, apriori or hybrid. threads: 0, every "

@@ -6,6 +6,7 @@
 
 #include "caliber/export.h"
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string_view>
@@ -138,6 +139,11 @@ struct EngineOptions {
   /// Also record ScheduleRecord::timeline (thread and times of every piece of work) and
   /// ScheduleRecord::task_roots; implies `profile`. Costs two clock reads per piece; off by default.
   bool timeline = false;
+  /// Called on the calling thread between the chunks of a long call: query_many every 8,192
+  /// entries, sweep_many and sweep every 8,192 sweeps' worth of work. A host that wants to stop
+  /// the call (Python on Ctrl-C) throws from it: the call ends by that exception, its results
+  /// dropped, and the engine takes its next call as usual. Empty (default): never called.
+  std::function<void()> between_chunks;
 };
 
 /// Runs frames with a method on the threads the host allows (EngineOptions::threads). Keeps,

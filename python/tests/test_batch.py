@@ -218,3 +218,67 @@ def test_type_errors_are_one_line_of_bounded_length():
         assert "\n" not in text and len(text) < 2000, text[:200]
         for part in shown:
             assert part in text, (part, text)
+
+
+
+def _interrupting(call):
+    """Runs call() with SIGINT sent 0.2 s in, a handler raising Interrupted: whether the call raised
+    it, and the seconds the call took."""
+    import signal
+    import threading
+    import time
+
+    class Interrupted(Exception):
+        pass
+
+    def handler(signum, frame):
+        raise Interrupted()
+
+    previous = signal.signal(signal.SIGINT, handler)
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    raised = False
+    try:
+        timer.start()
+        call()
+    except Interrupted:
+        raised = True
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
+    return raised, time.perf_counter() - start
+
+
+def _seconds(call):
+    import time
+    start = time.perf_counter()
+    call()
+    return time.perf_counter() - start
+
+
+def test_a_long_batch_or_sweep_call_stops_on_ctrl_c():
+    # A tenth of each call is timed whole; the call itself, stopped 0.2 s in, must end well before
+    # the whole would (without the check between chunks, the handler ran only once it returned).
+    far = np.zeros((4000000, 7))  # four million distance entries: seconds of work
+    far[:, 0] = 3.0
+    far[:, 3] = 1.0
+    start = np.zeros((1000000, 7))
+    start[:, 0] = 3.0
+    start[:, 3] = 1.0
+    end = start.copy()
+    end[:, 0] = -3.0
+    engine = caliber.Engine(threads=2)
+    calls = [
+        lambda n: engine.query_many(TETRA, caliber.Pose(), FAN, far[:n], kind="distance"),
+        lambda n: caliber.query_many(TETRA, caliber.Pose(), FAN, far[:n], kind="distance"),
+        lambda n: caliber.sweep_many(TETRA, caliber.Pose(), caliber.Pose(), FAN, start[:n], end[:n]),
+    ]
+    for call, n in zip(calls, (len(far), len(far), len(start))):
+        tenth = _seconds(lambda: call(n // 10))
+        raised, took = _interrupting(lambda: call(n))
+        assert raised
+        assert took < 5 * tenth + 0.5, (took, tenth)
+    # The engine takes its next call as usual, with the same answers.
+    batch = engine.query_many(TETRA, caliber.Pose(), FAN, far[:3], kind="distance")
+    one = caliber.query(TETRA, caliber.Pose(), FAN, caliber.Pose([3.0, 0, 0], [1, 0, 0, 0]), kind="distance")
+    assert batch.distances.tolist() == [one.distances[0]] * 3

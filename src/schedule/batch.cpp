@@ -58,6 +58,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   std::vector<QueryResult> results;
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {
+    if (first > 0 && mOptions.between_chunks) mOptions.between_chunks();
     const std::size_t count = std::min(kChunk, n - first);
     const auto context = [&](std::size_t i) {  // entry first + i's
       const std::size_t e = first + i;

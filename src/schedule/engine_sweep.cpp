@@ -29,6 +29,9 @@ namespace {
 /// pair early, 0.68-0.96x up to 8,781 (a split search prunes less at first). Below, one thread.
 constexpr std::uint64_t kSplitNodeTests = 16384;
 
+/// Sweeps run in one parallel loop between two calls of EngineOptions::between_chunks.
+constexpr std::size_t kSweepChunk = 8192;
+
 }  // namespace
 
 void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::SweepJob>& jobs,
@@ -42,6 +45,7 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
   std::iota(active.begin(), active.end(), std::size_t{0});
   const tasks::History no_history;
   std::vector<QueryResult> results;
+  bool started = false;  // whether work was done (the hook is called between chunks of it)
   while (!active.empty()) {
     whole.clear();
     split.clear();
@@ -51,9 +55,12 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
     }
     // Whole queries, a sweep to a thread: until it is over, or (when queries can be split) until
     // one of them was heavy, to be looked at again with the sweeps left.
-    if (!whole.empty()) {
+    // In chunks of kSweepChunk sweeps, options.between_chunks called between them.
+    for (std::size_t first = 0; first < whole.size(); first += kSweepChunk) {
+      if (started && options.between_chunks) options.between_chunks();
+      started = true;
       executor.execute([&] {
-        parallel::parallel_for_each(0, whole.size(), [&](std::size_t k) {
+        parallel::parallel_for_each(first, std::min(whole.size(), first + kSweepChunk), [&](std::size_t k) {
           schedule::SweepJob& job = jobs[whole[k]];
           do {
             job.done = job.advance.take(
@@ -64,6 +71,8 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
     }
     // Heavy queries of the few sweeps left: one each, as the pairs of one run of the method.
     if (!split.empty()) {
+      if (started && options.between_chunks) options.between_chunks();
+      started = true;
       EngineOptions run = options;
       run.threads = threads;
       run.stealing_depth = schedule::stealing_cutoff(split.size(), threads, options.stealing_depth);

@@ -15,6 +15,7 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "caliber/sweep.h"
 #include "support/random_poses.h"
 #include "support/torus_sphere.h"
 
@@ -136,6 +137,31 @@ TEST(Batch, ManyEntriesAcrossChunksAndEitherSideFixed) {
   const BatchResult empty = engine.query_many(*shapes().torus, one, *shapes().sphere, {}, request);
   EXPECT_EQ(empty.size(), 0u);
   EXPECT_TRUE(empty.contacts.empty());
+}
+
+TEST(Batch, TheHookBetweenChunksIsCalledAndMayStopTheCall) {
+  const std::vector<Pose> many = poses_near(3 * 8192 + 5, 22, 3.0);
+  const std::vector<Pose> one{Pose{}};
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  int calls = 0;
+  EngineOptions options;
+  options.threads = 2;
+  options.between_chunks = [&] { ++calls; };
+  Engine counting(options);
+  expect_queries(counting.query_many(*shapes().torus, one, *shapes().sphere, many, request), one, many, request, "hooked");
+  EXPECT_EQ(calls, 3) << "between the four chunks";
+  struct Stop {};
+  options.between_chunks = [&] { throw Stop{}; };
+  Engine stopping(options);
+  EXPECT_THROW((void)stopping.query_many(*shapes().torus, one, *shapes().sphere, many, request), Stop);
+  // The engine takes its next call as usual.
+  const std::vector<Pose> few(many.begin(), many.begin() + 40);
+  expect_queries(stopping.query_many(*shapes().torus, one, *shapes().sphere, few, request), one, few, request, "after");
+  const std::vector<SweptPose> motions(
+      3 * 8192, SweptPose{Pose::from_values(3, 0, 0, 1, 0, 0, 0), Pose::from_values(-3, 0, 0, 1, 0, 0, 0)});
+  const SweptPose still{};
+  EXPECT_THROW((void)stopping.sweep_many(*shapes().torus, {&still, 1}, *shapes().sphere, motions), Stop);
 }
 
 TEST(Batch, BadBatchesAreErrorsNamingThePose) {
