@@ -29,7 +29,7 @@ std::vector<ShownContact> shown_contacts(const World& world, const StepResult& s
 
 ShownBox node_box(const Model& model, std::uint32_t node, const Pose& pose) {
   const BvhNode& n = data(model).nodes[node];
-  const Eigen::Vector3d center(n.box_center[0], n.box_center[1], n.box_center[2]);
+  const Eigen::Vector3d center = data(model).origin + Eigen::Vector3d(n.box_center[0], n.box_center[1], n.box_center[2]);
   return ShownBox{pose.apply(center), Eigen::Vector3d(n.box_half[0], n.box_half[1], n.box_half[2]), pose.rotation_matrix()};
 }
 

@@ -94,8 +94,10 @@ nlohmann::json task_records(const World& world, const StepResult& s, int& budget
       if (budget <= 0) break;
       --budget;
       const std::uint32_t object = s.pair_records[root.pair].pair.a;
-      const BvhNode& n = data(world.model(object)).nodes[root.node_a];
-      roots.push_back({object, n.box_center[0], n.box_center[1], n.box_center[2], n.box_half[0], n.box_half[1], n.box_half[2]});
+      const ModelData& m = data(world.model(object));
+      const BvhNode& n = m.nodes[root.node_a];
+      const Eigen::Vector3d c = m.origin + Eigen::Vector3d(n.box_center[0], n.box_center[1], n.box_center[2]);
+      roots.push_back({object, c[0], c[1], c[2], n.box_half[0], n.box_half[1], n.box_half[2]});
     }
     tasks.push_back({{"thread", thread[t]}, {"node_tests", r.task_node_tests[t]}, {"roots", roots}});
   }

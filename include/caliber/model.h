@@ -48,7 +48,7 @@ class CALIBER_EXPORT Model {
   [[nodiscard]] std::size_t node_count() const;
   /// Height of the BVH (a one-triangle model has height 1).
   [[nodiscard]] int height() const;
-  /// Largest distance of a vertex from the object-space origin.
+  /// Largest distance from the object-space origin of a vertex that a triangle uses.
   [[nodiscard]] double extent() const;
   /// Whether the triangle adjacency was built (BuildOptions::adjacency: contact queries need it).
   [[nodiscard]] bool has_adjacency() const;

@@ -19,7 +19,7 @@ struct WorldBox {
 inline WorldBox world_box(const Model& model, const Pose& pose, double grow) {
   const ModelData& m = data(model);
   const BvhNode& root = m.nodes[0];
-  const Eigen::Vector3d c(root.box_center[0], root.box_center[1], root.box_center[2]);
+  const Eigen::Vector3d c = m.origin + Eigen::Vector3d(root.box_center[0], root.box_center[1], root.box_center[2]);
   const Eigen::Vector3d h(root.box_half[0], root.box_half[1], root.box_half[2]);
   const Eigen::Matrix3d r = pose.rotation_matrix();
   const Eigen::Vector3d center = r * c + pose.translation;

@@ -15,6 +15,7 @@
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
 #include "bvh/split.h"
+#include "bvh/volume_origin.h"
 #include "util/float_round.h"
 #include "parallel/executor.h"
 
@@ -356,13 +357,14 @@ namespace {
 std::shared_ptr<ModelData> build_on_this_thread(Mesh mesh, const BuildOptions& options) {
   auto model = std::make_shared<ModelData>();
   model->normals = bvh::face_normals(mesh, kBuildGrain);
-  Builder builder(mesh, model->normals);
-  builder.build(*model, options.oriented_boxes);
-  double extent = 0.0;
-  for (const auto& tri : mesh.triangles) {
-    for (const std::uint32_t v : tri) extent = std::max(extent, mesh.vertices[v].squaredNorm());
+  model->origin = bvh::volume_origin(mesh);
+  {  // the volumes of the vertices moved by -origin (the mesh itself is kept as given)
+    const Mesh moved = model->origin == Vec3::Zero() ? Mesh{} : bvh::moved_by(mesh, -model->origin);
+    Builder builder(model->origin == Vec3::Zero() ? mesh : moved, model->normals);
+    builder.build(*model, options.oriented_boxes);
   }
-  model->extent = std::sqrt(extent);  // sqrt is monotone and correctly rounded: the largest norm
+  model->extent = bvh::largest_norm(mesh, Vec3::Zero());
+  model->local_extent = bvh::largest_norm(mesh, model->origin);
   if (options.adjacency)
     bvh::vertex_adjacency(mesh, kBuildGrain, model->corner_vertex, model->vertex_offsets, model->vertex_triangles);
   model->mesh = std::move(mesh);

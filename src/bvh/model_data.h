@@ -238,6 +238,12 @@ struct ModelData : Model {
   }
   /// Largest distance of a vertex from the object-space origin (used to bound rounding error).
   double extent = 0.0;
+  /// The point the node volumes are relative to (object space): a node's stored center c stands
+  /// for origin + c. The center of the vertices' box for a mesh far from its own origin (farther
+  /// than the box is large), so that its nodes are as fine as at the origin; else zero.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  /// Largest distance of a vertex from `origin` (extent when origin is zero).
+  double local_extent = 0.0;
   /// Height of the BVH (a root-only tree has height 1).
   int height = 0;
 };

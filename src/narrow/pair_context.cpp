@@ -25,8 +25,13 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
   mRot = ra.transpose() * rb;
   mTrans = ra.transpose() * (pose_b.translation - pose_a.translation);
+  // A point x of B's volumes (x + origin_B in B's frame) is at R (x + origin_B) + T in A's frame,
+  // at R x + (R origin_B + T - origin_A) from A's volume origin. Both origins zero: mTrans itself.
+  const bool local = mA.origin != Eigen::Vector3d::Zero() || mB.origin != Eigen::Vector3d::Zero();
+  const Eigen::Vector3d node_trans = local ? Eigen::Vector3d(mRot * mB.origin + mTrans - mA.origin) : mTrans;
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
-  mScale = mA.extent + mB.extent + mTrans.norm();
+  mScale = mA.local_extent + mB.local_extent + node_trans.norm();
+  if (local) mScale += kAbsoluteShare * (mA.extent + mB.extent + mTrans.norm());
   mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
@@ -37,7 +42,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
       mNodeFrame.rot[i][j] = mRot(i, j);
       mNodeFrame.abs_rot[i][j] = mAbsRot(i, j);
     }
-    mNodeFrame.trans[i] = mTrans[i];
+    mNodeFrame.trans[i] = node_trans[i];
   }
   // The angle is read by the contact kind's tests alone (cones_can_face, normals_allow): the
   // other kinds skip the cosine and sine (a tenth of a small query's context).
@@ -87,7 +92,7 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
 }
 
 void PairContext::prepare_disk_a(SideA& s) const {
-  for (int i = 0; i < 3; ++i) s.center_from_b[i] = s.center[i] - mTrans[i];
+  for (int i = 0; i < 3; ++i) s.center_from_b[i] = s.center[i] - mNodeFrame.trans[i];
   const double mid = s.slab_axis[0] * s.center[0] + s.slab_axis[1] * s.center[1] + s.slab_axis[2] * s.center[2];
   s.disk_lo = s.slab_lo - mid;
   s.disk_hi = s.slab_hi - mid;

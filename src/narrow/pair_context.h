@@ -147,7 +147,7 @@ class PairContext {
   void sphere_center_in_a(std::uint32_t ib, double out[3]) const {
     const BvhNode& nb = mB.nodes[ib];
     for (int i = 0; i < 3; ++i)
-      out[i] = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mTrans[i];
+      out[i] = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mNodeFrame.trans[i];
   }
   /// sphere_apart given cb, sphere_center_in_a(ib): the same value.
   [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib, const double cb[3]) const {
@@ -164,6 +164,10 @@ class PairContext {
 
   /// The distance within which the node and leaf tests keep what a distance d keeps: d plus the
   /// safety margin (rounding in the transformed centers and vertices, certified far below it).
+  /// mScale: the extents of A and B about their volume origins plus the distance between those;
+  /// where a model's volumes have an origin of their own (ModelData::origin), plus a thousandth of
+  /// the absolute scale (extents about the origins and distance), for the vertices and the
+  /// translation between the volume origins round at that scale: a margin of 1e-12 of it.
   [[nodiscard]] double reach_for(double d) const { return d + kRelativeMargin * (mScale + d); }
 
   using OrientedBox = narrow::OrientedBox;
@@ -186,7 +190,8 @@ class PairContext {
     OrientedBox computed;
     const OrientedBox& own = own_frame(mB, ib, computed);
     for (int i = 0; i < 3; ++i) {
-      s.frame.center[i] = mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mTrans[i];
+      s.frame.center[i] =
+          mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mNodeFrame.trans[i];
     }
     for (int k = 0; k < 3; ++k) {
       s.frame.half[k] = own.half[k];
@@ -265,6 +270,9 @@ class PairContext {
   /// few ulps (~1e-16 relative) of the coordinates' magnitude; 1e-9 of it is far above that and far
   /// below any size that changes how much the prune prunes.
   static constexpr double kRelativeMargin = 1e-9;
+  /// The share of the absolute scale in mScale where volumes have an origin of their own: a margin
+  /// of 1e-12 of it, a thousand times the few ulps (~1e-15 relative) its rounding costs.
+  static constexpr double kAbsoluteShare = 1e-3;
 
   /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
   [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
@@ -313,7 +321,7 @@ class PairContext {
       s.half[i] = n.box_half[i];
     }
     // B's frame: x_b = R^T (x_a - T).
-    const double rel[3] = {s.box[0] - mTrans[0], s.box[1] - mTrans[1], s.box[2] - mTrans[2]};
+    const double rel[3] = {s.box[0] - mNodeFrame.trans[0], s.box[1] - mNodeFrame.trans[1], s.box[2] - mNodeFrame.trans[2]};
     for (int j = 0; j < 3; ++j) {
       s.box_in_b[j] = mRot(0, j) * rel[0] + mRot(1, j) * rel[1] + mRot(2, j) * rel[2];
       s.reach_on_b[j] = mAbsRot(0, j) * s.half[0] + mAbsRot(1, j) * s.half[1] + mAbsRot(2, j) * s.half[2];
@@ -335,7 +343,7 @@ class PairContext {
       s.half[i] = n.box_half[i];
     }
     for (int i = 0; i < 3; ++i) {
-      s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mTrans[i];
+      s.box_in_a[i] = mRot(i, 0) * s.box[0] + mRot(i, 1) * s.box[1] + mRot(i, 2) * s.box[2] + mNodeFrame.trans[i];
       s.reach_on_a[i] = mAbsRot(i, 0) * s.half[0] + mAbsRot(i, 1) * s.half[1] + mAbsRot(i, 2) * s.half[2];
     }
   }
@@ -345,7 +353,7 @@ class PairContext {
     const BvhNode& n = mB.nodes[ib];
     s.radius = n.radius;
     const double c[3] = {n.center[0], n.center[1], n.center[2]};
-    for (int i = 0; i < 3; ++i) s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mTrans[i];
+    for (int i = 0; i < 3; ++i) s.center[i] = mRot(i, 0) * c[0] + mRot(i, 1) * c[1] + mRot(i, 2) * c[2] + mNodeFrame.trans[i];
   }
   /// A node's oriented box in its own model's frame: the model's oriented box where it keeps them, else
   /// computed by the same function.
@@ -371,10 +379,10 @@ class PairContext {
   QueryKind mKind;
   const GroupCompatibility* mGroups;
   Eigen::Matrix3d mRot;
-  Eigen::Matrix3d mAbsRot;  ///< |mRot|, grown by a relative hair (rounding in the rotation)
-  Eigen::Vector3d mTrans;
+  Eigen::Matrix3d mAbsRot;           ///< |mRot|, grown by a relative hair (rounding in the rotation)
+  Eigen::Vector3d mTrans;            ///< B's origin in A's frame: what B's vertices are moved by (B's nodes: mNodeFrame.trans)
   double mDescendAlone;              ///< descend_alone_ratio()
-  double mScale;                     ///< extents of A and B plus their distance: what the safety margin is relative to
+  double mScale;                     ///< what the safety margin is relative to (see reach_for)
   double mReach;                     ///< tolerance + safety margin added to the sum of radii
   double mSlabReach;                 ///< mReach for gaps along a slab axis (up to 1 + 1e-6 long)
   double mTheta;                     ///< contact angle, radians

@@ -13,18 +13,11 @@
 
 namespace caliber::narrow {
 
-/// The largest distance from the model's origin of a vertex its triangles use: how far a point of
-/// it can be from the axis it turns about. (A vertex no triangle uses is no part of the model: it
-/// moves nothing, and a stray one far away must not inflate the speed bound, the default
-/// tolerance or the swept boxes.)
-inline double radius_about_origin(const Model& model) {
-  const Mesh& mesh = model.mesh();
-  double r2 = 0.0;
-  for (const auto& tri : mesh.triangles) {
-    for (const std::uint32_t v : tri) r2 = std::max(r2, mesh.vertices[v].squaredNorm());
-  }
-  return std::sqrt(r2);
-}
+/// The largest distance from the model's origin of a vertex its triangles use (Model::extent):
+/// how far a point of it can be from the axis it turns about. (A vertex no triangle uses is no
+/// part of the model: it moves nothing, and a stray one far away must not inflate the speed bound,
+/// the default tolerance or the swept boxes.)
+inline double radius_about_origin(const Model& model) { return model.extent(); }
 
 /// The margin for rounding, as a share of the scene's size (radii and translations): poses
 /// interpolated and distances computed in double precision are off by a few units in the last

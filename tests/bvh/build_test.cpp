@@ -57,7 +57,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh().triangles[t]) {
-      const Eigen::Vector3d& p = m.mesh().vertices[v];
+      const Eigen::Vector3d p = m.mesh().vertices[v] - data(m).origin;  // volumes are relative to it
       EXPECT_LE((p - c).norm(), node.radius) << "node " << index << " sphere must cover its vertices";
       EXPECT_TRUE(((p - bc).cwiseAbs().array() <= bh.array()).all()) << "node " << index << " box must cover its vertices";
       const double along = stored_axis.dot(p);
@@ -86,7 +86,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
     const Eigen::Vector3d center(kept.center[0], kept.center[1], kept.center[2]);
     for (const std::uint32_t t : below) {
       for (const std::uint32_t v : m.mesh().triangles[t]) {
-        const Eigen::Vector3d& p = m.mesh().vertices[v];
+        const Eigen::Vector3d p = m.mesh().vertices[v] - data(m).origin;
         for (int k = 0; k < 3; ++k) {
           const Eigen::Vector3d axis_k(kept.axis[k][0], kept.axis[k][1], kept.axis[k][2]);
           EXPECT_LE(std::abs(axis_k.dot(p - center)), kept.half[k] + 1e-12 * (1.0 + p.norm() + center.norm()))
