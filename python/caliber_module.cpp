@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -141,6 +142,22 @@ caliber::Mesh mesh_from_arrays(const Vertices& vertices, const Faces& faces) {
   return caliber::mesh_from_buffers(xyz, indices, "arrays");
 }
 
+/// Refuses a uint64 face index past the int64 range the library reads indices in, naming its value
+/// as given (cast, 2^64 - 1 would read as -1). Smaller indices are checked by the library.
+void check_wide_indices(const py::array& vertices, const py::array& faces) {
+  if (faces.dtype().kind() != 'u' || faces.itemsize() != 8 || faces.ndim() != 2 || faces.shape(1) != 3) return;
+  if (vertices.ndim() != 2 || vertices.shape(1) != 3) return;  // refused by mesh_from_arrays first
+  const auto wide = faces.cast<py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>>();
+  const std::uint64_t* data = wide.data();
+  for (py::ssize_t i = 0; i < wide.size(); ++i) {
+    if (data[i] > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+      throw caliber::Error(caliber::ErrorCode::bad_index, "arrays",
+                           "face " + std::to_string(i / 3) + " refers to vertex " + std::to_string(data[i]) +
+                               " but there are only " + std::to_string(vertices.shape(0)));
+    }
+  }
+}
+
 /// A mesh from the arrays a user hands in: faces must hold integers and vertices real numbers
 /// (float or integer); a float, bool or complex face array, or a bool or complex vertex array, is
 /// refused rather than cast (0.9 would become vertex 0).
@@ -158,6 +175,7 @@ caliber::Mesh mesh_from_user_arrays(const py::object& vertex_data, const py::obj
         caliber::ErrorCode::bad_argument, "faces",
         std::string("must hold integer vertex indices, not dtype ") + py::str(faces.dtype()).cast<std::string>());
   }
+  check_wide_indices(vertices, faces);
   return mesh_from_arrays(vertices.cast<Vertices>(), faces.cast<Faces>());
 }
 

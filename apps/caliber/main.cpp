@@ -4,8 +4,9 @@
 //   caliber refine IN OUT -l K   1-to-4 subdivision
 //   caliber bench [SCENES...]    every method on every scene: report.md, results.json, figures
 //   caliber view SCENE --out F   an HTML page showing the scene's steps, contacts and tasks
-// Exit codes: 0 success, 2 bad input or not enough memory for it (message on stderr), 130 a run
-// stopped by SIGINT (what it measured is written), 1 unexpected internal error.
+// Exit codes: 0 success, 2 bad input or not enough memory for it (message on stderr), 130 and 143
+// a long command (run, view, bench, refine) stopped by SIGINT or SIGTERM (what it measured is
+// written, and no temporary file is left), 1 unexpected internal error.
 
 #include <iostream>
 #include <string>

@@ -26,29 +26,55 @@ std::filesystem::path canonical_or_same(const std::filesystem::path& p) {
   throw Error(ErrorCode::unreadable, path.string(), problem);
 }
 
+/// The system's reason for the call that just failed (read at once, before anything else sets errno).
+std::string system_reason() { return errno != 0 ? std::strerror(errno) : "the system gave no reason"; }
+
+/// The temporary file's name for `name` in its folder: ".NAME.caliber-PID.tmp", NAME cut so that the
+/// whole stays within the 255 bytes a file name may take (a long name that is valid stays writable).
+std::string temporary_name(const std::string& name) {
+  constexpr std::size_t kNameMax = 255;
+  const std::string suffix = ".caliber-" + std::to_string(::getpid()) + ".tmp";
+  std::string temporary(".");
+  temporary.append(name, 0, kNameMax - 1 - suffix.size());
+  return temporary + suffix;
+}
+
+/// Why `folder` cannot hold a new file: it does not exist, it is not a folder, or the reason the
+/// system gives (a folder that cannot be searched, say). Empty when it is a folder.
+std::string folder_problem(const std::filesystem::path& folder) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(folder, ec);
+  if (std::filesystem::is_directory(status)) return "";
+  if (status.type() == std::filesystem::file_type::not_found) return "no folder " + folder.string();
+  if (std::filesystem::exists(status)) return folder.string() + " is not a folder";
+  return "folder " + folder.string() + ": " + ec.message();
+}
+
 }  // namespace
 
 OutputFile::OutputFile(const std::string& path, const std::string& option) : mPath(path) {
   if (path.empty()) throw Error(ErrorCode::bad_value, option, "needs a file name");
   std::error_code ec;
   const auto status = std::filesystem::status(mPath, ec);
+  // A name too long, a folder that cannot be searched: refused now, for the reason the system gives.
+  if (ec && status.type() != std::filesystem::file_type::not_found)
+    fail(mPath, "cannot be written (" + option + "): " + ec.message());
   if (!ec && std::filesystem::is_directory(status)) fail(mPath, "is a directory (" + option + " names the file to write)");
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    errno = 0;
     mOut.open(mPath, std::ios::binary | std::ios::trunc);  // a device or a pipe: no rename possible
-    if (!mOut) fail(mPath, "cannot be opened for writing (" + option + "): " + std::strerror(errno));
+    if (!mOut) fail(mPath, "cannot be opened for writing (" + option + "): " + system_reason());
     return;
   }
   const std::filesystem::path folder = mPath.has_parent_path() ? mPath.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(folder, ec)) fail(mPath, "cannot be written (" + option + "): no folder " + folder.string());
-  std::string name = ".";
-  name += mPath.filename().string();
-  name += ".caliber-";
-  name += std::to_string(::getpid());
-  name += ".tmp";
-  mTemp = folder / name;
+  if (const std::string problem = folder_problem(folder); !problem.empty()) {
+    fail(mPath, "cannot be written (" + option + "): " + problem);
+  }
+  mTemp = folder / temporary_name(mPath.filename().string());
+  errno = 0;
   mOut.open(mTemp, std::ios::binary | std::ios::trunc);
   if (!mOut) {
-    const std::string why = std::strerror(errno);
+    const std::string why = system_reason();
     mTemp.clear();
     fail(mPath, "cannot be written (" + option + "): " + why);
   }
@@ -79,8 +105,9 @@ void OutputFile::commit() {
   std::error_code ec;
   std::filesystem::rename(mTemp, mPath, ec);
   if (ec) {
+    const std::string why = ec.message();  // before the removal below sets ec again
     std::filesystem::remove(mTemp, ec);
-    fail(mPath, "could not be put in place: " + ec.message());
+    fail(mPath, "could not be put in place: " + why);
   }
 }
 

@@ -26,7 +26,8 @@ class Progress {
       const int filled = mTotal ? static_cast<int>(kWidth * done / mTotal) : kWidth;
       std::fprintf(stderr, "\r[%s%s] %zu/%zu %s\033[K", std::string(filled, '#').c_str(),
                    std::string(kWidth - filled, '.').c_str(), done, mTotal, line.c_str());
-      if (done == mTotal) std::fputc('\n', stderr);
+      mOpen = done != mTotal;
+      if (!mOpen) std::fputc('\n', stderr);
     } else {
       const auto now = std::chrono::steady_clock::now();
       if (++mLines > kEveryLine && done != mTotal && now - mLast < std::chrono::seconds(1)) return;
@@ -36,11 +37,21 @@ class Progress {
     std::fflush(stderr);
   }
 
+  /// Ends the bar's line when the work stopped short of the total (a signal stopped it), so that
+  /// what is written next starts on a line of its own.
+  void end() const {
+    if (!mOpen) return;
+    mOpen = false;
+    std::fputc('\n', stderr);
+    std::fflush(stderr);
+  }
+
  private:
   static constexpr std::size_t kEveryLine = 100;
   std::size_t mTotal;
   bool mTerminal;
   mutable std::size_t mLines = 0;
+  mutable bool mOpen = false;  ///< a bar is on the terminal's last line, not ended
   mutable std::chrono::steady_clock::time_point mLast{};
 };
 

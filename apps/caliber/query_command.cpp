@@ -37,6 +37,7 @@ struct QueryOptions {
   int threads = 0;
   int repeat = 1;
   std::size_t max_pairs = 0;
+  bool max_pairs_given = false;  ///< --max-pairs on the command line (refused with --first)
   bool first = false;
   bool lowest_ids = false;
 };
@@ -72,6 +73,9 @@ int run_query(const QueryOptions& opt) {
   request.tolerance = opt.tolerance;
   if (request.kind == caliber::QueryKind::distance && !opt.tolerance_given) request.tolerance = caliber::kUnbounded;
   request.angle_deg = opt.angle;
+  if (opt.first && opt.max_pairs_given) {
+    throw caliber::Error(caliber::ErrorCode::bad_argument, "--first", "is --max-pairs 1: give --first or --max-pairs, not both");
+  }
   request.max_pairs = opt.first ? 1 : opt.max_pairs;
   request.lowest_ids = opt.lowest_ids;
   caliber::validate_request(request);
@@ -214,8 +218,9 @@ Runner add_query_command(CLI::App& app) {
   cmd->add_option("--max-pairs", opt->max_pairs,
                   "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
       ->check(at_least(0))
-      ->capture_default_str();
-  cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1");
+      ->capture_default_str()
+      ->each([opt](const std::string&) { opt->max_pairs_given = true; });
+  cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1; not with --max-pairs");
   cmd->add_flag("--lowest-ids", opt->lowest_ids,
                 "Distance on intersecting meshes: report the intersecting pair with the lowest triangle ids (every "
                 "pair at distance 0 examined) instead of the traversal's first");

@@ -10,6 +10,7 @@
 #include "caliber/mesh.h"
 #include "caliber/error.h"
 #include "commands.h"
+#include "interrupt.h"
 #include "output_file.h"
 
 namespace caliber::cli {
@@ -32,6 +33,7 @@ Runner add_refine_command(CLI::App& app) {
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext != ".off") throw Error(ErrorCode::bad_argument, "OUT", "must name an .off file: refine writes OFF");
     check_distinct_files({{"OUT", opt->out}}, {{"IN", opt->in}});
+    const InterruptGuard interrupt;  // from before OUT's temporary file is made until it is in place or removed
     OutputFile file(opt->out, "OUT");
     const Mesh in = load_mesh(opt->in);
     Mesh out;
@@ -41,6 +43,10 @@ Runner add_refine_command(CLI::App& app) {
       throw Error(ErrorCode::out_of_memory, opt->in, "out of memory while refining it " + std::to_string(opt->levels) + " times");
     }
     write_off(out, file.stream());
+    if (interrupted()) {  // one step only: nothing partial to keep, and the temporary file is removed
+      std::printf("interrupted (%s): %s not written\n", interrupt_name(), opt->out.c_str());
+      return interrupted_exit_code();
+    }
     file.commit();
     std::printf("%s: %zu triangles -> %s: %zu triangles\n", opt->in.c_str(), in.triangles.size(), opt->out.c_str(),
                 out.triangles.size());

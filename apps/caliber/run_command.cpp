@@ -150,6 +150,8 @@ int run_scene(const RunOptions& opt) {
       throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*k) + " is listed twice");
     }
   }
+  // SIGINT and SIGTERM handled from before the first output is made until every one is in place.
+  const InterruptGuard interrupt;
   // Every output is checked, and kept apart from every input, before any work is done.
   NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
   for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
@@ -190,9 +192,8 @@ int run_scene(const RunOptions& opt) {
   std::vector<SimulatedRun> sims;
   for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
   const Progress progress(static_cast<std::size_t>(sc.steps));
-  const InterruptGuard interrupt;
   std::size_t limited_steps = 0;
-  for (int k = 0; k < sc.steps && !gInterrupted.load(); ++k) {
+  for (int k = 0; k < sc.steps && !interrupted(); ++k) {
     StepResult s;
     try {
       s = step(world, engine, k);
@@ -210,9 +211,12 @@ int run_scene(const RunOptions& opt) {
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
-  const bool interrupted = gInterrupted.load();
-  if (interrupted)
-    std::printf("\ninterrupted (SIGINT) after %zu of %d steps: writing what was measured\n", stats.steps(), sc.steps);
+  progress.end();
+  const bool stopped = interrupted();
+  if (stopped) {
+    std::printf("\ninterrupted (%s) after %zu of %d steps: writing what was measured\n", interrupt_name(), stats.steps(),
+                sc.steps);
+  }
   if (contacts_out) contacts_out->commit();
   if (exporter) exporter->commit();
 
@@ -261,12 +265,12 @@ int run_scene(const RunOptions& opt) {
                                {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
                                {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
                                {"simulated_speedup", simulated}});
-    if (interrupted) report->member("interrupted", true);
+    if (stopped) report->member("interrupted", true);
     report->close();
     json_out->commit();
   }
   check_stdout();
-  return interrupted ? 130 : 0;
+  return stopped ? interrupted_exit_code() : 0;
 }
 
 }  // namespace

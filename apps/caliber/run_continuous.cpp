@@ -71,6 +71,8 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
   SweepRequest request;
   request.tolerance = opt.tolerance;
   validate_sweep_request(request);
+  // SIGINT and SIGTERM handled from before the report is opened until it is in place.
+  const InterruptGuard interrupt;
   std::unique_ptr<OutputFile> json_out;
   if (!opt.json.empty()) {
     check_distinct_files({{"--json", opt.json}}, scene_inputs(opt.scene_file, scene));
@@ -98,11 +100,10 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
   }
   const int intervals = std::max(sc.steps - 1, 0);
   const Progress progress(static_cast<std::size_t>(intervals));
-  const InterruptGuard interrupt;
   std::size_t touched = 0, undecided = 0;
   int done = 0;
   double first = -1.0;
-  for (int k = 0; k < intervals && !gInterrupted.load(); ++k, ++done) {
+  for (int k = 0; k < intervals && !interrupted(); ++k, ++done) {
     const auto start = Clock::now();
     const std::vector<PairSweep> pairs = world.sweep(k, engine, request);
     const double ms = ms_since(start);
@@ -120,7 +121,12 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     std::snprintf(line, sizeof line, "step %d -> %d: %zu pairs not free, %.2f ms", k, k + 1, pairs.size(), ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
-  const bool interrupted = gInterrupted.load();
+  progress.end();
+  const bool stopped = interrupted();
+  if (stopped) {
+    std::printf("\ninterrupted (%s) after %d of %d step intervals: writing what was measured\n", interrupt_name(), done,
+                intervals);
+  }
   std::printf("\nsummary over %d step intervals\n", done);
   std::printf("  pairs that touch    %zu (undecided: %zu)\n", touched, undecided);
   if (first >= 0.0) std::printf("  first contact      at step %.6f (t = %.6f s)\n", first, first * sc.dt);
@@ -129,12 +135,12 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     nlohmann::json summary = {{"intervals", done}, {"pairs_touching", touched}, {"pairs_undecided", undecided}};
     summary["first_contact_step"] = first >= 0.0 ? nlohmann::json(first) : nlohmann::json(nullptr);
     report->member("summary", summary);
-    if (interrupted) report->member("interrupted", true);
+    if (stopped) report->member("interrupted", true);
     report->close();
     json_out->commit();
   }
   check_stdout();
-  return interrupted ? 130 : 0;
+  return stopped ? interrupted_exit_code() : 0;
 }
 
 }  // namespace caliber::cli

@@ -16,8 +16,9 @@ struct ContinuousOptions {
   std::string json;        ///< the report's path, or empty
 };
 
-/// Runs the scene's step intervals through World::sweep; returns the exit code (130 when
-/// interrupted). Throws caliber::Error on a bad tolerance or report path, before any work.
+/// Runs the scene's step intervals through World::sweep; returns the exit code (130 when SIGINT
+/// stopped it, 143 for SIGTERM; what was swept is written). Throws caliber::Error on a bad
+/// tolerance or report path, before any work.
 int run_continuous(const ContinuousOptions& opt, Scene scene);
 
 }  // namespace caliber::cli

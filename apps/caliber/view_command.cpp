@@ -18,6 +18,7 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "commands.h"
+#include "interrupt.h"
 #include "json_output.h"
 #include "output_file.h"
 #include "progress.h"
@@ -165,6 +166,8 @@ int view_scene(const ViewOptions& opt) {
   options.method = parse_method(opt.method);
   options.threads = opt.threads;
   options.timeline = true;
+  // SIGINT and SIGTERM handled from before the page is opened until it is in place (or removed).
+  const InterruptGuard interrupt;
   check_distinct_files({{"--out", opt.out}}, scene_inputs(opt.scene, scene));
   OutputFile out(opt.out, "--out");
 
@@ -193,21 +196,30 @@ int view_scene(const ViewOptions& opt) {
   data.member("objects", objects);
   data.open_array("steps");
   const Progress progress(static_cast<std::size_t>(sc.steps));
-  for (int k = 0; k < sc.steps; ++k) {
+  int done = 0;
+  for (int k = 0; k < sc.steps && !interrupted(); ++k, ++done) {
     const StepResult s = step(world, engine, k);
     data.item(step_view(world, s, world.poses_at(k), opt.max_boxes));
     progress.update(static_cast<std::size_t>(k + 1), "step " + std::to_string(k) + ": " + std::to_string(s.contacts.size()) +
                                                          " contacts, " + std::to_string(s.schedule->task_node_tests.size()) +
                                                          " run-time tasks");
   }
+  progress.end();
+  const bool stopped = interrupted();  // a signal during the writing below stops nothing: the page is whole
+  if (stopped) {
+    std::printf("interrupted (%s) after %d of %d steps: %s\n", interrupt_name(), done, sc.steps,
+                done > 0 ? "writing the page of the steps done" : "no page written");
+    if (done == 0) return interrupted_exit_code();  // the temporary file removed, as after a failure
+  }
   data.close_array();
+  if (stopped) data.member("interrupted", true);
   data.close();
   out.stream() << kPageMiddle << kViewerScript << kPageTail;
   out.commit();
-  std::printf("wrote %s: %s, %d steps, %zu objects, %s on %d thread(s)\n", opt.out.c_str(), sc.name.c_str(), sc.steps,
+  std::printf("wrote %s: %s, %d steps, %zu objects, %s on %d thread(s)\n", opt.out.c_str(), sc.name.c_str(), done,
               world.object_count(), std::string(to_string(engine.options().method)).c_str(), engine.threads());
   check_stdout();
-  return 0;
+  return stopped ? interrupted_exit_code() : 0;
 }
 
 }  // namespace

@@ -37,6 +37,7 @@
 #include "bench_records.h"
 #include "bench_report.h"
 #include "commands.h"
+#include "interrupt.h"
 #include "machine.h"
 #include "output_file.h"
 #include "progress.h"
@@ -209,9 +210,26 @@ struct BenchRun {
   bool stopped = false;
   std::vector<double> sequential_s;  ///< per scene: one sequential run, in seconds (0 until run)
 
-  /// Whether work of `estimate_s` fits; if not, records that the run stops here.
+  /// Whether a signal (SIGINT, SIGTERM) stopped the bench; records that it stops here, before `what`.
+  bool interrupted_before(const std::string& what) {
+    if (stopped) return true;
+    if (!interrupted()) return false;
+    stopped = true;
+    progress.end();
+    log.add({{"kind", "stopped"},
+             {"reason", "interrupted"},
+             {"signal", interrupt_name()},
+             {"after_s", budget.elapsed_s()},
+             {"next", what}});
+    std::fprintf(stderr, "\ncaliber bench: interrupted (%s) after %.0f s; not run: %s and what follows\n", interrupt_name(),
+                 budget.elapsed_s(), what.c_str());
+    return true;
+  }
+
+  /// Whether work of `estimate_s` fits and no signal stopped the bench; if not, records that the
+  /// run stops here.
   bool fits(double estimate_s, const std::string& what) {
-    if (stopped) return false;
+    if (interrupted_before(what)) return false;
     if (budget.allows(estimate_s)) return true;
     stopped = true;
     log.add({{"kind", "stopped"}, {"reason", "budget"}, {"after_s", budget.elapsed_s()}, {"next", what}});
@@ -321,7 +339,7 @@ std::vector<double> measure_ceiling(const Scene& scene, int copies) {
           ready.wait(lock, [&] { return loaded >= copies; });  // all start stepping together
         }
         const auto start = Clock::now();
-        for (int k = 0; k < scene.steps; ++k) static_cast<void>(step(world, engine, k));
+        for (int k = 0; k < scene.steps && !interrupted(); ++k) static_cast<void>(step(world, engine, k));
         ms[static_cast<std::size_t>(i)] = 1000.0 * seconds_since(start) / scene.steps;
       } catch (...) {
         errors[static_cast<std::size_t>(i)] = std::current_exception();
@@ -373,6 +391,9 @@ void simulate_scene(BenchRun& b, const World& world, double sequential_s) {
       SimulatedRun simulated(v.method, p);
       std::vector<double> estimated, effective;
       for (int k = 0; k < steps; ++k) {
+        if (b.interrupted_before(sc.name + " " + v.name + " simulated on " + std::to_string(p) + " cores, step " +
+                                 std::to_string(k)))
+          return;
         const StepResult s = step(world, engine, k);
         simulated.add(s);
         if (p == 8 || p == b.opt.simulate.front()) {
@@ -445,7 +466,9 @@ void bench_scene(BenchRun& b, std::size_t si) {
       // Each copy loads and builds its own world, then all step at once.
       if (!b.fits(b.load_s[si] + 1.5 * sequential_s, sc.name + " ceiling at " + std::to_string(t) + " copies")) return;
       std::fprintf(stderr, "%s: the machine's ceiling, %d sequential copies at once\n", sc.name.c_str(), t);
-      b.log.add({{"kind", "ceiling"}, {"scene", sc.name}, {"copies", t}, {"copy_step_ms", measure_ceiling(sc, t)}});
+      const std::vector<double> copy_ms = measure_ceiling(sc, t);  // cut short by a signal: not recorded
+      if (b.interrupted_before(sc.name + " ceiling at " + std::to_string(t) + " copies")) return;
+      b.log.add({{"kind", "ceiling"}, {"scene", sc.name}, {"copies", t}, {"copy_step_ms", copy_ms}});
     }
   }
   simulate_scene(b, world, sequential_s);
@@ -469,7 +492,7 @@ void record_gantt(BenchRun& b) {
     o.timeline = true;
     Engine engine(o);
     StepResult s;
-    for (int k = 0; k <= step; ++k) s = caliber::step(world, engine, k);  // hybrid needs the previous steps' history
+    for (int k = 0; k <= step && !interrupted(); ++k) s = caliber::step(world, engine, k);  // hybrid needs the history
     Json spans = Json::array();
     for (const TaskSpan& span : s.schedule->timeline) {
       spans.push_back({span.thread, span.start_ms, span.end_ms,
@@ -479,6 +502,7 @@ void record_gantt(BenchRun& b) {
     }
     gantt["methods"][name] = {{"narrow_ms", s.narrow_ms}, {"spans", spans}};
   }
+  if (b.interrupted_before("the timeline")) return;  // cut short: not recorded
   b.log.add(gantt);
 }
 
@@ -501,6 +525,16 @@ std::string fcl_report(const BenchOptions& opt) {
   return ss.str();
 }
 
+/// Why the figures are not drawn: --no-figures, or a signal that stopped the bench (empty: they are).
+std::string no_figures_note(bool figures) {
+  if (!figures) return "Figures not drawn (--no-figures).";
+  if (interrupted()) {
+    return std::string("Figures not drawn: the bench was interrupted (") + interrupt_name() +
+           "); `caliber bench --from-log` draws them from its log.";
+  }
+  return "";
+}
+
 /// results.json, the figures (scripts/plot_bench.py, matplotlib) and report.md in `out`, from the
 /// bench's records.
 void write_outputs(const std::vector<Json>& records, const std::filesystem::path& out, bool figures) {
@@ -512,8 +546,8 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
     file.commit();
   };
   write_json();
-  std::string figures_note;
-  if (figures) {
+  std::string figures_note = no_figures_note(figures);
+  if (figures_note.empty()) {
     std::filesystem::path script;
     for (const auto& candidate :
          {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
@@ -527,8 +561,6 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
     } else if (run_command(python() + " " + quote(script.string()) + " " + quote(out.string())) != 0) {
       figures_note = "Figures not drawn: `python3 scripts/plot_bench.py` failed (is python3-matplotlib installed?).";
     }
-  } else {
-    figures_note = "Figures not drawn (--no-figures).";
   }
   results["figures_note"] = figures_note;
   write_json();
@@ -569,10 +601,13 @@ int report_from_log(const BenchOptions& opt) {
   std::filesystem::create_directories(out);
   write_outputs(records, out, opt.figures);
   check_stdout();
-  return 0;
+  return interrupted() ? interrupted_exit_code() : 0;
 }
 
 int run_bench(BenchOptions opt) {
+  // SIGINT and SIGTERM handled from before anything is created until the outputs are in place: the
+  // bench stops after the step in progress and reports what it measured.
+  const InterruptGuard interrupt;
   if (!opt.from_log.empty()) return report_from_log(opt);
   const Budget budget(opt.budget_s);  // counts from here: loading the scenes is part of the run
   if (opt.scenes.empty()) {
@@ -694,6 +729,8 @@ int run_bench(BenchOptions opt) {
   for (std::size_t si = 0; si < worlds.size() && !b.stopped; ++si) bench_scene(b, si);
   record_gantt(b);
   if (b.fits(opt.fcl ? 60.0 : 0.0, "the FCL comparison")) log.add({{"kind", "fcl"}, {"report", fcl_report(opt)}});
+  static_cast<void>(b.interrupted_before("the figures"));  // a signal during the FCL comparison: recorded
+  const bool stopped = interrupted();
 
   write_outputs(log.records(), opt.out, opt.figures);
   const Json results = results_from_records(log.records());
@@ -702,7 +739,7 @@ int run_bench(BenchOptions opt) {
     return 1;
   }
   check_stdout();
-  return 0;
+  return stopped ? interrupted_exit_code() : 0;
 }
 
 }  // namespace

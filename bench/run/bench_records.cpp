@@ -293,6 +293,10 @@ Json results_from_records(const std::vector<Json>& records) {
       results["fcl_report"] = r["report"];
     } else if (kind == "stopped") {
       results["stopped"] = {{"reason", r["reason"]}, {"after_s", r["after_s"]}};
+      if (r["reason"] == "interrupted") {
+        results["stopped"]["signal"] = r.value("signal", "a signal");
+        results["interrupted"] = true;
+      }
     }
   }
   results["scenes"] = Json::array();

@@ -16,7 +16,8 @@
 //   mismatch    scene, method, threads, step: contacts that differ from sequential's
 //   gantt       the per-thread timeline of one step (see bench_command.cpp)
 //   fcl         report: the FCL comparison's Markdown
-//   stopped     reason, after_s, runs_done: the run ended early (its budget)
+//   stopped     reason, after_s, next: the run ended early, reason "budget" (--budget-s) or
+//               "interrupted" (with signal: "SIGINT" or "SIGTERM"), before `next`
 
 #include <filesystem>
 #include <fstream>

@@ -73,7 +73,10 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   if (r.contains("runs_done") && r.contains("runs_planned")) {
     out << "Runs done: " << r["runs_done"] << " of " << r["runs_planned"] << " planned";
     if (r.contains("stopped")) {
-      out << "; **cut short by its time budget** (`--budget-s`) after " << num(r["stopped"]["after_s"].get<double>(), "%.0f")
+      out << (r["stopped"]["reason"] == "interrupted"
+                  ? "; **interrupted** (" + r["stopped"].value("signal", std::string("a signal")) + ")"
+                  : std::string("; **cut short by its time budget** (`--budget-s`)"))
+          << " after " << num(r["stopped"]["after_s"].get<double>(), "%.0f")
           << " s: this report covers what ran, and a configuration missing below was not measured";
     } else if (r["runs_done"].get<std::size_t>() < r["runs_planned"].get<std::size_t>()) {
       out << "; **the log ends before the run did** (killed, or cut by a time limit): this report covers the runs it holds";

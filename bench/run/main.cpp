@@ -1,6 +1,7 @@
 // caliber-bench: the benchmark of the six methods as a program of its own (the same as
 // `caliber bench`, which the caliber program keeps as a thin entry to this code).
-// Exit codes: 0 success, 2 bad input (message on stderr), 1 unexpected internal error.
+// Exit codes: 0 success, 2 bad input (message on stderr), 130 and 143 stopped by SIGINT or SIGTERM
+// (what was measured is reported), 1 unexpected internal error or contacts that differ.
 
 #include <iostream>
 #include <new>

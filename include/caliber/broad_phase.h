@@ -23,8 +23,9 @@ namespace caliber {
 /// three axes): a tree of boxes over the objects in Morton order prunes the search, each pair met
 /// once. Runs on the calling thread; Engine::find_pairs runs the same search on the engine's threads
 /// and keeps the tree from one frame to the next.
-/// Throws caliber::Error (source "broad phase") on a null model, sizes that do not match, a
-/// negative or non-finite reach, or an ignored pair that names no two objects a < b.
+/// Throws caliber::Error (source "broad phase") on a null model, sizes that do not match, or an
+/// ignored pair that names no two objects a < b; and (source "reach") on a reach that is negative,
+/// not finite or above 1e15 (kMaxCoordinate, as a query's tolerance).
 [[nodiscard]] CALIBER_EXPORT std::vector<ObjectPair> broad_phase(const std::vector<std::shared_ptr<const Model>>& models,
                                                                  const std::vector<Pose>& poses, double reach,
                                                                  const std::vector<bool>& fixed = {},

@@ -15,6 +15,7 @@ caliber.query_many's on one machine. A worker that dies mid-sweep costs the chun
 scheduler runs them again on the workers left (up to Dask's distributed.scheduler.allowed-failures
 times per chunk).
 """
+import operator
 import re
 
 import numpy as np
@@ -22,6 +23,19 @@ import numpy as np
 import caliber
 
 _ROW = re.compile(r"^(poses_[ab])\[(\d+)\]")
+
+
+def _positive_integer(value, name):
+    """`value` as an int >= 1: a Python or numpy integer (not a bool, not a float)."""
+    try:
+        if isinstance(value, (bool, np.bool_)):
+            raise TypeError
+        number = operator.index(value)
+    except TypeError:
+        raise caliber.Error(f"{name}: must be an integer >= 1, not {type(value).__name__} {value!r}") from None
+    if number < 1:
+        raise caliber.Error(f"{name}: must be an integer >= 1, not {number}")
+    return number
 
 
 def _run_chunk(a, poses_a, b, poses_b, first, request):
@@ -62,8 +76,7 @@ def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=No
     dask.distributed Client): the same arguments and the same Batch, bit for bit. `chunk`: poses
     per task (a dead worker's chunks run again); `threads`: threads per chunk on its worker (1 fits
     workers started with one thread per core)."""
-    if not isinstance(chunk, int) or chunk < 1:
-        raise caliber.Error(f"chunk: must be an integer >= 1, not {chunk!r}")
+    chunk = _positive_integer(chunk, "chunk")
     if not isinstance(a, caliber.Model) or not isinstance(b, caliber.Model):
         raise caliber.Error("a, b: must be caliber.Model")
     na, take_a = _side(poses_a, "poses_a")
@@ -73,6 +86,9 @@ def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=No
     n = max(na, nb) if na != 0 and nb != 0 else 0
     request = dict(kind=kind, tolerance=tolerance, angle=angle, max_pairs=max_pairs, order=order,
                    lowest_ids=lowest_ids, threads=threads)
+    # The request checked here, before anything is sent: a bad kind, tolerance, angle, max_pairs,
+    # order, lowest_ids or threads is one error from this machine, not one from every chunk.
+    caliber.query_many(a, np.empty((0, 7)), b, np.empty((0, 7)), **request)
     if n == 0:  # nothing to send: the empty Batch, from this machine
         return caliber.query_many(a, take_a(0, 0), b, take_b(0, 0), **request)
     model_a, model_b = client.scatter([a, b], broadcast=True, hash=False)

@@ -117,6 +117,13 @@ def test_meshes_from_arrays_equal_meshes_from_files():
     assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.points_a, b.points_a)
     with pytest.raises(caliber.Error, match="arrays: face 0 refers to vertex 9"):
         caliber.Mesh(m.vertices, np.array([[0, 1, 9]]))
+    # uint64 indices past int64 are named as given (cast, 2**64 - 1 read as -1).
+    wide = np.array([[0, 1, 2], [0, 1, 2**64 - 1], [2**63, 1, 2]], dtype=np.uint64)
+    with pytest.raises(caliber.Error, match=r"^arrays: face 1 refers to vertex 18446744073709551615 but there are only \d+$"):
+        caliber.Mesh(m.vertices, wide)
+    with pytest.raises(caliber.Error, match="arrays: face 1 refers to vertex 9223372036854775808 "):
+        caliber.Mesh(m.vertices, wide[[0, 2]])
+    assert np.array_equal(caliber.Mesh(m.vertices, m.faces.astype(np.uint64)).faces, m.faces)
     with pytest.raises(ValueError, match="n x 3"):
         caliber.Mesh(np.zeros((3, 2)), m.faces)
 
@@ -228,8 +235,12 @@ def test_engine_find_pairs_keeps_its_tree_and_finds_the_broad_phase_pairs():
     assert engine.find_pairs(models, poses, fixed=fixed) == caliber.broad_phase(models, poses, 0.0, fixed=fixed)
     some = caliber.broad_phase(models, poses)[:3]
     assert engine.find_pairs(models, poses, ignored=some) == caliber.broad_phase(models, poses, ignored=some)
-    with pytest.raises(caliber.Error, match="reach must be finite"):
+    with pytest.raises(caliber.Error, match="^tolerance: a distance query without one reaches every pair"):
         engine.find_pairs(models, poses, kind="distance")  # an unbounded distance names its pairs
+    for reach in (1e300, 1e15 * (1 + 2**-52), float("inf"), float("nan"), -1.0):
+        with pytest.raises(caliber.Error, match=r"^reach: must be finite, >= 0 and at most 1e15"):
+            caliber.broad_phase(models, poses, reach)
+    assert caliber.broad_phase(models, poses, 1e15) == [(a, b) for a in range(len(models)) for b in range(a + 1, len(models))]
     with pytest.raises(caliber.Error, match="3 models but 2 poses"):
         engine.find_pairs(models[:3], poses[:2])
 
@@ -460,6 +471,7 @@ def test_tampered_model_states_are_caliber_errors():
         "faces: must be an m x 3 array": (v, np.zeros((2, 2, 2), dtype=int), True),
         "refers to vertex 99": (v, np.array([[0, 1, 99]]), True),
         "refers to vertex -1": (v, np.array([[0, 1, -1]]), True),
+        "refers to vertex 18446744073709551615": (v, np.array([[0, 1, 2**64 - 1]], dtype=np.uint64), True),
         "non-finite": (np.where(v == v.max(), np.nan, v), f, True),
     }
     for message, state in states.items():

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "caliber/broad_phase.h"
 #include "caliber/error.h"
+#include "caliber/mesh.h"
 #include "mesh/pose_check.h"
 #include "parallel/executor.h"
 
@@ -45,7 +47,14 @@ void find_pairs(State& state, const std::vector<std::shared_ptr<const Model>>& m
                 double reach, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored,
                 std::vector<ObjectPair>& out) {
   validate_objects("broad phase", models, poses, "pose", fixed, ignored);
-  if (!(reach >= 0.0) || !std::isfinite(reach)) throw Error(ErrorCode::bad_value, "broad phase", "reach must be finite and >= 0");
+  // As a query's tolerance (validate_request): a reach past caliber's range would grow every box
+  // past the range its exact tests are proved in.
+  if (!(reach >= 0.0) || !std::isfinite(reach) || reach > kMaxCoordinate) {
+    char given[32];
+    std::snprintf(given, sizeof given, "%g", reach);
+    throw Error(ErrorCode::bad_value, "reach",
+                std::string("must be finite, >= 0 and at most 1e15 (caliber's limit on coordinates), not ") + given);
+  }
   pair_keys(ignored, state.ignored);
   const std::size_t n = models.size();
   const double grow = 0.5 * reach;

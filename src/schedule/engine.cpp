@@ -122,6 +122,10 @@ void Engine::forget() {
 void Engine::find_pairs(Frame& frame, const std::vector<bool>& fixed, const std::vector<ObjectPair>& ignored) {
   const schedule::OneCallAtATime hold(mImpl->busy, "find_pairs");
   validate_request(frame.request);
+  if (frame.request.kind == QueryKind::distance && frame.request.tolerance == kUnbounded) {
+    throw Error(ErrorCode::bad_value, "tolerance",
+                "a distance query without one reaches every pair: find_pairs needs a tolerance to bound its reach");
+  }
   mImpl->executor.execute(
       [&] { broad::find_pairs(mImpl->broad, frame.models, frame.poses, reach(frame.request), fixed, ignored, frame.pairs); });
 }

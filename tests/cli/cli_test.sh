@@ -66,6 +66,11 @@ contains bad-pose "--pose-a"
 check zero-quat 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0 0 0 0 0 0 0"
 check bad-kind 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind collide
 contains bad-kind "unknown query kind"
+check first-and-max-pairs 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --first --max-pairs 3
+contains first-and-max-pairs "caliber: --first: is --max-pairs 1: give --first or --max-pairs, not both"
+check first-alone 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind proximity --tolerance 0.1 --first --json
+python3 -c "import json, sys; r = json.loads(sys.argv[1]); assert len(r['pairs']) == 1 and r['limit_reached']" "$out" &&
+  passes=$((passes + 1)) || { echo "FAIL first-alone: $out"; failures=$((failures + 1)); }
 check neg-tol 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind proximity --tolerance -1
 check bad-angle 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind contact --angle 200
 check no-args 2 "$cli"
@@ -446,6 +451,18 @@ check out-over-mesh 2 "$cli" run "$r2/s/q.json" --json "$r2/s/tetra.off"
 check out-no-folder 2 "$cli" run "$data/scenes/tetras.json" --json /nonexistent/r.json
 contains out-no-folder "no folder /nonexistent"
 contains out-no-folder "/nonexistent/r.json"
+# The reason an output cannot be written is the system's: a "folder" that is a file; a name of 251
+# bytes is written (its temporary file's name is cut to fit), one of 300 is too long, before any work.
+touch "$r2/plain"
+check out-folder-is-file 2 "$cli" run "$data/scenes/tetras.json" --contacts "$r2/plain/c.jsonl"
+contains out-folder-is-file "$r2/plain/c.jsonl: cannot be written (--contacts): $r2/plain is not a folder"
+long=$(printf 'x%.0s' $(seq 245))
+check out-long-name 0 "$cli" run "$data/scenes/tetras.json" --contacts "$r2/$long.jsonl"
+[ -s "$r2/$long.jsonl" ] && passes=$((passes + 1)) || { echo "FAIL out-long-name: not written"; failures=$((failures + 1)); }
+rm -f "$r2/$long.jsonl"
+check out-name-too-long 2 "$cli" run "$data/scenes/tetras.json" --contacts "$r2/$long$long.jsonl"
+contains out-name-too-long "cannot be written (--contacts): File name too long"
+case "$out" in *"step 0"*) echo "FAIL out-name-too-long: the run went on"; failures=$((failures + 1)) ;; esac
 if [ -w /dev/full ]; then
   check out-full-contacts 2 "$cli" run "$data/scenes/tetras.json" --contacts /dev/full
   contains out-full-contacts "/dev/full: could not be written"

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -167,7 +168,13 @@ TEST(BroadPhase, BadInputIsAnErrorNamingTheProblem) {
             "broad phase: 2 models but 1 poses (one per object)");
   EXPECT_EQ(message([&] { return broad_phase(two, poses, 0.0, {true}); }),
             "broad phase: 2 objects but 1 fixed flags (none, or one per object)");
-  EXPECT_EQ(message([&] { return broad_phase(two, poses, -1.0); }), "broad phase: reach must be finite and >= 0");
+  EXPECT_EQ(message([&] { return broad_phase(two, poses, -1.0); }),
+            "reach: must be finite, >= 0 and at most 1e15 (caliber's limit on coordinates), not -1");
+  EXPECT_EQ(message([&] { return broad_phase(two, poses, 1e300); }),
+            "reach: must be finite, >= 0 and at most 1e15 (caliber's limit on coordinates), not 1e+300");
+  EXPECT_EQ(message([&] { return broad_phase(two, poses, std::numeric_limits<double>::infinity()); }),
+            "reach: must be finite, >= 0 and at most 1e15 (caliber's limit on coordinates), not inf");
+  EXPECT_EQ(broad_phase(two, poses, 1e15).size(), 1u);  // the largest reach, as the largest tolerance
   EXPECT_EQ(message([&] {
               return broad_phase(two, poses, 0.0, {}, {{1, 1}});
             }),
