@@ -211,10 +211,18 @@ class DuplicateKeys final : public nlohmann::json_sax<Json> {
   bool key(string_t& key) override {
     if (!mStack.back().keys.insert(key).second) {
       std::string path;
+      const auto name = [&path](const std::string& part) {
+        if (!path.empty()) path.push_back('.');
+        path.append(part);
+      };
       for (std::size_t i = 0; i + 1 < mStack.size(); ++i) {
-        path += mStack[i].object ? (path.empty() ? "" : ".") + mStack[i].key : "[" + std::to_string(mStack[i].index) + "]";
+        if (mStack[i].object) {
+          name(mStack[i].key);
+        } else {
+          path.append("[").append(std::to_string(mStack[i].index)).append("]");
+        }
       }
-      path += (path.empty() ? "" : ".") + key;
+      name(key);
       throw Error(ErrorCode::unreadable, mSource,
                   "'" + path + "': the key is given twice in one object (which value was meant?)");
     }
