@@ -75,10 +75,12 @@ SweepAdvance::SweepAdvance(double ra, const SweptPose& motion_a, double rb, cons
   mTolerance = sweep_tolerance(request, std::max(ra, rb), mMargin);
   // Bounds may only be rounded up: a speed a hair too high costs a step, a hair too low a miss.
   mSpeed = (speed_bound(motion_a, ra) + speed_bound(motion_b, rb)) * (1.0 + 1e-12);
+  mTurnA = turn_angle(motion_a.start.rotation, motion_a.end.rotation) * (1.0 + 1e-12);
+  mTurnB = turn_angle(motion_b.start.rotation, motion_b.end.rotation) * (1.0 + 1e-12);
   mResult.time = 0.0;
 }
 
-bool SweepAdvance::take(const QueryResult& r) {
+bool SweepAdvance::take(const QueryResult& r, const PairContext& ctx) {
   const double t = mResult.time;
   ++mResult.queries;
   mLastTests = r.stats.node_tests;
@@ -98,13 +100,34 @@ bool SweepAdvance::take(const QueryResult& r) {
     mResult.closest = r.contacts.front();
     return true;
   }
-  // No contact before t + (d - margin) / mu: every point moves at most mu per unit t.
-  if (mSpeed == 0.0 || t + (d - mMargin) / mSpeed >= 1.0) {
+  // No contact before t + (d - margin) / mu: every point moves at most mu per unit t. Nor before
+  // the local advance, pair of triangles by pair (what lets parts slide past each other).
+  double step = mSpeed == 0.0 ? 1.0 : (d - mMargin) / mSpeed;
+  if (t + step < 1.0) {
+    LocalMotion m;
+    m.translation = ctx.pose_a().rotation.conjugate() * ((mMotionB.end.translation - mMotionB.start.translation) -
+                                                         (mMotionA.end.translation - mMotionA.start.translation));
+    m.turn_a = mTurnA;
+    m.turn_b = mTurnB;
+    m.margin = mMargin;
+    // The closest pair's own advance bounds the local one from above: only where it goes further
+    // than the global step (a grazing pass) is there something to gain from the traversal.
+    const double closest = pair_advance(ctx, m, mLastA, mLastB);
+    if (closest > kGrazing * step) {
+      // At most mReach global steps, and no more node pairs than half the query's node tests:
+      // a pass that only grazes gains much for little, one that closes in is left to the query.
+      const double cap = std::min({1.0 - t, closest, mReach * step});
+      const double local = local_advance(ctx, m, cap, r.stats.node_tests / 2 + 64);
+      mReach = local >= cap ? std::min(mReach * kLocalGrowth, 1e15) : kLocalReach;
+      step = std::max(step, local);
+    }
+  }
+  if (t + step >= 1.0) {
     mResult.status = SweepStatus::free;
     mResult.time = 1.0;
     return true;
   }
-  mResult.time = t + (d - mMargin) / mSpeed;
+  mResult.time = t + step;
   if (mResult.queries >= mMaxQueries) {
     mResult.status = SweepStatus::undecided;
     return true;
@@ -116,7 +139,10 @@ SweepResult sweep_checked(const Model& a, double ra, const SweptPose& motion_a, 
                           const SweptPose& motion_b, const SweepRequest& request) {
   const QueryRequest distance = sweep_distance_request(request.groups);
   SweepAdvance advance(ra, motion_a, rb, motion_b, request);
-  while (!advance.take(query_whole(PairContext(a, advance.pose_a(), b, advance.pose_b(), distance)))) {}
+  for (bool done = false; !done;) {
+    const PairContext ctx(a, advance.pose_a(), b, advance.pose_b(), distance);
+    done = advance.take(query_whole(ctx), ctx);
+  }
   return advance.result();
 }
 

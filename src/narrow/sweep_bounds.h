@@ -10,6 +10,7 @@
 
 #include "caliber/model.h"
 #include "caliber/sweep.h"
+#include "narrow/pair_context.h"
 
 namespace caliber::narrow {
 
@@ -43,6 +44,37 @@ inline double sweep_tolerance(const SweepRequest& request, double radius, double
 /// the triangle pairs whose groups may touch (`groups`: SweepRequest::groups).
 [[nodiscard]] QueryRequest sweep_distance_request(const GroupCompatibility* groups);
 
+/// A local advance first tries to prove this many global steps (the models' closest distance over
+/// their fastest point); each time it proves all it tried, the next tries kLocalGrowth times more.
+inline constexpr double kLocalReach = 64.0;
+inline constexpr double kLocalGrowth = 8.0;
+/// A local advance is tried only where the closest pair alone could go this many global steps
+/// (a grazing pass): where it goes little further, so would the local advance, at a price.
+inline constexpr double kGrazing = 8.0;
+
+/// How a pair moves from the poses of a query on, in A's frame at that query: what local_advance
+/// bounds the speed of each pair of triangles by.
+struct LocalMotion {
+  Eigen::Vector3d translation;  ///< B's translation less A's, per unit t, in A's frame at the query
+  double turn_a = 0.0;          ///< A's turn (radians per unit t) about its origin
+  double turn_b = 0.0;          ///< B's likewise
+  double margin = 0.0;          ///< the sweep's margin for rounding (taken off every separation)
+};
+
+/// How far (a share of the sweep) triangles ta of A and tb of B can move by `m` from the poses of
+/// `ctx` before they could come within the margin (infinity when their groups may not touch).
+[[nodiscard]] double pair_advance(const PairContext& ctx, const LocalMotion& m, std::uint32_t ta, std::uint32_t tb);
+
+/// How far (a share of the sweep, at most `cap`) the pair of `ctx` can move by `m` from the poses
+/// of `ctx` before any of its triangle pairs could come within the margin: the smallest, over the
+/// pairs of triangles, of their separation along the direction between their closest points over
+/// the speed at which it can shrink (the translation along that direction, and each triangle's
+/// turn about its model's origin); node pairs farther apart than `cap` times their fastest point
+/// are left out. Never more than the time to the first contact; for two parts sliding past each
+/// other, far more than their closest distance over their fastest point. After `budget` node
+/// pairs, gives up: 0.
+[[nodiscard]] double local_advance(const PairContext& ctx, const LocalMotion& m, double cap, std::uint64_t budget);
+
 /// One pair's conservative advancement, a distance query at a time, on input already checked:
 /// the next query is at poses pose_a() and pose_b() (time time()); take() its answer, until
 /// take() says the sweep is over (result()). Whoever makes the queries (one thread, or the
@@ -53,9 +85,10 @@ class SweepAdvance {
   SweepAdvance(double ra, const SweptPose& motion_a, double rb, const SweptPose& motion_b, const SweepRequest& request);
   [[nodiscard]] Pose pose_a() const { return mMotionA.at(mResult.time); }
   [[nodiscard]] Pose pose_b() const { return mMotionB.at(mResult.time); }
-  /// Takes the answer of the distance query (sweep_distance_request) at pose_a() and pose_b();
+  /// Takes the answer of the distance query (sweep_distance_request) at pose_a() and pose_b(),
+  /// made on `ctx` (a context of those poses and that request, whose local_advance it takes too);
   /// returns true when that ends the sweep.
-  bool take(const QueryResult& r);
+  bool take(const QueryResult& r, const PairContext& ctx);
   /// The answer, once take() has returned true (before: free up to time(), not yet over).
   [[nodiscard]] const SweepResult& result() const { return mResult; }
   /// The node tests of the last query taken (how heavy the next one may be).
@@ -71,6 +104,8 @@ class SweepAdvance {
  private:
   SweptPose mMotionA, mMotionB;
   double mMargin, mTolerance, mSpeed;
+  double mTurnA = 0.0, mTurnB = 0.0;  ///< the slerp angles of the two motions
+  double mReach = kLocalReach;        ///< how many global steps the next local advance may prove
   std::uint64_t mMaxQueries;
   std::uint64_t mLastTests = 0;
   std::uint32_t mLastA = 0, mLastB = 0;  ///< the last query's closest pair, when mHasLast

@@ -63,8 +63,8 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
         parallel::parallel_for_each(first, std::min(whole.size(), first + kSweepChunk), [&](std::size_t k) {
           schedule::SweepJob& job = jobs[whole[k]];
           do {
-            job.done = job.advance.take(
-                narrow::query_whole(narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance)));
+            const narrow::PairContext ctx(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance);
+            job.done = job.advance.take(narrow::query_whole(ctx), ctx);
           } while (!job.done && !(can_split && job.advance.last_node_tests() >= kSplitNodeTests));
         });
       });
@@ -95,7 +95,11 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
         new (where) narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance);
       };
       run_pairs(run, method, ids, distance, no_history, make, results, record, nearest);
-      for (std::size_t k = 0; k < split.size(); ++k) jobs[split[k]].done = jobs[split[k]].advance.take(results[k]);
+      for (std::size_t k = 0; k < split.size(); ++k) {
+        schedule::SweepJob& job = jobs[split[k]];
+        job.done = job.advance.take(results[k],
+                                    narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance));
+      }
       schedule::g_split_sweep_queries.fetch_add(split.size(), std::memory_order_relaxed);
     }
     std::erase_if(active, [&](std::size_t i) { return jobs[i].done; });

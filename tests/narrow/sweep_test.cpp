@@ -178,10 +178,13 @@ TEST(Sweep, AnInterpolatedTranslationBelowTheSmallestCoordinateIsZeroNotAnError)
 }
 
 TEST(Sweep, UndecidedWhenTheQueriesRunOut) {
-  // A grazing pass just outside a tiny tolerance takes many small advances: with a budget of 3
-  // queries the sweep stops undecided, free of contact up to the time it reached.
+  // A grazing pass just outside a tiny tolerance, turning as it goes (about the axis across the
+  // gap, so it never comes closer), takes many small advances: its turn, unlike a slide, can bring
+  // any point closer, as far as the bound knows. With a budget of 3 queries the sweep stops
+  // undecided, free of contact up to the time it reached.
   const auto a = build_model(make_box(0.5, 0.5, 0.5, 1));
-  const SweptPose pass{at(-3.0, 1.0 + 1e-5, 0.0), at(3.0, 1.0 + 1e-5, 0.0)};
+  SweptPose pass{at(-3.0, 1.0 + 1e-5, 0.0), at(3.0, 1.0 + 1e-5, 0.0)};
+  pass.end.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY()));
   SweepRequest request;
   request.tolerance = 1e-6;
   request.max_queries = 3;
@@ -190,6 +193,97 @@ TEST(Sweep, UndecidedWhenTheQueriesRunOut) {
   EXPECT_EQ(s.queries, 3u);
   EXPECT_GT(s.time, 0.0);
   EXPECT_LT(s.time, 1.0);
+}
+
+/// The queries the sweep would take with the models' fastest point alone against their closest
+/// distance (the bound before the local advance), counted by running that advance here, up to
+/// 3,000.
+std::uint64_t global_bound_queries(const Model& a, const SweptPose& ma, const Model& b, const SweptPose& mb, double tolerance) {
+  const auto speed = [](const SweptPose& m, const Model& model) {
+    const Eigen::Quaterniond d = m.start.rotation.conjugate() * m.end.rotation;
+    const double turn = 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
+    return (m.end.translation - m.start.translation).norm() + turn * model.extent();
+  };
+  const double mu = speed(ma, a) + speed(mb, b);
+  std::uint64_t queries = 0;
+  for (double t = 0.0; t < 1.0 && queries < 3000; ++queries) {  // (3,000 is enough to say "many")
+    const double d = distance(a, ma.at(t), b, mb.at(t));
+    if (d <= tolerance) break;
+    t += (d - 1e-9 * (a.extent() + b.extent() + 4.0)) / mu;
+  }
+  return queries;
+}
+
+TEST(Sweep, PartsSlidingPastEachOtherTakeAFewQueries) {
+  // Two plates sliding past each other face to face 1e-6 apart, a rod grazing a box, each free:
+  // the local advance bounds each pair of triangles along the direction between them, across
+  // which a slide brings nothing closer.
+  const auto plate = build_model(make_plate(0.5, 0.02, 12));
+  const auto rod = build_model(make_box(0.6, 0.01, 0.01, 2));
+  const auto block = build_model(make_box(0.3, 0.3, 0.3, 3));
+  struct Case {
+    const char* name;
+    const Model& a;
+    const Model& b;
+    SweptPose motion_b;
+  };
+  const Case cases[] = {
+      {"plates", *plate, *plate, {at(-1.2, 0.3, 0.02 + 1e-6), at(1.2, -0.2, 0.02 + 1e-6)}},
+      {"rod over a block", *block, *rod, {at(-1.5, 0.0, 0.31 + 1e-6), at(1.5, 0.2, 0.31 + 1e-6)}},
+  };
+  for (const Case& c : cases) {
+    SweepRequest request;
+    request.tolerance = 1e-7;
+    const SweptPose still{Pose{}, Pose{}};
+    const SweepResult s = sweep(c.a, still, c.b, c.motion_b, request);
+    EXPECT_EQ(s.status, SweepStatus::free) << c.name;
+    const std::uint64_t before = global_bound_queries(c.a, still, c.b, c.motion_b, request.tolerance);
+    EXPECT_LE(s.queries * 10, before) << c.name << ": " << s.queries << " queries against " << before;
+    EXPECT_EQ(before, 3000u) << c.name << ": many queries with the global bound alone";
+    for (int k = 0; k <= 200; ++k) {
+      EXPECT_GT(distance(c.a, still.at(k / 200.0), c.b, c.motion_b.at(k / 200.0)), request.tolerance) << c.name;
+    }
+  }
+}
+
+TEST(Sweep, RandomSlidesNeverMissASampledContact) {
+  // Plates and boxes sliding near each other, tilted a little and turning a little: the local
+  // advance takes long strides where it can; time sampled at 1/2000, every sampled contact comes
+  // at or after t*, and the models are within the tolerance at t*.
+  const auto plate = build_model(make_plate(0.5, 0.02, 6));
+  const auto box = build_model(make_box(0.2, 0.1, 0.05, 2));
+  std::mt19937_64 rng(58);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto tilt = [&](double degrees) {
+    return Eigen::Quaterniond(
+        Eigen::AngleAxisd(degrees * u(rng) * 3.14159265358979 / 180.0, Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()));
+  };
+  int contacts = 0, frees = 0;
+  for (int m = 0; m < 120; ++m) {
+    const Model& b = m % 2 == 0 ? *plate : *box;
+    const double height = 0.01 + (m % 2 == 0 ? 0.01 : 0.05) + 0.02 * (u(rng) + 0.6);
+    const SweptPose mb{at(-1.3, 0.5 * u(rng), height, tilt(2.0)), at(1.3, 0.5 * u(rng), height + 0.02 * u(rng), tilt(2.0))};
+    const SweptPose still{Pose{}, Pose{}};
+    SweepRequest request;
+    request.tolerance = 1e-5;
+    const SweepResult s = sweep(*plate, still, b, mb, request);
+    ASSERT_NE(s.status, SweepStatus::undecided) << "motion " << m;
+    for (int k = 0; k <= 2000; ++k) {
+      const double t = k / 2000.0;
+      if (!intersect(*plate, still.at(t), b, mb.at(t))) continue;
+      ASSERT_EQ(s.status, SweepStatus::contact) << "motion " << m << ": a sampled contact at t = " << t << " was missed";
+      ASSERT_LE(s.time, t) << "motion " << m << ": reported after a sampled contact";
+      break;
+    }
+    if (s.status == SweepStatus::contact) {
+      ++contacts;
+      EXPECT_LE(distance(*plate, still.at(s.time), b, mb.at(s.time)), request.tolerance) << "motion " << m;
+    } else {
+      ++frees;
+    }
+  }
+  EXPECT_GT(contacts, 15);
+  EXPECT_GT(frees, 15);
 }
 
 }  // namespace
