@@ -2,6 +2,7 @@
 
 #include "output_file.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -29,11 +30,13 @@ std::filesystem::path canonical_or_same(const std::filesystem::path& p) {
 /// The system's reason for the call that just failed (read at once, before anything else sets errno).
 std::string system_reason() { return errno != 0 ? std::strerror(errno) : "the system gave no reason"; }
 
-/// The temporary file's name for `name` in its folder: ".NAME.caliber-PID.tmp", NAME cut so that the
-/// whole stays within the 255 bytes a file name may take (a long name that is valid stays writable).
+/// The temporary file's name for `name` in its folder: ".NAME.caliber-PID-N.tmp", NAME cut so that
+/// the whole stays within the 255 bytes a file name may take (a long name that is valid stays
+/// writable), N counting this process's outputs (two long names cut to the same prefix get two).
 std::string temporary_name(const std::string& name) {
   constexpr std::size_t kNameMax = 255;
-  const std::string suffix = ".caliber-" + std::to_string(::getpid()) + ".tmp";
+  static std::atomic<unsigned> outputs{0};
+  const std::string suffix = ".caliber-" + std::to_string(::getpid()) + "-" + std::to_string(outputs++) + ".tmp";
   std::string temporary(".");
   temporary.append(name, 0, kNameMax - 1 - suffix.size());
   return temporary + suffix;

@@ -58,15 +58,16 @@ class CALIBER_EXPORT World {
   /// engine: one engine per thread.
   [[nodiscard]] Frame frame(int step, Engine& engine) const;
   /// The pairs that come within the tolerance between step k and step k + 1, each object moving
-  /// along the scene's own motion: the step is cut into pieces, each swept by Engine::sweep along
-  /// SweptPoses, so that no object turns more than a quarter turn in a piece (a velocity motion's
-  /// turn is then the slerp's) and every keyframe inside the step ends a piece (between two keys a
-  /// keyframe motion is the slerp's). A pair's answer is that of the first piece in which it is
-  /// not free (its queries and stats count that piece's). The scene's groups apply unless the
-  /// request names its own. Pairs of two static objects and ignored pairs are skipped. The times
-  /// are fractions of the step: t* = 0.25 is a quarter of the way from k to k + 1. Throws
-  /// caliber::Error naming the object when a velocity motion turns more than 4,096 quarter turns
-  /// in a step.
+  /// along the scene's own motion. An object that turns more than a quarter turn in the step, or
+  /// has keys inside it, has its motion cut there (pieces of at most a quarter turn, ending at its
+  /// keys): within a piece its motion is a SweptPose's. Pairs of objects without cuts are swept
+  /// whole by Engine::sweep (on its threads); a pair with cuts over both objects' pieces, one
+  /// after another on the calling thread (caliber::sweep's answer for each), its answer that of
+  /// the first piece where it is not free (its queries and stats count every piece swept). The
+  /// scene's groups apply unless the request names its own. Pairs of two static objects and
+  /// ignored pairs are skipped. The times are fractions of the step: t* = 0.25 is a quarter of the
+  /// way from k to k + 1. Throws caliber::Error naming the object when a motion turns more than
+  /// 4,096 quarter turns in a step.
   [[nodiscard]] std::vector<PairSweep> sweep(int step, Engine& engine, const SweepRequest& request = {}) const;
   /// The query request every task runs (with the scene's group compatibility when it has one).
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
@@ -78,9 +79,19 @@ class CALIBER_EXPORT World {
   [[nodiscard]] Frame posed_frame(int step) const;
   /// The poses of all objects at time t (seconds), inside step `step` (named in errors).
   [[nodiscard]] std::vector<Pose> poses_at_time(double t, int step) const;
-  /// The times (seconds) at which step k's motion is cut for the swept query, from k dt to
-  /// (k + 1) dt: pieces in which no object turns more than a quarter turn, cut at every key inside.
-  [[nodiscard]] std::vector<double> sweep_times(int step) const;
+  /// Object i's pose at time t, inside step `step` (named in errors).
+  [[nodiscard]] Pose object_pose(std::size_t i, double t, int step) const;
+  /// The times (seconds) strictly inside step k at which object i's motion is cut for the swept
+  /// query: pieces in which it turns at most a quarter turn, cut at every key of its own inside.
+  [[nodiscard]] std::vector<double> sweep_cuts(std::size_t i, int step) const;
+  /// World::sweep's pairs of two objects in `whole` (no cuts): one Engine::sweep over the step.
+  [[nodiscard]] std::vector<PairSweep> sweep_whole(Engine& engine, const SweepRequest& request,
+                                                   const std::vector<std::uint32_t>& whole, const std::vector<Pose>& from,
+                                                   const std::vector<Pose>& to) const;
+  /// World::sweep's pairs with an object that has cuts (cuts[i]: sweep_cuts(i, step)): each
+  /// pair swept over both objects' pieces, one after another.
+  [[nodiscard]] std::vector<PairSweep> sweep_cut(int step, const SweepRequest& request,
+                                                 const std::vector<std::vector<double>>& cuts) const;
 
   Scene mScene;
   QueryRequest mRequest;

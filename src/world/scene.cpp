@@ -381,6 +381,11 @@ Pose pose_at(const Pose& initial, const Motion& motion, double t) {
       // The first key at or after t (binary search: a baked animation has one key a frame).
       const std::size_t i = static_cast<std::size_t>(
           std::lower_bound(keys.begin(), keys.end(), t, [](const Keyframe& k, double at) { return k.time < at; }) - keys.begin());
+      if (keys[i].time == t) {  // a key's own pose, not the slerp's end (which may be its negation)
+        p.translation = keys[i].position;
+        p.rotation = keys[i].orientation;
+        return p;
+      }
       const Keyframe& k0 = keys[i - 1];
       const Keyframe& k1 = keys[i];
       const double s = (t - k0.time) / (k1.time - k0.time);

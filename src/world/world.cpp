@@ -172,16 +172,21 @@ std::vector<Pose> World::poses_at(int step) const { return poses_at_time(step * 
 std::vector<Pose> World::poses_at_time(double t, int step) const {
   std::vector<Pose> poses;
   poses.reserve(mScene.objects.size());
+  for (std::size_t i = 0; i < mScene.objects.size(); ++i) poses.push_back(object_pose(i, t, step));
+  return poses;
+}
+
+Pose World::object_pose(std::size_t i, double t, int step) const {
   // A motion that leaves caliber's range is named by file, object and key.
-  const std::string source = source_of(mScene);
-  for (std::size_t i = 0; i < mScene.objects.size(); ++i) {
-    const SceneObject& o = mScene.objects[i];
-    poses.push_back(pose_at(o.pose, o.motion, t));
-    const Eigen::Vector3d& at = poses.back().translation;
+  const SceneObject& o = mScene.objects[i];
+  Pose pose = pose_at(o.pose, o.motion, t);
+  {
+    const Eigen::Vector3d& at = pose.translation;
     const bool far = !at.allFinite() || at.cwiseAbs().maxCoeff() > kMaxCoordinate;
     bool tiny = false;
     for (int k = 0; k < 3; ++k) tiny = tiny || (at[k] != 0.0 && std::abs(at[k]) < kMinCoordinate);
-    if (!far && !tiny && poses.back().rotation.coeffs().allFinite()) continue;
+    if (!far && !tiny && pose.rotation.coeffs().allFinite()) return pose;
+    const std::string source = source_of(mScene);
     const std::string key = "objects[" + std::to_string(i) + "].motion";
     if (tiny && !far) {
       throw Error(ErrorCode::bad_value, source,
@@ -197,7 +202,6 @@ std::vector<Pose> World::poses_at_time(double t, int step) const {
                 "object '" + o.name + "' (" + key + ".angular): the turn by step " + std::to_string(step) +
                     " (angular velocity x time) overflows a double");
   }
-  return poses;
 }
 
 const Model& World::model(std::size_t i) const {

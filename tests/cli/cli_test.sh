@@ -460,6 +460,11 @@ long=$(printf 'x%.0s' $(seq 245))
 check out-long-name 0 "$cli" run "$data/scenes/tetras.json" --contacts "$r2/$long.jsonl"
 [ -s "$r2/$long.jsonl" ] && passes=$((passes + 1)) || { echo "FAIL out-long-name: not written"; failures=$((failures + 1)); }
 rm -f "$r2/$long.jsonl"
+# Two long names alike up to where their temporary names are cut: each output gets its own.
+check out-long-names-apart 0 "$cli" run "$data/scenes/tetras.json" --json "$r2/${long}_r.json" --contacts "$r2/${long}_c.json"
+if grep -q "\"summary\"" "$r2/${long}_r.json" && ! grep -q "\"summary\"" "$r2/${long}_c.json"; then passes=$((passes + 1)); else
+  echo "FAIL out-long-names-apart: the outputs were mixed up"; failures=$((failures + 1)); fi
+rm -f "$r2/${long}_r.json" "$r2/${long}_c.json"
 check out-name-too-long 2 "$cli" run "$data/scenes/tetras.json" --contacts "$r2/$long$long.jsonl"
 contains out-name-too-long "cannot be written (--contacts): File name too long"
 case "$out" in *"step 0"*) echo "FAIL out-name-too-long: the run went on"; failures=$((failures + 1)) ;; esac
@@ -485,7 +490,7 @@ check bench-bad-scene-no-folder 2 "$cli" bench "$r2/s/tol.json" --out "$r2/bench
 # SIGINT: the step in progress ends, what was measured is written, exit 130.
 "$cli" run "$data/scenes/tetras.json" --steps 100000000 --json "$r2/int.json" --contacts "$r2/int.jsonl" > /dev/null 2>&1 &
 pid=$!
-for _ in $(seq 100); do [ -s "$r2/.int.jsonl.caliber-$pid.tmp" ] && break; sleep 0.1; done
+for _ in $(seq 100); do compgen -G "$r2/.int.jsonl.caliber-$pid-*.tmp" > /dev/null && break; sleep 0.1; done
 sleep 0.5
 kill -INT "$pid"
 wait "$pid"

@@ -2,7 +2,7 @@
 # SIGTERM (kill, timeout, systemd, batch schedulers) and SIGINT (Ctrl-C) during the long commands:
 # run, run --continuous, view, bench and refine stop after the step in progress, write what they
 # measured ("interrupted": true in a JSON report or page) and exit 128 + the signal's number (143,
-# 130); no temporary file (.NAME.caliber-PID.tmp) is ever left. And a report that cannot be put in
+# 130); no temporary file (.NAME.caliber-PID-N.tmp) is ever left. And a report that cannot be put in
 # place at the end names the system's reason.
 # usage: signal_test.sh CALIBER TEST_DATA_DIR
 set -u
@@ -30,8 +30,8 @@ stop() {
   "$@" > "$tmp/$name.out" 2>&1 &
   local pid=$!
   local temp
-  temp="$(dirname "$watched")/.$(basename "$watched").caliber-$pid.tmp"
-  for _ in $(seq 200); do [ -s "$temp" ] || [ -s "$watched" ] && break; sleep 0.05; done
+  temp="$(dirname "$watched")/.$(basename "$watched").caliber-$pid-*.tmp"
+  for _ in $(seq 200); do compgen -G "$temp" > /dev/null || [ -s "$watched" ] && break; sleep 0.05; done
   sleep 0.3
   kill "-$signal" "$pid"
   finish "$pid"
@@ -123,7 +123,7 @@ d="$tmp/refine"
 mkdir "$d"
 "$cli" refine "$tmp/grid.off" "$d/fine.off" --levels 4 > "$tmp/refine.out" 2>&1 &
 pid=$!
-for _ in $(seq 200); do [ -e "$d/.fine.off.caliber-$pid.tmp" ] && break; sleep 0.01; done
+for _ in $(seq 200); do compgen -G "$d/.fine.off.caliber-$pid-*.tmp" > /dev/null && break; sleep 0.01; done
 kill -TERM "$pid"
 finish "$pid"
 verdict refine 143 "$d" && [ ! -e "$d/fine.off" ] && passes=$((passes + 1)) || {
@@ -135,7 +135,7 @@ d="$tmp/rename"
 mkdir "$d"
 "$cli" run "$scene" --steps 100000000 --json "$d/r.json" --contacts "$d/c.jsonl" > "$tmp/rename.out" 2>&1 &
 pid=$!
-for _ in $(seq 200); do [ -s "$d/.c.jsonl.caliber-$pid.tmp" ] && break; sleep 0.05; done
+for _ in $(seq 200); do compgen -G "$d/.c.jsonl.caliber-$pid-*.tmp" > /dev/null && break; sleep 0.05; done
 mkdir "$d/c.jsonl"
 kill -INT "$pid"
 finish "$pid"

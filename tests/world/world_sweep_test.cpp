@@ -26,6 +26,9 @@ class WorldSweep : public ::testing::Test {
   void SetUp() override {
     save_off(make_box(1.0, 0.02, 0.02, 1), dir / "rod.off");
     save_off(make_box(0.1, 0.1, 0.1, 1), dir / "block.off");
+    Mesh arm = make_box(0.475, 0.02, 0.02, 1);  // a bar from x = 0.05 to 1: on one side of its origin
+    for (auto& v : arm.vertices) v.x() += 0.525;
+    save_off(arm, dir / "arm.off");
   }
 
   World world(const std::string& json) const { return World(parse_scene(json, dir, "world_sweep_test.json")); }
@@ -223,6 +226,39 @@ TEST(KeyframeLookup, ThePoseBetweenAnyTwoOfManyKeysIsTheirInterpolation) {
   }
   EXPECT_EQ(pose_at(Pose{}, m, -1.0).translation, m.keys.front().position);
   EXPECT_EQ(pose_at(Pose{}, m, 1e9).translation, m.keys.back().position);
+}
+
+TEST_F(WorldSweep, AHalfTurnBetweenKeysIsTurnedTheScenesWay) {
+  // Keys at whole steps; the second interval is an exact half turn about z, and the first ends on
+  // the negation of its start quaternion. The sweep turns the arm as pose_at does (through the
+  // block at +y), whichever sign the interval's start pose comes in.
+  const World w = world(R"({"steps": 3, "dt": 1.0, "objects": [
+      {"name": "arm", "mesh": "arm.off", "motion": {"type": "keyframes", "keys": [
+          {"time": 0, "orientation": [-1, 0, 0, 0]}, {"time": 1, "orientation": [1, 0, 0, 0]},
+          {"time": 2, "orientation": [0, 0, 0, 1]}]}},
+      {"name": "block", "mesh": "block.off", "position": [0, 0.7, 0]}]})");
+  Engine engine;
+  EXPECT_TRUE(check_against_sampling(w, 0, engine).empty());
+  const std::vector<PairSweep> found = check_against_sampling(w, 1, engine);
+  ASSERT_EQ(found.size(), 1u) << "the arm passes the block at a quarter turn";
+  EXPECT_EQ(found[0].result.status, SweepStatus::contact);
+}
+
+TEST_F(WorldSweep, AFastTurnCutsOnlyItsOwnPairs) {
+  // A cube spinning fast far from two slow neighbours: their pair is swept whole, as without it.
+  const std::string objects = R"(
+      {"name": "a", "mesh": "block.off", "motion": {"type": "velocity", "linear": [20, 0, 0]}},
+      {"name": "b", "mesh": "block.off", "position": [0.35, 0.05, 0]})";
+  const World alone = world(R"({"dt": 0.01, "objects": [)" + objects + "]}");
+  const World with = world(R"({"dt": 0.01, "objects": [)" + objects + R"(,
+      {"name": "spinner", "mesh": "rod.off", "position": [50, 50, 0], "motion": {"type": "velocity", "angular": [0, 0, 5000]}}]})");
+  Engine engine;
+  const std::vector<PairSweep> base = alone.sweep(0, engine);
+  const std::vector<PairSweep> got = with.sweep(0, engine);
+  ASSERT_EQ(base.size(), 1u);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].result.time, base[0].result.time);
+  EXPECT_EQ(got[0].result.queries, base[0].result.queries) << "not once per piece of the spinner's 32";
 }
 
 }  // namespace
