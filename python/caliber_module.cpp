@@ -917,6 +917,22 @@ def _batch_from_state(state):
             return r;
           },
           py::arg("engine"), py::arg("k"), "Step k: poses and broad phase, then the engine.")
+      .def(
+          "sweep",
+          [](const caliber::World& world, caliber::Engine& engine, int k, double tolerance, std::uint64_t max_queries) {
+            const caliber::SweepRequest request = sweep_request(tolerance, max_queries);
+            std::vector<caliber::PairSweep> swept;
+            {
+              py::gil_scoped_release release;
+              swept = world.sweep(k, engine, request);
+            }
+            py::list out;
+            for (const caliber::PairSweep& p : swept) out.append(py::make_tuple(py::make_tuple(p.pair.a, p.pair.b), p.result));
+            return out;
+          },
+          py::arg("engine"), py::arg("k"), py::kw_only(), py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000,
+          "The pairs that touch between step k and k + 1, following the scene's motions (cut where an object turns more "
+          "than a quarter turn or has keys), with the scene's groups: [((a, b), Sweep)], times as fractions of the step.")
       .def("__reduce__", [](const caliber::World&) -> py::object {
         throw not_picklable("World", "load the scene file again where it is needed");
       });

@@ -278,6 +278,26 @@ def test_a_scene_steps_through_the_engine():
         assert a.pairs.tolist() == b.pairs.tolist() and np.array_equal(a.distances, b.distances)
 
 
+def test_a_scene_is_swept_with_its_groups_and_turns(tmp_path):
+    # A tetrahedron spinning 229 degrees a step past another at 90 degrees: found by its own turn,
+    # not the shorter arc; in groups that may not touch, not found.
+    def world(groups):
+        scene = tmp_path / f"spin{len(groups)}.json"
+        scene.write_text(json.dumps(dict({
+            "dt": 0.01,
+            "objects": [{"name": "spinner", "mesh": TETRA, "group": 1, "position": [0, 0, 0],
+                         "motion": {"type": "velocity", "angular": [0, 0, 400]}},
+                        {"name": "other", "mesh": TETRA, "group": 2, "position": [-1.6, 0.1, 0]}]}, **groups)))
+        return caliber.World(scene)
+
+    found = world({}).sweep(caliber.Engine(), 0)
+    assert [pair for pair, _ in found] == [(0, 1)]
+    assert found[0][1].status == "contact" and 0.0 < found[0][1].time < 0.5
+    assert world({"groups": {"compatible": [[1, 1], [2, 2]]}}).sweep(caliber.Engine(), 0) == []
+    with pytest.raises(caliber.Error, match="tolerance"):
+        world({}).sweep(caliber.Engine(), 0, tolerance=-1.0)
+
+
 def test_a_scene_step_cut_by_max_pairs_says_so(tmp_path):
     def world(query):
         scene = tmp_path / f"cut{len(query)}.json"
