@@ -13,15 +13,9 @@
 namespace caliber {
 namespace {
 
-/// The angle (radians, in [0, pi]) of the shorter rotation from q0 to q1: what slerp turns by.
-double turn_angle(const Eigen::Quaterniond& q0, const Eigen::Quaterniond& q1) {
-  const Eigen::Quaterniond d = q0.conjugate() * q1;
-  return 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
-}
-
 /// An upper bound on the speed (distance per unit t) of any point of the model along the motion.
 double speed_bound(const SweptPose& m, double radius) {
-  return (m.end.translation - m.start.translation).norm() + turn_angle(m.start.rotation, m.end.rotation) * radius;
+  return (m.end.translation - m.start.translation).norm() + narrow::turn_angle(m.start.rotation, m.end.rotation) * radius;
 }
 
 }  // namespace

@@ -20,6 +20,12 @@ namespace caliber::narrow {
 /// the default tolerance or the swept boxes.)
 inline double radius_about_origin(const Model& model) { return model.extent(); }
 
+/// The angle (radians, in [0, pi]) of the shorter rotation from q0 to q1: what slerp turns by.
+inline double turn_angle(const Eigen::Quaterniond& q0, const Eigen::Quaterniond& q1) {
+  const Eigen::Quaterniond d = q0.conjugate() * q1;
+  return 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
+}
+
 /// The margin for rounding, as a share of the scene's size (radii and translations): poses
 /// interpolated and distances computed in double precision are off by a few units in the last
 /// place of that size; 1e-9 of it covers them many times over.

@@ -22,12 +22,6 @@ constexpr double kPieceTurn = 0.5 * std::numbers::pi;
 /// The most pieces an object's turn may ask for in one step: a faster turn is refused.
 constexpr double kMaxTurnPieces = 4096.0;
 
-/// The angle of the shorter rotation from q0 to q1 (what slerp turns by).
-double turn_angle(const Eigen::Quaterniond& q0, const Eigen::Quaterniond& q1) {
-  const Eigen::Quaterniond d = q0.conjugate() * q1;
-  return 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
-}
-
 /// A time inside a piece, as a fraction of the step, rounded towards the step's start: the
 /// mapping may not make a contact later than the piece found it.
 double step_fraction(double begin, double end, double t0, double span, double t) {
@@ -44,7 +38,7 @@ double turn_rate(const Motion& m, double t0, double t1) {
   std::size_t j = it == keys.begin() ? 0 : static_cast<std::size_t>(it - keys.begin()) - 1;
   double rate = 0.0;
   for (; j + 1 < keys.size() && keys[j].time < t1; ++j) {
-    rate = std::max(rate, turn_angle(keys[j].orientation, keys[j + 1].orientation) / (keys[j + 1].time - keys[j].time));
+    rate = std::max(rate, narrow::turn_angle(keys[j].orientation, keys[j + 1].orientation) / (keys[j + 1].time - keys[j].time));
   }
   return rate;
 }

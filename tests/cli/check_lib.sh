@@ -22,3 +22,20 @@ contains() {  # contains NAME TEXT
     passes=$((passes + 1))
   fi
 }
+
+# write_grid_off FILE: a flat grid of 200 x 200 squares (80,000 triangles) as an OFF file.
+write_grid_off() {
+  python3 - "$1" <<'PY'
+import sys
+n = 200
+with open(sys.argv[1], "w") as f:
+    f.write(f"OFF\n{(n + 1) ** 2} {2 * n * n} 0\n")
+    for i in range(n + 1):
+        for j in range(n + 1):
+            f.write(f"{i} {j} 0\n")
+    for i in range(n):
+        for j in range(n):
+            a, b, c, d = i * (n + 1) + j, i * (n + 1) + j + 1, (i + 1) * (n + 1) + j, (i + 1) * (n + 1) + j + 1
+            f.write(f"3 {a} {b} {d}\n3 {a} {d} {c}\n")
+PY
+}

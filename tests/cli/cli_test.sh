@@ -422,19 +422,7 @@ done
 if cmp -s "$r2/q-1, .jsonl" "$r2/q-1e2.jsonl" && grep -q '"tri_a"' "$r2/q-1, .jsonl"; then passes=$((passes + 1)); else
   echo "FAIL huge-quaternion: [1e200, 0, 0, 1e200] did not give [1, 0, 0, 1]'s contacts"; failures=$((failures + 1)); fi
 # Refinement that cannot fit: refused before allocating.
-python3 - "$r2/grid.off" <<'PY'
-import sys
-n = 200
-with open(sys.argv[1], "w") as f:
-    f.write(f"OFF\n{(n + 1) ** 2} {2 * n * n} 0\n")
-    for i in range(n + 1):
-        for j in range(n + 1):
-            f.write(f"{i} {j} 0\n")
-    for i in range(n):
-        for j in range(n):
-            a, b, c, d = i * (n + 1) + j, i * (n + 1) + j + 1, (i + 1) * (n + 1) + j, (i + 1) * (n + 1) + j + 1
-            f.write(f"3 {a} {b} {d}\n3 {a} {d} {c}\n")
-PY
+write_grid_off "$r2/grid.off"
 check refine-too-big 2 "$cli" refine "$r2/grid.off" "$r2/grid7.off" --levels 7
 contains refine-too-big "of memory available"
 [ -e "$r2/grid7.off" ] && { echo "FAIL refine-too-big: wrote an output"; failures=$((failures + 1)); }

@@ -106,19 +106,7 @@ PY
 fi
 
 # refine: one step, nothing partial to keep: no output and no temporary file.
-python3 - "$tmp/grid.off" <<'PY'
-import sys
-n = 200
-with open(sys.argv[1], "w") as f:
-    f.write(f"OFF\n{(n + 1) ** 2} {2 * n * n} 0\n")
-    for i in range(n + 1):
-        for j in range(n + 1):
-            f.write(f"{i} {j} 0\n")
-    for i in range(n):
-        for j in range(n):
-            a, b, c, d = i * (n + 1) + j, i * (n + 1) + j + 1, (i + 1) * (n + 1) + j, (i + 1) * (n + 1) + j + 1
-            f.write(f"3 {a} {b} {d}\n3 {a} {d} {c}\n")
-PY
+write_grid_off "$tmp/grid.off"
 d="$tmp/refine"
 mkdir "$d"
 "$cli" refine "$tmp/grid.off" "$d/fine.off" --levels 4 > "$tmp/refine.out" 2>&1 &
