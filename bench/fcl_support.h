@@ -1,11 +1,7 @@
 #pragma once
-// What the FCL comparisons share: FCL models of caliber's meshes, poses in FCL's form, a mesh's
-// box, and median timing.
+// What the FCL comparisons share: FCL models of caliber's meshes and poses in FCL's form, with
+// bench_support.h (the meshes' directory, a mesh's box, median timing).
 
-#include <algorithm>
-#include <chrono>
-#include <filesystem>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -14,33 +10,11 @@
 
 #include "caliber/mesh.h"
 #include "caliber/pose.h"
+#include "bench_support.h"
 
 namespace caliber::bench {
 
 using FclModel = fcl::BVHModel<fcl::OBBRSSd>;
-
-/// Where the benches look for the CGAL meshes without --meshes: data/meshes under the working
-/// directory where there is one (a device pack, a checkout's root), else the source tree's
-/// (CALIBER_BENCH_MESHES: the benches run from build/ too).
-inline std::filesystem::path default_meshes_dir() {
-  const std::filesystem::path here = "data/meshes";
-#ifdef CALIBER_BENCH_MESHES
-  if (!std::filesystem::is_directory(here)) return CALIBER_BENCH_MESHES;
-#endif
-  return here;
-}
-
-/// Median wall time of `repeat` runs of f, in milliseconds.
-inline double median_ms(int repeat, const std::function<void()>& f) {
-  std::vector<double> times;
-  for (int i = 0; i < repeat; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
-}
 
 /// FCL's OBBRSS hierarchy of a mesh (FCL's default split).
 inline std::shared_ptr<FclModel> build_fcl(const Mesh& mesh) {
@@ -60,24 +34,6 @@ inline fcl::Transform3d to_fcl(const Pose& pose) {
   tf.linear() = pose.rotation_matrix();
   tf.translation() = pose.translation;
   return tf;
-}
-
-/// The axis-aligned box of a mesh's vertices: its low and high corners.
-inline void box(const Mesh& m, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
-  lo = m.vertices[0];
-  hi = lo;
-  for (const auto& v : m.vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
-}
-
-/// The center and diagonal of a mesh's box.
-inline void box_center(const Mesh& m, Eigen::Vector3d& center, double& diagonal) {
-  Eigen::Vector3d lo, hi;
-  box(m, lo, hi);
-  center = 0.5 * (lo + hi);
-  diagonal = (hi - lo).norm();
 }
 
 }  // namespace caliber::bench

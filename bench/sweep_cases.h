@@ -13,7 +13,7 @@
 #include "caliber/mesh.h"
 #include "caliber/procedural.h"
 #include "caliber/sweep.h"
-#include "fcl_support.h"
+#include "bench_support.h"
 
 namespace caliber::bench {
 

@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libtbb-dev libassimp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libfcl-dev      # benchmarks only: the peer comparison against FCL
+  libembree-dev   # benchmarks only: the narrow phase against Embree's rtcCollide
   libbullet-dev   # benchmarks only: the broad phase against Bullet's dynamic AABB tree
   libcgal-demo    # CGAL's mesh collection, extracted by scripts/fetch_meshes.sh
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
