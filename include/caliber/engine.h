@@ -113,12 +113,13 @@ struct EngineOptions {
   /// its own of N threads, at most the process's limit. caliber never changes the limit (no
   /// tbb::global_control). `sequential` always runs on the calling thread.
   int threads = 0;
-  /// Calibrated methods: the thread count the cut is made for (Omega = total weight / (beta *
-  /// plan_threads)); 0 means `threads`. The cut for P threads run on one thread measures each of
-  /// its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
+  /// The thread count the cut is made for (calibrated methods: Omega = total weight / (beta *
+  /// plan_threads); stealing: the heavy pairs' share, below); 0 means `threads`. Cut for one
+  /// thread, every method runs each pair whole. The cut for P threads run on one thread measures
+  /// each of its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
   int plan_threads = 0;
   /// Stealing: CD-tree depth from which a subtree is traversed serially by one task. Only pairs
-  /// whose a priori weight is at least 1 / (64 x threads) of the step's are split; the others run
+  /// whose a priori weight is at least 1 / (64 x plan threads) of the step's are split; the others run
   /// whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).

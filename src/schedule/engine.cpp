@@ -198,14 +198,16 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
     state.shared = shared.get();
   }
   schedule::PairsRun run;
+  const int cut_threads = options.plan_threads > 0 ? options.plan_threads : options.threads;
   executor.execute([&] {
     // The contexts are made on the executor's threads, inside the call's first parallel region.
     state.contexts = contexts.build(n, make);
     if (method == Method::stealing) {
-      schedule::run_stealing(options.stealing_depth, state, record);
+      schedule::run_stealing(options.stealing_depth, cut_threads, state, record);
     } else {
       const auto planning = util::Clock::now();
-      if (method == Method::sequential || method == Method::exploitation) {
+      // Cut for one thread, the calibrated methods have nothing to balance either: a task per pair.
+      if (method == Method::sequential || method == Method::exploitation || cut_threads <= 1) {
         run.plan = tasks::plan_pairs(n);
       } else {
         run.plan = tasks::plan_calibrated(

@@ -27,6 +27,8 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
 /// traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
 /// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.
-void run_stealing(int depth, StepState& state, ScheduleRecord& record);
+/// `threads`: the threads the work is cut for (EngineOptions::plan_threads, else the step's); on
+/// one, nothing is split (every pair runs whole: there is nothing to balance).
+void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& record);
 
 }  // namespace caliber::schedule

@@ -179,6 +179,34 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
   EXPECT_GT(second.schedule->generated, 1u);
 }
 
+TEST_F(EngineScenes, CutForOneThreadEveryPairRunsWhole) {
+  // One heavy pair: cut for one thread, no method splits it (there is nothing to balance); cut for
+  // two threads and run on one (the load-balance simulation), every method still splits it.
+  const World single(parse_scene(R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}}]})",
+                                 dir, "single.json"));
+  for (const Method method : {Method::stealing, Method::apriori, Method::aposteriori, Method::hybrid}) {
+    for (const int plan_threads : {0, 2}) {
+      EngineOptions options;
+      options.profile = true;  // the tests read the schedule
+      options.method = method;
+      options.threads = 1;
+      options.plan_threads = plan_threads;
+      Engine engine(options);
+      step(single, engine, 0);
+      const StepResult s = step(single, engine, 1);  // a posteriori splits from the second step
+      const std::string what = std::string(to_string(method)) + " cut for " + std::to_string(plan_threads) + " threads";
+      if (method == Method::stealing) {
+        EXPECT_EQ(s.schedule->task_node_tests.size() == 1, plan_threads == 0) << what;
+        EXPECT_EQ(s.schedule->split_node_tests == 0, plan_threads == 0) << what;
+      } else {
+        EXPECT_EQ(s.schedule->split, plan_threads == 0 ? 0u : 1u) << what;
+        EXPECT_EQ(s.schedule->generated == 1, plan_threads == 0) << what;
+      }
+    }
+  }
+}
+
 TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_EQ(list_schedule_makespan({}, 4), 0.0);
   EXPECT_EQ(list_schedule_makespan({5, 5, 5, 5}, 2), 10.0);
