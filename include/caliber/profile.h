@@ -32,7 +32,7 @@ struct TaskSpan {
 /// BVH against a node of B's). A task traverses depth first from each of its roots.
 struct TaskRoot {
   std::uint32_t pair = 0;    ///< index in the frame's pairs (StepResult::pair_records)
-  std::uint32_t node_a = 0;  ///< node of A's BVH (Model::nodes)
+  std::uint32_t node_a = 0;  ///< node of A's BVH (an index below Model::node_count())
   std::uint32_t node_b = 0;  ///< node of B's BVH
 };
 
