@@ -64,17 +64,17 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
   // is at least 1 / (64 x threads) of the total. The lighter ones run whole, in a parallel loop
   // over them (splitting thousands of light pairs costs more than it balances), each finalized by
   // the thread that traversed it, at once.
-  // Cut for one thread there is nothing to balance: every pair runs whole.
+  // Cut for one thread there is nothing to balance: every pair runs whole (no depth to split to).
+  if (threads <= 1) depth = 0;
   std::vector<std::uint32_t> heavy, light;
-  const bool alone = threads <= 1;
-  if (depth > 0 && n > 1 && !alone) {
+  if (depth > 0 && n > 1) {
     const std::vector<double> weight = tasks::root_weights(state.contexts);
     double total = 0.0;
     for (const double w : weight) total += w;
     const double threshold = total / (64.0 * threads);
     for (std::uint32_t i = 0; i < n; ++i) (weight[i] >= threshold ? heavy : light).push_back(i);
   } else {
-    for (std::uint32_t i = 0; i < n; ++i) (depth > 0 && !alone ? heavy : light).push_back(i);
+    for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
   }
   parallel::TaskGroup group;
   for (const std::uint32_t i : heavy) {

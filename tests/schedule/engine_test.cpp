@@ -112,6 +112,12 @@ class EngineScenes : public ::testing::Test {
     save_off(make_sphere(0.6, 10, 14), dir / "sphere.off");
     save_off(make_torus(0.8, 0.25, 16, 10), dir / "torus.off");
   }
+  /// A torus and a sphere overlapping, proximity: one heavy pair.
+  [[nodiscard]] World one_heavy_pair() const {
+    return World(parse_scene(R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
+      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}}]})",
+                             dir, "single.json"));
+  }
   test::TempDir temp{"engine"};
   const std::filesystem::path& dir = temp.path();
 };
@@ -155,9 +161,7 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
   const World crowd(parse_scene(json, dir, "crowd.json"));
   EXPECT_EQ(crowd.broad_phase(crowd.poses_at(0)).size(), 300u);
   expect_all_methods_identical(crowd, 1);
-  const World single(parse_scene(R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
-      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}}]})",
-                                 dir, "single.json"));
+  const World single = one_heavy_pair();
   expect_all_methods_identical(single, 2);
   // One heavy pair on two threads is split: more than one run-time task.
   EngineOptions options;
@@ -182,9 +186,7 @@ TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
 TEST_F(EngineScenes, CutForOneThreadEveryPairRunsWhole) {
   // One heavy pair: cut for one thread, no method splits it (there is nothing to balance); cut for
   // two threads and run on one (the load-balance simulation), every method still splits it.
-  const World single(parse_scene(R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [
-      {"name": "a", "mesh": "torus.off"}, {"name": "b", "mesh": "sphere.off", "position": [0.8, 0, 0], "motion": {"type": "velocity"}}]})",
-                                 dir, "single.json"));
+  const World single = one_heavy_pair();
   for (const Method method : {Method::stealing, Method::apriori, Method::aposteriori, Method::hybrid}) {
     for (const int plan_threads : {0, 2}) {
       EngineOptions options;
