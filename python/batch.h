@@ -270,46 +270,49 @@ inline caliber::QuaternionOrder parse_order(const std::string& order) {
   throw caliber::Error(caliber::ErrorCode::bad_value, "order", "must be 'wxyz' or 'xyzw', not '" + order + "'");
 }
 
-/// Registers caliber.Batch, the answers of Engine.query_many and caliber.query_many. Its arrays
-/// are read-only.
-inline void bind_batch(py::module_& m) {
-  py::class_<PyBatch>(m, "Batch",
-                      "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
-                      "max_pairs cut it; per reported triangle pair, one row like Result's, with the entry it belongs to.")
-      .def_property_readonly("offsets", view_of<PyBatch, &PyBatch::offsets>,
-                             "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
-      .def_property_readonly("hit", view_of<PyBatch, &PyBatch::hit>, "N bools: the entry reported a pair")
-      .def_property_readonly("limit_reached", view_of<PyBatch, &PyBatch::limit_reached>,
-                             "N bools: the entry found more than max_pairs")
-      .def_property_readonly("distance", view_of<PyBatch, &PyBatch::distance>,
-                             "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")
-      .def_property_readonly("pairs", view_of<PyBatch, &PyBatch::pairs>, "k x 2 triangle ids")
-      .def_property_readonly("entries", view_of<PyBatch, &PyBatch::entries>, "k: the entry of each row")
-      .def_property_readonly("points_a", view_of<PyBatch, &PyBatch::points_a>)
-      .def_property_readonly("points_b", view_of<PyBatch, &PyBatch::points_b>)
-      .def_property_readonly("normals", view_of<PyBatch, &PyBatch::normals>)
-      .def_property_readonly("distances", view_of<PyBatch, &PyBatch::distances>)
-      .def_property_readonly("depths", view_of<PyBatch, &PyBatch::depths>)
-      .def_readonly("node_tests", &PyBatch::node_tests)
-      .def_readonly("leaf_tests", &PyBatch::leaf_tests)
-      .def_readonly("batch_ms", &PyBatch::batch_ms,
-                    "wall time of the C++ batch in milliseconds, without reading the poses or making these arrays (0 for a "
-                    "Batch unpickled or joined)")
-      .def("__len__", [](const PyBatch& b) { return static_cast<std::size_t>(b.hit.shape(0)); })
-      .def_static(
-          "concatenate",
-          [](const std::vector<const PyBatch*>& parts) {
-            for (const PyBatch* p : parts) {
-              if (p == nullptr) throw caliber::Error(caliber::ErrorCode::bad_argument, "Batch.concatenate", "got None");
-            }
-            return PyBatch::concatenate(parts);
-          },
-          py::arg("batches"),
-          "One Batch of the given batches' entries, in order (what a sweep cut in chunks gathers); counters summed.")
-      .def("__reduce__", [](const PyBatch& b) {
-        return py::make_tuple(py::module_::import("caliber").attr("_batch_from_state"), py::make_tuple(b.state()));
-      });
+/// Registers caliber.Batch, the answers of Engine.query_many and caliber.query_many, and returns
+/// the class. Its arrays are read-only.
+inline py::class_<PyBatch> bind_batch(py::module_& m) {
+  auto cls =
+      py::class_<PyBatch>(m, "Batch",
+                          "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
+                          "max_pairs cut it; per reported triangle pair, one row like Result's, with the entry it belongs to.")
+          .def_property_readonly("offsets", view_of<PyBatch, &PyBatch::offsets>,
+                                 "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
+          .def_property_readonly("hit", view_of<PyBatch, &PyBatch::hit>, "N bools: the entry reported a pair")
+          .def_property_readonly("limit_reached", view_of<PyBatch, &PyBatch::limit_reached>,
+                                 "N bools: the entry found more than max_pairs")
+          .def_property_readonly(
+              "distance", view_of<PyBatch, &PyBatch::distance>,
+              "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")
+          .def_property_readonly("pairs", view_of<PyBatch, &PyBatch::pairs>, "k x 2 triangle ids")
+          .def_property_readonly("entries", view_of<PyBatch, &PyBatch::entries>, "k: the entry of each row")
+          .def_property_readonly("points_a", view_of<PyBatch, &PyBatch::points_a>)
+          .def_property_readonly("points_b", view_of<PyBatch, &PyBatch::points_b>)
+          .def_property_readonly("normals", view_of<PyBatch, &PyBatch::normals>)
+          .def_property_readonly("distances", view_of<PyBatch, &PyBatch::distances>)
+          .def_property_readonly("depths", view_of<PyBatch, &PyBatch::depths>)
+          .def_readonly("node_tests", &PyBatch::node_tests)
+          .def_readonly("leaf_tests", &PyBatch::leaf_tests)
+          .def_readonly("batch_ms", &PyBatch::batch_ms,
+                        "wall time of the C++ batch in milliseconds, without reading the poses or making these arrays (0 for a "
+                        "Batch unpickled or joined)")
+          .def("__len__", [](const PyBatch& b) { return static_cast<std::size_t>(b.hit.shape(0)); })
+          .def_static(
+              "concatenate",
+              [](const std::vector<const PyBatch*>& parts) {
+                for (const PyBatch* p : parts) {
+                  if (p == nullptr) throw caliber::Error(caliber::ErrorCode::bad_argument, "Batch.concatenate", "got None");
+                }
+                return PyBatch::concatenate(parts);
+              },
+              py::arg("batches"),
+              "One Batch of the given batches' entries, in order (what a sweep cut in chunks gathers); counters summed.")
+          .def("__reduce__", [](const PyBatch& b) {
+            return py::make_tuple(py::module_::import("caliber").attr("_batch_from_state"), py::make_tuple(b.state()));
+          });
   m.def("_checked_batch", &PyBatch::from_state);
+  return cls;
 }
 
 }  // namespace caliber_python

@@ -65,12 +65,13 @@ struct PySweeps {
   }
 };
 
-/// Registers caliber.Sweeps (its arrays read-only views); `refuse_pickle` throws the module's not-picklable error.
+/// Registers caliber.Sweeps (its arrays read-only views), and returns the class; `refuse_pickle`
+/// throws the module's not-picklable error.
 template <class Refuse>
-void bind_sweeps(py::module_& m, Refuse&& refuse_pickle) {
-  py::class_<PySweeps>(m, "Sweeps",
-                       "The answers of sweep_many, a row per motion: contact, undecided, time (t* at a contact, 1 when "
-                       "free), and at a contact the closest triangle pair, its distance and points.")
+py::class_<PySweeps> bind_sweeps(py::module_& m, Refuse&& refuse_pickle) {
+  return py::class_<PySweeps>(m, "Sweeps",
+                              "The answers of sweep_many, a row per motion: contact, undecided, time (t* at a contact, 1 when "
+                              "free), and at a contact the closest triangle pair, its distance and points.")
       .def_property_readonly("contact", view_of<PySweeps, &PySweeps::contact>,
                              "N bools: the models come within the tolerance at time")
       .def_property_readonly("undecided", view_of<PySweeps, &PySweeps::undecided>,
