@@ -57,6 +57,7 @@ int main() {
   caliber::Frame frame;
   caliber::StepResult step, greedy_step;
   int threads = 0, greedy_threads = 0;
+  // [readme]
   arena.execute([&] {
     frame = make_frame();
     caliber::Engine engine;  // the default method, on the arena it is called from
@@ -68,6 +69,7 @@ int main() {
     greedy_threads = greedy.threads();
     greedy_step = greedy.step(frame);
   });
+  // [/readme]
   const std::size_t after = os_threads();
 
   caliber::EngineOptions sequential;

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     }
     const std::vector<caliber::Pose> path = caliber::poses_from_vectors(rows, caliber::QuaternionOrder::xyzw, "path");
     const std::vector<caliber::Pose> fixed{caliber::Pose{}};
+    // [readme]
     caliber::Engine engine;  // the default method, on the threads of the arena it is called from
     caliber::QueryRequest first_hit;
     first_hit.max_pairs = 1;
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
     distance.tolerance = caliber::kUnbounded;
     const caliber::BatchResult hits = engine.query_many(*a, fixed, *b, path, first_hit);
     const caliber::BatchResult gaps = engine.query_many(*a, fixed, *b, path, distance);
+    // [/readme]
     std::size_t touching = 0;
     for (std::size_t i = 0; i < hits.size(); ++i) touching += hits.hit(i) ? 1 : 0;
     for (std::size_t i = 0; i < path.size(); i += 250) {

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    // [readme]
     const auto a = caliber::build_model(caliber::load_mesh(argv[1]));
     const auto b = caliber::build_model(caliber::load_mesh(argv[2]));
     const caliber::Pose pose_b = caliber::parse_pose(argv[3], "pose of B");
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
     request.kind = caliber::QueryKind::contact;
     request.tolerance = std::atof(argv[4]);
     const caliber::QueryResult contacts = caliber::query(*a, caliber::Pose{}, *b, pose_b, request);
+    // [/readme]
     std::printf("caliber %s\n", caliber::kVersion);
     std::printf("interference: %zu pairs\n", hits.contacts.size());
     std::printf("contact: %zu contacts\n", contacts.contacts.size());

@@ -9,6 +9,7 @@
 
 int main() {
   try {
+    // [readme]
     const auto plate = caliber::build_model(caliber::make_plate(1.0, 0.002, 4));
     const auto needle = caliber::build_model(caliber::make_box(0.001, 0.001, 0.1, 1));
     const caliber::SweptPose still{caliber::Pose{}, caliber::Pose{}};
@@ -19,6 +20,7 @@ int main() {
     const bool at_start = !caliber::query(*plate, still.start, *needle, flight.start, touch).contacts.empty();
     const bool at_end = !caliber::query(*plate, still.end, *needle, flight.end, touch).contacts.empty();
     const caliber::SweepResult s = caliber::sweep(*plate, still, *needle, flight);
+    // [/readme]
     std::printf("touching at t = 0: %s, at t = 1: %s\n", at_start ? "yes" : "no", at_end ? "yes" : "no");
     if (s.status != caliber::SweepStatus::contact) {
       std::printf("no contact found\n");

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The size rules of the layout (docs/architecture.md): no function over 80 lines in src/ or
-python/, no file over 400 lines in src/, apps/ or python/. Prints every breach and exits 1 if there is one.
+python/, no file over 400 lines in src/, apps/ or python/, and a README.md of at most 12 KB (the
+quick starts are parts of the example files; the rest is linked). Prints every breach and exits 1 if there is one.
 
 A function is found by its body: a '{' that ends a line whose code (after the comments and strings
 are blanked) has a ')' and does not start a control statement, a namespace, a class, a struct, an
@@ -15,6 +16,7 @@ import sys
 
 MAX_FUNCTION = 80
 MAX_FILE = 400
+MAX_README = 12 * 1024
 CONTROL = re.compile(r"^\s*(\}\s*)?(if|else|for|while|switch|do|try|catch|namespace|struct|class|enum|union)\b")
 
 
@@ -93,6 +95,9 @@ def main():
             for start, length in functions(path):
                 if length > MAX_FUNCTION:
                     breaches.append(f"{path.relative_to(root)}:{start}: a function of {length} lines (at most {MAX_FUNCTION})")
+    readme = (root / "README.md").stat().st_size
+    if readme > MAX_README:
+        breaches.append(f"README.md: {readme} bytes (at most {MAX_README}: link the rest)")
     for b in breaches:
         print(b)
     if breaches:
