@@ -26,7 +26,7 @@
 
 #include <btBulletCollisionCommon.h>
 
-#include "broad/sweep.h"
+#include "support/sweep_and_prune.h"
 #include "broad/world_box.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
@@ -36,8 +36,8 @@
 namespace {
 
 using namespace caliber;
-using broad::sweep_along_x;
 using broad::WorldBox;
+using test::sweep_along_x;
 using Clock = std::chrono::steady_clock;
 
 struct Boxes {

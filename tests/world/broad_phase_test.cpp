@@ -14,7 +14,6 @@
 
 #include "support/error_message.h"
 
-#include "broad/sweep.h"
 #include "broad/world_box.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
@@ -24,13 +23,14 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "support/random_poses.h"
+#include "support/sweep_and_prune.h"
 
 namespace caliber {
 namespace {
 
-using broad::sweep_along_x;
 using broad::world_box;
 using broad::WorldBox;
+using test::sweep_along_x;
 
 /// Every pair of boxes compared: the pairs the broad phase must give, no more, no less.
 std::vector<ObjectPair> every_overlap(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
@@ -40,7 +40,7 @@ std::vector<ObjectPair> every_overlap(const std::vector<std::shared_ptr<const Mo
   std::vector<ObjectPair> pairs;
   for (std::uint32_t a = 0; a < boxes.size(); ++a) {
     for (std::uint32_t b = a + 1; b < boxes.size(); ++b) {
-      if (broad::boxes_overlap(boxes[a], boxes[b])) pairs.push_back({a, b});
+      if (test::boxes_overlap(boxes[a], boxes[b])) pairs.push_back({a, b});
     }
   }
   return pairs;

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// A plain sweep and prune along x over world boxes: the broad phase caliber had before its tree,
-/// kept as the reference the tree is tested (tests/world/broad_phase_test.cpp) and measured
-/// (bench/broad_phase.cpp) against. Not used by the library.
+/// A plain sweep and prune along x over world boxes: the reference the broad phase's tree is
+/// checked against (tests/world/broad_phase_test.cpp) and measured against (bench/broad_phase.cpp).
+/// Not part of the library.
 
 #include <algorithm>
 #include <cstdint>
@@ -11,16 +11,16 @@
 #include "broad/world_box.h"
 #include "caliber/engine.h"
 
-namespace caliber::broad {
+namespace caliber::test {
 
 /// Whether two boxes overlap (closed intervals on the three axes).
-inline bool boxes_overlap(const WorldBox& x, const WorldBox& y) {
+inline bool boxes_overlap(const broad::WorldBox& x, const broad::WorldBox& y) {
   return (x.lo.array() <= y.hi.array()).all() && (y.lo.array() <= x.hi.array()).all();
 }
 
 /// The pairs (a < b, sorted) whose boxes overlap: sorted by low x, each box against those that
 /// start before it ends along x.
-inline std::vector<ObjectPair> sweep_along_x(const std::vector<WorldBox>& boxes) {
+inline std::vector<ObjectPair> sweep_along_x(const std::vector<broad::WorldBox>& boxes) {
   std::vector<std::uint32_t> order(boxes.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -38,4 +38,4 @@ inline std::vector<ObjectPair> sweep_along_x(const std::vector<WorldBox>& boxes)
   return pairs;
 }
 
-}  // namespace caliber::broad
+}  // namespace caliber::test
