@@ -8,7 +8,7 @@ them in data/meshes/, which git ignores). Re-run after changing a parameter here
 With --grid N [N ...] it writes instead the scenes of many parts (data/scenes/grid_N.json, which
 git ignores: 100,000 parts make 40 MB of JSON): N copies of CGAL's `eight` refined twice (10,144
 triangles each) on a jittered cubic grid, neighbours touching, each drifting and turning, contact
-query, 20 steps. `bench/grid_growth.py` measures them (`caliber run` and `caliber bench` take them
+query, 20 steps. `bench/grid_growth.py` measures them (`caliber run` and `caliber-bench` take them
 like any scene).
 """
 import argparse

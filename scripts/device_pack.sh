@@ -33,17 +33,18 @@ limit_mib=64
 
 rm -rf "$pack"
 mkdir -p "$pack/bin" "$pack/lib" "$pack/scenes" "$pack/data/meshes"
-binaries=(caliber bench_batch bench_broad_phase bench_sweep_many)
+binaries=(caliber caliber-bench bench_batch bench_broad_phase bench_sweep_many)
 for binary in "${binaries[@]}"; do
   cp "$root/build/$binary" "$pack/bin/"
   strip "$pack/bin/$binary"
 done
 # A baseline to compare with, interleaved (scripts/device_compare.sh): BASELINE_BUILD names the
-# build folder of an older commit (git worktree add /tmp/old COMMIT; build caliber_cli, bench_batch
+# build folder of an older commit (git worktree add /tmp/old COMMIT; build caliber_cli, caliber_bench_program, bench_batch
 # and bench_sweep_many there); its binaries go to .devicepack/old/ (same libraries).
 if [ -n "${BASELINE_BUILD:-}" ]; then
   mkdir -p "$pack/old"
-  for binary in caliber bench_batch bench_sweep_many; do
+  for binary in caliber caliber-bench bench_batch bench_sweep_many; do
+    [ -f "$BASELINE_BUILD/$binary" ] || continue  # an older build has no caliber-bench
     cp "$BASELINE_BUILD/$binary" "$pack/old/" && strip "$pack/old/$binary"
   done
   cp "$root/scripts/device_compare.sh" "$pack/"
@@ -104,8 +105,10 @@ if [ "${1:-}" = bench ]; then
   done
   if [ "$named" = 0 ]; then
     shift
-    exec "$here/bin/caliber" bench scenes/two_large.json scenes/two_small.json scenes/funnel.json scenes/front_car.json "$@"
+    exec "$here/bin/caliber-bench" scenes/two_large.json scenes/two_small.json scenes/funnel.json scenes/front_car.json "$@"
   fi
+  shift
+  exec "$here/bin/caliber-bench" "$@"
 fi
 exec "$here/bin/caliber" "$@"
 RUN

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Figures of a `caliber bench` run, from DIR/results.json (python3-matplotlib, Debian's package).
+"""Figures of a `caliber-bench` run, from DIR/results.json (python3-matplotlib, Debian's package).
 
     python3 scripts/plot_bench.py DIR
 
@@ -9,7 +9,7 @@ Writes into DIR, as PNG and SVG:
   correlation       estimated vs effective node tests per run-time task, with Pearson r, for the
                     calibrated methods (the paper's Fig. 11);
   gantt             one step per thread, exploitation vs hybrid (stage, depth-first, finalization).
-`caliber bench` runs this itself; it still writes report.md when this cannot run.
+`caliber-bench` runs this itself; it still writes report.md when this cannot run.
 """
 
 import json
@@ -129,7 +129,7 @@ def gantt_figure(r, out):
 
 def main():
     if len(sys.argv) != 2:
-        sys.exit("usage: plot_bench.py DIR (with DIR/results.json from caliber bench)")
+        sys.exit("usage: plot_bench.py DIR (with DIR/results.json from caliber-bench)")
     out = sys.argv[1]
     with open(os.path.join(out, "results.json")) as f:
         r = json.load(f)

@@ -1,33 +1,16 @@
 #pragma once
-// The subcommands of the caliber program. Each registers its options and returns an exit code.
-
-#include <functional>
-#include <string>
+// The subcommands of the caliber program: query, run, refine and view. Each registers its options
+// and returns a Runner.
 
 #include <CLI/CLI.hpp>
 
+#include "options.h"
+
 namespace caliber::cli {
-
-/// An option check with a plain message (CLI11's own number checks print their range's limits as
-/// 300-digit numbers): a whole number >= `least`.
-inline CLI::Validator at_least(long long least) {
-  return CLI::Validator(
-      [least](std::string& text) -> std::string {
-        long long value = 0;
-        return CLI::detail::lexical_cast(text, value) && value >= least
-                   ? std::string()
-                   : "must be a whole number >= " + std::to_string(least) + ", not " + text;
-      },
-      "N >= " + std::to_string(least));
-}
-
-/// A subcommand: registered on the app, then run if it was the one parsed.
-using Runner = std::function<int()>;
 
 Runner add_query_command(CLI::App& app);
 Runner add_run_command(CLI::App& app);
 Runner add_refine_command(CLI::App& app);
-Runner add_bench_command(CLI::App& app);
 Runner add_view_command(CLI::App& app);
 
 }  // namespace caliber::cli

@@ -9,9 +9,9 @@
 #include <system_error>
 
 #include "caliber/error.h"
+#include "json_output.h"
 #include "output_file.h"
 #include "step_geometry.h"
-#include "util/printable.h"
 
 namespace caliber::cli {
 namespace {
@@ -37,10 +37,10 @@ void write_objects(const World& world, const std::vector<Pose>& poses, int k, co
     vertices += world.model(i).mesh().vertices.size();
     faces += world.model(i).mesh().triangles.size();
   }
-  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << printable(world.scene().name) << ", step " << k
+  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << line_text(world.scene().name) << ", step " << k
       << ", every object's mesh posed in the world frame; face property 'object' is the object id\n";
   for (std::size_t i = 0; i < world.object_count(); ++i)
-    out << "comment object " << i << " " << printable(world.scene().objects[i].name) << "\n";
+    out << "comment object " << i << " " << line_text(world.scene().objects[i].name) << "\n";
   out << "element vertex " << vertices << "\nproperty double x\nproperty double y\nproperty double z\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       << "element face " << faces << "\nproperty list uchar uint vertex_indices\nproperty uint object\nend_header\n";
@@ -77,7 +77,7 @@ void write_contacts(const World& world, const StepResult& step, const std::vecto
   const double length = 0.03 * scene_diagonal(world, poses);
   OutputFile file(path, "--export");
   std::ostream& out = file.stream();
-  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << printable(world.scene().name) << ", step " << step.step << ", "
+  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << line_text(world.scene().name) << ", step " << step.step << ", "
       << to_string(world.request().kind) << " query: vertex 2k is contact k's point, vertex 2k+1 the end of its normal ("
       << length << " long); edge k joins them\n"
       << "element vertex " << 2 * contacts.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
@@ -107,7 +107,7 @@ void write_bvh(const World& world, const std::vector<Pose>& poses, int k, int de
   }
   OutputFile file(path, "--export");
   std::ostream& out = file.stream();
-  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << printable(world.scene().name) << ", step " << k
+  out << "ply\nformat ascii 1.0\ncomment caliber: scene " << line_text(world.scene().name) << ", step " << k
       << ", the box of every BVH node down to depth " << depth << " (root: 0), posed; 8 vertices and 12 edges per box\n"
       << "element vertex " << 8 * boxes.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
       << "element edge " << 12 * boxes.size() << "\nproperty int vertex1\nproperty int vertex2\n"

@@ -2,10 +2,9 @@
 //   caliber query A B [...]      two meshes, one query
 //   caliber run SCENE [...]      a scene over its time steps
 //   caliber refine IN OUT -l K   1-to-4 subdivision
-//   caliber bench [SCENES...]    every method on every scene: report.md, results.json, figures
 //   caliber view SCENE --out F   an HTML page showing the scene's steps, contacts and tasks
 // Exit codes: 0 success, 2 bad input or not enough memory for it (message on stderr), 130 and 143
-// a long command (run, view, bench, refine) stopped by SIGINT or SIGTERM (what it measured is
+// a long command (run, view, refine) stopped by SIGINT or SIGTERM (what it measured is
 // written, and no temporary file is left), 1 unexpected internal error.
 
 #include <iostream>
@@ -24,8 +23,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("caliber ") + caliber::kVersion);
   const std::vector<caliber::cli::Runner> commands = {caliber::cli::add_query_command(app), caliber::cli::add_run_command(app),
-                                                      caliber::cli::add_refine_command(app), caliber::cli::add_bench_command(app),
-                                                      caliber::cli::add_view_command(app)};
+                                                      caliber::cli::add_refine_command(app), caliber::cli::add_view_command(app)};
   // An empty value is refused, not read as 0 or as no output file ("--tolerance ''", "--json ''").
   const CLI::Validator non_empty(
       [](std::string& value) { return value.empty() ? std::string("must not be empty") : std::string(); }, "", "NONEMPTY");

@@ -2,8 +2,6 @@
 
 #include "step_geometry.h"
 
-#include "bvh/model_data.h"
-
 #include <Eigen/Geometry>
 
 namespace caliber::cli {
@@ -28,24 +26,20 @@ std::vector<ShownContact> shown_contacts(const World& world, const StepResult& s
 }
 
 ShownBox node_box(const Model& model, std::uint32_t node, const Pose& pose) {
-  const BvhNode& n = data(model).nodes[node];
-  const Eigen::Vector3d center = data(model).origin + Eigen::Vector3d(n.box_center[0], n.box_center[1], n.box_center[2]);
-  return ShownBox{pose.apply(center), Eigen::Vector3d(n.box_half[0], n.box_half[1], n.box_half[2]), pose.rotation_matrix()};
+  const NodeBox box = caliber::node_box(model, node);
+  return ShownBox{pose.apply(box.center), box.half, pose.rotation_matrix()};
 }
 
 std::vector<std::pair<std::uint32_t, int>> nodes_to_depth(const Model& model, int depth) {
   std::vector<std::pair<std::uint32_t, int>> out;
-  const std::vector<BvhNode>& nodes = data(model).nodes;
-  if (nodes.empty() || depth < 0) return out;
+  if (model.node_count() == 0 || depth < 0) return out;
   std::vector<std::uint32_t> level{0};
   for (int d = 0; d <= depth && !level.empty(); ++d) {
     std::vector<std::uint32_t> next;
     for (const std::uint32_t i : level) {
       out.emplace_back(i, d);
-      if (!nodes[i].is_leaf()) {
-        next.push_back(nodes[i].index);
-        next.push_back(nodes[i].index + 1);
-      }
+      const NodeBox box = caliber::node_box(model, i);
+      next.insert(next.end(), box.children, box.children + box.child_count);
     }
     level = std::move(next);
   }

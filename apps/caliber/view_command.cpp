@@ -11,7 +11,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bvh/model_data.h"
 #include "caliber/engine.h"
 #include "caliber/profile.h"
 #include "caliber/error.h"
@@ -95,10 +94,8 @@ nlohmann::json task_records(const World& world, const StepResult& s, int& budget
       if (budget <= 0) break;
       --budget;
       const std::uint32_t object = s.pair_records[root.pair].pair.a;
-      const ModelData& m = data(world.model(object));
-      const BvhNode& n = m.nodes[root.node_a];
-      const Eigen::Vector3d c = m.origin + Eigen::Vector3d(n.box_center[0], n.box_center[1], n.box_center[2]);
-      roots.push_back({object, c[0], c[1], c[2], n.box_half[0], n.box_half[1], n.box_half[2]});
+      const NodeBox box = caliber::node_box(world.model(object), root.node_a);
+      roots.push_back({object, box.center[0], box.center[1], box.center[2], box.half[0], box.half[1], box.half[2]});
     }
     tasks.push_back({{"thread", thread[t]}, {"node_tests", r.task_node_tests[t]}, {"roots", roots}});
   }

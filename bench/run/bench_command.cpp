@@ -1,4 +1,4 @@
-// caliber bench: every scene x method x thread count, repeated, medians; the paper's Table 1 and
+// caliber-bench: every scene x method x thread count, repeated, medians; the paper's Table 1 and
 // Table 2, the 1-thread overhead, the load-balance simulation beyond this machine's cores, the
 // estimate-vs-effective correlation, a per-thread timeline, the FCL peer comparison (when
 // bench_fcl_compare is built), the run's key figures in one table; report.md +
@@ -36,7 +36,7 @@
 #include "caliber/world.h"
 #include "bench_records.h"
 #include "bench_report.h"
-#include "commands.h"
+#include "bench_command.h"
 #include "interrupt.h"
 #include "machine.h"
 #include "output_file.h"
@@ -221,7 +221,7 @@ struct BenchRun {
              {"signal", interrupt_name()},
              {"after_s", budget.elapsed_s()},
              {"next", what}});
-    std::fprintf(stderr, "\ncaliber bench: interrupted (%s) after %.0f s; not run: %s and what follows\n", interrupt_name(),
+    std::fprintf(stderr, "\ncaliber-bench: interrupted (%s) after %.0f s; not run: %s and what follows\n", interrupt_name(),
                  budget.elapsed_s(), what.c_str());
     return true;
   }
@@ -233,7 +233,7 @@ struct BenchRun {
     if (budget.allows(estimate_s)) return true;
     stopped = true;
     log.add({{"kind", "stopped"}, {"reason", "budget"}, {"after_s", budget.elapsed_s()}, {"next", what}});
-    std::fprintf(stderr, "\ncaliber bench: --budget-s %g reached after %.0f s; not run: %s and what follows\n", opt.budget_s,
+    std::fprintf(stderr, "\ncaliber-bench: --budget-s %g reached after %.0f s; not run: %s and what follows\n", opt.budget_s,
                  budget.elapsed_s(), what.c_str());
     return false;
   }
@@ -530,7 +530,7 @@ std::string no_figures_note(bool figures) {
   if (!figures) return "Figures not drawn (--no-figures).";
   if (interrupted()) {
     return std::string("Figures not drawn: the bench was interrupted (") + interrupt_name() +
-           "); `caliber bench --from-log` draws them from its log.";
+           "); `caliber-bench --from-log` draws them from its log.";
   }
   return "";
 }
@@ -581,7 +581,7 @@ NamedFiles bench_outputs(const std::filesystem::path& out, const std::vector<std
   return files;
 }
 
-/// `caliber bench --from-log FILE`: the report of a bench run from its log, whole or cut short.
+/// `caliber-bench --from-log FILE`: the report of a bench run from its log, whole or cut short.
 int report_from_log(const BenchOptions& opt) {
   const std::filesystem::path log_file = opt.from_log;
   const std::vector<Json> records = read_bench_log(log_file);
@@ -698,7 +698,7 @@ int run_bench(BenchOptions opt) {
         units += opt.simulate.size() * static_cast<std::size_t>(simulated_steps(opt, w->scene()));
     }
   }
-  std::printf("caliber bench on %s\n%zu scene(s), %zu method(s), threads {", bench::machine_description().c_str(), worlds.size(),
+  std::printf("caliber-bench on %s\n%zu scene(s), %zu method(s), threads {", bench::machine_description().c_str(), worlds.size(),
               variants.size());
   for (std::size_t i = 0; i < opt.threads.size(); ++i) std::printf("%s%d", i ? ", " : "", opt.threads[i]);
   std::printf("}, %d repeat(s); results in %s, each run logged to %s as it ends\n", opt.repeat, opt.out.c_str(),
@@ -735,7 +735,7 @@ int run_bench(BenchOptions opt) {
   write_outputs(log.records(), opt.out, opt.figures);
   const Json results = results_from_records(log.records());
   if (!results["contacts_identical"].get<bool>()) {
-    std::fprintf(stderr, "caliber bench: some method returned contacts that differ from sequential's (see above)\n");
+    std::fprintf(stderr, "caliber-bench: some method returned contacts that differ from sequential's (see above)\n");
     return 1;
   }
   check_stdout();
@@ -744,9 +744,9 @@ int run_bench(BenchOptions opt) {
 
 }  // namespace
 
-Runner add_bench_command(CLI::App& app) {
+Runner add_bench_options(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
-  CLI::App* cmd = app.add_subcommand("bench", "Every scene x method x thread count: the paper's tables and figures, measured");
+  CLI::App* cmd = &app;
   cmd->add_option("SCENES", opt->scenes, "Scene files (default: scenes/{two_large,two_small,funnel,front_car}.json)");
   cmd->add_option("--methods", opt->methods, "Methods (and hybrid+history); sequential is always run as the reference")
       ->delimiter(',')
@@ -775,7 +775,7 @@ Runner add_bench_command(CLI::App& app) {
   cmd->add_option("--from-log", opt->from_log,
                   "Measure nothing: rebuild results.json, the figures and report.md from a bench log (a run cut short "
                   "included), into --out or the log's folder");
-  return [cmd, opt]() { return cmd->parsed() ? run_bench(*opt) : -1; };
+  return [opt]() { return run_bench(*opt); };
 }
 
 }  // namespace caliber::cli

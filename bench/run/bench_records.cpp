@@ -1,4 +1,4 @@
-// The JSON-lines log of `caliber bench` and results.json rebuilt from it (see bench_records.h).
+// The JSON-lines log of `caliber-bench` and results.json rebuilt from it (see bench_records.h).
 
 #include "bench_records.h"
 
@@ -162,7 +162,7 @@ std::vector<Json> read_bench_log(const std::filesystem::path& file) {
       throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + " is not a bench record");
     }
     if (records.empty() && r["kind"] != "header") {
-      throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber bench log)");
+      throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber-bench log)");
     }
     if (i > 0 && r["kind"] == "header") {
       throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + ": a second header");
@@ -172,7 +172,7 @@ std::vector<Json> read_bench_log(const std::filesystem::path& file) {
     }
     records.push_back(std::move(r));
   }
-  if (records.empty()) throw Error(ErrorCode::unreadable, file.string(), "empty (not a caliber bench log)");
+  if (records.empty()) throw Error(ErrorCode::unreadable, file.string(), "empty (not a caliber-bench log)");
   return records;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The JSON-lines log of `caliber bench`: one record per line, written and flushed the moment it is
+// The JSON-lines log of `caliber-bench`: one record per line, written and flushed the moment it is
 // measured, so that a run cut short (a time limit, a lost machine) keeps every finished
 // configuration; and results.json rebuilt from such a log, whole or partial.
 //

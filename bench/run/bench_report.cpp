@@ -1,4 +1,4 @@
-// report.md of `caliber bench`, written from its results.json: every figure in it is measured
+// report.md of `caliber-bench`, written from its results.json: every figure in it is measured
 // (or simulated, and said so) in that run.
 
 #include "bench_report.h"
@@ -62,7 +62,7 @@ void write_bench_report(const Json& r, const std::filesystem::path& file) {
   const int cores = r["hardware_threads"].get<int>();
   const int max_t = threads.back();
 
-  out << "# caliber bench\n\n";
+  out << "# caliber-bench\n\n";
   out << "Machine: " << r["machine"].get<std::string>() << ".\n\n";
   out << "Each configuration ran " << r["repeat"].get<int>() << " time(s), in interleaved rounds (round r runs every "
       << "configuration once, so that a slow spell of a shared machine does not land on one configuration); times are "

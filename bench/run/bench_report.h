@@ -1,5 +1,5 @@
 #pragma once
-// report.md of `caliber bench`, from the run's results.json.
+// report.md of `caliber-bench`, from the run's results.json.
 
 #include <filesystem>
 

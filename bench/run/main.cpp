@@ -1,5 +1,5 @@
-// caliber-bench: the benchmark of the six methods as a program of its own (the same as
-// `caliber bench`, which the caliber program keeps as a thin entry to this code).
+// caliber-bench: the benchmark of the six methods (bench_command.cpp), a program of its own beside
+// the caliber program.
 // Exit codes: 0 success, 2 bad input (message on stderr), 130 and 143 stopped by SIGINT or SIGTERM
 // (what was measured is reported), 1 unexpected internal error or contacts that differ.
 
@@ -8,20 +8,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench_command.h"
 #include "caliber/error.h"
-#include "commands.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"caliber-bench: every method on every scene, medians, report.md and results.json"};
-  app.require_subcommand(1);
-  const caliber::cli::Runner bench = caliber::cli::add_bench_command(app);
-  // `caliber-bench bench ...` reads oddly: the options go straight after the program's name.
-  std::vector<std::string> args{argv[0], "bench"};
-  for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
-  std::vector<char*> argp;
-  for (std::string& a : args) argp.push_back(a.data());
+  CLI::App app{"caliber-bench: every scene x method x thread count: the paper's tables and figures, measured"};
+  const caliber::cli::Runner bench = caliber::cli::add_bench_options(app);
   try {
-    app.parse(static_cast<int>(argp.size()), argp.data());
+    app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::cerr << "caliber-bench: " << e.what() << "\n";

@@ -6,6 +6,7 @@
 
 #include "caliber/export.h"
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -59,6 +60,20 @@ class CALIBER_EXPORT Model {
   Model() = default;
   ~Model() = default;
 };
+
+/// One node of a model's BVH as a viewer draws it: its box (center and half-extents along the
+/// model's axes, in the model's frame) and its children's node indices (none for a leaf). Node 0 is
+/// the root; TaskRoot and the profile name nodes by the same indices.
+struct NodeBox {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+  std::uint32_t children[2] = {0, 0};
+  int child_count = 0;  ///< 0 for a leaf, else 2
+};
+
+/// Node `node` of the model's BVH (node < node_count()). Throws caliber::Error on a node past the
+/// last.
+[[nodiscard]] CALIBER_EXPORT NodeBox node_box(const Model& model, std::uint32_t node);
 
 /// Validates the mesh and builds its model in O(n log n). Throws caliber::Error on a bad mesh.
 [[nodiscard]] CALIBER_EXPORT std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options = {});

@@ -306,5 +306,34 @@ TEST(BuildModel, AdjacencyIsLinearInTheCornersOfAHugeFan) {
   EXPECT_EQ(neighbours(*model, 5).size(), mesh.triangles.size() - 1) << "the hub: every other triangle";
 }
 
+// node_box, the viewer's view of the BVH: every node's box holds the vertices of the triangles
+// below it (walked through the children it gives), leaves have no children, and every node is
+// reached once.
+TEST(NodeBox, ChildrenCoverTheTreeAndBoxesHoldTheirTriangles) {
+  const auto model = build_model(make_torus(1.0, 0.3, 12, 8));
+  const Mesh& mesh = model->mesh();
+  std::vector<int> seen(model->node_count(), 0);
+  std::function<std::vector<std::uint32_t>(std::uint32_t)> below = [&](std::uint32_t node) {
+    ++seen[node];
+    const NodeBox box = node_box(*model, node);
+    std::vector<std::uint32_t> triangles;
+    for (int c = 0; c < box.child_count; ++c) {
+      const auto more = below(box.children[c]);
+      triangles.insert(triangles.end(), more.begin(), more.end());
+    }
+    if (box.child_count == 0) triangles.push_back(static_cast<std::uint32_t>(data(*model).nodes[node].index));
+    for (const std::uint32_t t : triangles) {
+      for (const auto v : mesh.triangles[t]) {
+        const Eigen::Vector3d d = (mesh.vertices[v] - box.center).cwiseAbs() - box.half;
+        EXPECT_LE(d.maxCoeff(), 1e-6) << "node " << node << " triangle " << t;
+      }
+    }
+    return triangles;
+  };
+  EXPECT_EQ(below(0).size(), mesh.triangles.size());
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+  EXPECT_THROW((void)node_box(*model, static_cast<std::uint32_t>(model->node_count())), Error);
+}
+
 }  // namespace
 }  // namespace caliber

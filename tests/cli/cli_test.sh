@@ -2,6 +2,7 @@
 # End-to-end checks of the caliber command line: output shape and exit codes.
 set -u
 cli="$1"
+bench="$(dirname "$cli")/caliber-bench"  # the benchmark program, built beside caliber
 data="$2"
 source "$(dirname "$0")/check_lib.sh"
 
@@ -206,8 +207,15 @@ contains refine "64 triangles"
 check refine-query 0 "$cli" query "$tmp/fine.off" "$data/tetra.off" --show 0
 check refine-bad-levels 2 "$cli" refine "$data/tetra.off" "$tmp/x.off" --levels 12
 check refine-missing 2 "$cli" refine "$data/nope.off" "$tmp/x.off"
-# caliber bench: a tiny run writes the report and the raw figures; bad options fail before any work.
-check bench 0 "$cli" bench "$data/scenes/tetras.json" --steps 4 --repeat 2 --threads 1,2 --simulate 4 --no-fcl --no-figures --out "$tmp/bench"
+# The benchmark is a program of its own: caliber has no bench command and none of its code.
+check no-bench-command 2 "$cli" bench "$data/scenes/tetras.json"
+if nm -C "$cli" 2>/dev/null | grep -qE "run_bench|add_bench_options|bench_records|write_bench_report|machine_description"; then
+  echo "FAIL no-bench-symbols: caliber holds the bench's code"; failures=$((failures + 1))
+else
+  passes=$((passes + 1))
+fi
+# caliber-bench: a tiny run writes the report and the raw figures; bad options fail before any work.
+check bench 0 "$bench" "$data/scenes/tetras.json" --steps 4 --repeat 2 --threads 1,2 --simulate 4 --no-fcl --no-figures --out "$tmp/bench"
 contains bench "wrote $tmp/bench/report.md"
 python3 - "$tmp/bench" <<'PY' || { echo "FAIL bench-files"; failures=$((failures + 1)); }
 import json, sys
@@ -248,14 +256,14 @@ assert sum(1 for x in records if x["kind"] == "run") == 22
 PY
 # The report rebuilt from the log alone is the same report; from a log cut in the middle of a line,
 # a report of the runs it holds.
-check bench-from-log 0 "$cli" bench --from-log "$tmp/bench/runs.jsonl" --out "$tmp/bench-again" --no-figures
+check bench-from-log 0 "$bench" --from-log "$tmp/bench/runs.jsonl" --out "$tmp/bench-again" --no-figures
 python3 - "$tmp/bench" "$tmp/bench-again" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-from-log-same"; failures=$((failures + 1)); }
 import sys
 a, b = (open(d + "/report.md").read() for d in sys.argv[1:])
 assert a == b
 PY
 head -c 2500 "$tmp/bench/runs.jsonl" > "$tmp/cut.jsonl"
-check bench-from-cut-log 0 "$cli" bench --from-log "$tmp/cut.jsonl" --out "$tmp/bench-cut" --no-figures
+check bench-from-cut-log 0 "$bench" --from-log "$tmp/cut.jsonl" --out "$tmp/bench-cut" --no-figures
 contains bench-from-cut-log "wrote $tmp/bench-cut/report.md"
 grep -q "the log ends before the run did" "$tmp/bench-cut/report.md" && passes=$((passes + 1)) ||
   { echo "FAIL bench-cut-report"; failures=$((failures + 1)); }
@@ -289,7 +297,7 @@ contains run-continuous-contacts "--continuous"
 check run-continuous-tolerance 2 "$cli" run "$data/../../scenes/funnel.json" --continuous --sweep-tolerance -1
 contains run-continuous-tolerance "tolerance"
 # (two_small: its runs take long enough; its meshes are extracted by scripts/fetch_meshes.sh before the tests)
-check bench-budget 0 "$cli" bench "$data/../../scenes/two_small.json" --steps 100 --repeat 3 --threads 1,2 --simulate 4 --no-fcl \
+check bench-budget 0 "$bench" "$data/../../scenes/two_small.json" --steps 100 --repeat 3 --threads 1,2 --simulate 4 --no-fcl \
   --no-figures --budget-s 1 --out "$tmp/bench-budget"
 contains bench-budget "--budget-s 1 reached"
 python3 - "$tmp/bench-budget" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-budget-files"; failures=$((failures + 1)); }
@@ -304,13 +312,13 @@ assert r["runs_done"] < r["runs_planned"], (r["runs_done"], r["runs_planned"])
 assert "cut short by its time budget" in open(sys.argv[1] + "/report.md").read()
 PY
 # A budget spent before the sequential reference finished: the report still says so (written whole).
-check bench-budget-nothing 0 "$cli" bench "$data/scenes/tetras.json" --steps 100000 --repeat 1 --threads 1 --simulate 2 --no-fcl \
+check bench-budget-nothing 0 "$bench" "$data/scenes/tetras.json" --steps 100000 --repeat 1 --threads 1 --simulate 2 --no-fcl \
   --no-figures --budget-s 0.001 --out "$tmp/bench-nothing"
 grep -q "nothing to report yet" "$tmp/bench-nothing/report.md" && passes=$((passes + 1)) ||
   { echo "FAIL bench-budget-nothing-report"; failures=$((failures + 1)); }
 echo "not json" > "$tmp/bad.jsonl"
 touch "$tmp/a-file"
-check bench-bad-log 2 "$cli" bench --from-log "$tmp/bad.jsonl" --out "$tmp/bench3"
+check bench-bad-log 2 "$bench" --from-log "$tmp/bad.jsonl" --out "$tmp/bench3"
 contains bench-bad-log "line 1 is not a bench record"
 # A record with a field missing or of the wrong type, or naming a scene the header lacks: exit 2,
 # naming the file and the line.
@@ -324,22 +332,22 @@ for name, change in (("nofield", lambda r: r.pop("total_ms")), ("badtype", lambd
     change(r)
     open(f"{sys.argv[2]}/{name}.jsonl", "w").write("\n".join(lines[:run] + [json.dumps(r)] + lines[run + 1:]) + "\n")
 PY
-check bench-log-nofield 2 "$cli" bench --from-log "$tmp/nofield.jsonl" --out "$tmp/bench3"
+check bench-log-nofield 2 "$bench" --from-log "$tmp/nofield.jsonl" --out "$tmp/bench3"
 contains bench-log-nofield 'no "total_ms"'
-check bench-log-badtype 2 "$cli" bench --from-log "$tmp/badtype.jsonl" --out "$tmp/bench3"
+check bench-log-badtype 2 "$bench" --from-log "$tmp/badtype.jsonl" --out "$tmp/bench3"
 contains bench-log-badtype '"threads" has the wrong type'
-check bench-log-badscene 2 "$cli" bench --from-log "$tmp/badscene.jsonl" --out "$tmp/bench3"
+check bench-log-badscene 2 "$bench" --from-log "$tmp/badscene.jsonl" --out "$tmp/bench3"
 contains bench-log-badscene "names a scene the header does not list"
-check bench-from-log-out-file 2 "$cli" bench --from-log "$tmp/bench/runs.jsonl" --out "$tmp/a-file"
-check bench-missing-log 2 "$cli" bench --from-log "$tmp/none.jsonl"
-check bench-bad-budget 2 "$cli" bench "$data/scenes/tetras.json" --budget-s -5 --out "$tmp/bench2"
-check bench-out-file 2 "$cli" bench "$data/scenes/tetras.json" --out "$tmp/a-file"
+check bench-from-log-out-file 2 "$bench" --from-log "$tmp/bench/runs.jsonl" --out "$tmp/a-file"
+check bench-missing-log 2 "$bench" --from-log "$tmp/none.jsonl"
+check bench-bad-budget 2 "$bench" "$data/scenes/tetras.json" --budget-s -5 --out "$tmp/bench2"
+check bench-out-file 2 "$bench" "$data/scenes/tetras.json" --out "$tmp/a-file"
 contains bench-out-file "not a folder"
-check bench-missing 2 "$cli" bench "$data/scenes/nope.json" --out "$tmp/bench2"
+check bench-missing 2 "$bench" "$data/scenes/nope.json" --out "$tmp/bench2"
 contains bench-missing "nope.json"
-check bench-bad-method 2 "$cli" bench "$data/scenes/tetras.json" --methods sequential,turbo --out "$tmp/bench2"
-check bench-bad-threads 2 "$cli" bench "$data/scenes/tetras.json" --threads 0 --out "$tmp/bench2"
-check bench-bad-repeat 2 "$cli" bench "$data/scenes/tetras.json" --repeat 0 --out "$tmp/bench2"
+check bench-bad-method 2 "$bench" "$data/scenes/tetras.json" --methods sequential,turbo --out "$tmp/bench2"
+check bench-bad-threads 2 "$bench" "$data/scenes/tetras.json" --threads 0 --out "$tmp/bench2"
+check bench-bad-repeat 2 "$bench" "$data/scenes/tetras.json" --repeat 0 --out "$tmp/bench2"
 rm -rf "$tmp"
 
 # Bad inputs (docs/bad_input.md): readers by extension, linear adjacency, exact range,
@@ -473,7 +481,7 @@ python3 -c "import json, sys; json.load(open(sys.argv[1]))" "$r2/same.json" && p
   echo "FAIL out-concurrent: invalid JSON"; failures=$((failures + 1)); }
 ls "$r2"/.same.json.* > /dev/null 2>&1 && { echo "FAIL out-concurrent: temporary file left"; failures=$((failures + 1)); }
 # bench checks its scenes before it creates a folder.
-check bench-bad-scene-no-folder 2 "$cli" bench "$r2/s/tol.json" --out "$r2/benchdir"
+check bench-bad-scene-no-folder 2 "$bench" "$r2/s/tol.json" --out "$r2/benchdir"
 [ -e "$r2/benchdir" ] && { echo "FAIL bench-bad-scene-no-folder: created $r2/benchdir"; failures=$((failures + 1)); }
 # SIGINT: the step in progress ends, what was measured is written, exit 130.
 "$cli" run "$data/scenes/tetras.json" --steps 100000000 --json "$r2/int.json" --contacts "$r2/int.jsonl" > /dev/null 2>&1 &
@@ -499,7 +507,7 @@ check scene-fifo 2 timeout 10 "$cli" run "$h/fifo.json"
 contains scene-fifo "fifo.json: is not a regular file"
 check scene-dev-zero 2 timeout 10 "$cli" run /dev/zero
 contains scene-dev-zero "/dev/zero: is not a regular file"
-check log-fifo 2 timeout 10 "$cli" bench --from-log "$h/fifo.json" --out "$h/b"
+check log-fifo 2 timeout 10 "$bench" --from-log "$h/fifo.json" --out "$h/b"
 contains log-fifo "is not a regular file"
 check empty-output-name 2 "$cli" run "$data/scenes/tetras.json" --json ""
 contains empty-output-name "--json: must not be empty"
@@ -545,10 +553,10 @@ check motion-tiny-export 2 "$cli" run "$h/tiny.json" --export "$h/e5" --export-s
 [ -e "$h/e5" ] || [ -e "$h/r5.json" ] && { echo "FAIL motion-tiny-export: a failed run left $(ls "$h")"; failures=$((failures + 1)); }
 check export-steps-twice 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e6" --export-steps 0,0
 contains export-steps-twice "--export-steps: step 0 is listed twice"
-check bench-log-folder 2 "$cli" bench "$data/scenes/tetras.json" --out "$h/b1" --log "$h" --steps 2
+check bench-log-folder 2 "$bench" "$data/scenes/tetras.json" --out "$h/b1" --log "$h" --steps 2
 contains bench-log-folder "--log: '$h' is a folder, not a log file"
 [ -e "$h/b1" ] && { echo "FAIL bench-log-folder: created $h/b1"; failures=$((failures + 1)); }
-check bench-scene-twice 2 "$cli" bench "$data/scenes/tetras.json" "$data/scenes/tetras.json" --out "$h/b2" --steps 2
+check bench-scene-twice 2 "$bench" "$data/scenes/tetras.json" "$data/scenes/tetras.json" --out "$h/b2" --steps 2
 contains bench-scene-twice "scene 'tetras' is given twice"
 check query-threads-range 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --threads -5
 check sweep-tolerance-nan 2 "$cli" run "$data/scenes/tetras.json" --sweep-tolerance nan

@@ -5,6 +5,7 @@
 # usage: outputs_test.sh CALIBER TEST_DATA_DIR
 set -u
 cli="$1"
+bench="$(dirname "$cli")/caliber-bench"  # the benchmark program, built beside caliber
 data="$(cd "$2" && pwd)"
 source "$(dirname "$0")/check_lib.sh"
 tmp=$(mktemp -d)
@@ -104,17 +105,17 @@ printf '{"name": "b", "steps": 1, "objects": [{"name": "a", "mesh": "tetra.off"}
 cp "$tmp/b/s.json" "$tmp/b/results.json"
 before=$(cat "$tmp/b/"* | md5sum)
 quick=(--threads 1 --repeat 1 --no-fcl --no-figures --simulate 2)
-check bench-log-over-mesh 2 "$cli" bench "$tmp/b/s.json" --log "$tmp/b/tetra.off" --out "$tmp/b/out1" "${quick[@]}"
+check bench-log-over-mesh 2 "$bench" "$tmp/b/s.json" --log "$tmp/b/tetra.off" --out "$tmp/b/out1" "${quick[@]}"
 contains bench-log-over-mesh "--log: would overwrite the input mesh of object 'a'"
-check bench-log-over-scene 2 "$cli" bench "$tmp/b/s.json" --log "$tmp/b/s.json" --out "$tmp/b/out2" "${quick[@]}"
+check bench-log-over-scene 2 "$bench" "$tmp/b/s.json" --log "$tmp/b/s.json" --out "$tmp/b/out2" "${quick[@]}"
 contains bench-log-over-scene "--log: would overwrite the input scene file"
-check bench-out-over-scene 2 "$cli" bench "$tmp/b/results.json" --out "$tmp/b" "${quick[@]}"
+check bench-out-over-scene 2 "$bench" "$tmp/b/results.json" --out "$tmp/b" "${quick[@]}"
 contains bench-out-over-scene "--out's results.json: would overwrite the input scene file"
 [ "$(cat "$tmp/b/"* | md5sum)" = "$before" ] || { echo "FAIL bench-inputs: an input changed"; failures=$((failures + 1)); }
 [ -e "$tmp/b/out1" ] || [ -e "$tmp/b/out2" ] && { echo "FAIL bench-inputs: a refused bench made its folder"; failures=$((failures + 1)); }
-check bench-from-log-over-log 0 "$cli" bench "$tmp/b/s.json" --out "$tmp/b/out3" "${quick[@]}"
+check bench-from-log-over-log 0 "$bench" "$tmp/b/s.json" --out "$tmp/b/out3" "${quick[@]}"
 cp "$tmp/b/out3/runs.jsonl" "$tmp/b/out3/report.md"
-check bench-from-log-over-log 2 "$cli" bench --from-log "$tmp/b/out3/report.md"
+check bench-from-log-over-log 2 "$bench" --from-log "$tmp/b/out3/report.md"
 contains bench-from-log-over-log "--out's report.md: would overwrite the input --from-log"
 
 # Reports are streamed: a million-step run --json keeps its memory (max RSS) under 100 MB; a run

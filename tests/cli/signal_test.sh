@@ -7,6 +7,7 @@
 # usage: signal_test.sh CALIBER TEST_DATA_DIR
 set -u
 cli="$1"
+bench="$(dirname "$cli")/caliber-bench"  # the benchmark program, built beside caliber
 data="$(cd "$2" && pwd)"
 source "$(dirname "$0")/check_lib.sh"
 tmp=$(mktemp -d)
@@ -93,7 +94,7 @@ fi
 
 # bench: results.json and report.md of the runs done, the log's last record says why it stopped.
 d="$tmp/bench"
-stop bench TERM "$d/runs.jsonl" "$cli" bench "$scene" --steps 2000000 --repeat 1 --threads 1 --no-fcl --no-ceiling --out "$d"
+stop bench TERM "$d/runs.jsonl" "$bench" "$scene" --steps 2000000 --repeat 1 --threads 1 --no-fcl --no-ceiling --out "$d"
 if verdict bench 143 "$d"; then
   python3 - "$d" <<'PY' || { echo "FAIL bench-results"; failures=$((failures + 1)); }
 import json, sys

@@ -41,6 +41,8 @@ nlohmann::json to_json(const QueryResult& result) {
 
 std::string json_text(std::string_view text) { return utf8_or_escaped(text); }
 
+std::string line_text(std::string_view text) { return printable(text); }
+
 JsonObjectWriter::JsonObjectWriter(std::ostream& out, std::string (*filter)(const std::string&)) : mOut(out), mFilter(filter) {
   mOut << '{';
 }

@@ -23,6 +23,10 @@ nlohmann::json to_json(const QueryResult& result);
 /// written as the text \xNN, so that any path reaches the report (JSON holds only Unicode).
 [[nodiscard]] std::string json_text(std::string_view text);
 
+/// Text from outside (a scene or object name) for a one-line text format, a PLY header comment:
+/// control characters and bytes that are not UTF-8 as \xNN.
+[[nodiscard]] std::string line_text(std::string_view text);
+
 /// A JSON object written member by member: an array of many records (a run's steps) goes out one
 /// record at a time as the records are made, and is never held whole. `filter` (optional)
 /// rewrites each piece of JSON text before it is written (the viewer's script_safe).
