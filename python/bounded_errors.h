@@ -169,7 +169,7 @@ inline pybind11::object bounded(pybind11::handle original, pybind11::handle modu
 }
 
 /// Wraps (bounded) every public function of module m except those named in `skip`, and every
-/// public method, static method and __init__ of its classes.
+/// public method, static method, __init__, __repr__, __len__ and __reduce__ of its classes.
 inline void bound_type_errors(pybind11::module_& m, std::initializer_list<const char*> skip) {
   namespace py = pybind11;
   const py::object module_name = m.attr("__name__");
@@ -189,7 +189,8 @@ inline void bound_type_errors(pybind11::module_& m, std::initializer_list<const 
       const py::object cls = py::reinterpret_borrow<py::object>(value);
       for (const auto& [mkey, method] : py::dict(cls.attr("__dict__"))) {
         const std::string mname = py::str(mkey);
-        if (!is_public(mname) && mname != "__init__") continue;
+        const bool wrapped_dunder = mname == "__init__" || mname == "__repr__" || mname == "__len__" || mname == "__reduce__";
+        if (!is_public(mname) && !wrapped_dunder) continue;
         if (PyInstanceMethod_Check(method.ptr()) != 0) {
           const py::handle function = PyInstanceMethod_GET_FUNCTION(method.ptr());
           if (PyCFunction_Check(function.ptr()) == 0) continue;

@@ -132,6 +132,21 @@ std::string float_text(double value);
 /// "<caliber.Name: what>", what every repr without a constructor call prints.
 std::string bracket_repr(const char* name, const std::string& what);
 
+/// The __repr__ of the bound class T (`name` in "caliber.Name"): "<caliber.Name: what>", `what` of
+/// the object (alone where not `bracketed`), or "never built" for an object made by __new__ alone,
+/// which the class's caster refuses.
+template <class T, class What>
+auto repr_of(const char* name, What what, bool bracketed = true) {
+  return [name, what, bracketed](py::handle self) -> std::string {
+    if (!py::isinstance<T>(self)) {
+      throw py::type_error(std::string("__repr__ of caliber.") + name + " takes a caliber." + name + ", not " +
+                           py::str(self.get_type().attr("__name__")).cast<std::string>());
+    }
+    if (is_half_built(self, py::detail::get_type_info(typeid(T)))) return bracket_repr(name, "never built");
+    return bracketed ? bracket_repr(name, what(self.cast<const T&>())) : what(self.cast<const T&>());
+  };
+}
+
 /// "1 thing" or "n things" (`plural`: "things" when not given).
 std::string count_of(std::size_t n, const char* thing, const char* plural = nullptr);
 

@@ -82,13 +82,12 @@ std::string batch_repr(const PyBatch& b) {
   const auto n = static_cast<std::size_t>(b.hit.shape(0));
   std::size_t hits = 0;
   for (std::size_t i = 0; i < n; ++i) hits += b.hit.data()[i] ? 1 : 0;
-  return bracket_repr("Batch", count_of(n, "entry", "entries") + ", " + count_of(hits, "hit") + ", " +
-                                   count_of(static_cast<std::size_t>(b.entries.shape(0)), "pair"));
+  return (count_of(n, "entry", "entries") + ", " + count_of(hits, "hit") + ", " +
+          count_of(static_cast<std::size_t>(b.entries.shape(0)), "pair"));
 }
 
 std::string engine_repr(const caliber::Engine& engine) {
-  return bracket_repr("Engine", "method " + std::string(caliber::to_string(engine.options().method)) + ", " +
-                                    count_of(engine.threads(), "thread"));
+  return ("method " + std::string(caliber::to_string(engine.options().method)) + ", " + count_of(engine.threads(), "thread"));
 }
 
 void bind_batches(EngineClass& cls) {
@@ -187,10 +186,51 @@ void bind_frames(EngineClass& cls) {
       request_args());
 }
 
+/// An engine of the default method on `threads` threads, for one call of the module-level batch
+/// functions.
+caliber::Engine engine_for(int threads) {
+  caliber::EngineOptions options;
+  options.threads = threads;
+  return caliber::Engine(interruptible(options));
+}
+
+/// caliber.query_many and caliber.sweep_many: Engine(threads=threads)'s methods, on a new engine.
+void bind_module_batches(py::module_& m) {
+  std::apply(
+      [&](auto&&... request) {
+        m.def(
+            "query_many",
+            [](const PyModel& a, const py::object& poses_a, const PyModel& b, const py::object& poses_b, const std::string& kind,
+               std::optional<double> tolerance, double angle, std::size_t max_pairs, const std::string& order, int threads,
+               bool lowest_ids) {
+              const caliber::QueryRequest query = make_request(kind, tolerance, angle, max_pairs, lowest_ids);
+              caliber::Engine engine = engine_for(threads);
+              return query_many(engine, a, poses_a, b, poses_b, query, order);
+            },
+            py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"), request..., py::kw_only(),
+            py::arg("order") = "wxyz", py::arg("threads") = 0, py::arg("lowest_ids") = false,
+            "Engine(threads=threads).query_many(...): model a against model b at many poses, in parallel, the GIL "
+            "released once. Returns a Batch: per entry hit, distance, limit_reached; per reported pair a row with its "
+            "entry.");
+      },
+      request_args());
+  m.def(
+      "sweep_many",
+      [](const PyModel& a, const py::object& start_a, const py::object& end_a, const PyModel& b, const py::object& start_b,
+         const py::object& end_b, double tolerance, std::uint64_t max_queries, const std::string& order, int threads) {
+        caliber::Engine engine = engine_for(threads);
+        return sweep_many(engine, a, start_a, end_a, b, start_b, end_b, tolerance, max_queries, order);
+      },
+      py::arg("a"), py::arg("start_a"), py::arg("end_a"), py::arg("b"), py::arg("start_b"), py::arg("end_b"), py::kw_only(),
+      py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000, py::arg("order") = "wxyz", py::arg("threads") = 0,
+      "Engine(threads=threads).sweep_many(...): the swept query along many motions, in parallel, without the GIL. "
+      "Returns Sweeps.");
+}
+
 }  // namespace
 
 void bind_engine(py::module_& m) {
-  bind_batch(m).def("__repr__", &batch_repr);
+  bind_batch(m).def("__repr__", repr_of<PyBatch>("Batch", &batch_repr));
   EngineClass cls(m, "Engine", "The parallel engine: a method on the threads the process allows; keeps temporal state.");
   cls.def(py::init([](const std::string& method, int threads) {
             caliber::EngineOptions options;
@@ -204,7 +244,7 @@ void bind_engine(py::module_& m) {
       .def_property_readonly("threads", &caliber::Engine::threads)
       .def_property_readonly("method",
                              [](const caliber::Engine& e) { return std::string(caliber::to_string(e.options().method)); })
-      .def("__repr__", &engine_repr)
+      .def("__repr__", repr_of<caliber::Engine>("Engine", &engine_repr))
       .def("__reduce__",
            [](const caliber::Engine&) -> py::object {
              throw not_picklable("Engine", "it holds temporal state and threads; make a new Engine where it is needed");
@@ -213,6 +253,7 @@ void bind_engine(py::module_& m) {
   bind_batches(cls);
   bind_find_pairs(cls);
   bind_frames(cls);
+  bind_module_batches(m);
   m.def(
       "broad_phase",
       [](const std::vector<PyModel>& models, const std::vector<caliber::Pose>& poses, double reach, const py::object& fixed_flags,

@@ -119,11 +119,15 @@ PyModel built(caliber::Mesh mesh, bool adjacency, bool oriented_boxes) {
   return PyModel{caliber::build_model(std::move(mesh), options)};
 }
 
+std::string mesh_repr(const caliber::Mesh& mesh) {
+  return count_of(mesh.vertices.size(), "vertex", "vertices") + ", " + count_of(mesh.triangles.size(), "triangle");
+}
+
 std::string model_repr(const PyModel& p) {
   std::string what = count_of(p.model->mesh().triangles.size(), "triangle") + ", BVH height " + std::to_string(p.model->height());
   if (p.model->has_adjacency()) what += ", adjacency";
   if (p.model->has_oriented_boxes()) what += ", oriented boxes";
-  return bracket_repr("Model", what);
+  return what;
 }
 
 }  // namespace
@@ -137,11 +141,7 @@ void bind_mesh(py::module_& m) {
       .def_property_readonly("vertices", &vertices_of)
       .def_property_readonly("faces", &faces_of)
       .def("__len__", [](const caliber::Mesh& mesh) { return mesh.triangles.size(); })
-      .def("__repr__",
-           [](const caliber::Mesh& mesh) {
-             return bracket_repr("Mesh", count_of(mesh.vertices.size(), "vertex", "vertices") + ", " +
-                                             count_of(mesh.triangles.size(), "triangle"));
-           })
+      .def("__repr__", repr_of<caliber::Mesh>("Mesh", &mesh_repr))
       .def("__reduce__",
            [](const caliber::Mesh& mesh) { return rebuilt_by("Mesh", py::make_tuple(vertices_of(mesh), faces_of(mesh))); });
 }
@@ -153,7 +153,7 @@ void bind_model(py::module_& m) {
              return built(mesh, adjacency, oriented_boxes);
            }),
            py::arg("mesh"), py::arg("adjacency") = true, py::arg("oriented_boxes") = false,
-           "adjacency: for contact queries; oriented_boxes: kept per node, for faster distance queries")
+           "adjacency: for contact queries; oriented_boxes: kept per node (120 bytes each), for faster distance queries")
       .def_static(
           "load",
           [](const py::object& path, bool adjacency, bool oriented_boxes) {
@@ -166,7 +166,7 @@ void bind_model(py::module_& m) {
       .def_property_readonly(
           "oriented_boxes", [](const PyModel& p) { return p.model->has_oriented_boxes(); },
           "whether each node's oriented box is kept (for faster distance queries)")
-      .def("__repr__", &model_repr)
+      .def("__repr__", repr_of<PyModel>("Model", &model_repr))
       .def(py::pickle(&model_state, &model_from_state))
       .def("__reduce__", [](const PyModel& p) { return rebuilt_by("_model_from_state", py::make_tuple(model_state(p))); });
   m.def("_checked_model", &model_from_state);

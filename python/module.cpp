@@ -14,9 +14,8 @@
 
 namespace {
 
-/// What pickles name to rebuild a Model, a Pose or a Batch (Python functions of module caliber:
-/// pickle cannot name a pybind11 function at protocols 0 and 1), calling the checked builders,
-/// and the module-level batch calls, each a call of a new Engine.
+/// What pickles name to rebuild a Model, a Pose or a Batch: Python functions of module caliber
+/// (pickle cannot name a pybind11 function at protocols 0 and 1), calling the checked builders.
 constexpr const char* kPythonPart = R"(
 def _model_from_state(state):
     """How a pickled Model is rebuilt: its state checked, its BVH built again."""
@@ -30,20 +29,6 @@ def _batch_from_state(state):
     """How a pickled Batch is rebuilt: its arrays checked against its offsets."""
     return _checked_batch(state)
 
-def query_many(a, poses_a, b, poses_b, kind="interference", tolerance=None, angle=30.0, max_pairs=0, *,
-               order="wxyz", threads=0, lowest_ids=False):
-    """Engine(threads=threads).query_many(...): model a against model b at many poses, in parallel, the GIL
-    released once. Returns a Batch: per entry hit, distance, limit_reached; per reported pair a row with its
-    entry."""
-    return Engine(threads=threads).query_many(a, poses_a, b, poses_b, kind=kind, tolerance=tolerance, angle=angle,
-                                              max_pairs=max_pairs, order=order, lowest_ids=lowest_ids)
-
-def sweep_many(a, start_a, end_a, b, start_b, end_b, *, tolerance=0.0, max_queries=100000, order="wxyz",
-               threads=0):
-    """Engine(threads=threads).sweep_many(...): the swept query along many motions, in parallel, without the
-    GIL. Returns Sweeps."""
-    return Engine(threads=threads).sweep_many(a, start_a, end_a, b, start_b, end_b, tolerance=tolerance,
-                                              max_queries=max_queries, order=order)
 )";
 
 /// caliber's pure-Python modules (caliber.distributed) sit in the folder caliber/ beside the

@@ -96,7 +96,7 @@ void bind_pose(py::module_& m) {
           },
           py::arg("order"), "the unit quaternion in `order`, 'wxyz' or 'xyzw'")
       .def("matrix", &matrix_of)
-      .def("__repr__", &pose_repr)
+      .def("__repr__", repr_of<caliber::Pose>("Pose", &pose_repr, false))
       .def("__reduce__", [](const caliber::Pose& p) {
         return rebuilt_by("_pose_from_state", py::make_tuple(translation_of(p), quaternion_of(p)));
       });

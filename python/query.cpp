@@ -118,7 +118,7 @@ std::string result_repr(const PyResult& r) {
   std::string what = std::string(caliber::to_string(r.kind)) + ", " + count_of(r.rows, "pair") + ", " +
                      count_of(r.node_tests, "node test") + ", " + count_of(r.leaf_tests, "leaf test");
   if (r.limit_reached) what += ", limit reached";
-  return bracket_repr("Result", what);
+  return (what);
 }
 
 void bind_result(py::module_& m) {
@@ -144,7 +144,7 @@ void bind_result(py::module_& m) {
       .def_readonly("limit_reached", &PyResult::limit_reached)
       .def_readonly("leaf_tests", &PyResult::leaf_tests)
       .def("__len__", [](const PyResult& r) { return r.rows; })
-      .def("__repr__", &result_repr)
+      .def("__repr__", repr_of<PyResult>("Result", &result_repr))
       .def("__reduce__", [](const PyResult&) -> py::object { throw not_picklable("Result", "pickle its arrays"); });
 }
 

@@ -18,7 +18,7 @@ std::string sweep_repr(const caliber::SweepResult& s) {
   } else if (s.status == caliber::SweepStatus::undecided) {
     what += ", free up to t=" + float_text(s.time);
   }
-  return bracket_repr("Sweep", what + ", " + count_of(s.queries, "query", "queries"));
+  return (what + ", " + count_of(s.queries, "query", "queries"));
 }
 
 std::string sweeps_repr(const PySweeps& s) {
@@ -28,8 +28,7 @@ std::string sweeps_repr(const PySweeps& s) {
     contacts += s.contact.data()[i] ? 1 : 0;
     undecided += s.undecided.data()[i] ? 1 : 0;
   }
-  return bracket_repr(
-      "Sweeps", count_of(n, "motion") + ", " + count_of(contacts, "contact") + ", " + std::to_string(undecided) + " undecided");
+  return (count_of(n, "motion") + ", " + count_of(contacts, "contact") + ", " + std::to_string(undecided) + " undecided");
 }
 
 py::object when_contact(const caliber::SweepResult& s, py::object value) {
@@ -54,7 +53,7 @@ void bind_sweep_result(py::module_& m) {
                                return when_contact(
                                    s, py::make_tuple(py::make_tuple(a.x(), a.y(), a.z()), py::make_tuple(b.x(), b.y(), b.z())));
                              })
-      .def("__repr__", &sweep_repr)
+      .def("__repr__", repr_of<caliber::SweepResult>("Sweep", &sweep_repr))
       .def("__reduce__", [](const caliber::SweepResult&) -> py::object { throw not_picklable("Sweep", "pickle its fields"); });
 }
 
@@ -75,7 +74,9 @@ void bind_sweep(py::module_& m) {
       "The first time t in [0, 1] at which a, moving from start_a to end_a, and b, from start_b to end_b (translation "
       "linear, rotation by slerp), come within tolerance (0: 1e-6 of the larger model's radius): never later than the "
       "first true contact, never a missed contact (docs/queries.md). Returns a Sweep.");
-  bind_sweeps(m, [] { return not_picklable("Sweeps", "pickle its arrays"); }).def("__repr__", &sweeps_repr);
+  bind_sweeps(m, [] {
+    return not_picklable("Sweeps", "pickle its arrays");
+  }).def("__repr__", repr_of<PySweeps>("Sweeps", &sweeps_repr));
 }
 
 }  // namespace caliber_python

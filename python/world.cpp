@@ -6,7 +6,7 @@ namespace caliber_python {
 namespace {
 
 std::string world_repr(const caliber::World& w) {
-  return bracket_repr("World", count_of(w.scene().objects.size(), "object") + ", " + count_of(w.scene().steps, "step"));
+  return (count_of(w.scene().objects.size(), "object") + ", " + count_of(w.scene().steps, "step"));
 }
 
 }  // namespace
@@ -51,7 +51,7 @@ void bind_world(py::module_& m) {
           py::arg("engine"), py::arg("k"), py::kw_only(), py::arg("tolerance") = 0.0, py::arg("max_queries") = 100000,
           "The pairs that touch between step k and k + 1, following the scene's motions (cut where an object turns more "
           "than a quarter turn or has keys), with the scene's groups: [((a, b), Sweep)], times as fractions of the step.")
-      .def("__repr__", &world_repr)
+      .def("__repr__", repr_of<caliber::World>("World", &world_repr))
       .def("__reduce__", [](const caliber::World&) -> py::object {
         throw not_picklable("World", "load the scene file again where it is needed");
       });

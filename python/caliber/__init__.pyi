@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import os
-from typing import Iterable, Optional, Sequence, Tuple, Union
+from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -110,7 +110,7 @@ class Batch:
     @property
     def batch_ms(self) -> float: ...
     @staticmethod
-    def concatenate(batches: Iterable[Batch]) -> Batch: ...
+    def concatenate(batches: Sequence[Batch]) -> Batch: ...
     def __len__(self) -> int: ...
 
 class Sweep:

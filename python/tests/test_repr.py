@@ -1,8 +1,11 @@
 """repr() of every class says what the object holds: counts, kind, status, method and threads; a
-Pose's repr is the call that makes it again."""
+Pose's repr is the call that makes it again (its quaternion normalized again, so to rounding); an
+object made by __new__ alone says it was never built."""
 import os
+import random
 
 import numpy as np
+import pytest
 
 import caliber
 
@@ -26,11 +29,25 @@ def test_mesh_and_model():
 
 def test_pose_repr_makes_the_same_pose():
     pose = caliber.Pose((1.5, -0.25, 1e-17), (0.3, 0.1, -0.2, 0.9))
-    text = repr(pose)
-    assert text.startswith("caliber.Pose((1.5, -0.25, 1e-17), (")
-    again = eval(text, {"caliber": caliber})
-    assert again.translation == pose.translation and again.quaternion == pose.quaternion
+    assert repr(pose).startswith("caliber.Pose((1.5, -0.25, 1e-17), (")
     assert repr(caliber.Pose()) == "caliber.Pose((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))"
+    rng = random.Random(7)
+    for _ in range(200):
+        pose = caliber.Pose([rng.uniform(-1e3, 1e3) for _ in range(3)], [rng.uniform(-1, 1) for _ in range(4)])
+        again = eval(repr(pose), {"caliber": caliber})
+        assert again.translation == pose.translation
+        assert np.allclose(again.quaternion, pose.quaternion, rtol=0, atol=4e-16)
+
+
+def test_repr_of_another_type_is_a_short_type_error():
+    with pytest.raises(TypeError, match="takes a caliber.Pose, not list"):
+        caliber.Pose.__repr__([0] * 100000)
+
+
+def test_never_built_objects_say_so():
+    for cls in (caliber.Mesh, caliber.Model, caliber.Pose, caliber.Result, caliber.Batch, caliber.Sweep, caliber.Sweeps,
+                caliber.Engine, caliber.World):
+        assert repr(cls.__new__(cls)) == f"<caliber.{cls.__name__}: never built>"
 
 
 def test_result_names_its_kind_and_counts():
