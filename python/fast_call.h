@@ -2,11 +2,12 @@
 // A module function called through CPython's vectorcall protocol (METH_FASTCALL | METH_KEYWORDS),
 // for a call a planner makes millions of times (caliber.query). pybind11's dispatcher builds an
 // argument tuple and a keyword dict, looks each parameter up in the dict by a string it creates
-// for the lookup and keeps the arguments in vectors: on a distance query of two tetrahedra, about
-// 4,600 of the 12,800 instructions spent above the C++ call (callgrind). The fast path below reads
-// the arguments of the common types itself (bound caliber objects, str, float, int, bool, None);
-// a call it does not take whole (another type, a missing, unknown or repeated argument, an error
-// of any kind) goes to the pybind11 function it stands for, which answers or raises as before.
+// for the lookup and keeps the arguments in vectors: on a distance query of two tetrahedra, a large
+// share of the instructions spent above the C++ call (bench/results/amd-epyc-2c/batch/README.md).
+// The fast path below reads the arguments of the common types itself (bound caliber objects, str,
+// float, int, bool, None); a call it does not take whole (another type, a missing, unknown or
+// repeated argument, an error of any kind) goes to the pybind11 function it stands for, which
+// answers or raises as before.
 
 #include <pybind11/pybind11.h>
 
@@ -95,7 +96,7 @@ inline bool as_string(PyObject* o, std::string_view& out) {
 
 /// The C++ value of an instance of bound class T, or null (also for an instance whose value was
 /// never built: the pybind11 function refuses it with its message). The type is looked up once,
-/// not at every call as a caster does (a hash of the C++ type's name: about 200 instructions).
+/// not at every call as a caster does (a hash of the C++ type's name).
 template <class T>
 const T* as_bound(PyObject* o) {
   static const pybind11::detail::type_info* const type = pybind11::detail::get_type_info(typeid(T));

@@ -97,9 +97,8 @@ enum class Method : std::uint8_t {
 [[nodiscard]] CALIBER_EXPORT Method parse_method(std::string_view name);
 
 /// The default method of the library, the command line and the Python module: work stealing, the
-/// fastest measured at 16 threads on the four benchmark scenes (16-core Intel Xeon, medians of 3
-/// interleaved rounds: stealing 9.1 / 4.0 / 8.2 / 8.1x, hybrid 8.5 / 2.2 / 8.1 / 5.4x on
-/// two_large / two_small / funnel / front_car; bench/results/intel-xeon-16c/).
+/// fastest measured at 16 threads on the four benchmark scenes, ahead of hybrid on each
+/// (bench/results/intel-xeon-16c/engine/README.md).
 inline constexpr Method kDefaultMethod = Method::stealing;
 
 /// Options of the engine.

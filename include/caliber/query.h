@@ -63,8 +63,8 @@ struct QueryRequest {
   /// query stops at the first intersecting pair of the traversal from the root, the pair every
   /// method and thread count reports (about the first hit's cost). true: every pair at distance 0
   /// is examined and the lowest triangle ids are reported, as for ties at any other distance
-  /// (query_brute_force's answer; on two intersecting meshes of 10^4-10^5 triangles, tens of times
-  /// slower). Ignored by the other kinds.
+  /// (query_brute_force's answer; on two intersecting meshes of 10^4-10^5 triangles, much slower).
+  /// Ignored by the other kinds.
   bool lowest_ids = false;
 };
 

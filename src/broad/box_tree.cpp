@@ -12,9 +12,10 @@
 namespace caliber::broad {
 namespace {
 
-/// The most objects in a leaf of the tree (2 and 8 measured within 6 % of it on grids of boxes).
+/// The most objects in a leaf of the tree (2 and 8 did about as well on grids of boxes).
 constexpr std::size_t kLeaf = 4;
-/// Leaves per parallel chunk of the pair search (about 0.1 ms of work on a grid of parts).
+/// Leaves per parallel chunk of the pair search (on a grid of parts, a short piece of work, yet
+/// large beside the cost of handing it out).
 constexpr std::size_t kChunk = 256;
 /// Refitting over the old order is kept while the tree's boxes have grown by less than this
 /// factor of their area right after the last sort.

@@ -28,10 +28,9 @@ struct CentroidBounds {
 };
 
 /// Bins per axis: the planes tried are the 7 between 8 equal bins of the centroids' range, on each
-/// axis. Against 16 and 32 (node tests of bench_fcl_compare's and bench_fcl_distance's cases,
-/// Intel Xeon VM): more bins saved 1-6 % of the interference node tests on the four large pairs
-/// (13-14 % on the fandisk and rotor) but made the turbine and blade's distance query at gap 1e-6
-/// test 1.6-1.8 times as many nodes.
+/// axis. Against 16 and 32 (node tests of bench_fcl_compare's and bench_fcl_distance's cases):
+/// more bins saved a little on the interference node tests but made the turbine and blade's
+/// distance query at gap 1e-6 test far more nodes (bench/results/intel-xeon-2c/kernels/README.md).
 inline constexpr int kSplitBins = 8;
 /// A cut leaves each side at least 1/kSplitBalance of the triangles, so the tree's height stays
 /// within log base 16/15 of the count (where no plane does, the range is cut at its median).

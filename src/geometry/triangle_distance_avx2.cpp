@@ -280,8 +280,8 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   Nearest nearest(a[0], b[0]);
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
-  // The third batch replaced a portable scalar call: 0.57-0.62 of the kernel's time on an Intel
-  // Xeon, where the call took more than both batches (bench/results/intel-xeon-2c/kernels).
+  // The third batch replaced a portable scalar call, which took longer than both batches together
+  // (the kernel's measurements: bench/results/intel-xeon-2c/kernels/README.md).
   // Every candidate is computed first and offered in order at the end, so that the batches do not
   // wait on one another.
   Candidates4 edges[3];

@@ -25,7 +25,7 @@ inline void frames_relative(const OrientedBox& a, const OrientedBox& b, const do
 /// between the boxes in a's coordinates, where a's box is [-half, half] and b's center is t: p the
 /// point of a's box nearest to b's center, q the point of b's box nearest to p (through b's
 /// coordinates, r^T (p - t), clamped and brought back), then p the point of a's box nearest to q
-/// (a third step: armadillo node tests 1,297 -> 1,165 at gap 1e-6, a fourth saved little more).
+/// (the third step cut the armadillo's node tests at gap 1e-6; a fourth saved little more).
 ///
 /// For any n, the world direction N = sum_i n_i a_i has N . a_k = n_k, N . b_k = (r^T n)_k,
 /// N . d = n . t and |N| = |n|, each up to the axes' rounding (orthonormal to about 1e-15) and

@@ -168,7 +168,7 @@ CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, 
 }
 
 /// The same code with AVX-512VL's 32 vector registers (the test holds about 50 four-lane values;
-/// with 16 registers a sixth of its instructions were spills). The same operations (no FMA: this
+/// with 16 registers, many of its instructions were spills). The same operations (no FMA: this
 /// file is built with -ffp-contract=off), so the same decisions.
 __attribute__((target("avx2,avx512f,avx512vl"))) int node_within_2x2_avx512vl(const NodeTestFrame& f, std::uint32_t a0,
                                                                               std::uint32_t a1, std::uint32_t b0,

@@ -45,7 +45,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
     mNodeFrame.trans[i] = node_trans[i];
   }
   // The angle is read by the contact kind's tests alone (cones_can_face, normals_allow): the
-  // other kinds skip the cosine and sine (a tenth of a small query's context).
+  // other kinds skip the cosine and sine (a noticeable part of a small query's context).
   mTheta = request.angle_deg * std::numbers::pi / 180.0;
   mCosTheta = 1.0;
   mSinTheta = 0.0;

@@ -31,11 +31,11 @@ namespace caliber::narrow {
 /// partner waits): in the queries that collect pairs.
 inline constexpr double kDescendAloneRatio = 2.0;
 /// The same in the distance query, whose visits where one side splits cost nearly as much as
-/// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance,
-/// two runs, Intel Xeon VM): the bunny at gap 1 0.82-0.86, the rest within 0.94-1.00 on the
-/// armadillo and dragon, 0.86-1.07 on the turbine and blade, 0.92-1.11 on the fandisk and rotor.
-/// (In the queries that collect pairs, 4 was within 0.97-1.02 of 2 on the scenes and the FCL
-/// cases, except the turbine and blade, 1.07, and the fandisk and rotor, 0.91: they keep 2.)
+/// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance): 4
+/// was faster on the bunny at gap 1, as fast or a little faster on the armadillo and dragon, and
+/// faster on some cases, slower on others, on the turbine and blade and on the fandisk and rotor.
+/// (In the queries that collect pairs, 4 was about as fast as 2 on the scenes and the FCL cases,
+/// except the turbine and blade, slower, and the fandisk and rotor, faster: they keep 2.)
 inline constexpr double kDescendAloneRatioDistance = 4.0;
 
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
@@ -107,7 +107,7 @@ class PairContext {
   /// The node test of a visit where both sides split: node_test, and neither node's disk beyond
   /// the other's slab (disks_beyond_slabs; both nodes prepared with their disks). Visits where one
   /// side splits use node_test alone: on the turbine and blade, whose visits mostly split one side,
-  /// the disks refused no pair and cost about a fifth of the query.
+  /// the disks refused no pair and cost a noticeable part of the query.
   [[nodiscard]] bool node_test_2x2_lane(const SideA& a, const SideB& b) const {
     return node_test(a, b) && !narrow::disks_beyond_slabs(a, b, mSlabReach);
   }
@@ -210,9 +210,8 @@ class PairContext {
   /// along orthonormal axes the squared gaps add up to a squared distance) and, when that is within
   /// `reach`, the Frames' separation along the direction between a point of each (frames_apart).
   /// (The spheres' gap and the Frames' gaps along their own six axes were part of it up to stop
-  /// 35: counted on bench_fcl_distance's 25 cases, they alone refused 1 and 4 of the child pairs
-  /// these two let through, of 1,000-13,000 node tests a case, for about a third of the bound's
-  /// arithmetic.)
+  /// 35: counted on bench_fcl_distance's cases, they alone refused almost none of the child pairs
+  /// these two let through, for about a third of the bound's arithmetic.)
   [[nodiscard]] double gap(const NearA& a, const NearB& b, double reach) const {
     double boxes_a = 0.0, boxes_b = 0.0;
     for (int i = 0; i < 3; ++i) {

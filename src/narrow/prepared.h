@@ -79,12 +79,11 @@ struct NearB : BoxB {
 /// The nodes one distance traversal has prepared, kept as a tree that follows the BVH's: a
 /// prepared node links to its two children (adjacent in the BVH, so prepared together) once a
 /// visit has split it, and every later visit that splits it follows the link. So each node is
-/// prepared once however many partners it meets (the traversal meets a node 7-10 times on the
-/// bunny), with no lookup by index (against a hash table by index: 0.89-0.98 of the distance
-/// query's time on the bench's cases). A node is only ever reached through its parent's link (or
-/// as the traversal's root), so it has one entry. Entries never move, so a pointer to one stays
-/// valid while others are added. Cleared per traversal: a prepared node depends on the pair's
-/// relative pose.
+/// prepared once however many partners it meets (the traversal meets a node several times), with
+/// no lookup by index (a hash table by index made the distance query slower on every case of the
+/// bench). A node is only ever reached through its parent's link (or as the traversal's root), so
+/// it has one entry. Entries never move, so a pointer to one stays valid while others are added.
+/// Cleared per traversal: a prepared node depends on the pair's relative pose.
 template <class Prepared>
 class PreparedTree {
  public:

@@ -111,8 +111,8 @@ template <class Take>
   if (split_a && split_b) {
     // Both sides split: the four child pairs tested at once, then taken in cd_children order as
     // for_each_child takes them (a child on the taboo list marked reached, neither counted nor
-    // entered). (Where one side does not split, the scalar tests below were measured faster than
-    // four lanes with two wasted: step 1.01-1.03, queries up to 1.05.)
+    // entered). (Where one side does not split, the scalar tests below were faster than four lanes
+    // with two wasted, in the step and in the queries.)
     const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
@@ -295,7 +295,7 @@ template <class Wait>
 /// request asks for the lowest ids (QueryRequest::lowest_ids); so that it finds one sooner, among
 /// children at gap 0 the most overlapping spheres go first (touching_first). Counts node
 /// and leaf tests like traverse_depth_first; honours a taboo list the same way. (A binary heap's
-/// sift was a third of the bunny's time; with the buckets, 0.57-0.62 of the 4-ary heap's time.)
+/// sift took a large part of the bunny's time; the buckets are faster than a 4-ary heap too.)
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}) {
   using Reached = TraversalScratch::Reached;

@@ -20,8 +20,9 @@ namespace caliber::narrow {
 /// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
 /// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
 /// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
-/// colliding poses: 324 node tests to 131), which pair it meets first being the traversal's
-/// choice (QueryRequest::max_pairs). A traversal that visits every node keeps cd_children order.
+/// colliding poses: bench/results/amd-epyc-2c/batch/README.md), which pair it meets first being
+/// the traversal's choice (QueryRequest::max_pairs). A traversal that visits every node keeps
+/// cd_children order.
 inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
   if (count < 2) {  // nothing to order
     if (count == 1) *top++ = passed[0];

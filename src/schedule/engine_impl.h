@@ -46,7 +46,7 @@ class ContextStore {
       mSlots.reset(new Slot[mCapacity]);
     }
     auto* const base = reinterpret_cast<narrow::PairContext*>(mSlots.get());
-    // A context takes about 50 ns (front_car's 209: 0.01 ms a step on the 2-core VM): chunks of 64
+    // A context is quick to make (front_car's 209 take a negligible part of its step): chunks of 64
     // keep a small call on this thread and spread a large one.
     parallel::parallel_for(0, n, 64, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) make(i, static_cast<void*>(&base[i]));

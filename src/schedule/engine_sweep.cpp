@@ -22,11 +22,13 @@ namespace caliber {
 namespace {
 
 /// A query of at least this many node tests is split across threads when few sweeps are left: the
-/// last query of a sweep predicts its next (the models come closer, step by step). Measured on the
-/// 2-core VM (Engine::query_many of one distance entry, stealing, 2 threads against 1): two plates
-/// face to face, whose many equal distances the search must all visit, 1.16x at 8,751 node tests
-/// and 1.85x at 15,169; the bunny and blade of bench_sweep_many, whose search finds its nearest
-/// pair early, 0.68-0.96x up to 8,781 (a split search prunes less at first). Below, one thread.
+/// last query of a sweep predicts its next (the models come closer, step by step). Measured
+/// (Engine::query_many of one distance entry, stealing, 2 threads against 1): two plates face to
+/// face, whose many equal distances the search must all visit, gained little from the split on
+/// queries well below this size and nearly a second thread's worth near it; the bunny and blade of
+/// bench_sweep_many, whose search finds its nearest pair early, lost by it at every size tried, all
+/// below this one (a split search prunes less at first). Below, one thread (what the split gives a
+/// sweep: bench/results/amd-epyc-2c/sweep/README.md).
 constexpr std::uint64_t kSplitNodeTests = 16384;
 
 /// Sweeps run in one parallel loop between two calls of EngineOptions::between_chunks.

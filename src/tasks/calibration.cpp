@@ -27,10 +27,10 @@ double caliber_threshold(double total, double beta, int threads) {
 
 namespace {
 
-/// Nodes of one level of the stage handed to a thread at a time: a visit is up to four node tests
-/// of ~0.1-0.3 us, so a chunk is a few microseconds, and a level of a hundred nodes spreads over
-/// a dozen threads. Fixed chunks (not the partitioner's), so that the load-balance simulation
-/// replays the very pieces that ran.
+/// Nodes of one level of the stage handed to a thread at a time: a visit is up to four node tests,
+/// so a chunk is a short piece of work, and a level of a hundred nodes spreads over a dozen
+/// threads. Fixed chunks (not the partitioner's), so that the load-balance simulation replays the
+/// very pieces that ran.
 constexpr std::size_t kStageGrain = 8;
 
 /// A node waiting in the stage, with its weight.

@@ -179,7 +179,8 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
   plan.carted = cart.size();
   // A cart of thousands of light pairs is merged into finer tasks than Omega: the run-time tasks
   // are then near-equal, and a list schedule of a dozen of them ends on a tail of up to one whole
-  // task (grid_4096 on 2 threads: one thread idle for 8 % of the traversal).
+  // task (on grid_4096, one of two threads idle for part of the traversal:
+  // bench/results/amd-epyc-2c/many_objects/README.md).
   const double cart_omega =
       plan.omega / static_cast<double>(std::clamp<std::size_t>(cart.size() / kCartItemsPerTask, 1, kCartFiner));
   for (RunTask& t : merge_cart(std::move(cart), cart_omega)) plan.run.push_back(std::move(t));

@@ -104,9 +104,9 @@ struct InitialWeights {
 };
 inline constexpr std::size_t kRatioSample = 4096;
 /// What a pair costs beside its node tests (starting its traversal, its finalization), in node
-/// tests: added to every initial task's weight. Measured on a scene of thousands of light pairs
-/// (grid_32768, hybrid on 2 threads, 2-core AMD EPYC VM): a merged task of 54,000 whole pairs took
-/// about 87 ns a pair beside its node tests, which took 21 ns each (medians over 8 steps).
+/// tests: added to every initial task's weight. Set on a scene of thousands of light pairs
+/// (grid_32768, hybrid): in a merged task of whole pairs, the time a pair took beside its node
+/// tests, over the time one of its node tests took.
 inline constexpr double kPairWeight = 4.0;
 /// The cart is merged to Omega / k, k = cart items / kCartItemsPerTask, between 1 and kCartFiner:
 /// the paper's Omega for carts of up to a thousand items (the paper's scenes), up to 16 times

@@ -19,18 +19,18 @@
 ///    boxes on the six face axes), a patch spread over a sphere of radius r has about o / 2r of its
 ///    area inside a cap of height o (a cap's area is proportional to its height). Spheres alone
 ///    overrate thin parts, whose spheres are large and loose (on front_car that made the a priori
-///    method split the wrong pairs: 1.08x at 2 threads, against 1.6x once the boxes were used); but
-///    dividing a long part's least penetration (its thickness) by its diameter underrates it: two
-///    crossing rods, or the heavy pairs of front_car, weighed no more than light pairs (at 16
-///    threads the pairs that took 36,749 and 22,258 node tests were weighed 1,772 and 1,828, light
-///    ones up to 2,417; neither heavy pair was split, 1.9x simulated at 16).
+///    method split the wrong pairs, and gain far less than once the boxes were used); but dividing
+///    a long part's least penetration (its thickness) by its diameter underrates it: two crossing
+///    rods, or the heavy pairs of front_car, weighed no more than light pairs (the two pairs that
+///    took the most node tests weighed less than some light ones, and neither was ever split).
 ///  - axes: along each of the six box axes, the part of the node's extent inside the other's grown
 ///    box, the least of them (and of the sphere cap o / 2r): exact for a box-shaped spread of
 ///    triangles cut by one axis, but it overrates flat patches whose boxes overlap though their
-///    surfaces do not come near (two_large: 1.77x simulated at P = 2 with this share alone).
-/// Measured (bench/results/amd-epyc-2c/scaling/weights.md): the log correlation with the node
-/// tests each CD node's subtree takes rises on every scene (nodes with >= 1,000 tests: two_large
-/// 0.81 -> 0.83, two_small 0.82 -> 0.86, funnel 0.88 -> 0.92, front_car 0.59 -> 0.69).
+///    surfaces do not come near (with this share alone, two_large's simulated speed-up at P = 2
+///    fell below the depth share's).
+/// Measured (bench/results/amd-epyc-2c/scaling/weights.md): against the depth share alone, the log
+/// correlation with the node tests each CD node's subtree takes rises on every scene (nodes with
+/// >= 1,000 tests).
 /// The paper's printed formula is garbled; this one keeps its ingredients (P, r, the centers'
 /// distance) and its behaviour (heavier when larger and deeper in contact).
 

@@ -10,8 +10,8 @@
 /// on every pop. Entries come out nearest bucket first, in no particular order within a bucket; a
 /// user that needs the exact order must not rely on it (the distance traversal prunes each popped
 /// node against the best distance found so far, so any order gives the same answer). Buckets of a
-/// sixteenth (16 bits) were measured too coarse: turbine x blade, about 11 apart, took 2.6 times
-/// the node tests.
+/// sixteenth (16 bits) were too coarse on pairs far apart: turbine x blade took many more node
+/// tests.
 
 #include <algorithm>
 #include <bit>
@@ -72,7 +72,7 @@ class GapBuckets {
 
   /// Forgets every entry (keeps the memory): the bitmaps' nonzero words zeroed through the levels
   /// above them, a word at a time (not a bucket at a time: a distance traversal leaves hundreds
-  /// of entries waiting, and emptying them bucket by bucket took about a tenth of its time).
+  /// of entries waiting, and emptying them bucket by bucket took a noticeable part of its time).
   void clear() {
     for (std::size_t t = 0; t < std::size(mTop); ++t) {
       for (std::uint64_t top = mTop[t]; top != 0; top &= top - 1) {
