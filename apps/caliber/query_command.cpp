@@ -67,7 +67,8 @@ caliber::QueryResult query_with_engine(caliber::Engine& engine, const caliber::F
   return result;
 }
 
-int run_query(const QueryOptions& opt) {
+/// The request the options ask for, checked.
+caliber::QueryRequest request_of(const QueryOptions& opt) {
   caliber::QueryRequest request;
   request.kind = caliber::parse_query_kind(opt.kind);
   request.tolerance = opt.tolerance;
@@ -79,14 +80,15 @@ int run_query(const QueryOptions& opt) {
   request.max_pairs = opt.first ? 1 : opt.max_pairs;
   request.lowest_ids = opt.lowest_ids;
   caliber::validate_request(request);
-  const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
-  const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
+  return request;
+}
 
-  const caliber::Method method = caliber::parse_method(opt.method);
-  const auto build_start = Clock::now();
+/// The two models, built with what the query kind reads (B is A when both name the same file).
+std::pair<std::shared_ptr<const caliber::Model>, std::shared_ptr<const caliber::Model>> models_of(const QueryOptions& opt,
+                                                                                                  caliber::QueryKind kind) {
   caliber::BuildOptions build;
-  build.adjacency = request.kind == caliber::QueryKind::contact;        // only the contact reduction reads it
-  build.oriented_boxes = request.kind == caliber::QueryKind::distance;  // only the distance bound reads them
+  build.adjacency = kind == caliber::QueryKind::contact;        // only the contact reduction reads it
+  build.oriented_boxes = kind == caliber::QueryKind::distance;  // only the distance bound reads them
   const auto model_of = [&](const std::string& path) {
     try {
       return caliber::build_model(caliber::load_mesh(path), build);
@@ -94,9 +96,18 @@ int run_query(const QueryOptions& opt) {
       throw caliber::Error(caliber::ErrorCode::out_of_memory, path, "out of memory while loading and building its model");
     }
   };
-  const std::shared_ptr<const caliber::Model> model_a = model_of(opt.mesh_a);
-  const std::shared_ptr<const caliber::Model> model_b = opt.mesh_b == opt.mesh_a ? model_a : model_of(opt.mesh_b);
-  const double build_ms = ms_since(build_start);
+  auto model_a = model_of(opt.mesh_a);
+  auto model_b = opt.mesh_b == opt.mesh_a ? model_a : model_of(opt.mesh_b);
+  return {std::move(model_a), std::move(model_b)};
+}
+
+/// The query's result and its time per repetition (the first one cold), every repetition checked
+/// to give the same result. A method other than sequential runs as a one-pair frame of an engine.
+std::pair<caliber::QueryResult, std::vector<double>> timed_query(const QueryOptions& opt, const caliber::QueryRequest& request,
+                                                                 const caliber::Pose& pose_a, const caliber::Pose& pose_b,
+                                                                 const std::shared_ptr<const caliber::Model>& model_a,
+                                                                 const std::shared_ptr<const caliber::Model>& model_b) {
+  const caliber::Method method = caliber::parse_method(opt.method);
   std::unique_ptr<caliber::Engine> engine;
   caliber::Frame frame;
   if (method != caliber::Method::sequential) {
@@ -110,16 +121,12 @@ int run_query(const QueryOptions& opt) {
     frame.request = request;
   }
   caliber::QueryResult result;
-  std::vector<double> query_ms;  // one per repetition, the first one cold
+  std::vector<double> query_ms;
   for (int r = 0; r < opt.repeat; ++r) {
     caliber::QueryResult again;
     const auto start = Clock::now();
     try {
-      if (engine) {
-        again = query_with_engine(*engine, frame);
-      } else {
-        again = caliber::query(*model_a, pose_a, *model_b, pose_b, request);
-      }
+      again = engine ? query_with_engine(*engine, frame) : caliber::query(*model_a, pose_a, *model_b, pose_b, request);
     } catch (const std::bad_alloc&) {
       throw caliber::Error(caliber::ErrorCode::out_of_memory, opt.mesh_a + " x " + opt.mesh_b,
                            "out of memory while running the query (a smaller tolerance reports fewer pairs)");
@@ -131,23 +138,13 @@ int run_query(const QueryOptions& opt) {
       throw std::runtime_error("repetition " + std::to_string(r + 1) + " of the query gave a different result");
     }
   }
-  // Warm: the median of the repetitions after the first (the first alone when there is one).
-  const double cold_ms = query_ms.front();
-  const double warm_ms = query_ms.size() > 1 ? median_of({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
-  const caliber::Model& shown_a = *model_a;
-  const caliber::Model& shown_b = *model_b;
+  return {std::move(result), std::move(query_ms)};
+}
 
-  if (opt.json) {
-    nlohmann::json out = caliber::cli::to_json(result);
-    out["schema_version"] = caliber::cli::kSchemaVersion;
-    out["stats"]["build_ms"] = build_ms;
-    out["stats"]["query_ms"] = cold_ms;
-    out["stats"]["query_ms_warm"] = warm_ms;
-    out["stats"]["repeat"] = opt.repeat;
-    std::cout << out.dump() << "\n";
-    check_stdout();
-    return 0;
-  }
+/// The summary printed without --json: the closest pair of a distance query, the counts, the
+/// models, the times and the first pairs.
+void print_result(const QueryOptions& opt, const caliber::QueryRequest& request, const caliber::QueryResult& result,
+                  const caliber::Model& shown_a, const caliber::Model& shown_b, double build_ms, double cold_ms, double warm_ms) {
   if (request.kind == caliber::QueryKind::distance) {
     if (result.contacts.empty()) {
       std::printf("distance: none within the tolerance %g\n", request.tolerance);
@@ -184,6 +181,31 @@ int run_query(const QueryOptions& opt) {
   if (result.limit_reached) {
     std::printf("  limit reached: more than %zu pairs; the query stopped early and reports %zu of them\n", request.max_pairs,
                 result.contacts.size());
+  }
+}
+
+int run_query(const QueryOptions& opt) {
+  const caliber::QueryRequest request = request_of(opt);
+  const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
+  const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
+  (void)caliber::parse_method(opt.method);  // a bad method is refused before the models are built
+  const auto build_start = Clock::now();
+  const auto [model_a, model_b] = models_of(opt, request.kind);
+  const double build_ms = ms_since(build_start);
+  const auto [result, query_ms] = timed_query(opt, request, pose_a, pose_b, model_a, model_b);
+  // Warm: the median of the repetitions after the first (the first alone when there is one).
+  const double cold_ms = query_ms.front();
+  const double warm_ms = query_ms.size() > 1 ? median_of({query_ms.begin() + 1, query_ms.end()}) : cold_ms;
+  if (opt.json) {
+    nlohmann::json out = caliber::cli::to_json(result);
+    out["schema_version"] = caliber::cli::kSchemaVersion;
+    out["stats"]["build_ms"] = build_ms;
+    out["stats"]["query_ms"] = cold_ms;
+    out["stats"]["query_ms_warm"] = warm_ms;
+    out["stats"]["repeat"] = opt.repeat;
+    std::cout << out.dump() << "\n";
+  } else {
+    print_result(opt, request, result, *model_a, *model_b, build_ms, cold_ms, warm_ms);
   }
   check_stdout();
   return 0;

@@ -115,23 +115,33 @@ std::string pair_name(const World& world, const ObjectPair& t) {
   return world.scene().objects[t.a].name + " / " + world.scene().objects[t.b].name;
 }
 
-int run_scene(const RunOptions& opt) {
+/// The options checked before anything is loaded or written (the scene's own checks come later).
+void check_run_options(const RunOptions& opt) {
   if (!(opt.sweep_tolerance >= 0.0) || opt.sweep_tolerance > kMaxCoordinate ||
       (opt.sweep_tolerance != 0.0 && opt.sweep_tolerance < kMinCoordinate)) {
     throw Error(ErrorCode::bad_value, "--sweep-tolerance", "must be 0 or in [2^-120, 1e15]");
   }
-  Scene scene = load_scene(opt.scene);
+}
+
+/// The steps to run: the scene's, or --steps.
+int steps_of(const RunOptions& opt, int scene_steps) {
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
   if (opt.steps > 100000000) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
-  if (opt.steps > 0) scene.steps = opt.steps;
-  if (opt.continuous) {
-    if (!opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
-      throw Error(ErrorCode::bad_argument, "--continuous",
-                  "reports the pairs that touch between steps: it takes none of --contacts, --export, --max-pairs");
+  return opt.steps > 0 ? opt.steps : scene_steps;
+}
+
+/// The export steps, each listed once.
+void check_export_steps(const std::vector<int>& listed) {
+  for (auto k = listed.begin(); k != listed.end(); ++k) {
+    if (std::find(listed.begin(), k, *k) != k) {
+      throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*k) + " is listed twice");
     }
-    return run_continuous({opt.scene, opt.method, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
   }
-  if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
+}
+
+/// The engine the options ask for (its options, and the simulated core counts, checked here, before
+/// any output is made).
+Engine engine_of(const RunOptions& opt) {
   for (const int p : opt.simulate) {
     if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
   }
@@ -143,40 +153,31 @@ int run_scene(const RunOptions& opt) {
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
-  Engine engine(engine_options);  // its options checked before any output is made
-  const std::vector<int>& listed = opt.exports.steps;
-  for (auto k = listed.begin(); k != listed.end(); ++k) {
-    if (std::find(listed.begin(), k, *k) != k) {
-      throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*k) + " is listed twice");
-    }
-  }
-  // SIGINT and SIGTERM handled from before the first output is made until every one is in place.
-  const InterruptGuard interrupt;
-  // Every output is checked, and kept apart from every input, before any work is done.
-  NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
-  for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
-  check_distinct_files(outputs, scene_inputs(opt.scene, scene));
-  std::unique_ptr<Exporter> exporter;
-  if (!opt.exports.dir.empty()) exporter = std::make_unique<Exporter>(opt.exports, scene.steps);
+  return Engine(engine_options);
+}
+
+/// Where a run writes: the JSON report (streamed: what is known first, then each step as it ends,
+/// then the summary, so its memory does not grow with the steps and a failure leaves only the
+/// temporary file, removed), the contacts' lines and the PLY exports; each optional.
+struct RunSinks {
   std::unique_ptr<OutputFile> json_out, contacts_out;
-  if (!opt.json.empty()) json_out = std::make_unique<OutputFile>(opt.json, "--json");
-  if (!opt.contacts.empty()) contacts_out = std::make_unique<OutputFile>(opt.contacts, "--contacts");
-
-  const auto load_start = Clock::now();
-  const World world(std::move(scene));
-  const double load_ms = ms_since(load_start);
-  const Scene& sc = world.scene();
-  std::printf("scene %s: %zu objects (%zu distinct models), %zu triangles, %d steps of %g s, %s query (d = %g, angle %g)\n",
-              sc.name.c_str(), world.object_count(), world.distinct_models(), world.triangle_count(), sc.steps, sc.dt,
-              std::string(to_string(sc.query.kind)).c_str(), sc.query.tolerance, sc.query.angle_deg);
-  std::printf("loaded and built in %.1f ms; method %s on %d thread(s)\n", load_ms,
-              std::string(to_string(engine.options().method)).c_str(), engine.threads());
-  std::fflush(stdout);
-
-  // The report is streamed: what is known now, then each step as it ends, then the summary; so
-  // its memory does not grow with the steps, and a failure leaves only the temporary file, removed.
+  std::unique_ptr<Exporter> exporter;
   std::optional<JsonObjectWriter> report;
-  if (json_out) {
+
+  /// Every output checked, and kept apart from every input, before any work is done.
+  RunSinks(const RunOptions& opt, const Scene& scene) {
+    NamedFiles outputs{{"--json", opt.json}, {"--contacts", opt.contacts}};
+    for (const std::string& path : export_paths(opt.exports)) outputs.emplace_back("--export", path);
+    check_distinct_files(outputs, scene_inputs(opt.scene, scene));
+    if (!opt.exports.dir.empty()) exporter = std::make_unique<Exporter>(opt.exports, scene.steps);
+    if (!opt.json.empty()) json_out = std::make_unique<OutputFile>(opt.json, "--json");
+    if (!opt.contacts.empty()) contacts_out = std::make_unique<OutputFile>(opt.contacts, "--contacts");
+  }
+
+  /// The report's header: the scene, its query and the engine.
+  void open_report(const World& world, const Engine& engine) {
+    if (!json_out) return;
+    const Scene& sc = world.scene();
     report.emplace(json_out->stream());
     write_scene_header(*report, world);
     report->member(
@@ -187,10 +188,18 @@ int run_scene(const RunOptions& opt) {
     report->member("threads", engine.threads());
     report->open_array("steps");
   }
-  RunStats stats;
-  // Load-balance simulation, over the whole run.
-  std::vector<SimulatedRun> sims;
-  for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
+
+  /// What step k writes.
+  void write_step(const World& world, const StepResult& s, int k) {
+    if (report) report->item(step_record(s));
+    if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
+    if (exporter && exporter->wants(k)) exporter->write(world, s);
+  }
+};
+
+/// The steps, until the scene's last or an interrupt: each one measured, simulated and written.
+std::size_t run_steps(const World& world, Engine& engine, RunSinks& sinks, RunStats& stats, std::vector<SimulatedRun>& sims) {
+  const Scene& sc = world.scene();
   const Progress progress(static_cast<std::size_t>(sc.steps));
   std::size_t limited_steps = 0;
   for (int k = 0; k < sc.steps && !interrupted(); ++k) {
@@ -203,27 +212,19 @@ int run_scene(const RunOptions& opt) {
     stats.add(s);
     limited_steps += s.limit_reached ? 1 : 0;
     for (SimulatedRun& sim : sims) sim.add(s);
-    if (report) report->item(step_record(s));
-    if (contacts_out) contacts_out->stream() << contacts_line(world, s).dump() << '\n';
-    if (exporter && exporter->wants(k)) exporter->write(world, s);
+    sinks.write_step(world, s, k);
     char line[256];
     std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.pair_records.size(),
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
   progress.end();
-  const bool stopped = interrupted();
-  if (stopped) {
-    std::printf("\ninterrupted (%s) after %zu of %d steps: writing what was measured\n", interrupt_name(), stats.steps(),
-                sc.steps);
-  }
-  if (contacts_out) contacts_out->commit();
-  if (exporter) exporter->commit();
+  return limited_steps;
+}
 
-  if (limited_steps > 0) {
-    std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts are partial\n", limited_steps,
-                stats.steps(), sc.query.max_pairs, opt.max_pairs != 0 ? "--max-pairs" : "the scene's query");
-  }
+/// The summary printed at the end; returns the simulated speed-ups by core count.
+nlohmann::json print_summary(const RunOptions& opt, const World& world, const Engine& engine, const RunStats& stats,
+                             const std::vector<SimulatedRun>& sims) {
   const auto [heavy, heavy_share] = stats.heaviest_pair();
   const auto [second, second_share] = stats.second_heaviest_pair();
   std::printf("\nsummary over %zu steps\n", stats.steps());
@@ -249,26 +250,77 @@ int run_scene(const RunOptions& opt) {
     }
     std::printf("\n");
   }
+  return simulated;
+}
 
-  if (report) {
-    report->close_array();
-    report->member("summary", {{"steps", stats.steps()},
-                               {"objects", world.object_count()},
-                               {"triangles", world.triangle_count()},
-                               {"median_step_ms", stats.median_step_ms()},
-                               {"mean_step_ms", stats.mean_step_ms()},
-                               {"node_tests_per_step", stats.mean_node_tests()},
-                               {"contacts_per_step", stats.mean_contacts()},
-                               {"pairs_per_step", stats.mean_tasks()},
-                               {"candidate_pairs", stats.candidate_pairs()},
-                               {"steps_with_contacts", stats.steps_with_contacts()},
-                               {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
-                               {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
-                               {"simulated_speedup", simulated}});
-    if (stopped) report->member("interrupted", true);
-    report->close();
-    json_out->commit();
+/// The report's summary and its end.
+void close_report(RunSinks& sinks, const World& world, const RunStats& stats, const nlohmann::json& simulated, bool stopped) {
+  if (!sinks.report) return;
+  const auto [heavy, heavy_share] = stats.heaviest_pair();
+  const auto [second, second_share] = stats.second_heaviest_pair();
+  sinks.report->close_array();
+  sinks.report->member("summary", {{"steps", stats.steps()},
+                                   {"objects", world.object_count()},
+                                   {"triangles", world.triangle_count()},
+                                   {"median_step_ms", stats.median_step_ms()},
+                                   {"mean_step_ms", stats.mean_step_ms()},
+                                   {"node_tests_per_step", stats.mean_node_tests()},
+                                   {"contacts_per_step", stats.mean_contacts()},
+                                   {"pairs_per_step", stats.mean_tasks()},
+                                   {"candidate_pairs", stats.candidate_pairs()},
+                                   {"steps_with_contacts", stats.steps_with_contacts()},
+                                   {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
+                                   {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},
+                                   {"simulated_speedup", simulated}});
+  if (stopped) sinks.report->member("interrupted", true);
+  sinks.report->close();
+  sinks.json_out->commit();
+}
+
+int run_scene(const RunOptions& opt) {
+  check_run_options(opt);
+  Scene scene = load_scene(opt.scene);
+  scene.steps = steps_of(opt, scene.steps);
+  if (opt.continuous) {
+    if (!opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
+      throw Error(ErrorCode::bad_argument, "--continuous",
+                  "reports the pairs that touch between steps: it takes none of --contacts, --export, --max-pairs");
+    }
+    return run_continuous({opt.scene, opt.method, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
   }
+  if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
+  Engine engine = engine_of(opt);
+  check_export_steps(opt.exports.steps);
+  // SIGINT and SIGTERM handled from before the first output is made until every one is in place.
+  const InterruptGuard interrupt;
+  RunSinks sinks(opt, scene);
+  const auto load_start = Clock::now();
+  const World world(std::move(scene));
+  const double load_ms = ms_since(load_start);
+  const Scene& sc = world.scene();
+  std::printf("scene %s: %zu objects (%zu distinct models), %zu triangles, %d steps of %g s, %s query (d = %g, angle %g)\n",
+              sc.name.c_str(), world.object_count(), world.distinct_models(), world.triangle_count(), sc.steps, sc.dt,
+              std::string(to_string(sc.query.kind)).c_str(), sc.query.tolerance, sc.query.angle_deg);
+  std::printf("loaded and built in %.1f ms; method %s on %d thread(s)\n", load_ms,
+              std::string(to_string(engine.options().method)).c_str(), engine.threads());
+  std::fflush(stdout);
+  sinks.open_report(world, engine);
+  RunStats stats;
+  std::vector<SimulatedRun> sims;  // the load-balance simulation, over the whole run
+  for (const int p : opt.simulate) sims.emplace_back(engine.options().method, p);
+  const std::size_t limited_steps = run_steps(world, engine, sinks, stats, sims);
+  const bool stopped = interrupted();
+  if (stopped) {
+    std::printf("\ninterrupted (%s) after %zu of %d steps: writing what was measured\n", interrupt_name(), stats.steps(),
+                sc.steps);
+  }
+  if (sinks.contacts_out) sinks.contacts_out->commit();
+  if (sinks.exporter) sinks.exporter->commit();
+  if (limited_steps > 0) {
+    std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts are partial\n", limited_steps,
+                stats.steps(), sc.query.max_pairs, opt.max_pairs != 0 ? "--max-pairs" : "the scene's query");
+  }
+  close_report(sinks, world, stats, print_summary(opt, world, engine, stats, sims), stopped);
   check_stdout();
   return stopped ? interrupted_exit_code() : 0;
 }
