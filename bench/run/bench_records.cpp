@@ -35,16 +35,10 @@ void BenchLog::add(Json record) {
 
 namespace {
 
-/// Why a record cannot be read (empty when it can): its kind's fields, with their types, and the
-/// scenes and methods it names against the header's.
-std::string record_problem(const Json& r, const Json* header) {
-  const auto need = [&](const char* key, bool (Json::*is)() const) -> std::string {
-    if (!r.contains(key)) return std::string("no \"") + key + "\"";
-    if (!(r[key].*is)()) return std::string("\"") + key + "\" has the wrong type";
-    return {};
-  };
-  const std::string kind = r["kind"].get<std::string>();
-  std::vector<std::pair<const char*, bool (Json::*)() const>> fields;
+using Field = std::pair<const char*, bool (Json::*)() const>;
+
+/// The fields a record of `kind` must have, with their types; false for a kind no log holds.
+bool fields_of(const std::string& kind, std::vector<Field>& fields) {
   if (kind == "header") {
     fields = {{"machine", &Json::is_string},
               {"cpu", &Json::is_string},
@@ -93,37 +87,40 @@ std::string record_problem(const Json& r, const Json* header) {
   } else if (kind == "stopped") {
     fields = {{"reason", &Json::is_string}, {"after_s", &Json::is_number}};
   } else {
-    return "unknown record kind \"" + kind + "\"";
+    return false;
   }
-  for (const auto& [key, is] : fields) {
-    if (std::string p = need(key, is); !p.empty()) return p;
+  return true;
+}
+
+/// Why a header's lists cannot be read (empty when they can).
+std::string header_problem(const Json& r) {
+  for (const Json& list : {r["threads"], r["simulate"]}) {
+    for (const Json& x : list) {
+      if (!x.is_number_integer()) return "a thread or core count is not a whole number";
+    }
   }
-  if (kind == "header") {
-    for (const Json& list : {r["threads"], r["simulate"]}) {
-      for (const Json& x : list) {
-        if (!x.is_number_integer()) return "a thread or core count is not a whole number";
-      }
-    }
-    for (const Json& m : r["methods"]) {
-      if (!m.is_string()) return "a method is not a name";
-    }
-    for (const Json& sc : r["scenes"]) {
-      if (!sc.is_object() || !sc.contains("name") || !sc["name"].is_string() || !sc.contains("file") || !sc["file"].is_string() ||
-          !sc.contains("steps") || !sc["steps"].is_number_integer() || sc["steps"].get<long long>() < 1) {
-        return "a scene needs a name, a file and steps >= 1";
-      }
-    }
-    return {};
+  for (const Json& m : r["methods"]) {
+    if (!m.is_string()) return "a method is not a name";
   }
-  if (header == nullptr) return "comes before the header";
+  for (const Json& sc : r["scenes"]) {
+    if (!sc.is_object() || !sc.contains("name") || !sc["name"].is_string() || !sc.contains("file") || !sc["file"].is_string() ||
+        !sc.contains("steps") || !sc["steps"].is_number_integer() || sc["steps"].get<long long>() < 1) {
+      return "a scene needs a name, a file and steps >= 1";
+    }
+  }
+  return {};
+}
+
+/// Why a record's scene, method, phases or copies do not agree with the header (empty when they do).
+std::string reference_problem(const Json& r, const Json& header, const std::string& kind) {
   if (r.contains("scene")) {
-    const auto& scenes = (*header)["scenes"];
+    const auto& scenes = header["scenes"];
     if (std::none_of(scenes.begin(), scenes.end(), [&](const Json& sc) { return sc["name"] == r["scene"]; })) {
       return "names a scene the header does not list";
     }
   }
   if (r.contains("method") && kind != "gantt") {
-    const auto& methods = (*header)["methods"];
+    const auto& methods = header["methods"];
     if (std::none_of(methods.begin(), methods.end(), [&](const Json& m) { return m == r["method"]; })) {
       return "names a method the header does not list";
     }
@@ -139,6 +136,25 @@ std::string record_problem(const Json& r, const Json* header) {
     }
   }
   return {};
+}
+
+/// Why a record cannot be read (empty when it can): its kind's fields, with their types, and the
+/// scenes and methods it names against the header's.
+std::string record_problem(const Json& r, const Json* header) {
+  const auto need = [&](const char* key, bool (Json::*is)() const) -> std::string {
+    if (!r.contains(key)) return std::string("no \"") + key + "\"";
+    if (!(r[key].*is)()) return std::string("\"") + key + "\" has the wrong type";
+    return {};
+  };
+  const std::string kind = r["kind"].get<std::string>();
+  std::vector<Field> fields;
+  if (!fields_of(kind, fields)) return "unknown record kind \"" + kind + "\"";
+  for (const auto& [key, is] : fields) {
+    if (std::string p = need(key, is); !p.empty()) return p;
+  }
+  if (kind == "header") return header_problem(r);
+  if (header == nullptr) return "comes before the header";
+  return reference_problem(r, *header, kind);
 }
 
 }  // namespace
