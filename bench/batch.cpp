@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -108,62 +109,90 @@ std::string tiny_calls(int repeat, const BuildOptions& build) {
   return line;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The options: the meshes' folder, the poses, the engines' thread counts (at least one), the rounds,
+/// the report's file, and whether to time the tiny calls alone.
+struct Options {
   std::filesystem::path meshes = bench::default_meshes_dir();
   std::size_t poses_n = 10000;
   int repeat = 5;
   std::string out_path;
   bool tiny_only = false;
   std::vector<int> thread_counts = {1, 2};
+};
+
+/// The options of the command line, or none (the usage said on stderr) for one it does not know.
+std::optional<Options> parse(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
     if (arg == "--meshes" && has_value) {
-      meshes = argv[++i];
+      o.meshes = argv[++i];
     } else if (arg == "--poses" && has_value) {
-      poses_n = std::stoul(argv[++i]);
+      o.poses_n = std::stoul(argv[++i]);
     } else if (arg == "--threads" && has_value) {
-      thread_counts.clear();
-      while (i + 1 < argc && argv[i + 1][0] != '-') thread_counts.push_back(std::max(1, std::stoi(argv[++i])));
+      o.thread_counts.clear();
+      while (i + 1 < argc && argv[i + 1][0] != '-') o.thread_counts.push_back(std::max(1, std::stoi(argv[++i])));
     } else if (arg == "--repeat" && has_value) {
-      repeat = std::max(1, std::stoi(argv[++i]));
+      o.repeat = std::max(1, std::stoi(argv[++i]));
     } else if (arg == "--out" && has_value) {
-      out_path = argv[++i];
+      o.out_path = argv[++i];
     } else if (arg == "--tiny-only") {
-      tiny_only = true;
+      o.tiny_only = true;
     } else {
       std::fprintf(
           stderr, "usage: bench_batch [--meshes DIR] [--poses N] [--threads T ...] [--repeat R] [--out FILE.md] [--tiny-only]\n");
-      return 2;
+      return std::nullopt;
     }
   }
-  // Oriented boxes kept: the distance query reads them instead of computing them (what the CLI and
-  // scenes do for distance queries; the other kinds do not read them).
-  BuildOptions build;
-  build.oriented_boxes = true;
-  if (tiny_only) {
-    (void)tiny_calls(repeat, build);
-    return 0;
-  }
-  const Mesh bunny = load_mesh((meshes / "bunny00.off").string());
-  Mesh link = load_mesh((meshes / "turbine.off").string());
-  scale_mesh(link, 0.3);
-  const auto a = build_model(bunny, build), b = build_model(link, build);
-  const auto fa = bench::build_fcl(bunny), fb = bench::build_fcl(link);
-  const std::vector<Pose> all = path(bunny, link, poses_n);
+  if (o.thread_counts.empty()) o.thread_counts = {1};
+  return o;
+}
+
+/// The bunny (A) and the scaled turbine (the link, B), their models (ours and FCL's), the link's
+/// poses (all, and split by whether they collide), and an engine per thread count with its column's name.
+struct Setup {
+  Mesh bunny, link;
+  std::shared_ptr<const Model> a, b;
+  std::shared_ptr<bench::FclModel> fa, fb;
+  std::vector<Pose> all, colliding, free;
+  std::vector<std::unique_ptr<Engine>> engines;
+  std::vector<std::string> batch_names;
+  std::vector<Pose> identity{Pose{}};  ///< A's poses in a batch: the identity alone
+};
+
+/// Loads the meshes, builds the models, walks the path and starts the engines.
+Setup set_up(const Options& o, const BuildOptions& build) {
+  Setup s;
+  s.bunny = load_mesh((o.meshes / "bunny00.off").string());
+  s.link = load_mesh((o.meshes / "turbine.off").string());
+  scale_mesh(s.link, 0.3);
+  s.a = build_model(s.bunny, build), s.b = build_model(s.link, build);
+  s.fa = bench::build_fcl(s.bunny), s.fb = bench::build_fcl(s.link);
+  s.all = path(s.bunny, s.link, o.poses_n);
 
   // Which poses collide, by the first hit.
   QueryRequest first;
   first.max_pairs = 1;
-  std::vector<Pose> colliding, free;
-  for (const Pose& p : all) (query(*a, Pose{}, *b, p, first).contacts.empty() ? free : colliding).push_back(p);
+  for (const Pose& p : s.all) (query(*s.a, Pose{}, *s.b, p, first).contacts.empty() ? s.free : s.colliding).push_back(p);
 
-  struct Kind {
-    std::string name;
-    QueryRequest request;
-  };
+  for (const int threads : o.thread_counts) {
+    EngineOptions options;
+    options.threads = threads;
+    s.engines.push_back(std::make_unique<Engine>(options));
+    s.batch_names.push_back("batch, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
+  }
+  return s;
+}
+
+/// A query kind of the table: its name and its request.
+struct Kind {
+  std::string name;
+  QueryRequest request;
+};
+
+/// The query kinds, in the table's order: the first hit, every intersecting pair, the distance.
+std::vector<Kind> query_kinds() {
   std::vector<Kind> kinds(3);
   kinds[0].name = "first hit";
   kinds[0].request.max_pairs = 1;
@@ -171,113 +200,153 @@ int main(int argc, char** argv) {
   kinds[2].name = "distance";
   kinds[2].request.kind = QueryKind::distance;
   kinds[2].request.tolerance = kUnbounded;
+  return kinds;
+}
 
-  if (thread_counts.empty()) thread_counts = {1};
-  std::vector<std::unique_ptr<Engine>> engines;
-  std::vector<std::string> batch_names;
-  for (const int threads : thread_counts) {
-    EngineOptions options;
-    options.threads = threads;
-    engines.push_back(std::make_unique<Engine>(options));
-    batch_names.push_back("batch, " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
+/// The contenders on one query, in timing order: FCL's loop (B moved in `ob`), caliber::query's, a batch per engine.
+std::vector<Config> contenders(const Setup& s, const QueryRequest& request, const fcl::CollisionObjectd& oa,
+                               fcl::CollisionObjectd& ob, std::size_t& checksum) {
+  const bool distance = request.kind == QueryKind::distance;
+  std::vector<Config> configs;
+  configs.push_back({"FCL loop", [&, distance](const std::vector<Pose>& poses) {
+                       for (const Pose& p : poses) {
+                         ob.setTransform(bench::to_fcl(p));
+                         ob.computeAABB();
+                         if (distance) {
+                           fcl::DistanceRequestd dreq(true, true, 0.0, 0.0);
+                           fcl::DistanceResultd dres;
+                           fcl::distance(&oa, &ob, dreq, dres);
+                           checksum += dres.min_distance > 0.0;
+                         } else {
+                           fcl::CollisionRequestd creq(request.max_pairs == 1 ? 1 : 100000000, false);
+                           fcl::CollisionResultd cres;
+                           fcl::collide(&oa, &ob, creq, cres);
+                           checksum += cres.numContacts();
+                         }
+                       }
+                     }});
+  configs.push_back({"query loop", [&](const std::vector<Pose>& poses) {
+                       for (const Pose& p : poses) checksum += query(*s.a, Pose{}, *s.b, p, request).contacts.size();
+                     }});
+  for (std::size_t e = 0; e < s.engines.size(); ++e) {
+    configs.push_back({s.batch_names[e], [&, e](const std::vector<Pose>& poses) {
+                         checksum += s.engines[e]->query_many(*s.a, s.identity, *s.b, poses, request).contacts.size();
+                       }});
   }
-  const std::vector<Pose> identity{Pose{}};
-  fcl::CollisionObjectd oa(fa, bench::to_fcl(Pose{}));
-  fcl::CollisionObjectd ob(fb, bench::to_fcl(Pose{}));
+  return configs;
+}
+
+/// Whether the last engine's batch holds the single queries' entries, bit for bit, at about 50 poses (if not, said on stderr).
+bool batch_matches(const Setup& s, const Kind& k, const std::string& subset, const std::vector<Pose>& poses) {
+  const QueryRequest& request = k.request;
+  const BatchResult check = s.engines.back()->query_many(*s.a, s.identity, *s.b, poses, request);
+  for (std::size_t i = 0; i < poses.size(); i += std::max<std::size_t>(1, poses.size() / 50)) {
+    const QueryResult q = query(*s.a, Pose{}, *s.b, poses[i], request);
+    const auto got = check.contacts_of(i);
+    bool same = got.size() == q.contacts.size();
+    for (std::size_t c = 0; same && c < got.size(); ++c) {
+      same = got[c].tri_a == q.contacts[c].tri_a && got[c].tri_b == q.contacts[c].tri_b &&
+             got[c].distance == q.contacts[c].distance && got[c].point_a == q.contacts[c].point_a;
+    }
+    if (!same) {
+      std::fprintf(stderr, "bench_batch: %s, %s pose %zu: the batch differs from the query\n", k.name.c_str(), subset.c_str(), i);
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The contenders on `poses`, `repeat` interleaved rounds: each one's microseconds per pose, by name.
+std::map<std::string, std::vector<double>> time_rounds(const std::vector<Config>& configs, const std::vector<Pose>& poses,
+                                                       int repeat) {
+  std::map<std::string, std::vector<double>> times;
+  for (int r = 0; r < repeat; ++r) {
+    for (const Config& c : configs) {
+      const auto start = std::chrono::steady_clock::now();
+      c.run(poses);
+      times[c.name].push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() /
+                              static_cast<double>(poses.size()));
+    }
+  }
+  return times;
+}
+
+/// A row of the table: the medians of FCL's loop, caliber's loop and each batch, then the ratios.
+std::string table_row(const Kind& k, const std::string& subset, std::size_t count,
+                      const std::map<std::string, std::vector<double>>& times, const std::vector<std::string>& batch_names) {
+  char line[512];
+  const double fcl_us = median(times.at("FCL loop")), loop_us = median(times.at("query loop"));
+  std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f | %.2f |", k.name.c_str(), subset.c_str(), count, fcl_us, loop_us);
+  std::string row = line;
+  for (const std::string& name : batch_names) {
+    std::snprintf(line, sizeof line, " %.2f |", median(times.at(name)));
+    row += line;
+  }
+  const double b1 = median(times.at(batch_names.front())), bn = median(times.at(batch_names.back()));
+  std::snprintf(line, sizeof line, " %.3f | %.3f | %.2f |\n", loop_us / fcl_us, b1 / fcl_us, b1 / bn);
+  row += line;
+  return row;
+}
+
+/// One query kind on each subset of poses: checked, then timed; its rows printed and added to `table`. False if a batch differs.
+bool measure_kind(const Setup& s, const Kind& k, int repeat, const fcl::CollisionObjectd& oa, fcl::CollisionObjectd& ob,
+                  std::size_t& checksum, std::string& table) {
+  const std::vector<Config> configs = contenders(s, k.request, oa, ob, checksum);
+  for (const auto& [subset, poses] :
+       {std::pair<std::string, const std::vector<Pose>*>{"free", &s.free}, {"colliding", &s.colliding}, {"all", &s.all}}) {
+    if (poses->empty()) continue;
+    // Every batch's entries are the single queries', bit for bit.
+    if (!batch_matches(s, k, subset, *poses)) return false;
+    const std::string row = table_row(k, subset, poses->size(), time_rounds(configs, *poses, repeat), s.batch_names);
+    std::fputs(row.c_str(), stdout);
+    std::fflush(stdout);
+    table += row;
+  }
+  return true;
+}
+
+/// Writes the report to `path`: the setup, the table, then the tiny calls' lines.
+void write_report(const std::string& path, const Options& o, const Setup& s, const std::string& table, const std::string& tiny) {
+  std::ofstream out(path);
+  out << "# Batch queries against FCL 0.7's loop\n\n"
+      << "Machine: " << bench::machine_description() << "\n\n"
+      << "CGAL's turbine (" << s.link.triangles.size() << " triangles, scaled 0.3) swept along a path through the bunny ("
+      << s.bunny.triangles.size() << " triangles): " << s.all.size() << " poses, " << s.colliding.size()
+      << " colliding. Microseconds per pose, medians of " << o.repeat
+      << " interleaved rounds; each batch's entries checked against the single queries.\n\n"
+      << "| query | poses | count | FCL loop | query loop |";
+  for (const std::string& name : s.batch_names) out << " " << name << " |";
+  out << " loop / FCL | batch " << o.thread_counts.front() << "t / FCL | " << o.thread_counts.back() << "t / "
+      << o.thread_counts.front() << "t |\n|---|---|---|---|---|";
+  for (std::size_t e = 0; e < s.batch_names.size(); ++e) out << "---|";
+  out << "---|---|---|\n" << table << tiny;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Options> o = parse(argc, argv);
+  if (!o) return 2;
+  // Oriented boxes kept: the distance query reads them instead of computing them (what the CLI and
+  // scenes do for distance queries; the other kinds do not read them).
+  BuildOptions build;
+  build.oriented_boxes = true;
+  if (o->tiny_only) {
+    (void)tiny_calls(o->repeat, build);
+    return 0;
+  }
+  const Setup s = set_up(*o, build);
+  fcl::CollisionObjectd oa(s.fa, bench::to_fcl(Pose{}));
+  fcl::CollisionObjectd ob(s.fb, bench::to_fcl(Pose{}));
 
   std::string table;
-  char line[512];
   std::size_t checksum = 0;  // what every timed run found, kept so that no run is optimized away
-  for (const Kind& k : kinds) {
-    const QueryRequest& request = k.request;
-    const bool distance = request.kind == QueryKind::distance;
-    std::vector<Config> configs;
-    configs.push_back({"FCL loop", [&](const std::vector<Pose>& poses) {
-                         for (const Pose& p : poses) {
-                           ob.setTransform(bench::to_fcl(p));
-                           ob.computeAABB();
-                           if (distance) {
-                             fcl::DistanceRequestd dreq(true, true, 0.0, 0.0);
-                             fcl::DistanceResultd dres;
-                             fcl::distance(&oa, &ob, dreq, dres);
-                             checksum += dres.min_distance > 0.0;
-                           } else {
-                             fcl::CollisionRequestd creq(request.max_pairs == 1 ? 1 : 100000000, false);
-                             fcl::CollisionResultd cres;
-                             fcl::collide(&oa, &ob, creq, cres);
-                             checksum += cres.numContacts();
-                           }
-                         }
-                       }});
-    configs.push_back({"query loop", [&](const std::vector<Pose>& poses) {
-                         for (const Pose& p : poses) checksum += query(*a, Pose{}, *b, p, request).contacts.size();
-                       }});
-    for (std::size_t e = 0; e < engines.size(); ++e) {
-      configs.push_back({batch_names[e], [&, e](const std::vector<Pose>& poses) {
-                           checksum += engines[e]->query_many(*a, identity, *b, poses, request).contacts.size();
-                         }});
-    }
-    for (const auto& [subset, poses] :
-         {std::pair<std::string, const std::vector<Pose>*>{"free", &free}, {"colliding", &colliding}, {"all", &all}}) {
-      if (poses->empty()) continue;
-      // Every batch's entries are the single queries', bit for bit.
-      const BatchResult check = engines.back()->query_many(*a, identity, *b, *poses, request);
-      for (std::size_t i = 0; i < poses->size(); i += std::max<std::size_t>(1, poses->size() / 50)) {
-        const QueryResult q = query(*a, Pose{}, *b, (*poses)[i], request);
-        const auto got = check.contacts_of(i);
-        bool same = got.size() == q.contacts.size();
-        for (std::size_t c = 0; same && c < got.size(); ++c) {
-          same = got[c].tri_a == q.contacts[c].tri_a && got[c].tri_b == q.contacts[c].tri_b &&
-                 got[c].distance == q.contacts[c].distance && got[c].point_a == q.contacts[c].point_a;
-        }
-        if (!same) {
-          std::fprintf(stderr, "bench_batch: %s, %s pose %zu: the batch differs from the query\n", k.name.c_str(), subset.c_str(),
-                       i);
-          return 1;
-        }
-      }
-      std::map<std::string, std::vector<double>> times;
-      for (int r = 0; r < repeat; ++r) {
-        for (const Config& c : configs) {
-          const auto start = std::chrono::steady_clock::now();
-          c.run(*poses);
-          times[c.name].push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() /
-                                  static_cast<double>(poses->size()));
-        }
-      }
-      const double fcl_us = median(times["FCL loop"]), loop_us = median(times["query loop"]);
-      std::snprintf(line, sizeof line, "| %s | %s | %zu | %.2f | %.2f |", k.name.c_str(), subset.c_str(), poses->size(), fcl_us,
-                    loop_us);
-      std::string row = line;
-      for (const std::string& name : batch_names) {
-        std::snprintf(line, sizeof line, " %.2f |", median(times[name]));
-        row += line;
-      }
-      const double b1 = median(times[batch_names.front()]), bn = median(times[batch_names.back()]);
-      std::snprintf(line, sizeof line, " %.3f | %.3f | %.2f |\n", loop_us / fcl_us, b1 / fcl_us, b1 / bn);
-      row += line;
-      std::fputs(row.c_str(), stdout);
-      std::fflush(stdout);
-      table += row;
-    }
+  for (const Kind& k : query_kinds()) {
+    if (!measure_kind(s, k, o->repeat, oa, ob, checksum, table)) return 1;
   }
 
-  const std::string tiny = tiny_calls(repeat, build);
+  const std::string tiny = tiny_calls(o->repeat, build);
 
-  if (!out_path.empty()) {
-    std::ofstream out(out_path);
-    out << "# Batch queries against FCL 0.7's loop\n\n"
-        << "Machine: " << bench::machine_description() << "\n\n"
-        << "CGAL's turbine (" << link.triangles.size() << " triangles, scaled 0.3) swept along a path through the bunny ("
-        << bunny.triangles.size() << " triangles): " << all.size() << " poses, " << colliding.size()
-        << " colliding. Microseconds per pose, medians of " << repeat
-        << " interleaved rounds; each batch's entries checked against the single queries.\n\n"
-        << "| query | poses | count | FCL loop | query loop |";
-    for (const std::string& name : batch_names) out << " " << name << " |";
-    out << " loop / FCL | batch " << thread_counts.front() << "t / FCL | " << thread_counts.back() << "t / "
-        << thread_counts.front() << "t |\n|---|---|---|---|---|";
-    for (std::size_t e = 0; e < batch_names.size(); ++e) out << "---|";
-    out << "---|---|---|\n" << table << tiny;
-  }
+  if (!o->out_path.empty()) write_report(o->out_path, *o, s, table, tiny);
   return checksum == SIZE_MAX ? 1 : 0;  // (kept, so that no timed run is optimized away)
 }

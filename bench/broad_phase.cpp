@@ -19,6 +19,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -119,35 +120,45 @@ double median(std::vector<double> v) {
 
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The options: the object counts, the engines' thread counts (at least one), the steps, the rounds
+/// and the report's file.
+struct Options {
   std::vector<std::size_t> sizes = {1000, 4096, 32768, 100000};
   std::vector<int> thread_counts = {1, 2};
   int steps = 20, repeat = 5;
   std::string out_path;
+};
+
+/// The options of the command line, or none (the usage said on stderr) for one it does not know.
+std::optional<Options> parse(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool more = i + 1 < argc;
     if (arg == "--objects" && more) {
-      sizes.clear();
-      while (i + 1 < argc && argv[i + 1][0] != '-') sizes.push_back(std::stoul(argv[++i]));
+      o.sizes.clear();
+      while (i + 1 < argc && argv[i + 1][0] != '-') o.sizes.push_back(std::stoul(argv[++i]));
     } else if (arg == "--threads" && more) {
-      thread_counts.clear();
-      while (i + 1 < argc && argv[i + 1][0] != '-') thread_counts.push_back(std::max(1, std::stoi(argv[++i])));
+      o.thread_counts.clear();
+      while (i + 1 < argc && argv[i + 1][0] != '-') o.thread_counts.push_back(std::max(1, std::stoi(argv[++i])));
     } else if (arg == "--steps" && more) {
-      steps = std::max(2, std::stoi(argv[++i]));
+      o.steps = std::max(2, std::stoi(argv[++i]));
     } else if (arg == "--repeat" && more) {
-      repeat = std::max(1, std::stoi(argv[++i]));
+      o.repeat = std::max(1, std::stoi(argv[++i]));
     } else if (arg == "--out" && more) {
-      out_path = argv[++i];
+      o.out_path = argv[++i];
     } else {
       std::fprintf(stderr,
                    "usage: bench_broad_phase [--objects N ...] [--threads T ...] [--steps S] [--repeat R] [--out FILE.md]\n");
-      return 2;
+      return std::nullopt;
     }
   }
-  if (thread_counts.empty()) thread_counts = {1};
+  if (o.thread_counts.empty()) o.thread_counts = {1};
+  return o;
+}
+
+/// The table's head: its column names and the rule under them.
+std::string table_head(const std::vector<int>& thread_counts) {
   std::string table = "| objects | pairs/step |", rule = "|---|---|";
   for (const int threads : thread_counts) {
     table += " caliber " + std::to_string(threads) + (threads == 1 ? " thread ms |" : " threads ms |");
@@ -155,96 +166,145 @@ int main(int argc, char** argv) {
   }
   table += " afresh ms | sweep along x ms | Bullet dbvt ms | caliber " + std::to_string(thread_counts[0]) +
            "t / Bullet | Bullet's pairs (overlapping) |\n" + rule + "---|---|---|---|---|\n";
-  for (const std::size_t n : sizes) {
-    const Boxes scene = make_boxes(n);
-    std::vector<std::vector<Pose>> poses;
-    std::vector<std::vector<WorldBox>> boxes;
-    std::vector<std::vector<ObjectPair>> want;
-    for (int k = 0; k < steps; ++k) {
-      poses.push_back(scene.at(k));
-      boxes.push_back(boxes_of(scene, poses.back()));
-      want.push_back(sweep_along_x(boxes.back()));
+  return table;
+}
+
+/// Every step of a scene: the poses, their world boxes, and the pairs the sweep along x finds.
+struct Steps {
+  std::vector<std::vector<Pose>> poses;
+  std::vector<std::vector<WorldBox>> boxes;
+  std::vector<std::vector<ObjectPair>> want;
+};
+
+/// The first `steps` steps of `scene`, each with its boxes and the sweep's pairs.
+Steps steps_of(const Boxes& scene, int steps) {
+  Steps s;
+  for (int k = 0; k < steps; ++k) {
+    s.poses.push_back(scene.at(k));
+    s.boxes.push_back(boxes_of(scene, s.poses.back()));
+    s.want.push_back(sweep_along_x(s.boxes.back()));
+  }
+  return s;
+}
+
+/// What the rounds measured on one scene: milliseconds per step by contender ("t1", "t2", ...,
+/// "fresh", "sweep", "bullet"), and Bullet's pair cache over the first round's steps.
+struct Measured {
+  std::map<std::string, std::vector<double>> ms;
+  double bullet_pairs = 0.0, bullet_exact = 0.0;
+  bool bullet_holds_all = true;
+};
+
+/// caliber's engine on `threads` threads, built at step 0 (not timed): ms per step into `m`; false (on stderr) if pairs differ.
+bool time_engine(const Boxes& scene, const Steps& s, int steps, int threads, Measured& m) {
+  EngineOptions options;
+  options.threads = threads;
+  Engine engine(options);
+  Frame frame;
+  frame.models = scene.models;
+  frame.poses = s.poses[0];
+  engine.find_pairs(frame);
+  const auto t = Clock::now();
+  for (int k = 1; k < steps; ++k) {
+    frame.poses = s.poses[k];
+    engine.find_pairs(frame);
+    if (frame.pairs != s.want[k]) {
+      std::fprintf(stderr, "caliber's pairs differ from the sweep's at %zu objects, step %d\n", scene.models.size(), k);
+      return false;
     }
-    std::map<std::string, std::vector<double>> ms;
-    double bullet_pairs = 0.0, bullet_exact = 0.0;
-    bool bullet_holds_all = true;
-    for (int round = 0; round < repeat; ++round) {
-      for (const int threads : thread_counts) {
-        EngineOptions options;
-        options.threads = threads;
-        Engine engine(options);
-        Frame frame;
-        frame.models = scene.models;
-        frame.poses = poses[0];
-        engine.find_pairs(frame);
-        const auto t = Clock::now();
-        for (int k = 1; k < steps; ++k) {
-          frame.poses = poses[k];
-          engine.find_pairs(frame);
-          if (frame.pairs != want[k]) {
-            std::fprintf(stderr, "caliber's pairs differ from the sweep's at %zu objects, step %d\n", n, k);
-            return 1;
-          }
-        }
-        ms["t" + std::to_string(threads)].push_back(ms_since(t) / (steps - 1));
-      }
-      {
-        const auto t = Clock::now();
-        for (int k = 1; k < steps; ++k) {
-          if (broad_phase(scene.models, poses[k], 0.0).size() != want[k].size()) return 1;
-        }
-        ms["fresh"].push_back(ms_since(t) / (steps - 1));
-      }
-      {
-        const auto t = Clock::now();
-        for (int k = 1; k < steps; ++k) {
-          if (sweep_along_x(boxes_of(scene, poses[k])).size() != want[k].size()) return 1;
-        }
-        ms["sweep"].push_back(ms_since(t) / (steps - 1));
-      }
-      {
-        Bullet bullet(boxes[0]);
-        double total = 0.0;
-        for (int k = 1; k < steps; ++k) {
-          const auto t = Clock::now();
-          bullet.update(boxes[k]);
-          total += ms_since(t);
-          if (round == 0) {
-            const std::vector<ObjectPair> got = bullet.pairs();
-            std::size_t exact = 0;
-            for (const ObjectPair& p : got) exact += std::binary_search(want[k].begin(), want[k].end(), p) ? 1 : 0;
-            bullet_pairs += static_cast<double>(got.size()) / (steps - 1);
-            bullet_exact += static_cast<double>(exact) / (steps - 1);
-            bullet_holds_all = bullet_holds_all && exact == want[k].size();
-          }
-        }
-        ms["bullet"].push_back(total / (steps - 1));
-      }
+  }
+  m.ms["t" + std::to_string(threads)].push_back(ms_since(t) / (steps - 1));
+  return true;
+}
+
+/// Bullet's tree, built at step 0 (not timed), fed each step's boxes: ms per step into `m`; in round 0, what its pairs hold.
+void time_bullet(const Steps& s, int steps, int round, Measured& m) {
+  Bullet bullet(s.boxes[0]);
+  double total = 0.0;
+  for (int k = 1; k < steps; ++k) {
+    const auto t = Clock::now();
+    bullet.update(s.boxes[k]);
+    total += ms_since(t);
+    if (round == 0) {
+      const std::vector<ObjectPair> got = bullet.pairs();
+      std::size_t exact = 0;
+      for (const ObjectPair& p : got) exact += std::binary_search(s.want[k].begin(), s.want[k].end(), p) ? 1 : 0;
+      m.bullet_pairs += static_cast<double>(got.size()) / (steps - 1);
+      m.bullet_exact += static_cast<double>(exact) / (steps - 1);
+      m.bullet_holds_all = m.bullet_holds_all && exact == s.want[k].size();
     }
-    double pairs = 0.0;
-    for (int k = 1; k < steps; ++k) pairs += static_cast<double>(want[k].size()) / (steps - 1);
-    char cell[512];
-    std::snprintf(cell, sizeof cell, "| %zu | %.0f |", n, pairs);
-    std::string row = cell;
-    for (const int threads : thread_counts) {
-      std::snprintf(cell, sizeof cell, " %.2f |", median(ms["t" + std::to_string(threads)]));
-      row += cell;
+  }
+  m.ms["bullet"].push_back(total / (steps - 1));
+}
+
+/// The interleaved rounds: caliber per thread count, the search afresh, the sweep, then Bullet. False if any pairs differ.
+bool time_rounds(const Boxes& scene, const Steps& s, const Options& o, Measured& m) {
+  const int steps = o.steps;
+  for (int round = 0; round < o.repeat; ++round) {
+    for (const int threads : o.thread_counts) {
+      if (!time_engine(scene, s, steps, threads, m)) return false;
     }
-    const double first = median(ms["t" + std::to_string(thread_counts[0])]);
-    std::snprintf(cell, sizeof cell, " %.2f | %.2f | %.2f | %.2f | %.0f (%.0f)%s |\n", median(ms["fresh"]), median(ms["sweep"]),
-                  median(ms["bullet"]), first / median(ms["bullet"]), bullet_pairs, bullet_exact,
-                  bullet_holds_all ? "" : " MISSES PAIRS");
+    {
+      const auto t = Clock::now();
+      for (int k = 1; k < steps; ++k) {
+        if (broad_phase(scene.models, s.poses[k], 0.0).size() != s.want[k].size()) return false;
+      }
+      m.ms["fresh"].push_back(ms_since(t) / (steps - 1));
+    }
+    {
+      const auto t = Clock::now();
+      for (int k = 1; k < steps; ++k) {
+        if (sweep_along_x(boxes_of(scene, s.poses[k])).size() != s.want[k].size()) return false;
+      }
+      m.ms["sweep"].push_back(ms_since(t) / (steps - 1));
+    }
+    time_bullet(s, steps, round, m);
+  }
+  return true;
+}
+
+/// A row of the table: the objects, the pairs per step, each contender's median and Bullet's pairs.
+std::string table_row(std::size_t n, const Steps& s, const Options& o, const Measured& m) {
+  const int steps = o.steps;
+  double pairs = 0.0;
+  for (int k = 1; k < steps; ++k) pairs += static_cast<double>(s.want[k].size()) / (steps - 1);
+  char cell[512];
+  std::snprintf(cell, sizeof cell, "| %zu | %.0f |", n, pairs);
+  std::string row = cell;
+  for (const int threads : o.thread_counts) {
+    std::snprintf(cell, sizeof cell, " %.2f |", median(m.ms.at("t" + std::to_string(threads))));
     row += cell;
+  }
+  const double first = median(m.ms.at("t" + std::to_string(o.thread_counts[0])));
+  std::snprintf(cell, sizeof cell, " %.2f | %.2f | %.2f | %.2f | %.0f (%.0f)%s |\n", median(m.ms.at("fresh")),
+                median(m.ms.at("sweep")), median(m.ms.at("bullet")), first / median(m.ms.at("bullet")), m.bullet_pairs,
+                m.bullet_exact, m.bullet_holds_all ? "" : " MISSES PAIRS");
+  row += cell;
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Options> o = parse(argc, argv);
+  if (!o) return 2;
+  std::string table = table_head(o->thread_counts);
+  for (const std::size_t n : o->sizes) {
+    const Boxes scene = make_boxes(n);
+    const Steps s = steps_of(scene, o->steps);
+    Measured m;
+    if (!time_rounds(scene, s, *o, m)) return 1;
+    const std::string row = table_row(n, s, *o, m);
     table += row;
     std::fputs(row.c_str(), stdout);
     std::fflush(stdout);
   }
   const std::string head =
-      "Machine: " + bench::machine_description() + ". " + std::to_string(steps) +
-      " steps, milliseconds per step after the first (which builds each structure), medians of " + std::to_string(repeat) +
+      "Machine: " + bench::machine_description() + ". " + std::to_string(o->steps) +
+      " steps, milliseconds per step after the first (which builds each structure), medians of " + std::to_string(o->repeat) +
       " interleaved rounds. Boxes of half-size 0.45 on a jittered cubic grid of spacing 0.9, drifting; caliber's "
       "pairs equal the sweep's at every step (checked); Bullet is given the same boxes (their computation not timed).\n\n";
-  if (!out_path.empty()) std::ofstream(out_path) << head << table;
+  if (!o->out_path.empty()) std::ofstream(o->out_path) << head << table;
   std::printf("\n%s", head.c_str());
   return 0;
 }

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -79,90 +80,117 @@ std::string row(const std::string& name, const std::string& who, const Tally& t)
   return s.str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The options: the meshes' folder, the motions per case, the seed, the report's file, the cases to run and --no-fcl.
+struct Options {
   std::filesystem::path dir = bench::default_meshes_dir();
   int motions = 100;
   unsigned seed = 1;
   std::string out, only;
   bool with_fcl = true;
+};
+
+/// The options of the command line, or none (the usage said on stderr) for one it does not know.
+std::optional<Options> parse(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc)
-      dir = argv[++i];
+      o.dir = argv[++i];
     else if (!std::strcmp(argv[i], "--motions") && i + 1 < argc)
-      motions = std::max(1, std::atoi(argv[++i]));
+      o.motions = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
-      seed = static_cast<unsigned>(std::atoi(argv[++i]));
+      o.seed = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
-      out = argv[++i];
+      o.out = argv[++i];
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc)
-      only = argv[++i];
+      o.only = argv[++i];
     else if (!std::strcmp(argv[i], "--no-fcl"))
-      with_fcl = false;
+      o.with_fcl = false;
     else {
       std::fprintf(stderr,
                    "usage: bench_fcl_ccd [--meshes DIR] [--motions N] [--seed S] [--out FILE.md] [--only NAME] [--no-fcl]\n");
-      return 2;
+      return std::nullopt;
     }
   }
-  std::vector<bench::SweepCase> cases = bench::sweep_cases(dir, only);
-  std::string table =
-      "| case | library | motions | with a sampled contact | contact reported | misses | late | median ms | total ms |\n"
-      "|---|---|---|---|---|---|---|---|---|\n";
-  for (const bench::SweepCase& c : cases) {
-    const auto a = build_model(c.a);
-    const auto b = build_model(c.b);
-    const auto fa = bench::build_fcl(c.a);
-    const auto fb = bench::build_fcl(c.b);
-    bench::SweepMotions next_motion(c, seed);
-    Tally ours, theirs;
-    for (int m = 0; m < motions; ++m) {
-      const SweptPose motion = next_motion.next();
-      const double sampled = first_sampled_contact(*a, *b, motion);
+  return o;
+}
 
-      auto start = std::chrono::steady_clock::now();
-      const SweepResult s = sweep(*a, SweptPose{Pose{}, Pose{}}, *b, motion);
-      const double our_ms = ms_of(start);
-      ours.ms.push_back(our_ms);
-      ours.total_ms += our_ms;
-      count(ours, s.status == SweepStatus::contact, s.time, sampled);
+/// FCL's continuousCollide on one motion of B (A still), timed and counted into `theirs`.
+void fcl_motion(const std::shared_ptr<bench::FclModel>& fa, const std::shared_ptr<bench::FclModel>& fb, const SweptPose& motion,
+                double sampled, Tally& theirs) {
+  fcl::ContinuousCollisionRequestd request;
+  request.ccd_motion_type = fcl::CCDM_LINEAR;
+  request.ccd_solver_type = fcl::CCDC_CONSERVATIVE_ADVANCEMENT;
+  fcl::ContinuousCollisionResultd result;
+  // The motions built with their reference point at the origin: FCL 0.7's InterpMotion(tf1, tf2),
+  // which continuousCollide(geometry, tf_begin, tf_end, ...) builds, leaves that point
+  // uninitialized (and missed every contact here).
+  const fcl::Matrix3d identity = fcl::Matrix3d::Identity();
+  const fcl::Vector3d origin = fcl::Vector3d::Zero();
+  const auto start = std::chrono::steady_clock::now();
+  const fcl::InterpMotion<double> still(identity, origin, identity, origin, origin);
+  const fcl::InterpMotion<double> flight(motion.start.rotation_matrix(), motion.start.translation, motion.end.rotation_matrix(),
+                                         motion.end.translation, origin);
+  fcl::continuousCollide<double>(fa.get(), &still, fb.get(), &flight, request, result);
+  const double fcl_ms = ms_of(start);
+  theirs.ms.push_back(fcl_ms);
+  theirs.total_ms += fcl_ms;
+  count(theirs, result.is_collide, result.time_of_contact, sampled);
+}
 
-      if (!with_fcl) continue;
-      fcl::ContinuousCollisionRequestd request;
-      request.ccd_motion_type = fcl::CCDM_LINEAR;
-      request.ccd_solver_type = fcl::CCDC_CONSERVATIVE_ADVANCEMENT;
-      fcl::ContinuousCollisionResultd result;
-      // The motions built with their reference point at the origin: FCL 0.7's InterpMotion(tf1, tf2),
-      // which continuousCollide(geometry, tf_begin, tf_end, ...) builds, leaves that point
-      // uninitialized (and missed every contact here).
-      const fcl::Matrix3d identity = fcl::Matrix3d::Identity();
-      const fcl::Vector3d origin = fcl::Vector3d::Zero();
-      start = std::chrono::steady_clock::now();
-      const fcl::InterpMotion<double> still(identity, origin, identity, origin, origin);
-      const fcl::InterpMotion<double> flight(motion.start.rotation_matrix(), motion.start.translation,
-                                             motion.end.rotation_matrix(), motion.end.translation, origin);
-      fcl::continuousCollide<double>(fa.get(), &still, fb.get(), &flight, request, result);
-      const double fcl_ms = ms_of(start);
-      theirs.ms.push_back(fcl_ms);
-      theirs.total_ms += fcl_ms;
-      count(theirs, result.is_collide, result.time_of_contact, sampled);
-    }
-    table += row(c.name + " (" + std::to_string(c.a.triangles.size()) + " x " + std::to_string(c.b.triangles.size()) + ")",
-                 "caliber", ours);
-    if (with_fcl) table += row("", "FCL 0.7 (CA, OBBRSS)", theirs);
-    std::fprintf(stderr, "%s done\n", c.name.c_str());
+/// One case: each motion sampled, then swept by caliber, then (unless --no-fcl) by FCL; its rows added to `table`.
+void run_case(const bench::SweepCase& c, const Options& o, std::string& table) {
+  const auto a = build_model(c.a);
+  const auto b = build_model(c.b);
+  const auto fa = bench::build_fcl(c.a);
+  const auto fb = bench::build_fcl(c.b);
+  bench::SweepMotions next_motion(c, o.seed);
+  Tally ours, theirs;
+  for (int m = 0; m < o.motions; ++m) {
+    const SweptPose motion = next_motion.next();
+    const double sampled = first_sampled_contact(*a, *b, motion);
+
+    const auto start = std::chrono::steady_clock::now();
+    const SweepResult s = sweep(*a, SweptPose{Pose{}, Pose{}}, *b, motion);
+    const double our_ms = ms_of(start);
+    ours.ms.push_back(our_ms);
+    ours.total_ms += our_ms;
+    count(ours, s.status == SweepStatus::contact, s.time, sampled);
+
+    if (!o.with_fcl) continue;
+    fcl_motion(fa, fb, motion, sampled, theirs);
   }
+  table += row(c.name + " (" + std::to_string(c.a.triangles.size()) + " x " + std::to_string(c.b.triangles.size()) + ")",
+               "caliber", ours);
+  if (o.with_fcl) table += row("", "FCL 0.7 (CA, OBBRSS)", theirs);
+  std::fprintf(stderr, "%s done\n", c.name.c_str());
+}
+
+/// The report: the machine, the command line, what is measured, then the table.
+std::string report_of(const Options& o, const std::string& table) {
   std::ostringstream report;
-  report << "Machine: " << bench::machine_description() << ". `bench_fcl_ccd --motions " << motions << " --seed " << seed
-         << (only.empty() ? "" : " --only '" + only + "'") << (with_fcl ? "" : " --no-fcl")
+  report << "Machine: " << bench::machine_description() << ". `bench_fcl_ccd --motions " << o.motions << " --seed " << o.seed
+         << (o.only.empty() ? "" : " --only '" + o.only + "'") << (o.with_fcl ? "" : " --no-fcl")
          << "`: A still, B flying through or past A between two random poses (turned up to 90 degrees), caliber::sweep "
             "(default tolerance) against FCL's continuousCollide (conservative advancement, InterpMotion about the origin, "
             "default toc_err); "
             "truth: 1,001 sampled times with the exact interference test. misses: no contact reported where one was "
             "sampled; late: a time of contact after the first sampled one.\n\n"
          << table;
-  std::printf("%s", report.str().c_str());
-  if (!out.empty()) std::ofstream(out) << report.str();
+  return report.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Options> o = parse(argc, argv);
+  if (!o) return 2;
+  std::vector<bench::SweepCase> cases = bench::sweep_cases(o->dir, o->only);
+  std::string table =
+      "| case | library | motions | with a sampled contact | contact reported | misses | late | median ms | total ms |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
+  for (const bench::SweepCase& c : cases) run_case(c, *o, table);
+  const std::string report = report_of(*o, table);
+  std::printf("%s", report.c_str());
+  if (!o->out.empty()) std::ofstream(o->out) << report;
   return 0;
 }

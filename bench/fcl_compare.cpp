@@ -17,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -246,34 +247,63 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
-int main(int argc, char** argv) {
+namespace {
+
+/// The options: the meshes' folder, the report's file, the rounds, the scenes and their steps, and --no-mesh-pairs.
+struct Options {
   std::filesystem::path dir = caliber::bench::default_meshes_dir();
   std::string out;
   int repeat = 5;
   std::vector<std::string> scenes;
   std::vector<int> steps = {0, 50, 100};
   bool meshes = true;
+};
+
+/// The options of the command line, or none (the usage said on stderr) for one it does not know.
+std::optional<Options> parse(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc)
-      dir = argv[++i];
+      o.dir = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::max(1, std::atoi(argv[++i]));
+      o.repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
-      out = argv[++i];
+      o.out = argv[++i];
     else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc)
-      scenes = split_list(argv[++i]);
+      o.scenes = split_list(argv[++i]);
     else if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) {
-      steps.clear();
-      for (const std::string& k : split_list(argv[++i])) steps.push_back(std::atoi(k.c_str()));
+      o.steps.clear();
+      for (const std::string& k : split_list(argv[++i])) o.steps.push_back(std::atoi(k.c_str()));
     } else if (!std::strcmp(argv[i], "--no-mesh-pairs"))
-      meshes = false;
+      o.meshes = false;
     else {
       std::fprintf(stderr,
                    "usage: bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md] [--scenes A.json,B.json] "
                    "[--steps 0,50,100] [--no-mesh-pairs]\n");
-      return 2;
+      return std::nullopt;
     }
   }
+  return o;
+}
+
+/// Writes the report to `o.out`: the machine, the method, then the table.
+void write_report(const Options& o, const std::string& table) {
+  std::ofstream file(o.out);
+  file << "# caliber vs FCL 0.7 (BVHModel<OBBRSS>), sequential interference, all contacts\n\n"
+       << "Machine: " << caliber::bench::machine_description() << "\n\n"
+       << "Medians of " << o.repeat << " runs. Ratios are ours / FCL (lower is better for us). "
+       << "Build: caliber's sphere tree without adjacency vs FCL's OBBRSS build (scenes: every distinct model, "
+       << "summed). Scene rows: every candidate pair of the broad phase at that step, times summed; "
+       << "triangles = the scene's distinct models.\n\n"
+       << table;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Options> o = parse(argc, argv);
+  if (!o) return 2;
+  const std::filesystem::path& dir = o->dir;
   // Rotated, overlapping copies: the meshes' sizes differ, so offsets are in each mesh's units.
   const std::vector<Case> cases = {
       {"armadillo x armadillo", "armadillo.off", "armadillo.off", 30, {1, 2, 0.5}, {0.05, 0.03, -0.02}},
@@ -291,41 +321,32 @@ int main(int argc, char** argv) {
   table += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::printf("machine: %s\n", caliber::bench::machine_description().c_str());
   int skipped = 0;
-  for (const Case& c : meshes ? cases : std::vector<Case>{}) {
+  for (const Case& c : o->meshes ? cases : std::vector<Case>{}) {
     if (!std::filesystem::exists(dir / c.mesh_a) || !std::filesystem::exists(dir / c.mesh_b)) {
       std::fprintf(stderr, "skipping %s: meshes missing in %s (run scripts/fetch_meshes.sh)\n", c.name.c_str(), dir.c_str());
       ++skipped;
       continue;
     }
-    const std::string line = format_row(run_case(c, dir, repeat), false);
+    const std::string line = format_row(run_case(c, dir, o->repeat), false);
     std::fputs(line.c_str(), stdout);
     std::fflush(stdout);
     table += line;
   }
-  for (const std::string& scene : scenes) {
-    for (const Row& r : run_scene(scene, steps, repeat)) {
+  for (const std::string& scene : o->scenes) {
+    for (const Row& r : run_scene(scene, o->steps, o->repeat)) {
       const std::string line = format_row(r, true);
       std::fputs(line.c_str(), stdout);
       std::fflush(stdout);
       table += line;
     }
   }
-  if (meshes && skipped == static_cast<int>(cases.size()) && scenes.empty()) {
+  if (o->meshes && skipped == static_cast<int>(cases.size()) && o->scenes.empty()) {
     std::fprintf(stderr,
                  "bench_fcl_compare: none of the meshes is in %s and no --scenes were given: nothing to compare "
                  "(run scripts/fetch_meshes.sh, or pass --meshes DIR)\n",
                  dir.c_str());
     return 2;
   }
-  if (!out.empty()) {
-    std::ofstream file(out);
-    file << "# caliber vs FCL 0.7 (BVHModel<OBBRSS>), sequential interference, all contacts\n\n"
-         << "Machine: " << caliber::bench::machine_description() << "\n\n"
-         << "Medians of " << repeat << " runs. Ratios are ours / FCL (lower is better for us). "
-         << "Build: caliber's sphere tree without adjacency vs FCL's OBBRSS build (scenes: every distinct model, "
-         << "summed). Scene rows: every candidate pair of the broad phase at that step, times summed; "
-         << "triangles = the scene's distinct models.\n\n"
-         << table;
-  }
+  if (!o->out.empty()) write_report(*o, table);
   return 0;
 }

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -138,32 +139,94 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
   return row;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+/// The options: the meshes' folder, the rounds, the report's file, the cases to run (by name), and --warm and --ours-only.
+struct Options {
   std::filesystem::path dir = bench::default_meshes_dir();
   int repeat = 7;
   std::string out, only;
   bool ours_only = false, warm = false;
+};
+
+/// The options of the command line, or none (the usage said on stderr) for one it does not know.
+std::optional<Options> parse(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--meshes") && i + 1 < argc)
-      dir = argv[++i];
+      o.dir = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc)
-      repeat = std::max(1, std::atoi(argv[++i]));
+      o.repeat = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
-      out = argv[++i];
+      o.out = argv[++i];
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc)
-      only = argv[++i];
+      o.only = argv[++i];
     else if (!std::strcmp(argv[i], "--ours-only"))
-      ours_only = true;
+      o.ours_only = true;
     else if (!std::strcmp(argv[i], "--warm"))
-      warm = true;
+      o.warm = true;
     else {
       std::fprintf(
           stderr, "usage: bench_fcl_distance [--meshes DIR] [--repeat R] [--out FILE.md] [--only NAME] [--warm] [--ours-only]\n");
-      return 2;
+      return std::nullopt;
     }
   }
+  return o;
+}
+
+/// --ours-only on one case: caliber's query alone at each gap, its median time and work printed.
+void run_ours_only(const Case& c, const Model& a, const Model& b, int repeat) {
+  for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
+    const Pose pose_b = place(c, a.mesh(), b.mesh(), gap);
+    const QueryRequest request = distance_request();
+    QueryResult ours;
+    const double ms = bench::median_ms(repeat, [&] { ours = query(a, Pose{}, b, pose_b, request); });
+    std::printf("%s gap %g: %.12g in %.4f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,
+                ours.contacts.front().distance, ms, repeat, static_cast<unsigned long long>(ours.stats.node_tests),
+                static_cast<unsigned long long>(ours.stats.leaf_tests));
+  }
+}
+
+/// A line of the table: both distances, their relative difference, the pair, the times and the work.
+std::string format_row(const Row& r) {
+  const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);
+  char line[512];
+  std::snprintf(line, sizeof line, "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n",
+                r.name.c_str(), r.gap, r.ours, r.fcl, rel, r.same_pair ? "yes" : "no", r.ours_ms, r.fcl_ms, r.ours_ms / r.fcl_ms,
+                static_cast<unsigned long long>(r.node_tests), static_cast<unsigned long long>(r.leaf_tests),
+                static_cast<unsigned long long>(r.fcl_node_tests), static_cast<unsigned long long>(r.fcl_leaf_tests));
+  return line;
+}
+
+/// One case against FCL at each gap: its lines printed and added to `table`.
+void run_with_fcl(const Case& c, const std::shared_ptr<const Model>& a, const std::shared_ptr<const Model>& b, const Options& o,
+                  std::string& table) {
+  const auto fa = bench::build_fcl(a->mesh());
+  const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh());
+  for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
+    const std::string line = format_row(run(c, gap, *a, *b, fa, fb, o.repeat, o.warm));
+    table += line;
+    std::fputs(line.c_str(), stdout);
+    std::fflush(stdout);
+  }
+}
+
+/// Writes the report to `o.out`: the machine, the method, then the table.
+void write_report(const Options& o, const std::string& table) {
+  std::ofstream f(o.out);
+  f << "# Distance query against FCL\n\n"
+    << caliber::bench::machine_description() << "\n\n"
+    << "caliber::query (QueryKind::distance, unbounded) against fcl::distance (BVHModel<OBBRSS>, rel_err = abs_err = 0, "
+       "nearest points on); B turned, then moved along +x to start `gap` × A's box diagonal beyond A's box. Times: median of "
+    << o.repeat << " rounds, each timing one caliber query then one FCL query"
+    << (o.warm ? ", each right after an untimed run of itself (--warm)" : ", each right after the other library's (alternating)")
+    << ".\n\n"
+    << table;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Options> o = parse(argc, argv);
+  if (!o) return 2;
   const std::vector<Case> cases = {
       {"bunny x bunny", "bunny00.off", "bunny00.off", 25, {0, 1, 1}},
       {"armadillo x armadillo", "armadillo.off", "armadillo.off", 30, {1, 2, 0.5}},
@@ -180,59 +243,27 @@ int main(int argc, char** argv) {
   bvh_only.oriented_boxes = true;  // as the CLI and scenes build for distance queries
   int selected = 0;
   for (const Case& c : cases) {
-    if (c.name.find(only) == std::string::npos) continue;
+    if (c.name.find(o->only) == std::string::npos) continue;
     ++selected;
     for (const std::string& mesh : {c.mesh_a, c.mesh_b}) {
-      if (!std::filesystem::exists(dir / mesh)) {
+      if (!std::filesystem::exists(o->dir / mesh)) {
         std::fprintf(stderr, "bench_fcl_distance: %s is missing (run scripts/fetch_meshes.sh, or pass --meshes DIR)\n",
-                     (dir / mesh).c_str());
+                     (o->dir / mesh).c_str());
         return 2;
       }
     }
-    const auto a = build_model(load_mesh(dir / c.mesh_a), bvh_only);
-    const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(dir / c.mesh_b), bvh_only);
-    if (ours_only) {
-      for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
-        const Pose pose_b = place(c, a->mesh(), b->mesh(), gap);
-        const QueryRequest request = distance_request();
-        QueryResult ours;
-        const double ms = bench::median_ms(repeat, [&] { ours = query(*a, Pose{}, *b, pose_b, request); });
-        std::printf("%s gap %g: %.12g in %.4f ms (median of %d), %llu node tests, %llu leaf tests\n", c.name.c_str(), gap,
-                    ours.contacts.front().distance, ms, repeat, static_cast<unsigned long long>(ours.stats.node_tests),
-                    static_cast<unsigned long long>(ours.stats.leaf_tests));
-      }
+    const auto a = build_model(load_mesh(o->dir / c.mesh_a), bvh_only);
+    const auto b = c.mesh_b == c.mesh_a ? a : build_model(load_mesh(o->dir / c.mesh_b), bvh_only);
+    if (o->ours_only) {
+      run_ours_only(c, *a, *b, o->repeat);
       continue;
     }
-    const auto fa = bench::build_fcl(a->mesh());
-    const auto fb = c.mesh_b == c.mesh_a ? fa : bench::build_fcl(b->mesh());
-    for (const double gap : {1e-6, 1e-3, 1e-2, 0.1, 1.0}) {
-      const Row r = run(c, gap, *a, *b, fa, fb, repeat, warm);
-      const double rel = std::abs(r.ours - r.fcl) / std::max(std::abs(r.fcl), 1e-300);
-      char line[512];
-      std::snprintf(line, sizeof line,
-                    "| %s | %g | %.12g | %.12g | %.2e | %s | %.3f | %.3f | %.2f | %llu | %llu | %llu | %llu |\n", r.name.c_str(),
-                    r.gap, r.ours, r.fcl, rel, r.same_pair ? "yes" : "no", r.ours_ms, r.fcl_ms, r.ours_ms / r.fcl_ms,
-                    static_cast<unsigned long long>(r.node_tests), static_cast<unsigned long long>(r.leaf_tests),
-                    static_cast<unsigned long long>(r.fcl_node_tests), static_cast<unsigned long long>(r.fcl_leaf_tests));
-      table += line;
-      std::fputs(line, stdout);
-      std::fflush(stdout);
-    }
+    run_with_fcl(c, a, b, *o, table);
   }
   if (selected == 0) {
-    std::fprintf(stderr, "bench_fcl_distance: no case's name contains \"%s\" (--only)\n", only.c_str());
+    std::fprintf(stderr, "bench_fcl_distance: no case's name contains \"%s\" (--only)\n", o->only.c_str());
     return 2;
   }
-  if (!out.empty()) {
-    std::ofstream f(out);
-    f << "# Distance query against FCL\n\n"
-      << caliber::bench::machine_description() << "\n\n"
-      << "caliber::query (QueryKind::distance, unbounded) against fcl::distance (BVHModel<OBBRSS>, rel_err = abs_err = 0, "
-         "nearest points on); B turned, then moved along +x to start `gap` × A's box diagonal beyond A's box. Times: median of "
-      << repeat << " rounds, each timing one caliber query then one FCL query"
-      << (warm ? ", each right after an untimed run of itself (--warm)" : ", each right after the other library's (alternating)")
-      << ".\n\n"
-      << table;
-  }
+  if (!o->out.empty()) write_report(*o, table);
   return 0;
 }
