@@ -12,6 +12,8 @@
 
 #include "caliber/error.h"
 #include "bvh/model_data.h"
+#include "bvh/validate.h"
+#include "util/assert.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
 #include "bvh/split.h"
@@ -387,6 +389,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
     parallel::Executor executor(options.threads);
     executor.execute([&] { out = build_on_this_thread(std::move(mesh), options); });
   }
+  CALIBER_ASSERT(bvh::bvh_problem(*out).empty(), "a built BVH keeps its invariants (bvh/validate.h)");
   return out;
 }
 

@@ -29,6 +29,7 @@
 #include "schedule/runner.h"
 #include "schedule/workers.h"
 #include "tasks/plan.h"
+#include "tasks/validate.h"
 #include "util/assert.h"
 #include "util/timing.h"
 
@@ -215,6 +216,7 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
             [&](std::size_t pair, const std::function<void()>& stage) { timeline.record(TaskSpan::Phase::stage, pair, stage); });
       }
       record.calibrate_ms = util::ms_since(planning);
+      CALIBER_ASSERT(tasks::plan_problem(run.plan, n).empty(), "a plan keeps its invariants (tasks/validate.h)");
       run.stage_root_tests = schedule::run_plan(run.plan, state, record);
     }
     // Each thread's node tests: its slots summed, in parallel when there are many (threads x pairs

@@ -14,6 +14,7 @@
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 #include "tasks/plan.h"
+#include "tasks/validate.h"
 #include "tasks/weights.h"
 
 namespace caliber::tasks {
@@ -68,6 +69,7 @@ std::vector<std::pair<std::vector<TrianglePair>, std::uint64_t>> run_serially(co
 }
 
 void expect_covers_like_query(const Plan& plan, const Pairs& p, const std::string& what) {
+  EXPECT_EQ(plan_problem(plan, p.pairs.size()), "") << what;
   const auto got = run_serially(plan, p);
   for (std::size_t i = 0; i < p.pairs.size(); ++i) {
     const ObjectPair t = p.pairs[i];
@@ -109,6 +111,34 @@ TEST(Plans, APrioriSplitsTheHeavyPairAndCoversItOnce) {
     return x.weight > y.weight;
   })) << "handed out heaviest first";
   expect_covers_like_query(plan, p, "apriori");
+}
+
+// plan_problem finds each kind of broken plan it names, and none in the plans the methods make.
+TEST(Plans, ProblemsOfBrokenPlansAreFound) {
+  const Pairs p;
+  EngineOptions options;
+  options.method = Method::apriori;
+  options.threads = 8;
+  const Plan good = plan_calibrated(options, p.pairs, p.contexts, History{});
+  ASSERT_EQ(plan_problem(good, p.pairs.size()), "");
+  ASSERT_GE(good.split, 1u);
+  const auto broken = [&](auto&& change) {
+    Plan plan = good;
+    change(plan);
+    return plan_problem(plan, p.pairs.size());
+  };
+  const auto first_root = [](Plan& plan) -> Root& { return const_cast<Root&>(plan.run.front().roots[0]); };
+  EXPECT_NE(broken([](Plan& plan) { plan.run.front().roots = RootList{}; }), "");
+  EXPECT_NE(broken([](Plan& plan) { plan.run.front().weight = -1.0; }), "");
+  EXPECT_NE(broken([](Plan& plan) { plan.run.front().weight += 1.0; }), "") << "the sum of the roots' weights";
+  EXPECT_NE(broken([&](Plan& plan) { first_root(plan).pair = 7; }), "");
+  EXPECT_NE(broken([&](Plan& plan) { first_root(plan).taboo = 3; }), "");
+  EXPECT_NE(broken([&](Plan& plan) { first_root(plan).stage = 1 << 20; }), "");
+  EXPECT_NE(broken([](Plan& plan) { plan.splits.pop_back(); }), "");
+  EXPECT_NE(broken([](Plan& plan) { plan.run.push_back(plan_pairs(2).run[1]); }), "") << "a pair run from its root twice";
+  EXPECT_NE(broken([](Plan& plan) { plan.run.push_back(plan_pairs(1).run[0]); }), "") << "a split pair run from its root";
+  EXPECT_EQ(plan_problem(plan_pairs(3), 3), "");
+  EXPECT_NE(plan_problem(plan_pairs(2), 3), "") << "a pair never run";
 }
 
 TEST(Plans, HybridScalesByLastStepsNodeTests) {

@@ -1,0 +1,78 @@
+// The one-pass check of a built BVH's invariants (validate.h).
+
+#include "bvh/validate.h"
+
+#include <vector>
+
+namespace caliber::bvh {
+namespace {
+
+/// Why leaf `i`'s volumes do not hold the vertices of its triangle (empty when they do).
+std::string leaf_problem(const ModelData& m, std::uint32_t i) {
+  const BvhNode& n = m.nodes[i];
+  const BvhNodeFilter& f = m.filters[i];
+  const Eigen::Vector3d c(n.center[0], n.center[1], n.center[2]);
+  const Eigen::Vector3d bc(n.box_center[0], n.box_center[1], n.box_center[2]);
+  const Eigen::Vector3d bh(n.box_half[0], n.box_half[1], n.box_half[2]);
+  const Eigen::Vector3d axis(f.cone_axis[0], f.cone_axis[1], f.cone_axis[2]);
+  for (const std::uint32_t v : m.mesh.triangles[n.index]) {
+    const Eigen::Vector3d p = m.mesh.vertices[v] - m.origin;
+    if (!((p - c).norm() <= n.radius)) return "leaf " + std::to_string(i) + ": its sphere misses a vertex";
+    if (!((p - bc).cwiseAbs().array() <= bh.array()).all()) return "leaf " + std::to_string(i) + ": its box misses a vertex";
+    const double along = axis.dot(p);
+    if (!(f.slab_lo <= along && along <= f.slab_hi)) return "leaf " + std::to_string(i) + ": its slab misses a vertex";
+  }
+  return {};
+}
+
+/// Why inner node `i`'s children do not fit it (empty when they do).
+std::string children_problem(const ModelData& m, std::uint32_t i) {
+  const BvhNode& n = m.nodes[i];
+  const std::size_t size = m.nodes.size();
+  if (n.index <= i || n.index + 1 >= size) return "node " + std::to_string(i) + ": children out of range or before it";
+  const BvhNode &a = m.nodes[n.index], &b = m.nodes[n.index + 1];
+  if (a.count + b.count != n.count) return "node " + std::to_string(i) + ": its children's counts do not add up";
+  if (m.first_leaf[n.index] != m.first_leaf[i] || m.first_leaf[n.index + 1] != m.first_leaf[i] + a.count) {
+    return "node " + std::to_string(i) + ": its children are not the two halves of its run of leaves";
+  }
+  if ((m.filters[n.index].groups | m.filters[n.index + 1].groups) != m.filters[i].groups) {
+    return "node " + std::to_string(i) + ": its group mask is not its children's";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string bvh_problem(const ModelData& m) {
+  const std::size_t triangles = m.mesh.triangles.size(), size = m.nodes.size();
+  if (triangles == 0) return "no triangle";
+  if (size != 2 * triangles - 1 || m.filters.size() != size || m.laterals.size() != size || m.first_leaf.size() != size ||
+      m.leaf_position.size() != triangles) {
+    return "the node arrays do not have 2n - 1 entries for n triangles";
+  }
+  if (m.nodes[0].count != triangles || m.first_leaf[0] != 0) return "the root does not hold every triangle";
+  std::vector<std::uint8_t> reached(size, 0), placed(triangles, 0);
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t i = stack.back();
+    stack.pop_back();
+    if (reached[i]++ != 0) return "node " + std::to_string(i) + " is reached twice";
+    const BvhNode& n = m.nodes[i];
+    if (n.is_leaf()) {
+      if (n.index >= triangles || placed[n.index]++ != 0) return "leaf " + std::to_string(i) + ": a bad or repeated triangle";
+      if (m.leaf_position[n.index] != m.first_leaf[i]) return "leaf " + std::to_string(i) + ": not at its triangle's place";
+      if (std::string p = leaf_problem(m, i); !p.empty()) return p;
+      continue;
+    }
+    if (n.count < 2) return "node " + std::to_string(i) + ": an inner node of fewer than two triangles";
+    if (std::string p = children_problem(m, i); !p.empty()) return p;
+    stack.push_back(n.index);
+    stack.push_back(n.index + 1);
+  }
+  for (std::size_t i = 0; i < size; ++i) {
+    if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
+  }
+  return {};
+}
+
+}  // namespace caliber::bvh

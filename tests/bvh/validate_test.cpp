@@ -1,0 +1,61 @@
+// bvh_problem (bvh/validate.h): none on built models, and each kind of broken BVH it names found.
+
+#include <functional>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bvh/model_data.h"
+#include "bvh/validate.h"
+#include "caliber/procedural.h"
+
+namespace caliber {
+namespace {
+
+TEST(BvhProblem, NoneOnBuiltModels) {
+  for (const Mesh& mesh : {make_torus(1.0, 0.3, 24, 16), make_sphere(0.5, 8, 12), make_box(1.0, 2.0, 3.0, 3)}) {
+    EXPECT_EQ(bvh::bvh_problem(data(*build_model(mesh))), "");
+  }
+  // A mesh far from its own origin: volumes relative to ModelData::origin.
+  Mesh far = make_box(0.1, 0.1, 0.1, 2);
+  for (auto& v : far.vertices) v += Eigen::Vector3d(3e6, -1e6, 5e5);
+  EXPECT_EQ(bvh::bvh_problem(data(*build_model(far))), "");
+}
+
+TEST(BvhProblem, EachBreakIsFound) {
+  const auto model = build_model(make_torus(1.0, 0.3, 24, 16));
+  ModelData& m = const_cast<ModelData&>(data(*model));
+  // Each change is undone after it is checked.
+  const auto broken = [&](auto&& change) {
+    const std::vector<BvhNode> nodes = m.nodes;
+    const std::vector<BvhNodeFilter> filters = m.filters;
+    const std::vector<std::uint32_t> first_leaf = m.first_leaf, leaf_position = m.leaf_position;
+    change();
+    const std::string problem = bvh::bvh_problem(m);
+    m.nodes = nodes;
+    m.filters = filters;
+    m.first_leaf = first_leaf;
+    m.leaf_position = leaf_position;
+    return problem;
+  };
+  std::uint32_t leaf = 0, inner = 1;  // the first leaf, and the first inner node below the root
+  while (!m.nodes[leaf].is_leaf()) ++leaf;
+  while (m.nodes[inner].is_leaf()) ++inner;
+  EXPECT_NE(broken([&] { m.nodes[leaf].radius *= 0.5f; }), "");
+  EXPECT_NE(broken([&] { m.nodes[leaf].box_half[1] = 0.0f; }), "");
+  EXPECT_NE(broken([&] { m.filters[leaf].slab_hi = m.filters[leaf].slab_lo - 1.0f; }), "");
+  EXPECT_NE(broken([&] { m.nodes[inner].count += 1; }), "");
+  EXPECT_NE(broken([&] { m.nodes[inner].index = inner; }), "") << "a child before its parent";
+  EXPECT_NE(broken([&] { m.first_leaf[m.nodes[inner].index + 1] += 1; }), "");
+  EXPECT_NE(broken([&] { m.filters[inner].groups ^= 2; }), "");
+  EXPECT_NE(broken([&] { m.nodes.pop_back(); }), "");
+  std::uint32_t other = leaf + 1;
+  while (!m.nodes[other].is_leaf()) ++other;
+  EXPECT_NE(broken([&] { m.nodes[other].index = m.nodes[leaf].index; }), "") << "a triangle in two leaves";
+  EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
+}
+
+}  // namespace
+}  // namespace caliber
