@@ -1,6 +1,6 @@
 // How well the a priori weight predicts the work below a CD node: for every pair of each scene at
 // a few steps, a full traversal records, for each CD node whose test passed, its a priori weight
-// (tasks::apriori_weight) and the node tests its subtree took; prints the Pearson correlation of
+// (plans::apriori_weight) and the node tests its subtree took; prints the Pearson correlation of
 // their logarithms over the nodes with at least 10, 100 and 1,000 tests. Deterministic (counts,
 // not times). Calibration only compares weights, so the correlation of logs is what matters.
 //   bench_weight_estimates SCENE.json... [--steps K]   (K sampled steps, 10 apart; default 3)
@@ -14,7 +14,7 @@
 #include "caliber/world.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
 namespace {
 
@@ -35,7 +35,7 @@ double below(const caliber::narrow::PairContext& ctx, caliber::narrow::NodePair 
     tests += 1.0;
     if (caliber::narrow::child_test(ctx, n, kids[k])) tests += below(ctx, kids[k], out);
   }
-  out.push_back({caliber::tasks::apriori_weight(ctx, n), tests + 1.0});
+  out.push_back({caliber::plans::apriori_weight(ctx, n), tests + 1.0});
   return tests;
 }
 

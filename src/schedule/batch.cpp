@@ -54,7 +54,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   options.threads = mImpl->executor.threads();
   // Entries are not objects that persist from call to call: the calibrated methods plan with no
   // history, and the engine's is left as it is.
-  const tasks::History no_history;
+  const plans::History no_history;
   std::vector<QueryResult> results;
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {

@@ -1,7 +1,7 @@
 // The engine: one traversal (narrow/traversal.h), several ways to cut and schedule it.
 //   sequential    the pairs one after another, on one thread          (plan: whole pairs)
 //   exploitation  the pairs handed out in order to the threads         (plan: whole pairs)
-//   aposteriori, apriori, hybrid   task calibration                    (plan: tasks/plan.h)
+//   aposteriori, apriori, hybrid   task calibration                    (plan: plans/plan.h)
 //   stealing      every pair's CD tree split recursively into tasks    (its own runner)
 // Every plan goes through one runner (schedule/runner.h); threads are reached only through
 // parallel/executor.h. All methods end with the same per-pair finalization and the same
@@ -28,8 +28,8 @@
 #include "schedule/engine_impl.h"
 #include "schedule/runner.h"
 #include "schedule/workers.h"
-#include "tasks/plan.h"
-#include "tasks/validate.h"
+#include "plans/plan.h"
+#include "plans/validate.h"
 #include "util/assert.h"
 #include "util/timing.h"
 
@@ -116,7 +116,7 @@ int Engine::threads() const { return mImpl->executor.threads(); }
 
 void Engine::forget() {
   const schedule::OneCallAtATime hold(mImpl->busy, "forget");
-  mImpl->history = tasks::History{};
+  mImpl->history = plans::History{};
   mImpl->broad = broad::State{};
 }
 
@@ -158,7 +158,7 @@ void reset_keeping_storage(ScheduleRecord& r) {
 
 /// After a step: what the temporal methods keep of each pair for the next one.
 void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
-              const tasks::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, tasks::History& history) {
+              const plans::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, plans::History& history) {
   // Only what the method reads next step: the other methods keep nothing per pair.
   if (options.method != Method::hybrid && options.method != Method::aposteriori) return;
   history.node_tests.reset(pairs);
@@ -174,7 +174,7 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
   if (options.method == Method::hybrid && options.node_history) {
     history.node_counts.clear();
     for (std::size_t s = 0; s < plan.splits.size(); ++s) {
-      history.node_counts[pairs[plan.split_pairs[s]]] = tasks::subtree_counts(plan.splits[s].stage, stage_root_tests[s]);
+      history.node_counts[pairs[plan.split_pairs[s]]] = plans::subtree_counts(plan.splits[s].stage, stage_root_tests[s]);
     }
   }
 }
@@ -182,7 +182,7 @@ void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs
 }  // namespace
 
 schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method method, const std::vector<ObjectPair>& pairs,
-                                           const QueryRequest& request, const tasks::History& plan_history,
+                                           const QueryRequest& request, const plans::History& plan_history,
                                            const std::function<void(std::size_t, void*)>& make, std::vector<QueryResult>& results,
                                            ScheduleRecord& record, std::span<const double> nearest) {
   const std::size_t n = pairs.size();
@@ -209,14 +209,14 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
       const auto planning = util::Clock::now();
       // Cut for one thread, the calibrated methods have nothing to balance either: a task per pair.
       if (method == Method::sequential || method == Method::exploitation || cut_threads <= 1) {
-        run.plan = tasks::plan_pairs(n);
+        run.plan = plans::plan_pairs(n);
       } else {
-        run.plan = tasks::plan_calibrated(
+        run.plan = plans::plan_calibrated(
             options, pairs, state.contexts, plan_history,
             [&](std::size_t pair, const std::function<void()>& stage) { timeline.record(TaskSpan::Phase::stage, pair, stage); });
       }
       record.calibrate_ms = util::ms_since(planning);
-      CALIBER_ASSERT(tasks::plan_problem(run.plan, n).empty(), "a plan keeps its invariants (tasks/validate.h)");
+      CALIBER_ASSERT(plans::plan_problem(run.plan, n).empty(), "a plan keeps its invariants (plans/validate.h)");
       run.stage_root_tests = schedule::run_plan(run.plan, state, record);
     }
     // Each thread's node tests: its slots summed, in parallel when there are many (threads x pairs

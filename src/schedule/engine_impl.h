@@ -24,7 +24,7 @@
 #include "narrow/sweep_bounds.h"
 #include "parallel/executor.h"
 #include "schedule/workers.h"
-#include "tasks/plan.h"
+#include "plans/plan.h"
 
 namespace caliber::schedule {
 
@@ -83,9 +83,9 @@ class OneCallAtATime {
 };
 
 /// What one run of the method over a set of pairs leaves besides their results: the plan, and per
-/// split of the plan the weight-driven stage's root counts (tasks::subtree_counts reads them).
+/// split of the plan the weight-driven stage's root counts (plans::subtree_counts reads them).
 struct PairsRun {
-  tasks::Plan plan;
+  plans::Plan plan;
   std::vector<std::vector<std::uint64_t>> stage_root_tests;
   std::vector<std::size_t> candidates;  ///< per pair: the candidates its finalization took in
 };
@@ -151,7 +151,7 @@ struct Engine::Impl {
   /// run_pairs calls so far: the workers' slots hold the work of run `runs` (StepState::run).
   std::uint64_t runs = 0;
   /// What the temporal methods remember of each pair. Changes only how work is cut.
-  tasks::History history;
+  plans::History history;
   /// Who ran what when, this step (EngineOptions::timeline).
   schedule::Timeline timeline;
   schedule::ContextStore contexts;
@@ -170,7 +170,7 @@ struct Engine::Impl {
   /// exported.)
   [[gnu::visibility("hidden")]] schedule::PairsRun run_pairs(const EngineOptions& options, Method method,
                                                              const std::vector<ObjectPair>& pairs, const QueryRequest& request,
-                                                             const tasks::History& history,
+                                                             const plans::History& history,
                                                              const std::function<void(std::size_t, void*)>& make,
                                                              std::vector<QueryResult>& results, ScheduleRecord& record,
                                                              std::span<const double> nearest = {});

@@ -45,7 +45,7 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
   const bool can_split = threads > 1 && method != Method::sequential && method != Method::exploitation;
   std::vector<std::size_t> active(jobs.size()), whole, split;
   std::iota(active.begin(), active.end(), std::size_t{0});
-  const tasks::History no_history;
+  const plans::History no_history;
   std::vector<QueryResult> results;
   bool started = false;  // whether work was done (the hook is called between chunks of it)
   while (!active.empty()) {

@@ -22,12 +22,12 @@ void finalize_into(StepState& state, std::size_t i, std::vector<narrow::Candidat
 /// list, is finalized by that task as soon as it is traversed (its candidates are all in that
 /// thread's slots): no second pass over it. Returns per pair 1 for those; `rest` gets the others,
 /// finalized once every task is done.
-std::vector<std::uint8_t> whole_pairs(const tasks::Plan& plan, const std::vector<std::size_t>& split_of,
+std::vector<std::uint8_t> whole_pairs(const plans::Plan& plan, const std::vector<std::size_t>& split_of,
                                       std::vector<std::uint32_t>& rest) {
   const std::size_t n = split_of.size();
   std::vector<std::uint8_t> roots_of(n, 0);  // 0: none seen, 1: one from the top, 2: otherwise
-  for (const tasks::RunTask& task : plan.run) {
-    for (const tasks::Root& root : task.roots) {
+  for (const plans::RunTask& task : plan.run) {
+    for (const plans::Root& root : task.roots) {
       const bool from_top = root.node == narrow::NodePair{0, 0} && root.taboo < 0 && root.owner < 0;
       roots_of[root.pair] = from_top && roots_of[root.pair] == 0 && split_of[root.pair] == SIZE_MAX ? 1 : 2;
     }
@@ -77,7 +77,7 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
   });
 }
 
-std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepState& state, ScheduleRecord& record) {
+std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record) {
   const std::size_t n = state.contexts.size();
   const auto phase = util::Clock::now();
   record.omega = plan.omega;
@@ -91,7 +91,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   if (state.timeline.on) {
     record.task_roots.resize(plan.run.size());
     for (std::size_t t = 0; t < plan.run.size(); ++t) {
-      for (const tasks::Root& root : plan.run[t].roots)
+      for (const plans::Root& root : plan.run[t].roots)
         record.task_roots[t].push_back(TaskRoot{root.pair, root.node.a, root.node.b});
     }
   }
@@ -123,7 +123,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
     state.timeline.record(TaskSpan::Phase::traverse, t, [&] {
       WorkerSlots& w = local_slots(state);
       std::uint64_t tests = 0;
-      for (const tasks::Root& root : plan.run[t].roots) {
+      for (const plans::Root& root : plan.run[t].roots) {
         QueryStats& stats = w.stats[root.pair];
         const std::uint64_t before = stats.node_tests;
         const narrow::TabooView taboo =
@@ -148,7 +148,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepSt
   }
   finalize_pairs(state, rest, [&](std::size_t i, std::vector<narrow::Candidate>& all, QueryStats& stats) {
     if (split_of[i] == SIZE_MAX) return;
-    const tasks::SplitResult& s = plan.splits[split_of[i]];
+    const plans::SplitResult& s = plan.splits[split_of[i]];
     all = s.candidates;
     stats = s.stats;
   });

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The two runners of the engine. The plan runner executes any method's plan (tasks/plan.h): the
+/// The two runners of the engine. The plan runner executes any method's plan (plans/plan.h): the
 /// run-time tasks handed out in order, each traversed depth first by one thread, which also
 /// finalizes the pairs it holds whole; the pairs cut into pieces are finalized once every task is
 /// done (the same finalization per pair either way). Stealing has its own runner (recursive
@@ -12,15 +12,15 @@
 #include "caliber/engine.h"
 #include "caliber/profile.h"
 #include "schedule/workers.h"
-#include "tasks/plan.h"
+#include "plans/plan.h"
 
 namespace caliber::schedule {
 
 /// Runs `plan` on the current executor; fills state.results and, in `record`, the plan's counts,
 /// the node tests and weight of every run-time task, the stage's counts, traverse_ms and
 /// finalize_ms. Returns, per split of the plan, the depth-first node tests of each stage record's
-/// root (tasks::subtree_counts reads them).
-std::vector<std::vector<std::uint64_t>> run_plan(const tasks::Plan& plan, StepState& state, ScheduleRecord& record);
+/// root (plans::subtree_counts reads them).
+std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record);
 
 /// Stealing: the CD tree of every heavy pair (a priori weight at least 1 / (64 x threads) of
 /// the total) split recursively into tasks down to `depth`, the other pairs whole, then each subtree

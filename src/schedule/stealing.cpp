@@ -4,7 +4,7 @@
 #include <functional>
 
 #include "schedule/runner.h"
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
 namespace caliber::schedule {
 namespace {
@@ -68,7 +68,7 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
   if (threads <= 1) depth = 0;
   std::vector<std::uint32_t> heavy, light;
   if (depth > 0 && n > 1) {
-    const std::vector<double> weight = tasks::root_weights(state.contexts);
+    const std::vector<double> weight = plans::root_weights(state.contexts);
     double total = 0.0;
     for (const double w : weight) total += w;
     const double threshold = total / (64.0 * threads);

@@ -10,7 +10,7 @@
 #include "caliber/engine.h"
 #include "caliber/scene.h"
 #include "narrow/pair_context.h"
-#include "tasks/calibration.h"
+#include "plans/calibration.h"
 
 namespace caliber {
 namespace {
@@ -24,7 +24,7 @@ TEST(Memory, PerPairStorageWithinTheStatedBound) {
   const std::size_t broad = 2 * sizeof(ObjectPair);  // found, then sorted into the frame
   // The largest plan entry per pair: a task of its own (sequential, exploitation); a cart root, its
   // two sort keys and its history entry (calibrated methods); stealing's 20 bytes are less.
-  const std::size_t plan = std::max(sizeof(tasks::RunTask), sizeof(tasks::Root) + 48 + 16);
+  const std::size_t plan = std::max(sizeof(plans::RunTask), sizeof(plans::Root) + 48 + 16);
   EXPECT_LE(plan, 184u);
   EXPECT_LE(context + static_cast<double>(result + broad + plan), 1100.0) << "bytes a pair, beside the threads' slots";
   // Per worker thread: the pair's candidate list and counts.

@@ -15,7 +15,7 @@
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 /// A piece of work for one thread: a CD-tree node of one pair, and whether the weight-driven stage
 /// already tested it (then the depth-first traversal starts below it, so no node is tested twice).
@@ -164,4 +164,4 @@ struct PosterioriSplit {
 PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::uint32_t pair, double weight, double omega,
                                   double eps, std::size_t taboo_cap);
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

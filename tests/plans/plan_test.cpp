@@ -13,11 +13,11 @@
 #include "caliber/query.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
-#include "tasks/plan.h"
-#include "tasks/validate.h"
-#include "tasks/weights.h"
+#include "plans/plan.h"
+#include "plans/validate.h"
+#include "plans/weights.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 namespace {
 
 struct Pairs {
@@ -252,4 +252,4 @@ TEST(Plans, APosterioriSplitsOnLastStepsContactsWithTabooLists) {
 }
 
 }  // namespace
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -1,11 +1,11 @@
 // The one-pass check of a plan's invariants (validate.h).
 
-#include "tasks/validate.h"
+#include "plans/validate.h"
 
 #include <cmath>
 #include <vector>
 
-namespace caliber::tasks {
+namespace caliber::plans {
 namespace {
 
 constexpr std::uint32_t kNotSplit = 0xFFFFFFFFu;
@@ -75,4 +75,4 @@ std::string plan_problem(const Plan& plan, std::size_t pairs) {
   return {};
 }
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -39,7 +39,7 @@
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 /// The a priori weight of CD-tree node n (see above). Reads the node's spheres only.
 double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n);
@@ -47,4 +47,4 @@ double apriori_weight(const narrow::PairContext& ctx, narrow::NodePair n);
 /// The a priori weight of every pair's root, in parallel on the caller's executor.
 std::vector<double> root_weights(narrow::PairContexts contexts);
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tasks/calibration.h"
+#include "plans/calibration.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,9 +16,9 @@
 #include "caliber/pose.h"
 #include "caliber/procedural.h"
 #include "parallel/executor.h"
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 namespace {
 
 Root item(std::uint32_t pair, double weight) { return Root{pair, narrow::NodePair{0, 0}, false, weight}; }
@@ -339,4 +339,4 @@ TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
 }
 
 }  // namespace
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -7,9 +7,9 @@
 #include <cstddef>
 #include <string>
 
-#include "tasks/plan.h"
+#include "plans/plan.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 /// The first broken invariant of `plan` over `pairs` object pairs, in words (empty when none):
 /// a weight-driven stage for each split pair, those pairs distinct and in range; every run-time
@@ -19,4 +19,4 @@ namespace caliber::tasks {
 /// pair none there.
 [[nodiscard]] std::string plan_problem(const Plan& plan, std::size_t pairs);
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -1,4 +1,4 @@
-#include "tasks/calibration.h"
+#include "plans/calibration.h"
 
 #include <algorithm>
 #include <functional>
@@ -10,9 +10,9 @@
 #include "util/assert.h"
 #include "util/timing.h"
 
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 Verdict classify(double weight, double omega, double eps) {
   if (weight > omega + eps) return Verdict::split;
@@ -334,4 +334,4 @@ PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::
   return out;
 }
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -1,11 +1,11 @@
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "parallel/executor.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 namespace {
 
@@ -53,4 +53,4 @@ std::vector<double> root_weights(narrow::PairContexts contexts) {
   return root;
 }
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

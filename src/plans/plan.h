@@ -13,9 +13,9 @@
 #include "caliber/engine.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
-#include "tasks/calibration.h"
+#include "plans/calibration.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 /// A value per object pair, sorted by pair: what one step leaves for the next (its size follows the
 /// step's pairs, not the run's).
@@ -127,4 +127,4 @@ using StageWrapper = std::function<void(std::size_t, const std::function<void()>
 [[nodiscard]] Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>& pairs,
                                    narrow::PairContexts contexts, const History& history, const StageWrapper& around_stage = {});
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

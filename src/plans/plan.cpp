@@ -1,15 +1,15 @@
 // Methods as plans: what each method hands the runner. The cut of a calibrated method is decided
 // here, before any depth-first traversal starts.
 
-#include "tasks/plan.h"
+#include "plans/plan.h"
 
 #include <algorithm>
 #include <numeric>
 
 #include "parallel/executor.h"
-#include "tasks/weights.h"
+#include "plans/weights.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 Plan plan_pairs(std::size_t pairs) {
   Plan plan;
@@ -197,4 +197,4 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
   return plan;
 }
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans

@@ -1,5 +1,5 @@
 // The cart's merge: light items sorted by weight (a radix sort) and packed into tasks of the
-// caliber, heaviest with lightest (tasks/calibration.h).
+// caliber, heaviest with lightest (plans/calibration.h).
 
 #include <algorithm>
 #include <bit>
@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "parallel/executor.h"
-#include "tasks/calibration.h"
+#include "plans/calibration.h"
 
-namespace caliber::tasks {
+namespace caliber::plans {
 
 namespace {
 
@@ -116,4 +116,4 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega) {
   return tasks;
 }
 
-}  // namespace caliber::tasks
+}  // namespace caliber::plans
