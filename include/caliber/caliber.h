@@ -10,6 +10,7 @@
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "caliber/executor.h"
 #include "caliber/export.h"
 #include "caliber/mesh.h"
 #include "caliber/model.h"

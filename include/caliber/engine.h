@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "caliber/batch.h"
+#include "caliber/executor.h"
 #include "caliber/model.h"
 #include "caliber/pose.h"
 #include "caliber/query.h"
@@ -112,6 +113,10 @@ struct EngineOptions {
   /// its own of N threads, at most the process's limit. caliber never changes the limit (no
   /// tbb::global_control). `sequential` always runs on the calling thread.
   int threads = 0;
+  /// A host's own job system (caliber/executor.h): when given, the engine runs on the threads it
+  /// lends for each call, at most `threads` of them (0: all it offers), and creates no thread of
+  /// its own. The host must outlive the engine. Null (the default): oneTBB, as `threads` says.
+  HostExecutor* host = nullptr;
   /// The thread count the cut is made for (calibrated methods: Omega = total weight / (beta *
   /// plan_threads); stealing: the heavy pairs' share, below); 0 means `threads`. Cut for one
   /// thread, every method runs each pair whole. The cut for P threads run on one thread measures

@@ -12,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include "caliber/executor.h"
+
 #include "caliber/mesh.h"
 
 namespace caliber {
@@ -29,6 +31,9 @@ struct BuildOptions {
   /// from (the host's); 1, on the calling thread alone, creating no thread; N > 1, an arena of its
   /// own of N threads, at most the process's limit. The model is the same whatever the count.
   int threads = 0;
+  /// A host's own job system (caliber/executor.h): when given, the build runs on the threads it
+  /// lends, at most `threads` of them (0: all it offers), and creates no thread of its own.
+  HostExecutor* host = nullptr;
 };
 
 /// A mesh with its BVH, normals and adjacency: what caliber::query and the engine traverse. Made

@@ -386,7 +386,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   if (parallel::current_thread_index() >= 0 && options.threads == 0) {
     out = build_on_this_thread(std::move(mesh), options);
   } else {
-    parallel::Executor executor(options.threads);
+    parallel::Executor executor(options.threads, options.host);
     executor.execute([&] { out = build_on_this_thread(std::move(mesh), options); });
   }
   CALIBER_ASSERT(bvh::bvh_problem(*out).empty(), "a built BVH keeps its invariants (bvh/validate.h)");

@@ -58,9 +58,15 @@ thread_local Executor::Pool* t_pool = nullptr;
 thread_local int t_index = -1;
 }  // namespace
 
-int current_thread_index() { return t_pool != nullptr ? t_index : -1; }
+int current_thread_index() {
+  if (detail::t_borrowed != nullptr) return detail::t_borrowed_index;
+  return t_pool != nullptr ? t_index : -1;
+}
 
-int concurrency() { return t_pool != nullptr ? static_cast<int>(t_pool->workers.size()) + 1 : 1; }
+int concurrency() {
+  if (detail::t_borrowed != nullptr) return detail::t_borrowed->threads();
+  return t_pool != nullptr ? static_cast<int>(t_pool->workers.size()) + 1 : 1;
+}
 
 void Executor::Pool::work() {
   t_pool = this;
@@ -76,8 +82,9 @@ void Executor::Pool::work() {
   }
 }
 
-Executor::Executor(int threads) : mRequested(threads), mPool(std::make_unique<Pool>()) {
+Executor::Executor(int threads, HostExecutor* host) : mRequested(threads), mHost(host), mPool(std::make_unique<Pool>()) {
   if (threads < 0) throw Error(ErrorCode::bad_value, "threads", "must be >= 0 (0: the machine's hardware threads)");
+  if (host != nullptr) return;  // the host's threads, lent for each execute()
   if (threads == 0) mRequested = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   for (int t = 1; t < mRequested; ++t) {
     mPool->workers.emplace_back([pool = mPool.get(), t] {
@@ -87,7 +94,10 @@ Executor::Executor(int threads) : mRequested(threads), mPool(std::make_unique<Po
   }
 }
 
-int Executor::threads() const { return mRequested; }
+int Executor::threads() const {
+  if (mHost != nullptr) return host_threads();
+  return mRequested;
+}
 
 Executor::~Executor() {
   {
@@ -99,6 +109,11 @@ Executor::~Executor() {
 }
 
 void Executor::execute(const std::function<void()>& f) {
+  if (mHost != nullptr) {
+    execute_borrowed(f);
+    return;
+  }
+  const detail::BorrowedScope outside(nullptr, -1);  // its constructs go to this pool, not a borrowed one
   Pool* const previous = t_pool;
   const int previous_index = t_index;
   t_pool = mPool.get();
@@ -114,7 +129,7 @@ void Executor::execute(const std::function<void()>& f) {
   t_index = previous_index;
 }
 
-TaskGroup::TaskGroup() : mPool(t_pool) {}
+TaskGroup::TaskGroup() : mBorrowed(detail::t_borrowed), mPool(t_pool) {}
 
 TaskGroup::~TaskGroup() {
   try {
@@ -124,6 +139,10 @@ TaskGroup::~TaskGroup() {
 }
 
 void TaskGroup::run(std::function<void()> f) {
+  if (mBorrowed != nullptr) {
+    mBorrowed->submit(std::move(f), mBorrowedJobs);
+    return;
+  }
   if (mPool == nullptr) {  // outside any executor: run it now
     try {
       f();
@@ -134,13 +153,17 @@ void TaskGroup::run(std::function<void()> f) {
   }
   {
     const std::lock_guard<std::mutex> lock(mPool->mutex);
+    mPool->queue.push_back(Executor::Pool::Job{std::move(f), this});  // first: a failed push leaves no job counted
     ++mPending;
-    mPool->queue.push_back(Executor::Pool::Job{std::move(f), this});
   }
   mPool->changed.notify_one();
 }
 
 void TaskGroup::wait() {
+  if (mBorrowed != nullptr) {
+    mBorrowed->wait(mBorrowedJobs);
+    return;
+  }
   std::exception_ptr error;
   if (mPool != nullptr) {
     std::unique_lock<std::mutex> lock(mPool->mutex);
@@ -193,8 +216,9 @@ int process_limit() {
 }
 }  // namespace
 
-Executor::Executor(int threads) : mRequested(threads) {
+Executor::Executor(int threads, HostExecutor* host) : mRequested(threads), mHost(host) {
   if (threads < 0) throw Error(ErrorCode::bad_value, "threads", "must be >= 0 (0: the arena caliber is called from)");
+  if (host != nullptr) return;  // the host's threads, lent for each execute()
   // An arena no wider than the limit in force, so that its slot indices stay below threads().
   if (threads > 1) mArena = std::make_unique<tbb::task_arena>(std::min(threads, process_limit()));
 }
@@ -202,12 +226,18 @@ Executor::Executor(int threads) : mRequested(threads) {
 Executor::~Executor() = default;
 
 int Executor::threads() const {
+  if (mHost != nullptr) return host_threads();
   if (mRequested == 1) return 1;
   const int arena = mArena ? mArena->max_concurrency() : tbb::this_task_arena::max_concurrency();
   return std::max(1, std::min(arena, process_limit()));
 }
 
 void Executor::execute(const std::function<void()>& f) {
+  if (mHost != nullptr) {
+    execute_borrowed(f);
+    return;
+  }
+  const detail::BorrowedScope outside(nullptr, -1);  // its constructs go to oneTBB, not a borrowed pool
   const int concurrency = threads();
   if (concurrency > 1 && mArena) {
     mArena->execute([&] {
@@ -222,18 +252,26 @@ void Executor::execute(const std::function<void()>& f) {
 }
 
 int current_thread_index() {
+  if (detail::t_borrowed != nullptr) return detail::t_borrowed_index;
   if (detail::t_concurrency == 0) return -1;
   if (detail::t_concurrency == 1) return 0;
   const int index = tbb::this_task_arena::current_thread_index();
   return index == tbb::task_arena::not_initialized ? -1 : index;
 }
 
-int concurrency() { return std::max(detail::t_concurrency, 1); }
+int concurrency() {
+  if (detail::t_borrowed != nullptr) return detail::t_borrowed->threads();
+  return std::max(detail::t_concurrency, 1);
+}
 
 TaskGroup::TaskGroup() = default;
 TaskGroup::~TaskGroup() {
   try {
-    mGroup.wait();
+    if (mBorrowed != nullptr) {
+      mBorrowed->wait(mBorrowedJobs);
+    } else {
+      mGroup.wait();
+    }
   } catch (...) {  // NOLINT(bugprone-empty-catch): an unwaited group's error has nowhere to go
   }
 }
@@ -244,6 +282,16 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
   grain = std::max<std::size_t>(grain, 1);
   if (end - begin <= grain) {
     body(begin, end);
+    return;
+  }
+  if (detail::t_borrowed != nullptr) {  // on the host's threads: chunks as tasks of the borrowed pool
+    const std::size_t length = end - begin, chunks = (length + grain - 1) / grain;
+    TaskGroup group;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t lo = begin + length * c / chunks, hi = begin + length * (c + 1) / chunks;
+      group.run([&body, lo, hi] { body(lo, hi); });
+    }
+    group.wait();
     return;
   }
   if (!detail::parallel_here()) {  // outside an executor, or a one-thread one: chunk by chunk, here
@@ -264,6 +312,39 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
 }
 
 #endif
+
+void Executor::execute_borrowed(const std::function<void()>& f) {
+  // The count read for this call (threads() at its start), or read now.
+  detail::BorrowedPool pool(mHostThreads > 0 ? std::exchange(mHostThreads, 0) : threads());
+  // The caller works for the pool from here on: a range the host runs here (inline, or inside
+  // finish()) returns at once. Its constructs go to the pool only while `f` runs: the host's own
+  // code in enqueue() and finish() runs as it would outside caliber.
+  const detail::Membership member(&pool);
+  const detail::BorrowedScope outside(nullptr, -1);
+  // The host's threads take the pool's jobs until it closes: one item each, after the caller's.
+  // The task outlives finish(): the host may keep a reference to it.
+  const HostExecutor::Task lent = [&pool](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) pool.lend(static_cast<int>(i) + 1);
+  };
+  void* handle = pool.threads() > 1 ? mHost->enqueue(lent, static_cast<std::size_t>(pool.threads() - 1), 1) : nullptr;
+  std::exception_ptr error;
+  try {
+    const detail::BorrowedScope scope(&pool, 0);
+    f();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  pool.close();
+  if (handle != nullptr) mHost->finish(handle);
+  if (error) std::rethrow_exception(error);
+}
+
+int Executor::host_threads() const {
+  // At most 1024, as EngineOptions::threads; at most the threads asked for, when asked.
+  const int offered = std::clamp(mHost->thread_count(), 1, 1024);
+  mHostThreads = mRequested > 0 ? std::min(mRequested, offered) : offered;
+  return mHostThreads;
+}
 
 void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& body) {
   std::atomic<std::size_t> next{0};

@@ -27,6 +27,9 @@
 #include <algorithm>
 #include <exception>
 
+#include "caliber/executor.h"
+#include "parallel/borrowed_pool.h"
+
 #ifdef CALIBER_EXECUTOR_STD
 #include <algorithm>
 #include <exception>
@@ -54,8 +57,10 @@ namespace caliber::parallel {
 /// inside execute() (parallel_for, TaskGroup, ...) runs there and on no other thread.
 class Executor {
  public:
-  /// `threads` >= 0 (see the class comment). Throws caliber::Error on a negative count.
-  explicit Executor(int threads);
+  /// `threads` >= 0 (see the class comment). Throws caliber::Error on a negative count. With a
+  /// `host`, the work runs on the threads the host lends for each execute() (borrowed_pool.h), at
+  /// most `threads` of them (0: all it offers), and caliber creates no thread.
+  explicit Executor(int threads, HostExecutor* host = nullptr);
   ~Executor();
   Executor(const Executor&) = delete;
   Executor& operator=(const Executor&) = delete;
@@ -70,7 +75,15 @@ class Executor {
   void execute(const std::function<void()>& f);
 
  private:
+  /// execute() on the host's threads.
+  void execute_borrowed(const std::function<void()>& f);
+  /// The host's threads for a call: thread_count() in [1, 1024], at most the threads asked for;
+  /// kept for the next execute(), so that a call's cut and its pool agree.
+  int host_threads() const;
+
   int mRequested;
+  HostExecutor* mHost;
+  mutable int mHostThreads = 0;  ///< read by threads() for the coming execute(), 0 when not
 #ifdef CALIBER_EXECUTOR_STD
  public:
   struct Pool;
@@ -122,6 +135,8 @@ class TaskGroup {
   void wait();
 
  private:
+  detail::BorrowedPool* mBorrowed;  ///< the host's threads' pool it was made in, or null
+  detail::BorrowedGroup mBorrowedJobs;
   Executor::Pool* mPool;
   std::size_t mPending = 0;   ///< guarded by the pool's mutex
   std::exception_ptr mError;  ///< guarded by the pool's mutex
@@ -131,6 +146,10 @@ class TaskGroup {
   /// rethrown by wait().
   template <class F>
   void run(F&& f) {
+    if (mBorrowed != nullptr) {
+      mBorrowed->submit(std::function<void()>(std::forward<F>(f)), mBorrowedJobs);
+      return;
+    }
     if (!detail::parallel_here()) {
       try {
         f();
@@ -146,11 +165,17 @@ class TaskGroup {
   }
   /// Waits for every task run() so far.
   void wait() {
+    if (mBorrowed != nullptr) {
+      mBorrowed->wait(mBorrowedJobs);
+      return;
+    }
     mGroup.wait();
     if (mError) std::rethrow_exception(std::exchange(mError, nullptr));
   }
 
  private:
+  detail::BorrowedPool* mBorrowed = detail::t_borrowed;  ///< the host's threads' pool it was made in, or null
+  detail::BorrowedGroup mBorrowedJobs;
   tbb::task_group mGroup;
   std::exception_ptr mError;  ///< of a task run serially
 #endif
@@ -186,6 +211,13 @@ void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {
   });
 #else
   if (begin >= end) return;
+  if (detail::t_borrowed != nullptr) {  // chunks of about an eighth of a thread's share
+    const std::size_t share = (end - begin) / (8 * static_cast<std::size_t>(detail::t_borrowed->threads()));
+    parallel_for(begin, end, std::max<std::size_t>(share, 1), [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) f(i);
+    });
+    return;
+  }
   if (!detail::parallel_here()) {
     for (std::size_t i = begin; i != end; ++i) f(i);
     return;
@@ -205,7 +237,7 @@ void parallel_sort(It first, It last, Less less) {
 #ifdef CALIBER_EXECUTOR_STD
   std::sort(first, last, less);
 #else
-  if (detail::parallel_here()) {
+  if (detail::parallel_here() && detail::t_borrowed == nullptr) {
     tbb::parallel_sort(first, last, less);
   } else {
     std::sort(first, last, less);

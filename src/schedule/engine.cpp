@@ -107,7 +107,8 @@ Engine::Engine(const EngineOptions& options) : mOptions(options) {
     throw Error(ErrorCode::bad_value, "epsilon", "must be a finite number >= 0");
   }
   if (mOptions.taboo_cap < 1) throw Error(ErrorCode::bad_value, "taboo cap", "must be >= 1");
-  mImpl = std::make_unique<Impl>(mOptions.method == Method::sequential ? 1 : mOptions.threads);
+  mImpl = std::make_unique<Impl>(mOptions.method == Method::sequential ? 1 : mOptions.threads,
+                                 mOptions.method == Method::sequential ? nullptr : mOptions.host);
 }
 
 Engine::~Engine() = default;

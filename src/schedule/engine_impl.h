@@ -143,7 +143,7 @@ struct SweepJob {
 namespace caliber {
 
 struct Engine::Impl {
-  explicit Impl(int threads) : executor(threads) {}
+  Impl(int threads, HostExecutor* host) : executor(threads, host) {}
   /// Set while a step (or forget) runs: a second call meanwhile is refused, not a data race.
   std::atomic<bool> busy{false};
   parallel::Executor executor;

@@ -1,0 +1,99 @@
+#pragma once
+/// \file
+/// The threads a host lends for one Executor::execute (caliber/executor.h): one queue of jobs that
+/// the caller and the lent threads take from. A thread waiting on a TaskGroup runs queued jobs
+/// meanwhile (newest first, so it tends to finish its own children); a lent thread takes the
+/// oldest (the biggest pieces of a recursive split). Every hand-off goes through one mutex.
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <mutex>
+
+namespace caliber::parallel::detail {
+
+/// A TaskGroup's jobs in a borrowed pool; guarded by the pool's mutex.
+struct BorrowedGroup {
+  std::size_t pending = 0;
+  std::exception_ptr error;  ///< the first error a job threw
+};
+
+class BorrowedPool;
+
+/// The borrowed pools the calling thread works for, innermost first, as a chain through the
+/// thread's stack: a thread lent to a pool it already works for (a host that runs a queued range
+/// while the thread waits inside that pool's call) must not take its jobs again.
+struct Membership {
+  explicit Membership(BorrowedPool* pool);
+  ~Membership();
+  Membership(const Membership&) = delete;
+  Membership& operator=(const Membership&) = delete;
+
+  BorrowedPool* pool;
+  Membership* outer;
+};
+
+class BorrowedPool {
+ public:
+  /// A pool of `threads` (the caller included).
+  explicit BorrowedPool(int threads) : mThreads(threads) {}
+  BorrowedPool(const BorrowedPool&) = delete;
+  BorrowedPool& operator=(const BorrowedPool&) = delete;
+
+  [[nodiscard]] int threads() const { return mThreads; }
+  /// Queues `fn` for `group`.
+  void submit(std::function<void()> fn, BorrowedGroup& group);
+  /// Waits until every job of `group` has run, running queued jobs meanwhile; rethrows the first
+  /// error one of them threw.
+  void wait(BorrowedGroup& group);
+  /// What a lent thread does (`index` >= 1, its index in the pool): take jobs until the pool
+  /// closes. Returns at once on a thread that already works for this pool (its caller, when the
+  /// host runs the ranges inline or inside finish()), and once the pool has closed.
+  void lend(int index);
+  /// The caller's work is over (every group waited for): lent threads return.
+  void close();
+
+ private:
+  struct Job {
+    std::function<void()> fn;
+    BorrowedGroup* group;
+  };
+  /// Runs a job taken off the queue (lock not held) and signs it off in its group.
+  void run_job(Job& job);
+
+  const int mThreads;
+  std::mutex mMutex;
+  std::condition_variable mChanged;  ///< a job was queued, a group finished, or the pool closed
+  std::deque<Job> mQueue;
+  bool mClosed = false;
+};
+
+/// The borrowed pool whose constructs the calling thread's work goes to, and its index there; null
+/// and -1 where its work goes elsewhere (oneTBB, the std::thread pool, or the calling thread).
+inline thread_local BorrowedPool* t_borrowed = nullptr;
+inline thread_local int t_borrowed_index = -1;
+inline thread_local Membership* t_membership = nullptr;
+
+/// Sends the calling thread's parallel constructs to `pool` (as thread `index`) for a scope; a null
+/// pool sends them back to the executor they would use outside any borrowed pool.
+class BorrowedScope {
+ public:
+  BorrowedScope(BorrowedPool* pool, int index) : mPool(t_borrowed), mIndex(t_borrowed_index) {
+    t_borrowed = pool;
+    t_borrowed_index = index;
+  }
+  ~BorrowedScope() {
+    t_borrowed = mPool;
+    t_borrowed_index = mIndex;
+  }
+  BorrowedScope(const BorrowedScope&) = delete;
+  BorrowedScope& operator=(const BorrowedScope&) = delete;
+
+ private:
+  BorrowedPool* mPool;
+  int mIndex;
+};
+
+}  // namespace caliber::parallel::detail
