@@ -42,6 +42,8 @@ consume() {  # PREFIX TAG [CXXFLAGS]: configures, builds and runs the examples a
   out="$("$work/examples-$2/swept_needle")" || fail "$2: swept_needle failed: $out"
   out="$("$work/examples-$2/engine_in_host_arena")" || fail "$2: engine_in_host_arena failed: $out"
   out="$("$work/examples-$2/openmp_host")" || fail "$2: openmp_host failed: $out"
+  out="$("$work/examples-$2/host_thread_pool")" || fail "$2: host_thread_pool failed: $out"
+  out="$("$work/examples-$2/host_openmp")" || fail "$2: host_openmp failed: $out"
   echo "check_package: $2: the examples build against the installed package and pass ($want_i pairs, $want_c contacts as the CLI)"
 }
 
