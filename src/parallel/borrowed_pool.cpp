@@ -4,6 +4,8 @@
 
 #include <utility>
 
+#include "caliber/executor.h"
+
 namespace caliber::parallel::detail {
 
 Membership::Membership(BorrowedPool* p) : pool(p), outer(t_membership) { t_membership = this; }
@@ -24,6 +26,15 @@ void BorrowedPool::run_job(Job& job) {
 }
 
 void BorrowedPool::submit(std::function<void()> fn, BorrowedGroup& group) {
+  if (mThreads == 1) {  // nobody else could take it: run it at once, as outside any executor
+    Job job{std::move(fn), &group};
+    {
+      const std::lock_guard<std::mutex> lock(mMutex);
+      ++group.pending;
+    }
+    run_job(job);
+    return;
+  }
   {
     const std::lock_guard<std::mutex> lock(mMutex);
     mQueue.push_back(Job{std::move(fn), &group});  // first: a failed push leaves no job counted
@@ -75,6 +86,31 @@ void BorrowedPool::close() {
     mClosed = true;
   }
   mChanged.notify_all();
+}
+
+void run_on_host(HostExecutor& host, int threads, const std::function<void()>& f) {
+  BorrowedPool pool(threads);
+  // The caller works for the pool from here on: a range the host runs here (inline, or inside
+  // finish()) returns at once. Its constructs go to the pool only while `f` runs: the host's own
+  // code in enqueue() and finish() runs as it would outside caliber.
+  const Membership member(&pool);
+  const BorrowedScope outside(nullptr, -1);
+  // The host's threads take the pool's jobs until it closes: one item each, after the caller's.
+  // The task outlives finish(): the host may keep a reference to it.
+  const HostExecutor::Task lent = [&pool](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) pool.lend(static_cast<int>(i) + 1);
+  };
+  void* handle = threads > 1 ? host.enqueue(lent, static_cast<std::size_t>(threads - 1), 1) : nullptr;
+  std::exception_ptr error;
+  try {
+    const BorrowedScope scope(&pool, 0);
+    f();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  pool.close();
+  if (handle != nullptr) host.finish(handle);
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace caliber::parallel::detail

@@ -12,6 +12,10 @@
 #include <functional>
 #include <mutex>
 
+namespace caliber {
+class HostExecutor;
+}
+
 namespace caliber::parallel::detail {
 
 /// A TaskGroup's jobs in a borrowed pool; guarded by the pool's mutex.
@@ -95,5 +99,10 @@ class BorrowedScope {
   BorrowedPool* mPool;
   int mIndex;
 };
+
+/// Runs `f` on the calling thread, joined by the threads `host` lends until it returns: a pool of
+/// `threads` (>= 1, the caller included), one range of one item enqueued per lent thread.
+/// Exceptions thrown by `f` (or by jobs it waits for) propagate to the caller.
+void run_on_host(HostExecutor& host, int threads, const std::function<void()>& f);
 
 }  // namespace caliber::parallel::detail

@@ -16,6 +16,12 @@
 #include "caliber/error.h"
 #include "parallel/executor.h"
 
+#ifndef CALIBER_EXECUTOR_STD
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#endif
+
 namespace caliber::parallel {
 namespace {
 
