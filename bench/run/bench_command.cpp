@@ -1,8 +1,8 @@
 // caliber-bench: every scene x method x thread count, repeated, medians; the paper's Table 1 and
 // Table 2, the 1-thread overhead, the load-balance simulation beyond this machine's cores, the
 // estimate-vs-effective correlation, a per-thread timeline, the FCL peer comparison (when
-// bench_fcl_compare is built), the run's key figures in one table; report.md +
-// results.json, then figures drawn by scripts/plot_bench.py (matplotlib) when it can run.
+// bench_fcl_compare is built), the run's key figures in one table; results.json, then the SVG
+// figures (bench_figures.h) and report.md, both drawn from the same in-memory results.
 
 #include <algorithm>
 #include <cstdio>
@@ -24,6 +24,7 @@
 #include "caliber/error.h"
 #include "caliber/scene.h"
 #include "caliber/world.h"
+#include "bench_figures.h"
 #include "bench_records.h"
 #include "bench_report.h"
 #include "bench_command.h"
@@ -66,7 +67,7 @@ std::string machine_slug() {
   return slug + "-" + std::to_string(std::max(1u, std::thread::hardware_concurrency())) + "c";
 }
 
-/// The directory of the running program (to find bench_fcl_compare and scripts/ next to it).
+/// The directory of the running program (to find bench_fcl_compare next to it).
 std::filesystem::path program_dir() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
@@ -78,9 +79,6 @@ int run_command(const std::string& command) {
   const int rc = std::system(command.c_str());
   return rc == -1 ? -1 : WEXITSTATUS(rc);
 }
-
-/// Debian's python3 (where python3-matplotlib installs), before whatever python3 is first on PATH.
-std::string python() { return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3"; }
 
 std::string quote(const std::string& s) {
   std::string q = "'";
@@ -117,8 +115,8 @@ std::string no_figures_note(bool figures) {
   return "";
 }
 
-/// results.json, the figures (scripts/plot_bench.py, matplotlib) and report.md in `out`, from the
-/// bench's records.
+/// results.json, the figures and report.md in `out`, from the bench's records: the figures and
+/// the report are drawn from the same results as the file.
 void write_outputs(const std::vector<Json>& records, const std::filesystem::path& out, bool figures) {
   Json results = results_from_records(records);
   const auto json_path = out / "results.json";
@@ -128,22 +126,8 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
     file.commit();
   };
   write_json();
-  std::string figures_note = no_figures_note(figures);
-  if (figures_note.empty()) {
-    std::filesystem::path script;
-    for (const auto& candidate :
-         {program_dir() / ".." / "scripts" / "plot_bench.py", std::filesystem::path("scripts/plot_bench.py")}) {
-      if (std::filesystem::exists(candidate)) {
-        script = candidate;
-        break;
-      }
-    }
-    if (script.empty()) {
-      figures_note = "Figures not drawn: scripts/plot_bench.py not found.";
-    } else if (run_command(python() + " " + quote(script.string()) + " " + quote(out.string())) != 0) {
-      figures_note = "Figures not drawn: `python3 scripts/plot_bench.py` failed (is python3-matplotlib installed?).";
-    }
-  }
+  const std::string figures_note = no_figures_note(figures);
+  if (figures_note.empty()) write_bench_figures(results, out);
   results["figures_note"] = figures_note;
   write_json();
   write_bench_report(results, out / "report.md");
@@ -155,10 +139,7 @@ void write_outputs(const std::vector<Json>& records, const std::filesystem::path
 NamedFiles bench_outputs(const std::filesystem::path& out, const std::vector<std::string>& scene_names) {
   NamedFiles files;
   std::vector<std::string> names = {"results.json", "report.md", "fcl_compare.md"};
-  for (const std::string& figure : {std::string("correlation"), std::string("gantt")}) {
-    names.insert(names.end(), {figure + ".png", figure + ".svg"});
-  }
-  for (const std::string& s : scene_names) names.insert(names.end(), {"speedup_" + s + ".png", "speedup_" + s + ".svg"});
+  for (const std::string& figure : bench_figure_names(scene_names)) names.push_back(figure);
   for (const std::string& name : names) files.emplace_back("--out's " + name, (out / name).string());
   return files;
 }
@@ -376,7 +357,7 @@ Runner add_bench_options(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output folder (default: bench/results/<machine>/engine)");
   cmd->add_option("--fcl-repeat", opt->fcl_repeat, "Runs per FCL comparison")->capture_default_str();
-  cmd->add_flag("!--no-figures", opt->figures, "Do not run scripts/plot_bench.py");
+  cmd->add_flag("!--no-figures", opt->figures, "Do not draw the SVG figures");
   cmd->add_flag("!--no-fcl", opt->fcl, "Do not run the FCL peer comparison");
   cmd->add_flag("!--no-ceiling", opt->ceiling,
                 "Do not measure the machine's ceiling (P independent sequential copies at once, for each thread count P > 1)");

@@ -253,11 +253,11 @@ void write_peers_and_figures(std::ostream& out, const Json& r, const std::filesy
   if (!note.empty()) out << note << "\n\n";
   const auto dir = file.parent_path();
   for (const Json& s : r["scenes"]) {
-    const std::string png = "speedup_" + s["name"].get<std::string>() + ".png";
-    if (std::filesystem::exists(dir / png)) out << "![speed-up, " << s["name"].get<std::string>() << "](" << png << ")\n";
+    const std::string svg = "speedup_" + s["name"].get<std::string>() + ".svg";
+    if (std::filesystem::exists(dir / svg)) out << "![speed-up, " << s["name"].get<std::string>() << "](" << svg << ")\n";
   }
-  for (const char* png : {"correlation.png", "gantt.png"}) {
-    if (std::filesystem::exists(dir / png)) out << "\n![" << png << "](" << png << ")\n";
+  for (const char* svg : {"correlation.svg", "gantt.svg"}) {
+    if (std::filesystem::exists(dir / svg)) out << "\n![" << svg << "](" << svg << ")\n";
   }
   out << "\nSpeed-up figures: measured thread counts solid, simulated core counts dashed, the linear limit dotted. "
          "Correlation: estimated vs effective node tests per run-time task (log-log). Gantt: one step of "

@@ -214,9 +214,10 @@ if nm -C "$cli" 2>/dev/null | grep -qE "run_bench|add_bench_options|bench_record
 else
   passes=$((passes + 1))
 fi
-# caliber-bench: a tiny run writes the report and the raw figures; bad options fail before any work.
-check bench 0 "$bench" "$data/scenes/tetras.json" --steps 4 --repeat 2 --threads 1,2 --simulate 4 --no-fcl --no-figures --out "$tmp/bench"
-contains bench "wrote $tmp/bench/report.md"
+# caliber-bench: a tiny run writes the report, the raw figures and the SVG figures; bad options fail
+# before any work.
+check bench 0 "$bench" "$data/scenes/tetras.json" --steps 4 --repeat 2 --threads 1,2 --simulate 4 --no-fcl --out "$tmp/bench"
+contains bench "wrote $tmp/bench/report.md and results.json and figures"
 python3 - "$tmp/bench" <<'PY' || { echo "FAIL bench-files"; failures=$((failures + 1)); }
 import json, sys
 d = sys.argv[1]
@@ -254,13 +255,76 @@ records = [json.loads(line) for line in open(d + "/runs.jsonl")]
 assert records[0]["kind"] == "header"
 assert sum(1 for x in records if x["kind"] == "run") == 22
 PY
-# The report rebuilt from the log alone is the same report; from a log cut in the middle of a line,
-# a report of the runs it holds.
-check bench-from-log 0 "$bench" --from-log "$tmp/bench/runs.jsonl" --out "$tmp/bench-again" --no-figures
+# The figures: well-formed SVG, drawn from the results (a solid line and a legend entry per measured
+# method, a dashed line per simulated one, every point inside the page), linked from the report.
+python3 - "$tmp/bench" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-figures"; failures=$((failures + 1)); }
+import json, os, sys, xml.dom.minidom
+d = sys.argv[1]
+r = json.load(open(d + "/results.json"))
+(s,) = r["scenes"]
+methods = sorted(m for m in s["methods"] if m != "sequential")
+has_points = any(s["methods"].get(m, {}).get("correlation", {}).get("points") for m in ("apriori", "hybrid", "hybrid+history"))
+names = ["speedup_tetras.svg", "gantt.svg"] + (["correlation.svg"] if has_points else [])
+assert sorted(f for f in os.listdir(d) if f.endswith((".svg", ".png"))) == sorted(names), os.listdir(d)
+def parse(name):
+    doc = xml.dom.minidom.parse(os.path.join(d, name)).documentElement
+    assert doc.tagName == "svg" and doc.getAttribute("font-family") == "sans-serif", name
+    w, h = float(doc.getAttribute("width")), float(doc.getAttribute("height"))
+    for line in doc.getElementsByTagName("polyline"):
+        for xy in line.getAttribute("points").split():
+            x, y = map(float, xy.split(","))
+            assert 0 <= x <= w and 0 <= y <= h, (name, x, y)
+    return doc, [t.firstChild.data for t in doc.getElementsByTagName("text") if t.firstChild]
+doc, texts = parse("speedup_tetras.svg")
+lines = doc.getElementsByTagName("polyline")
+solid = [l for l in lines if not l.getAttribute("stroke-dasharray")]
+assert len(solid) == len(methods), (len(solid), methods)
+assert len(lines) == 1 + 2 * len(methods), len(lines)  # the linear limit, measured and simulated per method
+assert [t for t in texts if t.endswith(" (measured)")] == [m + " (measured)" for m in methods], texts
+assert "speed-up over sequential" in texts and any(t.startswith("tetras: sequential ") for t in texts), texts
+assert {"1", "2", "4"} <= set(texts), texts  # log2 ticks
+doc, texts = parse("gantt.svg")
+assert sorted(t.split(":")[0] for t in texts if ": tetras step " in t) == ["exploitation", "hybrid"], texts
+assert {"weight-driven stage", "depth-first", "finalization", "thread 0", "thread 1"} <= set(texts), texts
+assert doc.getElementsByTagName("path"), "no bars"
+if has_points:
+    doc, texts = parse("correlation.svg")
+    assert any(t.startswith("tetras, ") and ": r = " in t for t in texts), texts
+report = open(d + "/report.md").read()
+for name in names:
+    assert "](" + name + ")" in report, name
+PY
+# The report and the figures rebuilt from the log alone are the same, byte for byte; from a log cut
+# in the middle of a line, a report of the runs it holds.
+check bench-from-log 0 "$bench" --from-log "$tmp/bench/runs.jsonl" --out "$tmp/bench-again"
 python3 - "$tmp/bench" "$tmp/bench-again" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-from-log-same"; failures=$((failures + 1)); }
-import sys
-a, b = (open(d + "/report.md").read() for d in sys.argv[1:])
-assert a == b
+import os, sys
+a, b = sys.argv[1:]
+names = sorted(f for f in os.listdir(a) if f.endswith(".svg")) + ["report.md"]
+assert sorted(f for f in os.listdir(b) if f.endswith(".svg")) + ["report.md"] == names, os.listdir(b)
+for name in names:
+    assert open(os.path.join(a, name), "rb").read() == open(os.path.join(b, name), "rb").read(), name
+PY
+# A tetras run has no correlation points: a log given some draws correlation.svg, a panel per
+# calibrated method with its r, every point (a zero clamped onto the log axes) a dot.
+python3 - "$tmp/bench/runs.jsonl" "$tmp/corr.jsonl" <<'PY'
+import json, sys
+with open(sys.argv[2], "w") as out:
+    for line in open(sys.argv[1]):
+        r = json.loads(line)
+        if r["kind"] == "simulation" and r["method"] in ("apriori", "hybrid"):
+            r["correlation"] = {"cores": r["cores"], "pearson": 0.5, "tasks": 4, "points": [[0, 0], [1.5, 3], [20, 10], [300, 400]]}
+        out.write(json.dumps(r) + "\n")
+PY
+check bench-from-log-correlation 0 "$bench" --from-log "$tmp/corr.jsonl" --out "$tmp/bench-corr"
+python3 - "$tmp/bench-corr/correlation.svg" <<'PY' && passes=$((passes + 1)) || { echo "FAIL bench-correlation-figure"; failures=$((failures + 1)); }
+import sys, xml.dom.minidom
+doc = xml.dom.minidom.parse(sys.argv[1]).documentElement
+texts = [t.firstChild.data for t in doc.getElementsByTagName("text") if t.firstChild]
+assert [t for t in texts if ": r = " in t] == ["tetras, apriori: r = 0.50", "tetras, hybrid: r = 0.50"], texts
+dots = [p for p in doc.getElementsByTagName("path") if p.getAttribute("stroke-linecap") == "round"]
+assert [p.getAttribute("d").count("M") for p in dots] == [4, 4], [p.getAttribute("d") for p in dots]
+assert {"0.1", "1", "10", "100"} <= set(texts), texts  # log10 ticks
 PY
 head -c 2500 "$tmp/bench/runs.jsonl" > "$tmp/cut.jsonl"
 check bench-from-cut-log 0 "$bench" --from-log "$tmp/cut.jsonl" --out "$tmp/bench-cut" --no-figures

@@ -97,12 +97,15 @@ d="$tmp/bench"
 stop bench TERM "$d/runs.jsonl" "$bench" "$scene" --steps 2000000 --repeat 1 --threads 1 --no-fcl --no-ceiling --out "$d"
 if verdict bench 143 "$d"; then
   python3 - "$d" <<'PY' || { echo "FAIL bench-results"; failures=$((failures + 1)); }
-import json, sys
+import json, os, sys
 r = json.load(open(sys.argv[1] + "/results.json"))
 assert r["interrupted"] is True and r["stopped"]["reason"] == "interrupted" and r["stopped"]["signal"] == "SIGTERM", r
 last = json.loads(open(sys.argv[1] + "/runs.jsonl").read().splitlines()[-1])
 assert last["kind"] == "stopped" and last["reason"] == "interrupted", last
 assert "**interrupted** (SIGTERM)" in open(sys.argv[1] + "/report.md").read()
+# No figures: they are left to --from-log.
+assert r["figures_note"].startswith("Figures not drawn: the bench was interrupted (SIGTERM)"), r["figures_note"]
+assert not [f for f in os.listdir(sys.argv[1]) if f.endswith(".svg")], os.listdir(sys.argv[1])
 PY
 fi
 
