@@ -16,12 +16,21 @@
 
 namespace caliber {
 
+/// Where a World builds its models, as BuildOptions::threads and BuildOptions::host: by default in
+/// the oneTBB arena the World is made in; with a host (caliber/executor.h), on the threads it lends
+/// and on no thread of caliber's own. The models are the same whatever the threads.
+struct WorldOptions {
+  int threads = 0;               ///< 0 .. 1024, as BuildOptions::threads
+  HostExecutor* host = nullptr;  ///< a host's own job system, or none
+};
+
 /// A loaded scene. Immutable after construction: `frame` may be called from any thread.
 class CALIBER_EXPORT World {
  public:
   /// Loads every mesh once (objects that share file, scale and refinement share one Model) and
-  /// builds the models. Throws caliber::Error on bad meshes (naming the object and file).
-  explicit World(Scene scene);
+  /// builds the models where `options` says. Throws caliber::Error on bad meshes (naming the
+  /// object and file) and on a thread count out of range.
+  explicit World(Scene scene, const WorldOptions& options = {});
   /// Copies and moves keep the request's group table pointing at their own scene's.
   World(const World& other);
   World(World&& other) noexcept;

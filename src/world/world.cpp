@@ -103,7 +103,7 @@ World& World::operator=(World&& other) noexcept {
   return *this;
 }
 
-World::World(Scene scene) : mScene(std::move(scene)) {
+World::World(Scene scene, const WorldOptions& options) : mScene(std::move(scene)) {
   validate_request(mScene.query);
   check_scene(mScene);
   mRequest = mScene.query;
@@ -135,6 +135,8 @@ World::World(Scene scene) : mScene(std::move(scene)) {
           }
         }
         BuildOptions build;
+        build.threads = options.threads;
+        build.host = options.host;
         build.adjacency = mRequest.kind == QueryKind::contact;        // only the contact reduction reads it
         build.oriented_boxes = mRequest.kind == QueryKind::distance;  // only the distance bound reads them
         it = cache.emplace(key, build_model(std::move(mesh), build)).first;

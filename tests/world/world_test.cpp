@@ -6,6 +6,8 @@
 #include <functional>
 #include <fstream>
 #include <random>
+#include <set>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -117,6 +119,55 @@ TEST_F(WorldFiles, SharedModelsGiveTheSameContactsAsSeparateOnes) {
     total += static_cast<int>(x.contacts.size());
   }
   EXPECT_GT(total, 0);
+}
+
+/// A host of two threads that runs every range itself, on the calling thread, and counts the calls
+/// and the threads they came from.
+class CountingHost final : public HostExecutor {
+ public:
+  int thread_count() const override { return 2; }
+  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
+    ++calls;
+    callers.insert(std::this_thread::get_id());
+    for (std::size_t b = 0; b < count; b += grain) task(b, std::min(count, b + grain), 1);
+    return nullptr;
+  }
+  void finish(void*) override { ADD_FAILURE() << "finish() of a call that ran inline"; }
+  int calls = 0;
+  std::set<std::thread::id> callers;
+};
+
+TEST_F(WorldFiles, ModelsBuildOnTheHostsThreadsAndAreTheSame) {
+  const std::string json = R"({"steps": 12, "dt": 0.1, "query": {"kind": "proximity", "tolerance": 0.15}, "objects": [
+      {"name": "ring", "mesh": "torus.off"},
+      {"name": "ball", "mesh": "sphere.off", "position": [0.9, 0, 0.3], "motion": {"type": "velocity", "linear": [-0.2, 0, -0.1]}}]})";
+  CountingHost host;
+  WorldOptions options;
+  options.host = &host;
+  const World lent(scene(json), options);
+  const World own(scene(json));
+  EXPECT_EQ(host.calls, 2) << "one build per distinct model, each on the host";
+  EXPECT_EQ(host.callers, std::set<std::thread::id>{std::this_thread::get_id()});
+  ASSERT_EQ(lent.distinct_models(), own.distinct_models());
+  for (std::size_t i = 0; i < lent.object_count(); ++i) {
+    EXPECT_EQ(lent.model(i).node_count(), own.model(i).node_count());
+    EXPECT_EQ(lent.model(i).height(), own.model(i).height());
+    EXPECT_EQ(lent.model(i).has_adjacency(), own.model(i).has_adjacency());
+  }
+  int total = 0;
+  for (int k = 0; k < 12; ++k) {
+    const StepResult x = test::reference_step(lent, k), y = test::reference_step(own, k);
+    ASSERT_EQ(x.contacts.size(), y.contacts.size()) << "step " << k;
+    for (std::size_t i = 0; i < x.contacts.size(); ++i) {
+      EXPECT_EQ(x.contacts[i].tri_b, y.contacts[i].tri_b);
+      EXPECT_EQ(x.contacts[i].point_a, y.contacts[i].point_a);
+    }
+    total += static_cast<int>(x.contacts.size());
+  }
+  EXPECT_GT(total, 0);
+  WorldOptions bad;
+  bad.threads = -1;
+  EXPECT_THROW(World(scene(json), bad), Error);
 }
 
 TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
