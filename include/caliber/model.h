@@ -60,6 +60,9 @@ class CALIBER_EXPORT Model {
   [[nodiscard]] bool has_adjacency() const;
   /// Whether the distance query's oriented boxes were kept (BuildOptions::oriented_boxes).
   [[nodiscard]] bool has_oriented_boxes() const;
+  /// Bytes the model holds: its mesh (vertices, triangles, groups), normals, BVH (what the
+  /// traversals read, the leaf order, oriented boxes when kept) and adjacency.
+  [[nodiscard]] std::size_t memory_bytes() const;
 
  protected:
   Model() = default;

@@ -97,6 +97,7 @@ class Builder {
     model.filters.resize(mWorkCount);
     model.laterals.resize(mWorkCount);
     model.first_leaf.resize(mWorkCount);
+    if (!mMesh.groups.empty()) model.group_masks.resize(mWorkCount);
     if (oriented_boxes) model.oriented_boxes.resize(mWorkCount);
     model.leaf_position.resize(mOrder.size());
     parallel::parallel_for(0, mWorkCount, kBuildGrain, [&](std::size_t lo, std::size_t hi) {
@@ -104,6 +105,7 @@ class Builder {
         convert(mWork[i].node, model.nodes[i], model.filters[i], model.laterals[i]);
         if (oriented_boxes) node_oriented_box(model.nodes[i], model.filters[i], model.laterals[i], model.oriented_boxes[i]);
         model.first_leaf[i] = mWork[i].node.first;
+        if (!model.group_masks.empty()) model.group_masks[i] = mWork[i].node.groups;
       }
     });
     for (std::uint32_t p = 0; p < mOrder.size(); ++p) model.leaf_position[mOrder[p]] = p;
@@ -331,7 +333,6 @@ class Builder {
     filter.cone_angle = w.cone >= 0.0 ? round_up(w.cone) : -1.0f;
     filter.cone_cos = static_cast<float>(std::cos(static_cast<double>(filter.cone_angle)));
     filter.cone_sin = static_cast<float>(std::sin(static_cast<double>(filter.cone_angle)));
-    filter.groups = w.groups;
     // The dot products above carry a few ulps of |axis|_1 * |v|_inf; the pad is far above that.
     const double slab_pad = 1e-13 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
     filter.slab_lo = w.cone >= 0.0 ? round_down(w.slab_lo - slab_pad) : 0.0f;

@@ -45,8 +45,8 @@ struct BvhNode {
 static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
 
 /// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
-/// tests have passed; the cone only by contact queries) and its group mask (read only with groups).
-/// Kept apart from BvhNode so that the first two tests touch 48 bytes.
+/// tests have passed; the cone only by contact queries): 32 bytes, two to a cache line. Kept apart
+/// from BvhNode so that the first two tests touch 48 bytes.
 struct BvhNodeFilter {
   /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
   float cone_axis[3];
@@ -60,9 +60,8 @@ struct BvhNodeFilter {
   /// below are nearly coplanar, whatever their tilt against the box's axes; both 0 when the axis
   /// is 0 (no normal below), which prunes nothing.
   float slab_lo, slab_hi;
-  /// Bit g set when some triangle below is in primitive group g.
-  std::uint64_t groups;
 };
+static_assert(sizeof(BvhNodeFilter) == 32);
 
 /// What only the distance query reads of a node: the ranges along the two lateral axes of its cone
 /// axis (lateral_axes), every vertex v below having lateral_lo[k] <= axis_k . v <= lateral_hi[k],
@@ -184,8 +183,11 @@ struct ModelData : Model {
   Mesh mesh;
   /// BVH nodes, root first; siblings adjacent.
   std::vector<BvhNode> nodes;
-  /// filters[i]: normal cone, slab and group mask of nodes[i].
+  /// filters[i]: normal cone and slab of nodes[i].
   std::vector<BvhNodeFilter> filters;
+  /// group_masks[i]: bit g set when some triangle below nodes[i] is in primitive group g. Empty
+  /// when the mesh has no groups (every triangle in group 0): see group_mask.
+  std::vector<std::uint64_t> group_masks;
   /// laterals[i]: the lateral ranges of nodes[i] (distance queries).
   std::vector<BvhNodeLateral> laterals;
   /// oriented_boxes[i]: the oriented box of nodes[i], as node_oriented_box computes it from the
@@ -196,6 +198,9 @@ struct ModelData : Model {
   std::vector<std::uint32_t> first_leaf;
   /// Position of each triangle in the leaf order (see first_leaf).
   std::vector<std::uint32_t> leaf_position;
+
+  /// The group mask of node i (read only by queries with a group table).
+  [[nodiscard]] std::uint64_t group_mask(std::uint32_t i) const { return group_masks.empty() ? 1 : group_masks[i]; }
 
   /// Whether triangle t lies below node i.
   [[nodiscard]] bool holds(std::uint32_t node, std::uint32_t triangle) const {

@@ -22,6 +22,8 @@ std::string leaf_problem(const ModelData& m, std::uint32_t i) {
     const double along = axis.dot(p);
     if (!(f.slab_lo <= along && along <= f.slab_hi)) return "leaf " + std::to_string(i) + ": its slab misses a vertex";
   }
+  const std::uint64_t group = std::uint64_t{1} << (m.mesh.groups.empty() ? 0 : m.mesh.groups[n.index]);
+  if (m.group_mask(i) != group) return "leaf " + std::to_string(i) + ": its group mask is not its triangle's group";
   return {};
 }
 
@@ -35,7 +37,7 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   if (m.first_leaf[n.index] != m.first_leaf[i] || m.first_leaf[n.index + 1] != m.first_leaf[i] + a.count) {
     return "node " + std::to_string(i) + ": its children are not the two halves of its run of leaves";
   }
-  if ((m.filters[n.index].groups | m.filters[n.index + 1].groups) != m.filters[i].groups) {
+  if ((m.group_mask(n.index) | m.group_mask(n.index + 1)) != m.group_mask(i)) {
     return "node " + std::to_string(i) + ": its group mask is not its children's";
   }
   return {};
@@ -49,6 +51,9 @@ std::string bvh_problem(const ModelData& m) {
   if (size != 2 * triangles - 1 || m.filters.size() != size || m.laterals.size() != size || m.first_leaf.size() != size ||
       m.leaf_position.size() != triangles) {
     return "the node arrays do not have 2n - 1 entries for n triangles";
+  }
+  if (m.group_masks.size() != (m.mesh.groups.empty() ? 0 : size)) {
+    return "the group masks are not one a node (a mesh with groups) or none (a mesh without)";
   }
   if (m.nodes[0].count != triangles || m.first_leaf[0] != 0) return "the root does not hold every triangle";
   std::vector<std::uint8_t> reached(size, 0), placed(triangles, 0);

@@ -83,7 +83,7 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
     const int k = __builtin_ctz(static_cast<unsigned>(left));
     const BvhNodeFilter& fa = mA.filters[ia[k / 2]];
     const BvhNodeFilter& fb = mB.filters[ib[k % 2]];
-    if ((mGroups != nullptr && !groups_can_touch(fa.groups, fb.groups)) ||
+    if ((mGroups != nullptr && !groups_can_touch(mA.group_mask(ia[k / 2]), mB.group_mask(ib[k % 2]))) ||
         (mKind == QueryKind::contact && !cones_can_face(fa, fb))) {
       pass &= ~(1 << k);
     }
@@ -132,7 +132,7 @@ void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, co
   // What gap adds to the geometry: groups that forbid every pair below.
   if (mGroups == nullptr) return;
   for (int k = 0; k < 4; ++k) {
-    if (out[k] <= reach && !groups_can_touch(mA.filters[as[k / 2]->index].groups, mB.filters[bs[k % 2]->index].groups)) {
+    if (out[k] <= reach && !groups_can_touch(mA.group_mask(as[k / 2]->index), mB.group_mask(bs[k % 2]->index))) {
       out[k] = std::numeric_limits<double>::infinity();
     }
   }

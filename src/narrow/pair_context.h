@@ -220,7 +220,7 @@ class PairContext {
     }
     const double boxes = std::sqrt(std::max(boxes_a, boxes_b));
     if (boxes > reach) return boxes;
-    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) {
+    if (mGroups != nullptr && !groups_can_touch(mA.group_mask(a.index), mB.group_mask(b.index))) {
       return std::numeric_limits<double>::infinity();
     }
     double d[3], r[3][3], t[3];
@@ -290,7 +290,7 @@ class PairContext {
     }
     if (box_beyond_slab(a.slab_axis, a.slab_on_b, a.slab_lo, a.slab_hi, b.box_in_a, b.half, slab_reach)) return false;
     if (box_beyond_slab(b.slab_axis, b.slab_on_a, b.slab_lo, b.slab_hi, a.box_in_b, a.half, slab_reach)) return false;
-    if (mGroups != nullptr && !groups_can_touch(mA.filters[a.index].groups, mB.filters[b.index].groups)) return false;
+    if (mGroups != nullptr && !groups_can_touch(mA.group_mask(a.index), mB.group_mask(b.index))) return false;
     return true;
   }
   bool cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const;

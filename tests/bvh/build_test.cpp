@@ -42,7 +42,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
     auto left = check_subtree(m, node.index);
     auto right = check_subtree(m, node.index + 1);
     EXPECT_EQ(data(m).nodes[node.index].count + data(m).nodes[node.index + 1].count, node.count);
-    EXPECT_EQ(data(m).filters[node.index].groups | data(m).filters[node.index + 1].groups, filter.groups);
+    EXPECT_EQ(data(m).group_mask(node.index) | data(m).group_mask(node.index + 1), data(m).group_mask(index));
     below = std::move(left);
     below.insert(below.end(), right.begin(), right.end());
   }
@@ -146,6 +146,22 @@ TEST(BuildModel, OrientedBoxesOnlyWhenAskedAndCoveringTheirTriangles) {
   check_model(*build_model(flat, options));
 }
 
+TEST(BuildModel, GroupMasksAndTheirBytesOnlyForMeshesWithGroups) {
+  Mesh plain = make_torus(1.0, 0.3, 24, 16);
+  Mesh grouped = plain;
+  grouped.groups.assign(grouped.triangles.size(), 0);
+  for (std::size_t t = 0; t < grouped.groups.size(); t += 3) grouped.groups[t] = 2;
+  BuildOptions options;
+  options.adjacency = false;
+  const auto a = build_model(plain, options), b = build_model(grouped, options);
+  EXPECT_TRUE(data(*a).group_masks.empty());
+  EXPECT_EQ(data(*a).group_mask(0), 1u) << "every triangle in group 0";
+  EXPECT_EQ(data(*b).group_mask(0), 0b101u);
+  // The masks (8 bytes a node) and the groups (1 byte a triangle) are all that differ.
+  EXPECT_EQ(b->memory_bytes() - a->memory_bytes(), 8 * b->node_count() + b->triangle_count());
+  EXPECT_GE(a->memory_bytes(), (48 + 32) * a->node_count()) << "at least the nodes and their filters";
+}
+
 TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-10, 10);
@@ -162,7 +178,8 @@ TEST(BuildModel, InvariantsOnRandomSoupWithGroupsAndDegenerates) {
   }
   const auto model = build_model(mesh);
   check_model(*model);
-  EXPECT_EQ(data(*model).filters[0].groups, 0b11111u);
+  EXPECT_EQ(data(*model).group_mask(0), 0b11111u);
+  EXPECT_EQ(data(*model).group_masks.size(), model->node_count());
   EXPECT_LE(model->height(), height_bound(500));
 }
 

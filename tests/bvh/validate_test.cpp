@@ -32,12 +32,16 @@ TEST(BvhProblem, EachBreakIsFound) {
     const std::vector<BvhNode> nodes = m.nodes;
     const std::vector<BvhNodeFilter> filters = m.filters;
     const std::vector<std::uint32_t> first_leaf = m.first_leaf, leaf_position = m.leaf_position;
+    const std::vector<std::uint64_t> group_masks = m.group_masks;
+    const std::vector<std::uint8_t> groups = m.mesh.groups;
     change();
     const std::string problem = bvh::bvh_problem(m);
     m.nodes = nodes;
     m.filters = filters;
     m.first_leaf = first_leaf;
     m.leaf_position = leaf_position;
+    m.group_masks = group_masks;
+    m.mesh.groups = groups;
     return problem;
   };
   std::uint32_t leaf = 0, inner = 1;  // the first leaf, and the first inner node below the root
@@ -49,7 +53,27 @@ TEST(BvhProblem, EachBreakIsFound) {
   EXPECT_NE(broken([&] { m.nodes[inner].count += 1; }), "");
   EXPECT_NE(broken([&] { m.nodes[inner].index = inner; }), "") << "a child before its parent";
   EXPECT_NE(broken([&] { m.first_leaf[m.nodes[inner].index + 1] += 1; }), "");
-  EXPECT_NE(broken([&] { m.filters[inner].groups ^= 2; }), "");
+  EXPECT_NE(broken([&] { m.group_masks.assign(m.nodes.size(), 1); }), "") << "masks for a mesh without groups";
+  EXPECT_EQ(broken([&] {
+              m.mesh.groups.assign(m.mesh.triangles.size(), 0);
+              m.group_masks.assign(m.nodes.size(), 1);
+            }),
+            "")
+      << "every triangle in group 0, every mask 1";
+  EXPECT_NE(broken([&] {
+              m.mesh.groups.assign(m.mesh.triangles.size(), 0);
+              m.group_masks.assign(m.nodes.size(), 1);
+              m.group_masks[inner] = 3;
+            }),
+            "")
+      << "an inner mask that is not its children's";
+  EXPECT_NE(broken([&] {
+              m.mesh.groups.assign(m.mesh.triangles.size(), 0);
+              m.group_masks.assign(m.nodes.size(), 1);
+              m.group_masks[leaf] = 2;
+            }),
+            "")
+      << "a leaf mask that is not its triangle's group";
   EXPECT_NE(broken([&] { m.nodes.pop_back(); }), "");
   std::uint32_t other = leaf + 1;
   while (!m.nodes[other].is_leaf()) ++other;
