@@ -193,12 +193,12 @@ std::vector<Row> run_scene(const std::filesystem::path& file, const std::vector<
     row.build_ours = build_ours_ms;
     row.build_fcl = build_fcl_ms;
     const std::vector<caliber::Pose> poses = world.poses_at(k);
-    const std::vector<caliber::ObjectPair> tasks = world.broad_phase(poses);
-    row.tris_b = tasks.size();
-    for (const caliber::ObjectPair& t : tasks) {
-      const caliber::Model* a = &world.model(t.a);
-      const caliber::Model* b = &world.model(t.b);
-      compare_pair(*ours[a], poses[t.a], *ours[b], poses[t.b], theirs[a], theirs[b], repeat, row);
+    const std::vector<caliber::ObjectPair> pairs = world.broad_phase(poses);
+    row.tris_b = pairs.size();
+    for (const caliber::ObjectPair& p : pairs) {
+      const caliber::Model* a = &world.model(p.a);
+      const caliber::Model* b = &world.model(p.b);
+      compare_pair(*ours[a], poses[p.a], *ours[b], poses[p.b], theirs[a], theirs[b], repeat, row);
     }
     rows.push_back(row);
   }

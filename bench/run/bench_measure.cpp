@@ -125,7 +125,7 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
                {"triangles", world.triangle_count()},
                {"node_tests_per_step", stats.mean_node_tests()},
                {"contacts_per_step", stats.mean_contacts()},
-               {"pairs_per_step", stats.mean_tasks()},
+               {"pairs_per_step", stats.mean_pairs()},
                {"candidate_pairs", stats.candidate_pairs()},
                {"heaviest_pair_share", heavy_share},
                {"second_pair_share", second_share},

@@ -130,7 +130,7 @@ class Builder {
     const std::uint32_t left_next = first + 2, right_next = left_next + 2 * (mid - begin) - 2;
     int hl = 0, hr = 0;
     if (end - begin > kParallelBuildCount) {
-      parallel::TaskGroup halves;
+      parallel::JobGroup halves;
       halves.run([&] { hl = build_range(first, left_next, begin, mid, left); });
       hr = build_range(first + 1, right_next, mid, end, right);
       halves.wait();

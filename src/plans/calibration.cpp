@@ -175,7 +175,7 @@ std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const s
 
 }  // namespace
 
-SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
+SplitResult split_pair(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
                        double eps, const NodeCounts* measured) {
   const auto weight_of = [&](narrow::NodePair n) {
     if (measured != nullptr) {

@@ -166,8 +166,11 @@ import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["scene"] == "tetras" and len(r["steps"]) == 12
 s = r["steps"][0]
-for key in ("broad_ms", "narrow_ms", "reduce_ms", "node_tests", "contacts", "tasks"):
+for key in ("broad_ms", "narrow_ms", "reduce_ms", "node_tests", "contacts", "pairs"):
     assert key in s, key
+assert r["schema_version"] == 2
+assert all(set(p) == {"a", "b", "node_tests", "leaf_tests", "contacts", "limit_reached"} for st in r["steps"] for p in st["pairs"])
+assert sum(p["contacts"] for p in s["pairs"]) == s["contacts"] or s["limit_reached"]
 assert r["summary"]["steps_with_contacts"] > 0
 lines = open(sys.argv[2]).read().splitlines()
 assert len(lines) == 12
