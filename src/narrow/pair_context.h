@@ -21,7 +21,7 @@
 #include "narrow/disks.h"
 #include "narrow/distance_bound_avx2.h"
 #include "narrow/frames_apart.h"
-#include "narrow/leaf_stage.h"
+#include "narrow/leaf_buffer.h"
 #include "narrow/node_test_avx2.h"
 #include "narrow/prepared.h"
 
@@ -238,11 +238,11 @@ class PairContext {
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
-  /// The same, the pair waiting in `stage` for the batch kernels: once they run (a full batch, or
+  /// The same, the pair waiting in `buffer` for the batch kernels: once they run (a full batch, or
   /// flush_leaves), `out` has what leaf_test would have appended, in the same order.
-  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const;
-  /// Finishes the pairs waiting in `stage` (their candidates appended to `out`) and empties it.
-  void flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const;
+  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
+  /// Finishes the pairs waiting in `buffer` (their candidates appended to `out`) and empties it.
+  void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const;
 
   /// The leaf test of a distance traversal: when the triangles are within `bound` (and allowed by
   /// groups), writes their distance and closest points to `out` and returns true. The arithmetic of
@@ -303,10 +303,10 @@ class PairContext {
   /// only place that calls it.
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
-  /// The staged refusal (the pairs it does not refuse move on), the staged closest points (the
+  /// The buffered refusal (the pairs it does not refuse move on), the buffered closest points (the
   /// kept pairs appended to `out`).
-  void refuse_staged(LeafStage& stage, std::vector<Candidate>& out) const;
-  void finish_staged(LeafStage& stage, std::vector<Candidate>& out) const;
+  void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
+  void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   /// The contact kind's normal test on a leaf pair (true for the other kinds).
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;

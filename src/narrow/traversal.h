@@ -89,17 +89,17 @@ template <class Take>
 /// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
 /// Each child node of A and of B is prepared once for the (up to) four pairs it takes part in.
-/// So every CD node below a root is tested exactly once, by its parent's visit. With a stage, a
-/// leaf pair may wait there for its closest points (PairContext::leaf_test with a stage): the
+/// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
+/// leaf pair may wait there for its closest points (PairContext::leaf_test with a buffer): the
 /// caller flushes it before reading `out`.
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
-                                        NodePair passed[4], TabooView taboo = {}, LeafStage* stage = nullptr) {
+                                        NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) {
     ++stats.leaf_tests;
-    if (stage != nullptr) {
-      ctx.leaf_test(a.index, b.index, out, *stage);
+    if (buffer != nullptr) {
+      ctx.leaf_test(a.index, b.index, out, *buffer);
     } else {
       ctx.leaf_test(a.index, b.index, out);
     }
@@ -183,10 +183,10 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
   // test's pair as it is kept).
-  LeafStage stage;
-  LeafStage* const staged = limit == nullptr ? &stage : nullptr;
+  LeafBuffer buffer;
+  LeafBuffer* const buffered = limit == nullptr ? &buffer : nullptr;
   while (top != base) {
-    const int count = visit(ctx, *--top, out, counted, passed, taboo, staged);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, buffered);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (limit != nullptr && count < 0) {
       if (out.size() != seen) {
@@ -205,7 +205,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     }
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
-  ctx.flush_leaves(stage, out);
+  ctx.flush_leaves(buffer, out);
   stats.node_tests += counted.node_tests;
   stats.leaf_tests += counted.leaf_tests;
 }
