@@ -271,7 +271,7 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   summary[slot].children = children;
   summary.resize(summary.size() + children);
   std::uint32_t next = at;
-  const bool both = count == 4;  // both sides split: the visit tests the children with the disks
+  const bool both = count == 4;  // both sides descend: the visit tests the children with the disks
   for (int k = 0; k < count; ++k) {
     if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], both, bounds[k], bounds[k + 1], summary);
   }

@@ -28,7 +28,7 @@ struct Root {
   std::int32_t owner = -1;  ///< a posteriori: the taboo list this root is on (sub-tasks)
   std::int32_t slot = -1;   ///< a posteriori: its place on that list
   std::int32_t stage = -1;  ///< weight-driven stage: index of its record in SplitResult::stage
-  bool disks = false;       ///< untested, its CD parent splits both sides: tested with the disks
+  bool disks = false;       ///< untested, its CD parent descends on both sides: tested with the disks
 
   /// How its traversal tests it (narrow::RootTest), as its parent's visit would.
   [[nodiscard]] narrow::RootTest root_test() const {
@@ -145,7 +145,7 @@ struct SummaryNode {
   std::uint32_t contacts = 0;  ///< reported triangle pairs below it
   std::uint32_t first = 0;     ///< index of its first child in the summary
   std::uint32_t children = 0;  ///< how many children (only those with contacts below)
-  bool disks = false;          ///< its parent splits both sides (its node test has the disks)
+  bool disks = false;          ///< its parent descends on both sides (its node test has the disks)
 };
 
 /// Builds the summary tree of pair context ctx's CD tree from the previous step's reported triangle

@@ -189,7 +189,7 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
       const int count = s.children == 0 ? 0 : narrow::cd_children(kind_ctx, s.node, kids);
       for (std::uint32_t c = 0; c < s.children; ++c) {
         EXPECT_NE(std::find(kids, kids + count, kind_summary[s.first + c].node), kids + count) << to_string(kind);
-        // A child of a visit where both sides split is tested with the disks (narrow::child_test).
+        // A child of a visit where both sides descend is tested with the disks (narrow::child_test).
         EXPECT_EQ(kind_summary[s.first + c].disks, count == 4) << to_string(kind);
         both_and_one[count == 4] += 1;
       }
