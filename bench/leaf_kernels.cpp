@@ -1,7 +1,7 @@
 // Leaf kernels against FCL's, on the triangle pairs the scenes really send to the leaf test.
 //
 // The pairs: every leaf pair whose node test passes, at step 50 of two_small, funnel, front_car and
-// two_large (every candidate object pair of the broad phase), with B's triangle in A's frame exactly
+// two_large (every object pair of the broad phase), with B's triangle in A's frame exactly
 // as caliber's leaf test sees it (up to kMaxPairs per scene, taken evenly). Each benchmark runs one
 // kernel over all of a scene's pairs; items/s is triangle pairs per second.
 //
@@ -21,7 +21,7 @@
 //   bench_leaf_kernels [--scenes DIR] [google benchmark flags, e.g. --benchmark_repetitions=5]
 //   bench_leaf_kernels --census [--scenes DIR]
 //
-// --census times nothing: for each scene's pairs it counts the kernel's candidates that a
+// --census times nothing: for each scene's pairs it counts the kernel's feature pairs that a
 // plane-distance bound shows cannot win (see census()), what skipping them could save at most.
 //
 // Before timing, the distances of both kernels are compared on every pair (they must agree to
@@ -241,18 +241,18 @@ void leaf_test_buffered(benchmark::State& state, const std::string& scene) {
   state.counters["kept"] = static_cast<double>(out.size()) / static_cast<double>(std::max<std::size_t>(s.pairs.size(), 1));
 }
 
-/// The share of the kernel's candidates that a cheap lower bound shows cannot win, on each scene's
-/// pairs: a vertex-face candidate (a corner of one triangle against the other) is at least the
+/// The share of the kernel's feature pairs that a cheap lower bound shows cannot win, on each scene's
+/// pairs: a vertex-face feature pair (a corner of one triangle against the other) is at least the
 /// corner's distance to the other's plane; an edge pair is at least the distance to a plane that
-/// has both ends of one of the edges on one side. A candidate whose bound exceeds the pair's final
+/// has both ends of one of the edges on one side. A feature pair whose bound exceeds the pair's final
 /// distance (by a relative 1e-9) cannot change the kernel's answer, so this counts what an ideal
 /// skip, knowing the answer beforehand and with no rounding margin, could leave out: an upper
-/// bound on the saving. "all 8" counts the candidates that every pair of a batch of eight could
+/// bound on the saving. "all 8" counts the feature pairs that every pair of a batch of eight could
 /// leave out together (what the eight-lane kernel can skip without moving pairs between lanes).
 void census() {
   for (const std::string scene : {"two_small", "funnel", "front_car", "two_large"}) {
     const Sample& s = sample(scene);
-    std::vector<std::uint16_t> skip(s.pairs.size());  // bit c: candidate c (9 edge pairs, then 6 corners)
+    std::vector<std::uint16_t> skip(s.pairs.size());  // bit c: feature pair c (9 edge pairs, then 6 corners)
     for (std::size_t k = 0; k < s.pairs.size(); ++k) {
       const TrianglePair& p = s.pairs[k];
       const double d = caliber::geometry::closest_points_triangles(p.a, p.b).distance;

@@ -234,9 +234,9 @@ nlohmann::json print_summary(const RunOptions& opt, const World& world, const En
   std::printf("  node tests / step  %.0f\n", stats.mean_node_tests());
   std::printf("  contacts / step    %.1f (steps with contacts: %zu of %zu)\n", stats.mean_contacts(), stats.steps_with_contacts(),
               stats.steps());
-  std::printf("  pairs / step       %.1f (candidate pairs over the run: %zu)\n", stats.mean_pairs(), stats.candidate_pairs());
+  std::printf("  pairs / step       %.1f (distinct pairs over the run: %zu)\n", stats.mean_pairs(), stats.distinct_pairs());
   std::printf("  heaviest pair      %s: %.1f %% of node tests\n", pair_name(world, heavy).c_str(), 100.0 * heavy_share);
-  if (stats.candidate_pairs() > 1) {
+  if (stats.distinct_pairs() > 1) {
     std::printf("  second heaviest    %s: %.1f %% of node tests\n", pair_name(world, second).c_str(), 100.0 * second_share);
   }
   nlohmann::json simulated = nlohmann::json::object();
@@ -267,7 +267,7 @@ void close_report(RunSinks& sinks, const World& world, const RunStats& stats, co
                                    {"node_tests_per_step", stats.mean_node_tests()},
                                    {"contacts_per_step", stats.mean_contacts()},
                                    {"pairs_per_step", stats.mean_pairs()},
-                                   {"candidate_pairs", stats.candidate_pairs()},
+                                   {"distinct_pairs", stats.distinct_pairs()},
                                    {"steps_with_contacts", stats.steps_with_contacts()},
                                    {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
                                    {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},

@@ -32,7 +32,7 @@ class RunStats {
   /// Steps with at least one contact.
   [[nodiscard]] std::size_t steps_with_contacts() const { return mStepsWithContacts; }
   /// Distinct object pairs the broad phase kept over the run.
-  [[nodiscard]] std::size_t candidate_pairs() const { return mPairWork.size(); }
+  [[nodiscard]] std::size_t distinct_pairs() const { return mPairWork.size(); }
   /// The object pair with the most node tests over the run, and its share of all node tests (0..1).
   [[nodiscard]] std::pair<ObjectPair, double> heaviest_pair() const;
   /// The pair with the second most node tests over the run, and its share.

@@ -61,7 +61,7 @@ bool fields_of(const std::string& kind, std::vector<Field>& fields) {
               {"node_tests_per_step", &Json::is_number},
               {"contacts_per_step", &Json::is_number},
               {"pairs_per_step", &Json::is_number},
-              {"candidate_pairs", &Json::is_number},
+              {"distinct_pairs", &Json::is_number},
               {"heaviest_pair_share", &Json::is_number},
               {"second_pair_share", &Json::is_number},
               {"exploitation_bound", &Json::is_number}};

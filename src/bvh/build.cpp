@@ -198,23 +198,23 @@ class Builder {
     node.first = position;
     node.lo = a.cwiseMin(b).cwiseMin(c);
     node.hi = a.cwiseMax(b).cwiseMax(c);
-    // Candidate centers: the box center, the circumcenter and the edge midpoints (the smallest
+    // Trial centers: the box center, the circumcenter and the edge midpoints (the smallest
     // enclosing sphere is one of the last four); keep whichever covers with the smallest radius.
     const Vec3 ab = b - a, ac = c - a, n = ab.cross(ac);
     const double n2 = n.squaredNorm();
-    Vec3 candidates[5] = {0.5 * (node.lo + node.hi), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), a};
+    Vec3 trials[5] = {0.5 * (node.lo + node.hi), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), a};
     int count = 4;
-    if (n2 > 0.0) candidates[count++] = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
+    if (n2 > 0.0) trials[count++] = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
     node.radius = std::numeric_limits<double>::infinity();
     for (int i = 0; i < count; ++i) {
-      if (!candidates[i].allFinite()) continue;
+      if (!trials[i].allFinite()) continue;
       // The largest of the three norms: one square root of the largest square (sqrt is monotone
       // and correctly rounded, as norm() takes it).
-      const double r = std::sqrt(
-          std::max({(a - candidates[i]).squaredNorm(), (b - candidates[i]).squaredNorm(), (c - candidates[i]).squaredNorm()}));
+      const double r =
+          std::sqrt(std::max({(a - trials[i]).squaredNorm(), (b - trials[i]).squaredNorm(), (c - trials[i]).squaredNorm()}));
       if (r < node.radius) {
         node.radius = r;
-        node.center = candidates[i];
+        node.center = trials[i];
       }
     }
     node.radius *= 1.0 + 1e-14;

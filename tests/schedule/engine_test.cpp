@@ -148,7 +148,7 @@ TEST(EngineRealScenes, PaperScenesFirstSteps) {
 }
 
 TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
-  // 25 tetrahedra (4 triangles each) crowded together: 300 candidate pairs, all light.
+  // 25 tetrahedra (4 triangles each) crowded together: 300 pairs, all light.
   const std::string tetra = (std::filesystem::path(CALIBER_TEST_DATA) / "tetra.off").string();
   std::string json = R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [)";
   for (int i = 0; i < 25; ++i) {
