@@ -127,7 +127,7 @@ struct EngineOptions {
   /// whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
-  /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_sweep.md): with 2 threads, beta = 2
+  /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_beta.md): with 2 threads, beta = 2
   /// cuts scenes of many light pairs (funnel) into about 4 coarse tasks that cannot be balanced;
   /// a larger beta costs a longer serial weight-driven stage on a scene of one pair (two_small).
   double beta = 6.0;

@@ -1,4 +1,4 @@
-"""Pose sweeps over a Dask cluster (dask.distributed): caliber.query_many's answers, computed in
+"""Pose batches over a Dask cluster (dask.distributed): caliber.query_many's answers, computed in
 chunks of poses on the cluster's workers, gathered in input order.
 
     from dask.distributed import Client
@@ -11,7 +11,7 @@ chunks of poses on the cluster's workers, gathered in input order.
 Each model goes to every worker once (client.scatter with broadcast), the poses in chunks of
 `chunk` entries, each chunk one Dask job: caliber.query_many on the worker with `threads` threads.
 The chunks' Batches come back and are joined in order into one Batch, equal bit for bit to
-caliber.query_many's on one machine. A worker that dies mid-sweep costs the chunks it held: the
+caliber.query_many's on one machine. A worker that dies mid-batch costs the chunks it held: the
 scheduler runs them again on the workers left (up to Dask's distributed.scheduler.allowed-failures
 times per chunk).
 """
@@ -39,7 +39,7 @@ def _positive_integer(value, name):
 
 
 def _run_chunk(a, poses_a, b, poses_b, first, request):
-    """One chunk on a worker; a bad pose's error names its row in the whole sweep."""
+    """One chunk on a worker; a bad pose's error names its row in the whole batch."""
     try:
         return caliber.query_many(a, poses_a, b, poses_b, **request)
     except caliber.Error as e:

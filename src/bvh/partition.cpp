@@ -221,7 +221,7 @@ std::uint32_t partition_binned(std::span<std::uint32_t> order, std::span<Partiti
       ++bins[k][b[k]].count;
     }
   }
-  // Each axis's planes: the cost of the bins below a plane and of those above it, from a sweep
+  // Each axis's planes: the cost of the bins below a plane and of those above it, from a pass
   // each way; the cheapest plane that leaves both sides their share.
   const std::uint32_t least = std::max<std::uint32_t>(1, count / kPartitionBalance);
   double best = std::numeric_limits<double>::infinity();
