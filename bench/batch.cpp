@@ -150,7 +150,7 @@ std::optional<Options> parse(int argc, char** argv) {
 }
 
 /// The bunny (A) and the scaled turbine (the link, B), their models (ours and FCL's), the link's
-/// poses (all, and split by whether they collide), and an engine per thread count with its column's name.
+/// poses (all, and grouped by whether they collide), and an engine per thread count with its column's name.
 struct Setup {
   Mesh bunny, link;
   std::shared_ptr<const Model> a, b;

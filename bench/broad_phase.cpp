@@ -1,11 +1,11 @@
-// The broad phase against Bullet's dynamic AABB tree and a plain sweep along x: N boxes (half-size
+// The broad phase against Bullet's dynamic AABB tree and a plain sort along x: N boxes (half-size
 // 0.45) on a jittered cubic grid of spacing 0.9, each drifting, S steps. Per step, after a first
 // step that builds each structure (not timed): caliber's broad phase on an engine of 1 and 2 threads
 // (or those --threads names; Engine::find_pairs, its tree kept from step to step), the same search made afresh each step
-// (caliber::broad_phase), a sweep and prune along x over the same boxes, and Bullet 3's
+// (caliber::broad_phase), a sort and prune along x over the same boxes, and Bullet 3's
 // btDbvtBroadphase fed the same boxes (setAabb on every proxy, then calculateOverlappingPairs; the
 // boxes are computed outside its timing). Milliseconds per step, medians of interleaved rounds.
-// caliber's pairs are checked against the sweep's every step; Bullet's pair cache is counted apart:
+// caliber's pairs are checked against the x-sort's every step; Bullet's pair cache is counted apart:
 // how many of its pairs overlap, and whether it holds every pair that does.
 //
 //   bench_broad_phase [--objects N ...] [--threads T ...] [--steps S] [--repeat R] [--out FILE.md]
@@ -27,7 +27,7 @@
 
 #include <btBulletCollisionCommon.h>
 
-#include "support/sweep_and_prune.h"
+#include "support/x_sort_pairs.h"
 #include "broad/world_box.h"
 #include "caliber/broad_phase.h"
 #include "caliber/engine.h"
@@ -38,7 +38,7 @@ namespace {
 
 using namespace caliber;
 using broad::WorldBox;
-using test::sweep_along_x;
+using test::pairs_by_x_sort;
 using Clock = std::chrono::steady_clock;
 
 struct Boxes {
@@ -164,31 +164,31 @@ std::string table_head(const std::vector<int>& thread_counts) {
     table += " caliber " + std::to_string(threads) + (threads == 1 ? " thread ms |" : " threads ms |");
     rule += "---|";
   }
-  table += " afresh ms | sweep along x ms | Bullet dbvt ms | caliber " + std::to_string(thread_counts[0]) +
+  table += " afresh ms | x-sort ms | Bullet dbvt ms | caliber " + std::to_string(thread_counts[0]) +
            "t / Bullet | Bullet's pairs (overlapping) |\n" + rule + "---|---|---|---|---|\n";
   return table;
 }
 
-/// Every step of a scene: the poses, their world boxes, and the pairs the sweep along x finds.
+/// Every step of a scene: the poses, their world boxes, and the pairs the sort along x finds.
 struct Steps {
   std::vector<std::vector<Pose>> poses;
   std::vector<std::vector<WorldBox>> boxes;
   std::vector<std::vector<ObjectPair>> want;
 };
 
-/// The first `steps` steps of `scene`, each with its boxes and the sweep's pairs.
+/// The first `steps` steps of `scene`, each with its boxes and the x-sort's pairs.
 Steps steps_of(const Boxes& scene, int steps) {
   Steps s;
   for (int k = 0; k < steps; ++k) {
     s.poses.push_back(scene.at(k));
     s.boxes.push_back(boxes_of(scene, s.poses.back()));
-    s.want.push_back(sweep_along_x(s.boxes.back()));
+    s.want.push_back(pairs_by_x_sort(s.boxes.back()));
   }
   return s;
 }
 
 /// What the rounds measured on one scene: milliseconds per step by contender ("t1", "t2", ...,
-/// "fresh", "sweep", "bullet"), and Bullet's pair cache over the first round's steps.
+/// "fresh", "x_sort", "bullet"), and Bullet's pair cache over the first round's steps.
 struct Measured {
   std::map<std::string, std::vector<double>> ms;
   double bullet_pairs = 0.0, bullet_exact = 0.0;
@@ -209,7 +209,7 @@ bool time_engine(const Boxes& scene, const Steps& s, int steps, int threads, Mea
     frame.poses = s.poses[k];
     engine.find_pairs(frame);
     if (frame.pairs != s.want[k]) {
-      std::fprintf(stderr, "caliber's pairs differ from the sweep's at %zu objects, step %d\n", scene.models.size(), k);
+      std::fprintf(stderr, "caliber's pairs differ from the x-sort's at %zu objects, step %d\n", scene.models.size(), k);
       return false;
     }
   }
@@ -237,7 +237,7 @@ void time_bullet(const Steps& s, int steps, int round, Measured& m) {
   m.ms["bullet"].push_back(total / (steps - 1));
 }
 
-/// The interleaved rounds: caliber per thread count, the search afresh, the sweep, then Bullet. False if any pairs differ.
+/// The interleaved rounds: caliber per thread count, the search afresh, the x-sort, then Bullet. False if any pairs differ.
 bool time_rounds(const Boxes& scene, const Steps& s, const Options& o, Measured& m) {
   const int steps = o.steps;
   for (int round = 0; round < o.repeat; ++round) {
@@ -254,9 +254,9 @@ bool time_rounds(const Boxes& scene, const Steps& s, const Options& o, Measured&
     {
       const auto t = Clock::now();
       for (int k = 1; k < steps; ++k) {
-        if (sweep_along_x(boxes_of(scene, s.poses[k])).size() != s.want[k].size()) return false;
+        if (pairs_by_x_sort(boxes_of(scene, s.poses[k])).size() != s.want[k].size()) return false;
       }
-      m.ms["sweep"].push_back(ms_since(t) / (steps - 1));
+      m.ms["x_sort"].push_back(ms_since(t) / (steps - 1));
     }
     time_bullet(s, steps, round, m);
   }
@@ -277,7 +277,7 @@ std::string table_row(std::size_t n, const Steps& s, const Options& o, const Mea
   }
   const double first = median(m.ms.at("t" + std::to_string(o.thread_counts[0])));
   std::snprintf(cell, sizeof cell, " %.2f | %.2f | %.2f | %.2f | %.0f (%.0f)%s |\n", median(m.ms.at("fresh")),
-                median(m.ms.at("sweep")), median(m.ms.at("bullet")), first / median(m.ms.at("bullet")), m.bullet_pairs,
+                median(m.ms.at("x_sort")), median(m.ms.at("bullet")), first / median(m.ms.at("bullet")), m.bullet_pairs,
                 m.bullet_exact, m.bullet_holds_all ? "" : " MISSES PAIRS");
   row += cell;
   return row;
@@ -303,7 +303,7 @@ int main(int argc, char** argv) {
       "Machine: " + bench::machine_description() + ". " + std::to_string(o->steps) +
       " steps, milliseconds per step after the first (which builds each structure), medians of " + std::to_string(o->repeat) +
       " interleaved rounds. Boxes of half-size 0.45 on a jittered cubic grid of spacing 0.9, drifting; caliber's "
-      "pairs equal the sweep's at every step (checked); Bullet is given the same boxes (their computation not timed).\n\n";
+      "pairs equal the x-sort's at every step (checked); Bullet is given the same boxes (their computation not timed).\n\n";
   if (!o->out_path.empty()) std::ofstream(o->out_path) << head << table;
   std::printf("\n%s", head.c_str());
   return 0;

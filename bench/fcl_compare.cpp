@@ -5,7 +5,7 @@
 //
 //   bench_fcl_compare [--meshes DIR] [--repeat R] [--out FILE.md] [--scenes A.json,B.json] [--steps 0,50,100]
 //                     [--no-mesh-pairs]
-// With --scenes, also every candidate pair of each scene's broad phase at the given steps.
+// With --scenes, also every pair of each scene's broad phase at the given steps.
 
 #include <numbers>
 #include <algorithm>
@@ -167,7 +167,7 @@ Row run_case(const Case& c, const std::filesystem::path& dir, int repeat) {
   return row;
 }
 
-/// A scene at several steps: every candidate pair of the broad phase, our sequential interference
+/// A scene at several steps: every pair of the broad phase, our sequential interference
 /// query against FCL's on the same poses. Build times: every distinct model of the scene, summed.
 std::vector<Row> run_scene(const std::filesystem::path& file, const std::vector<int>& steps, int repeat) {
   const caliber::World world(caliber::load_scene(file));
@@ -193,12 +193,12 @@ std::vector<Row> run_scene(const std::filesystem::path& file, const std::vector<
     row.build_ours = build_ours_ms;
     row.build_fcl = build_fcl_ms;
     const std::vector<caliber::Pose> poses = world.poses_at(k);
-    const std::vector<caliber::ObjectPair> tasks = world.broad_phase(poses);
-    row.tris_b = tasks.size();
-    for (const caliber::ObjectPair& t : tasks) {
-      const caliber::Model* a = &world.model(t.a);
-      const caliber::Model* b = &world.model(t.b);
-      compare_pair(*ours[a], poses[t.a], *ours[b], poses[t.b], theirs[a], theirs[b], repeat, row);
+    const std::vector<caliber::ObjectPair> pairs = world.broad_phase(poses);
+    row.tris_b = pairs.size();
+    for (const caliber::ObjectPair& p : pairs) {
+      const caliber::Model* a = &world.model(p.a);
+      const caliber::Model* b = &world.model(p.b);
+      compare_pair(*ours[a], poses[p.a], *ours[b], poses[p.b], theirs[a], theirs[b], repeat, row);
     }
     rows.push_back(row);
   }
@@ -293,7 +293,7 @@ void write_report(const Options& o, const std::string& table) {
        << "Machine: " << caliber::bench::machine_description() << "\n\n"
        << "Medians of " << o.repeat << " runs. Ratios are ours / FCL (lower is better for us). "
        << "Build: caliber's sphere tree without adjacency vs FCL's OBBRSS build (scenes: every distinct model, "
-       << "summed). Scene rows: every candidate pair of the broad phase at that step, times summed; "
+       << "summed). Scene rows: every pair of the broad phase at that step, times summed; "
        << "triangles = the scene's distinct models.\n\n"
        << table;
 }

@@ -43,7 +43,7 @@ def run(cli, scene, method, threads, steps, tmp):
         s = json.load(f)["steps"][1:]
     return {"step_ms": statistics.median(x["broad_ms"] + x["narrow_ms"] + x["reduce_ms"] for x in s),
             "broad_ms": statistics.median(x["broad_ms"] for x in s),
-            "pairs": statistics.median(len(x["tasks"]) for x in s),
+            "pairs": statistics.median(len(x["pairs"]) for x in s),
             "rss_mb": rss / 1024.0}
 
 

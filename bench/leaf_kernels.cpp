@@ -1,7 +1,7 @@
 // Leaf kernels against FCL's, on the triangle pairs the scenes really send to the leaf test.
 //
 // The pairs: every leaf pair whose node test passes, at step 50 of two_small, funnel, front_car and
-// two_large (every candidate object pair of the broad phase), with B's triangle in A's frame exactly
+// two_large (every object pair of the broad phase), with B's triangle in A's frame exactly
 // as caliber's leaf test sees it (up to kMaxPairs per scene, taken evenly). Each benchmark runs one
 // kernel over all of a scene's pairs; items/s is triangle pairs per second.
 //
@@ -10,18 +10,18 @@
 //   closest_points_portable/SCENE  the same kernel's portable form (the same bits, no AVX2)
 //   closest_points_batch/SCENE  closest_points_triangles_batch, 8 pairs a call (AVX-512 where the
 //                          CPU has it; the same bits): the pairs copied into the batch, in order,
-//                          as the contact leaf test stages them, the copying timed too
+//                          as the contact leaf test buffers them, the copying timed too
 //   fcl_tri_distance/SCENE fcl::detail::TriangleDistance<double>::triDistance (FCL's, PQP's)
 //   intersect/SCENE        caliber::geometry::triangles_intersect (exact; the interference kernel)
 //   fcl_intersect/SCENE    fcl::detail::Intersect<double>::intersect_Triangle (FCL's collide kernel)
 //   leaf_test/SCENE        PairContext::leaf_test, the scene's contact query: the whole leaf test
-//   leaf_test_staged/SCENE the same through a stage (the depth-first traversal's way: the refusal
+//   leaf_test_buffered/SCENE the same through a buffer (the depth-first traversal's way: the refusal
 //                          and the closest points eight pairs at a time); the same pairs kept
 //
 //   bench_leaf_kernels [--scenes DIR] [google benchmark flags, e.g. --benchmark_repetitions=5]
 //   bench_leaf_kernels --census [--scenes DIR]
 //
-// --census times nothing: for each scene's pairs it counts the kernel's candidates that a
+// --census times nothing: for each scene's pairs it counts the kernel's feature pairs that a
 // plane-distance bound shows cannot win (see census()), what skipping them could save at most.
 //
 // Before timing, the distances of both kernels are compared on every pair (they must agree to
@@ -48,7 +48,7 @@
 #include "caliber/world.h"
 #include "geometry/triangle_distance.h"
 #include "geometry/triangle_intersect.h"
-#include "narrow/leaf_stage.h"
+#include "narrow/leaf_buffer.h"
 #include "narrow/pair_context.h"
 #include "narrow/traversal.h"
 
@@ -221,19 +221,19 @@ void leaf_test(benchmark::State& state, const std::string& scene) {
   state.counters["kept"] = static_cast<double>(out.size()) / static_cast<double>(std::max<std::size_t>(s.pairs.size(), 1));
 }
 
-void leaf_test_staged(benchmark::State& state, const std::string& scene) {
+void leaf_test_buffered(benchmark::State& state, const std::string& scene) {
   const Sample& s = sample(scene);
   std::vector<caliber::narrow::Candidate> out;
   out.reserve(s.pairs.size());
-  caliber::narrow::LeafStage stage;
+  caliber::narrow::LeafBuffer buffer;
   for (auto _ : state) {
     out.clear();
     for (std::size_t i = 0; i < s.pairs.size(); ++i) {
       const TrianglePair& p = s.pairs[i];
       const caliber::narrow::PairContext& ctx = *s.contexts[p.context];
-      ctx.leaf_test(p.ta, p.tb, out, stage);
-      // A stage holds one object pair's leaf pairs: flushed where the next pair's context differs.
-      if (i + 1 == s.pairs.size() || s.pairs[i + 1].context != p.context) ctx.flush_leaves(stage, out);
+      ctx.leaf_test(p.ta, p.tb, out, buffer);
+      // A buffer holds one object pair's leaf pairs: flushed where the next pair's context differs.
+      if (i + 1 == s.pairs.size() || s.pairs[i + 1].context != p.context) ctx.flush_leaves(buffer, out);
     }
     benchmark::DoNotOptimize(out.data());
   }
@@ -241,18 +241,18 @@ void leaf_test_staged(benchmark::State& state, const std::string& scene) {
   state.counters["kept"] = static_cast<double>(out.size()) / static_cast<double>(std::max<std::size_t>(s.pairs.size(), 1));
 }
 
-/// The share of the kernel's candidates that a cheap lower bound shows cannot win, on each scene's
-/// pairs: a vertex-face candidate (a corner of one triangle against the other) is at least the
+/// The share of the kernel's feature pairs that a cheap lower bound shows cannot win, on each scene's
+/// pairs: a vertex-face feature pair (a corner of one triangle against the other) is at least the
 /// corner's distance to the other's plane; an edge pair is at least the distance to a plane that
-/// has both ends of one of the edges on one side. A candidate whose bound exceeds the pair's final
+/// has both ends of one of the edges on one side. A feature pair whose bound exceeds the pair's final
 /// distance (by a relative 1e-9) cannot change the kernel's answer, so this counts what an ideal
 /// skip, knowing the answer beforehand and with no rounding margin, could leave out: an upper
-/// bound on the saving. "all 8" counts the candidates that every pair of a batch of eight could
+/// bound on the saving. "all 8" counts the feature pairs that every pair of a batch of eight could
 /// leave out together (what the eight-lane kernel can skip without moving pairs between lanes).
 void census() {
   for (const std::string scene : {"two_small", "funnel", "front_car", "two_large"}) {
     const Sample& s = sample(scene);
-    std::vector<std::uint16_t> skip(s.pairs.size());  // bit c: candidate c (9 edge pairs, then 6 corners)
+    std::vector<std::uint16_t> skip(s.pairs.size());  // bit c: feature pair c (9 edge pairs, then 6 corners)
     for (std::size_t k = 0; k < s.pairs.size(); ++k) {
       const TrianglePair& p = s.pairs[k];
       const double d = caliber::geometry::closest_points_triangles(p.a, p.b).distance;
@@ -335,7 +335,8 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("intersect/" + scene).c_str(), intersect, scene)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("fcl_intersect/" + scene).c_str(), fcl_intersect, scene)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("leaf_test/" + scene).c_str(), leaf_test, scene)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("leaf_test_staged/" + scene).c_str(), leaf_test_staged, scene)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("leaf_test_buffered/" + scene).c_str(), leaf_test_buffered, scene)
+        ->Unit(benchmark::kMillisecond);
   }
   int count = static_cast<int>(rest.size());
   benchmark::Initialize(&count, rest.data());

@@ -21,15 +21,15 @@
 class OpenMPHost final : public caliber::HostExecutor {
  public:
   int thread_count() const override { return omp_in_parallel() ? omp_get_num_threads() : 1; }
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
     if (!omp_in_parallel()) {
-      for (std::size_t begin = 0; begin < count; begin += grain) task(begin, std::min(count, begin + grain), 0);
+      for (std::size_t begin = 0; begin < count; begin += grain) job(begin, std::min(count, begin + grain), 0);
       return nullptr;
     }
     for (std::size_t begin = 0; begin < count; begin += grain) {
       const std::size_t end = std::min(count, begin + grain);
-#pragma omp task firstprivate(begin, end) shared(task)
-      task(begin, end, omp_get_thread_num());
+#pragma omp task firstprivate(begin, end) shared(job)
+      job(begin, end, omp_get_thread_num());
     }
     return this;
   }
@@ -40,7 +40,7 @@ class OpenMPHost final : public caliber::HostExecutor {
 
 static std::size_t os_threads() {
   std::size_t n = 0;
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) n += task.is_directory();
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) n += entry.is_directory();
   return n;
 }
 

@@ -34,8 +34,8 @@ class ThreadPool final : public caliber::HostExecutor {
     for (std::thread& t : mThreads) t.join();
   }
   int thread_count() const override { return static_cast<int>(mThreads.size()) + 1; }
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
-    auto* call = new Call{&task, 0};
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
+    auto* call = new Call{&job, 0};
     {
       const std::lock_guard<std::mutex> lock(mMutex);
       for (std::size_t begin = 0; begin < count; begin += grain, ++call->left) {
@@ -60,7 +60,7 @@ class ThreadPool final : public caliber::HostExecutor {
 
  private:
   struct Call {
-    const Task* task;
+    const Job* job;
     std::size_t left;  ///< ranges not yet done
   };
   struct Range {
@@ -71,7 +71,7 @@ class ThreadPool final : public caliber::HostExecutor {
     const Range r = mQueue.front();
     mQueue.pop_front();
     lock.unlock();
-    (*r.call->task)(r.begin, r.end, worker);
+    (*r.call->job)(r.begin, r.end, worker);
     lock.lock();
     if (--r.call->left == 0) mChanged.notify_all();
   }
@@ -92,7 +92,7 @@ class ThreadPool final : public caliber::HostExecutor {
 
 static std::size_t os_threads() {
   std::size_t n = 0;
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) n += task.is_directory();
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) n += entry.is_directory();
   return n;
 }
 

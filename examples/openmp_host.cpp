@@ -27,8 +27,8 @@ std::size_t os_threads() {
   return n;
 }
 
-/// Pose k of the planner's sweep: the sphere moving across the torus's tube, turning as it goes.
-caliber::Pose sweep(int k) {
+/// Pose k of the planner's path: the sphere moving across the torus's tube, turning as it goes.
+caliber::Pose path_pose(int k) {
   caliber::Pose pose;
   pose.translation = {0.7 + 0.01 * k, 0.0, 0.2};
   pose.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * k, Eigen::Vector3d::UnitZ()));
@@ -54,7 +54,7 @@ int main() {
     request.tolerance = 0.02;
     std::vector<caliber::QueryResult> results(kPoses);
 #pragma omp parallel for schedule(dynamic)
-    for (int k = 0; k < kPoses; ++k) results[k] = caliber::query(*torus, caliber::Pose{}, *sphere, sweep(k), request);
+    for (int k = 0; k < kPoses; ++k) results[k] = caliber::query(*torus, caliber::Pose{}, *sphere, path_pose(k), request);
     const std::size_t threads_after = os_threads();
 
     // The reference: the default engine (its own threads, started only now), one frame per pose.
@@ -64,7 +64,7 @@ int main() {
     for (int k = 0; k < kPoses; ++k) {
       caliber::Frame frame;
       frame.models = {torus, sphere};
-      frame.poses = {caliber::Pose{}, sweep(k)};
+      frame.poses = {caliber::Pose{}, path_pose(k)};
       frame.pairs = {{0, 1}};
       frame.request = request;
       const caliber::StepResult step = engine.step(frame);

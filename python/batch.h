@@ -307,7 +307,7 @@ inline py::class_<PyBatch> bind_batch(py::module_& m) {
                 return PyBatch::concatenate(parts);
               },
               py::arg("batches"),
-              "One Batch of the given batches' entries, in order (what a sweep cut in chunks gathers); counters summed.")
+              "One Batch of the given batches' entries, in order (what a pose batch cut in chunks gathers); counters summed.")
           .def("__reduce__", [](const PyBatch& b) {
             return py::make_tuple(py::module_::import("caliber").attr("_batch_from_state"), py::make_tuple(b.state()));
           });

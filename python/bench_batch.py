@@ -1,5 +1,5 @@
 """Batch queries from Python, measured: what a Python call costs beyond the C++ it runs, and a
-pose sweep over a Dask cluster on this machine with 1 and 2 worker processes. A measurement, not a
+pose batch over a Dask cluster on this machine with 1 and 2 worker processes. A measurement, not a
 test (interleaved rounds, medians).
 
   PYTHONPATH=build/python python3 python/bench_batch.py [--meshes data/meshes] [--poses 10000]
@@ -7,11 +7,11 @@ test (interleaved rounds, medians).
 
 - One call on two tetrahedra: Python's caliber.query against the C++ caliber::query (bench_batch
   --tiny-only, run between the Python rounds).
-- A sweep of the turbine (scaled 0.3) through the bunny along bench_batch's path: per pose,
+- A pose batch of the turbine (scaled 0.3) through the bunny along bench_batch's path: per pose,
   Python's query loop and query_many (1 and 2 threads) against the C++ batch inside the same call
   (Batch.batch_ms), free and colliding poses apart.
 - caliber.distributed over a LocalCluster of 1 and of 2 worker processes (one thread each): the
-  same distance sweep, the same Batch as query_many.
+  same distance pose batch, the same Batch as query_many.
 """
 import argparse
 import os
@@ -80,7 +80,7 @@ def models(args):
     return bunny, caliber.Model(caliber.Mesh(mesh.vertices * 0.3, mesh.faces), oriented_boxes=True)
 
 
-def sweep(args, lines):
+def path_batch(args, lines):
     bunny, link = models(args)
     poses = path(bunny.mesh, link.mesh, args.poses)
     ident = caliber.Pose()
@@ -146,7 +146,7 @@ def main():
     p.add_argument("--dask-chunk", type=int, default=2500)
     p.add_argument("--cpp", default="build/bench_batch")
     p.add_argument("--out")
-    p.add_argument("--skip", nargs="*", default=[], choices=["tiny", "sweep", "dask"])
+    p.add_argument("--skip", nargs="*", default=[], choices=["tiny", "path", "dask"])
     args = p.parse_args()
     t_lines = ["| call | C++ us | Python us | Python - C++ us |", "|---|---|---|---|"]
     s_lines = ["| query | poses | count | Python loop | query_many 1t | C++ batch 1t | ratio | query_many 2t | "
@@ -155,15 +155,15 @@ def main():
     if "tiny" not in args.skip:
         tiny(args, t_lines)
         print("\n".join(t_lines), flush=True)
-    if "sweep" not in args.skip:
-        sweep(args, s_lines)
+    if "path" not in args.skip:
+        path_batch(args, s_lines)
     if "dask" not in args.skip:
         dask(args, d_lines)
         print("\n".join(d_lines), flush=True)
     if args.out:
         with open(args.out, "w") as f:
             f.write("## One call on two tetrahedra (microseconds)\n\n" + "\n".join(t_lines) + "\n\n")
-            f.write("## The sweep from Python (microseconds per pose; ratio: Python's call over the C++ batch inside "
+            f.write("## The path batch from Python (microseconds per pose; ratio: Python's call over the C++ batch inside "
                     "it)\n\n" + "\n".join(s_lines) + "\n\n")
             f.write("## caliber.distributed, distance, LocalCluster of 1 and 2 worker processes\n\n" +
                     "\n".join(d_lines) + "\n")

@@ -159,7 +159,7 @@ def funnel():
 # --- front_car: 23 parts of an assembly. Two knob pairs in sliding contact hold most of the work
 # (about 60 % and 30 % of the node tests, the paper's imbalance); nineteen rods form a slowly
 # turning cage around them, close enough that almost every pair's bounds overlap (over 200
-# candidate pairs) but light to test.
+# pairs) but light to test.
 def rod_mesh():
     profile = [(ROD_RADIUS, -ROD_HALF + 2 * ROD_HALF * i / ROD_RINGS) for i in range(ROD_RINGS + 1)]
     v, t = revolution(profile, ROD_SEGMENTS, inward=False)

@@ -38,7 +38,7 @@ consume() {  # PREFIX TAG [CXXFLAGS]: configures, builds and runs the examples a
   out="$("$work/examples-$2/query_pair" "$a" "$b" "$pose" 0.3)" || fail "$2: query_pair failed"
   check_counts "$2" "$out"
   "$work/examples-$2/moving_pair" "$a" "$a" >/dev/null || fail "$2: moving_pair failed"
-  out="$("$work/examples-$2/pose_sweep" "$a" "$b")" || fail "$2: pose_sweep failed: $out"
+  out="$("$work/examples-$2/pose_batch" "$a" "$b")" || fail "$2: pose_batch failed: $out"
   out="$("$work/examples-$2/swept_needle")" || fail "$2: swept_needle failed: $out"
   out="$("$work/examples-$2/engine_in_host_arena")" || fail "$2: engine_in_host_arena failed: $out"
   out="$("$work/examples-$2/openmp_host")" || fail "$2: openmp_host failed: $out"

@@ -13,7 +13,7 @@ packages=(
   clang libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer (Debian 12 ships clang 14)
   clang-format git          # scripts/test.sh: the C++ layout check (.clang-format)
   python3-dev python3-pybind11 python3-numpy python3-pytest  # the Python module and its tests
-  python3-distributed       # caliber.distributed: pose sweeps over a Dask cluster, and its test
+  python3-distributed       # caliber.distributed: pose batches over a Dask cluster, and its test
   chromium                  # the viewer's test: the page in a headless browser
 )
 # The viewer is bundled at build time from npm packages (three.js, esbuild; puppeteer-core for its

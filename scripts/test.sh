@@ -23,6 +23,6 @@ ctest --output-on-failure -j "${JOBS:-2}"
 # above built (C++) and the line above ran (Python).
 python3 "$root/scripts/check_examples.py"
 echo "test: python3 imports caliber without PYTHONPATH; the README's Python example runs"
-# caliber.distributed on a LocalCluster of 2 worker processes, one of them killed mid-sweep.
+# caliber.distributed on a LocalCluster of 2 worker processes, one of them killed mid-batch.
 (cd "$root" && env -u PYTHONPATH /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests_distributed)
 echo "test: caliber.distributed gives query_many's answers on a 2-worker Dask cluster"

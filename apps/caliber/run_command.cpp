@@ -48,14 +48,14 @@ struct RunOptions {
 };
 
 nlohmann::json step_record(const StepResult& s) {
-  nlohmann::json tasks = nlohmann::json::array();
-  for (const PairRecord& t : s.pair_records) {
-    tasks.push_back({{"a", t.pair.a},
-                     {"b", t.pair.b},
-                     {"node_tests", t.stats.node_tests},
-                     {"leaf_tests", t.stats.leaf_tests},
-                     {"pairs", t.contacts},
-                     {"limit_reached", t.limit_reached}});
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const PairRecord& p : s.pair_records) {
+    pairs.push_back({{"a", p.pair.a},
+                     {"b", p.pair.b},
+                     {"node_tests", p.stats.node_tests},
+                     {"leaf_tests", p.stats.leaf_tests},
+                     {"contacts", p.contacts},
+                     {"limit_reached", p.limit_reached}});
   }
   const ScheduleRecord& c = *s.schedule;
   nlohmann::json schedule = {{"omega", c.omega},
@@ -64,7 +64,7 @@ nlohmann::json step_record(const StepResult& s) {
                              {"carted", c.carted},
                              {"generated", c.generated},
                              {"stage_node_tests", c.stage_node_tests},
-                             {"stage_task_node_tests", c.stage_task_node_tests},
+                             {"stage_pair_node_tests", c.stage_pair_node_tests},
                              {"split_node_tests", c.split_node_tests},
                              {"queue_peak", c.queue_peak},
                              {"task_node_tests", c.task_node_tests},
@@ -86,7 +86,7 @@ nlohmann::json step_record(const StepResult& s) {
           {"leaf_tests", s.stats.leaf_tests},
           {"contacts", s.contacts.size()},
           {"limit_reached", s.limit_reached},
-          {"tasks", tasks}};
+          {"pairs", pairs}};
 }
 
 nlohmann::json contacts_line(const World& world, const StepResult& s) {
@@ -179,7 +179,7 @@ struct RunSinks {
     if (!json_out) return;
     const Scene& sc = world.scene();
     report.emplace(json_out->stream());
-    write_scene_header(*report, world);
+    write_scene_header(*report, world, kReportSchemaVersion);
     report->member(
         "query",
         {{"kind", std::string(to_string(sc.query.kind))}, {"tolerance", sc.query.tolerance}, {"angle", sc.query.angle_deg}});
@@ -214,7 +214,7 @@ std::size_t run_steps(const World& world, Engine& engine, RunSinks& sinks, RunSt
     for (SimulatedRun& sim : sims) sim.add(s);
     sinks.write_step(world, s, k);
     char line[256];
-    std::snprintf(line, sizeof line, "step %d: %zu tasks, %llu node tests, %zu contacts, %.2f ms", k, s.pair_records.size(),
+    std::snprintf(line, sizeof line, "step %d: %zu pairs, %llu node tests, %zu contacts, %.2f ms", k, s.pair_records.size(),
                   static_cast<unsigned long long>(s.stats.node_tests), s.contacts.size(), s.broad_ms + s.narrow_ms + s.reduce_ms);
     progress.update(static_cast<std::size_t>(k + 1), line);
   }
@@ -234,9 +234,9 @@ nlohmann::json print_summary(const RunOptions& opt, const World& world, const En
   std::printf("  node tests / step  %.0f\n", stats.mean_node_tests());
   std::printf("  contacts / step    %.1f (steps with contacts: %zu of %zu)\n", stats.mean_contacts(), stats.steps_with_contacts(),
               stats.steps());
-  std::printf("  pairs / step       %.1f (candidate pairs over the run: %zu)\n", stats.mean_tasks(), stats.candidate_pairs());
+  std::printf("  pairs / step       %.1f (distinct pairs over the run: %zu)\n", stats.mean_pairs(), stats.distinct_pairs());
   std::printf("  heaviest pair      %s: %.1f %% of node tests\n", pair_name(world, heavy).c_str(), 100.0 * heavy_share);
-  if (stats.candidate_pairs() > 1) {
+  if (stats.distinct_pairs() > 1) {
     std::printf("  second heaviest    %s: %.1f %% of node tests\n", pair_name(world, second).c_str(), 100.0 * second_share);
   }
   nlohmann::json simulated = nlohmann::json::object();
@@ -266,8 +266,8 @@ void close_report(RunSinks& sinks, const World& world, const RunStats& stats, co
                                    {"mean_step_ms", stats.mean_step_ms()},
                                    {"node_tests_per_step", stats.mean_node_tests()},
                                    {"contacts_per_step", stats.mean_contacts()},
-                                   {"pairs_per_step", stats.mean_tasks()},
-                                   {"candidate_pairs", stats.candidate_pairs()},
+                                   {"pairs_per_step", stats.mean_pairs()},
+                                   {"distinct_pairs", stats.distinct_pairs()},
                                    {"steps_with_contacts", stats.steps_with_contacts()},
                                    {"heaviest_pair", {{"a", heavy.a}, {"b", heavy.b}, {"share", heavy_share}}},
                                    {"second_heaviest_pair", {{"a", second.a}, {"b", second.b}, {"share", second_share}}},

@@ -91,7 +91,7 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
   std::optional<JsonObjectWriter> report;
   if (json_out) {
     report.emplace(json_out->stream());
-    write_scene_header(*report, world);
+    write_scene_header(*report, world, kSchemaVersion);
     report->member("continuous", {{"tolerance", opt.tolerance}, {"max_queries", request.max_queries}});
     report->member("dt", sc.dt);
     report->member("method", std::string(to_string(engine.options().method)));

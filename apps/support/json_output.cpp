@@ -6,13 +6,13 @@ namespace caliber::cli {
 
 nlohmann::json json_vector(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
-void write_scene_header(JsonObjectWriter& report, const World& world) {
+void write_scene_header(JsonObjectWriter& report, const World& world, int version) {
   const Scene& sc = world.scene();
   nlohmann::json objects = nlohmann::json::array();
   for (std::size_t i = 0; i < world.object_count(); ++i) {
     objects.push_back({{"id", i}, {"name", json_text(sc.objects[i].name)}, {"mesh", json_text(sc.objects[i].mesh.string())}});
   }
-  report.member("schema_version", kSchemaVersion);
+  report.member("schema_version", version);
   report.member("scene", json_text(sc.name));
   report.member("file", json_text(sc.file.string()));
   report.member("objects", objects);

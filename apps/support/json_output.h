@@ -12,9 +12,11 @@
 
 namespace caliber::cli {
 
-/// The version of the JSON the CLI writes (run --json, run --contacts, query --json, the viewer's
-/// data; docs/json.md). Raised when a field changes meaning or goes away, not when one is added.
+/// The version of each JSON output the CLI writes (docs/json.md), raised when a field of that
+/// output changes meaning or goes away, not when one is added. kSchemaVersion: run --contacts,
+/// run --continuous --json, query --json and the viewer's data; kReportSchemaVersion: run --json.
 inline constexpr int kSchemaVersion = 1;
+inline constexpr int kReportSchemaVersion = 2;
 
 /// {"kind":…, "pairs":[[ia,ib],…], "contacts":[…], "stats":{"node_tests":…, "leaf_tests":…}}
 nlohmann::json to_json(const QueryResult& result);
@@ -51,9 +53,9 @@ class JsonObjectWriter {
   bool mFirstMember = true, mFirstItem = true;
 };
 
-/// The members a run's report starts with: schema_version, scene, file, and objects (one
-/// {"id", "name", "mesh"} per scene object).
-void write_scene_header(JsonObjectWriter& report, const World& world);
+/// The members a run's report starts with: schema_version (`version`), scene, file, and objects
+/// (one {"id", "name", "mesh"} per scene object).
+void write_scene_header(JsonObjectWriter& report, const World& world, int version);
 
 /// [x, y, z]
 [[nodiscard]] nlohmann::json json_vector(const Eigen::Vector3d& v);

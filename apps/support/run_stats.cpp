@@ -12,7 +12,7 @@ void RunStats::add(const StepResult& step) {
   mStepMs.push_back(step.broad_ms + step.narrow_ms + step.reduce_ms);
   mNodeTests += step.stats.node_tests;
   mContacts += step.contacts.size();
-  mTasks += step.pair_records.size();
+  mPairs += step.pair_records.size();
   if (!step.contacts.empty()) ++mStepsWithContacts;
   for (const PairRecord& t : step.pair_records) mPairWork[t.pair] += t.stats.node_tests;
 }
@@ -27,11 +27,11 @@ double RunStats::mean_step_ms() const {
 
 double RunStats::mean_node_tests() const { return steps() ? double(mNodeTests) / double(steps()) : 0.0; }
 double RunStats::mean_contacts() const { return steps() ? double(mContacts) / double(steps()) : 0.0; }
-double RunStats::mean_tasks() const { return steps() ? double(mTasks) / double(steps()) : 0.0; }
+double RunStats::mean_pairs() const { return steps() ? double(mPairs) / double(steps()) : 0.0; }
 
 std::vector<std::pair<std::uint64_t, ObjectPair>> RunStats::ranked() const {
   std::vector<std::pair<std::uint64_t, ObjectPair>> r;
-  for (const auto& [task, work] : mPairWork) r.emplace_back(work, task);
+  for (const auto& [pair, work] : mPairWork) r.emplace_back(work, pair);
   std::sort(r.begin(), r.end(),
             [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
   return r;

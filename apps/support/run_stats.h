@@ -25,14 +25,14 @@ class RunStats {
   [[nodiscard]] double mean_step_ms() const;
   /// Mean node tests per step.
   [[nodiscard]] double mean_node_tests() const;
-  /// Mean contacts (reported pairs) per step.
+  /// Mean contacts (reported triangle pairs) per step.
   [[nodiscard]] double mean_contacts() const;
-  /// Mean initial tasks (broad-phase pairs) per step.
-  [[nodiscard]] double mean_tasks() const;
+  /// Mean pairs (the broad phase's object pairs) per step.
+  [[nodiscard]] double mean_pairs() const;
   /// Steps with at least one contact.
   [[nodiscard]] std::size_t steps_with_contacts() const { return mStepsWithContacts; }
   /// Distinct object pairs the broad phase kept over the run.
-  [[nodiscard]] std::size_t candidate_pairs() const { return mPairWork.size(); }
+  [[nodiscard]] std::size_t distinct_pairs() const { return mPairWork.size(); }
   /// The object pair with the most node tests over the run, and its share of all node tests (0..1).
   [[nodiscard]] std::pair<ObjectPair, double> heaviest_pair() const;
   /// The pair with the second most node tests over the run, and its share.
@@ -44,7 +44,7 @@ class RunStats {
   std::vector<double> mStepMs;
   std::uint64_t mNodeTests = 0;
   std::uint64_t mContacts = 0;
-  std::uint64_t mTasks = 0;
+  std::uint64_t mPairs = 0;
   std::size_t mStepsWithContacts = 0;
   std::map<ObjectPair, std::uint64_t> mPairWork;
 };

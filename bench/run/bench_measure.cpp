@@ -125,8 +125,8 @@ std::optional<Json> measure_run(BenchRun& b, const World& world, const Variant& 
                {"triangles", world.triangle_count()},
                {"node_tests_per_step", stats.mean_node_tests()},
                {"contacts_per_step", stats.mean_contacts()},
-               {"pairs_per_step", stats.mean_tasks()},
-               {"candidate_pairs", stats.candidate_pairs()},
+               {"pairs_per_step", stats.mean_pairs()},
+               {"distinct_pairs", stats.distinct_pairs()},
                {"heaviest_pair_share", heavy_share},
                {"second_pair_share", second_share},
                {"exploitation_bound", heavy_share > 0 ? 1.0 / heavy_share : 1.0}});

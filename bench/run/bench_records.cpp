@@ -61,7 +61,7 @@ bool fields_of(const std::string& kind, std::vector<Field>& fields) {
               {"node_tests_per_step", &Json::is_number},
               {"contacts_per_step", &Json::is_number},
               {"pairs_per_step", &Json::is_number},
-              {"candidate_pairs", &Json::is_number},
+              {"distinct_pairs", &Json::is_number},
               {"heaviest_pair_share", &Json::is_number},
               {"second_pair_share", &Json::is_number},
               {"exploitation_bound", &Json::is_number}};
@@ -176,6 +176,11 @@ std::vector<Json> read_bench_log(const std::filesystem::path& file) {
     if (r.is_discarded() && i + 1 == lines.size() && i > 0) break;  // the line being written when the run was cut
     if (!r.is_object() || !r.contains("kind") || !r["kind"].is_string()) {
       throw Error(ErrorCode::unreadable, file.string(), "line " + std::to_string(i + 1) + " is not a bench record");
+    }
+    // Logs written before the object pairs met over a run were called distinct_pairs.
+    if (r["kind"] == "table1" && !r.contains("distinct_pairs") && r.contains("candidate_pairs")) {
+      r["distinct_pairs"] = r["candidate_pairs"];
+      r.erase("candidate_pairs");
     }
     if (records.empty() && r["kind"] != "header") {
       throw Error(ErrorCode::unreadable, file.string(), "no header record on line 1 (not a caliber-bench log)");

@@ -23,7 +23,7 @@ namespace caliber {
 
 struct ScheduleRecord;  // caliber/profile.h: the instrumentation, opt-in
 
-/// An object pair to test (a < b): one initial task of a step. Its two object indices are also
+/// An object pair to test (a < b) at a step. Its two object indices are also
 /// its identity from frame to frame (the temporal state of aposteriori and hybrid is keyed by them).
 struct ObjectPair {
   std::uint32_t a;  ///< object id
@@ -54,11 +54,11 @@ struct StepResult {
   int step = 0;                          ///< step index
   double time = 0.0;                     ///< simulated time (step * dt)
   double broad_ms = 0.0;                 ///< broad-phase wall time
-  double narrow_ms = 0.0;                ///< narrow-phase wall time (all tasks)
+  double narrow_ms = 0.0;                ///< narrow-phase wall time (all pairs)
   double reduce_ms = 0.0;                ///< gathering and sorting the contacts
   std::vector<PairRecord> pair_records;  ///< one per object pair of the frame, in its order
   std::vector<Contact> contacts;         ///< every pair's contacts, sorted by (object_a, object_b, tri_a, tri_b)
-  QueryStats stats;                      ///< totals over the tasks
+  QueryStats stats;                      ///< totals over the pairs
   /// How the work was cut and scheduled (caliber/profile.h): null unless EngineOptions::profile
   /// (or timeline) is on.
   std::shared_ptr<const ScheduleRecord> schedule;
@@ -84,8 +84,8 @@ struct Frame {
 
 /// How a step's narrow phase is cut and scheduled.
 enum class Method : std::uint8_t {
-  sequential,    ///< one thread, the initial tasks one after another
-  exploitation,  ///< a parallel loop over the initial tasks (the paper's "parallelism exploitation")
+  sequential,    ///< one thread, the pairs one after another
+  exploitation,  ///< a parallel loop over the pairs (the paper's "parallelism exploitation")
   stealing,      ///< recursive parallel traversal on oneTBB's work stealing, serial below a depth cut-off
   aposteriori,   ///< task calibration with temporal weights: last step's node tests, summary tree, taboo lists
   apriori,       ///< task calibration with geometric weights (the weight-driven stage splits heavy pairs)
@@ -122,12 +122,12 @@ struct EngineOptions {
   /// thread, every method runs each pair whole. The cut for P threads run on one thread measures
   /// each of its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
   int plan_threads = 0;
-  /// Stealing: CD-tree depth from which a subtree is traversed serially by one task. Only pairs
+  /// Stealing: CD-tree depth from which a subtree is traversed serially by one job. Only pairs
   /// whose a priori weight is at least 1 / (64 x plan threads) of the step's are split; the others run
   /// whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
-  /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_sweep.md): with 2 threads, beta = 2
+  /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_beta.md): with 2 threads, beta = 2
   /// cuts scenes of many light pairs (funnel) into about 4 coarse tasks that cannot be balanced;
   /// a larger beta costs a longer serial weight-driven stage on a scene of one pair (two_small).
   double beta = 6.0;

@@ -26,16 +26,16 @@ class CALIBER_EXPORT HostExecutor {
   /// caliber runs on the calling thread alone).
   [[nodiscard]] virtual int thread_count() const = 0;
 
-  /// A range of items: task(begin, end, worker) runs items [begin, end) on one thread; `worker` is
+  /// A range of items: job(begin, end, worker) runs items [begin, end) on one thread; `worker` is
   /// the host's index of that thread, in [0, thread_count()).
-  using Task = std::function<void(std::size_t begin, std::size_t end, int worker)>;
+  using Job = std::function<void(std::size_t begin, std::size_t end, int worker)>;
 
-  /// Starts `task` over the items [0, count), in ranges of at least `grain` items, on the host's
+  /// Starts `job` over the items [0, count), in ranges of at least `grain` items, on the host's
   /// threads, and returns without waiting for them: a handle for finish(). Or runs every range
   /// itself, on the calling thread, before returning, and answers nullptr ("ran inline"). It must
-  /// not wait for ranges that run on other threads: caliber's work starts once it returns. `task`
+  /// not wait for ranges that run on other threads: caliber's work starts once it returns. `job`
   /// stays valid until finish(handle) returns, so the host may keep a reference to it.
-  [[nodiscard]] virtual void* enqueue(const Task& task, std::size_t count, std::size_t grain) = 0;
+  [[nodiscard]] virtual void* enqueue(const Job& job, std::size_t count, std::size_t grain) = 0;
 
   /// Waits until every range of `handle` (from enqueue) has run; the calling thread may run some
   /// of them meanwhile.

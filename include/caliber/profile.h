@@ -15,7 +15,7 @@ namespace caliber {
 
 /// One piece of a step's work on one thread (EngineOptions::timeline): what a Gantt chart draws.
 struct TaskSpan {
-  /// Which part of the step: the weight-driven stage of one split task, one unit of depth-first
+  /// Which part of the step: the weight-driven stage of one split pair, one unit of depth-first
   /// traversal (a run-time task, a pair, a stealing piece), or one pair's finalization.
   enum class Phase : std::uint8_t { stage, traverse, finalize };
   int thread = 0;         ///< the executor's thread index (0 .. threads-1)
@@ -40,20 +40,20 @@ struct TaskRoot {
 /// that do not calibrate; `task_node_tests` is filled by every engine method.
 struct ScheduleRecord {
   double omega = 0.0;                                ///< the caliber Omega (in weight units)
-  std::size_t kept = 0;                              ///< initial tasks run as they are
-  std::size_t split = 0;                             ///< initial tasks split by the weight-driven stage
-  std::size_t carted = 0;                            ///< items merged in the cart (light tasks and light nodes)
+  std::size_t kept = 0;                              ///< pairs run as they are
+  std::size_t split = 0;                             ///< pairs split by the weight-driven stage
+  std::size_t carted = 0;                            ///< items merged in the cart (light pairs and light nodes)
   std::size_t generated = 0;                         ///< run-time tasks
   std::uint64_t stage_node_tests = 0;                ///< node tests made in the weight-driven stage
   std::size_t queue_peak = 0;                        ///< widest level of the weight-driven stage (nodes waiting at once)
-  std::vector<std::uint64_t> stage_task_node_tests;  ///< node tests of the weight-driven stage, per split task
-  /// The weight-driven stage level by level: for each level of each split task (the split tasks in
-  /// the order of stage_task_node_tests, each one's levels from the root down), the node tests of
+  std::vector<std::uint64_t> stage_pair_node_tests;  ///< node tests of the weight-driven stage, per split pair
+  /// The weight-driven stage level by level: for each level of each split pair (the split pairs in
+  /// the order of stage_pair_node_tests, each one's levels from the root down), the node tests of
   /// each chunk of the level's nodes that one thread ran. A level waits for the one above it.
   std::vector<std::vector<std::uint64_t>> stage_levels;
-  std::vector<std::uint32_t> stage_level_task;  ///< the split task (index in stage_task_node_tests) of each stage level
-  /// Per split task, the stage's wall time outside its levels' parallel visits (taking each
-  /// level's outcomes in order, the final sorts): serial within that task's stage.
+  std::vector<std::uint32_t> stage_level_pair;  ///< the split pair (index in stage_pair_node_tests) of each stage level
+  /// Per split pair, the stage's wall time outside its levels' parallel visits (taking each
+  /// level's outcomes in order, the final sorts): serial within that pair's stage.
   std::vector<double> stage_serial_ms;
   /// Node tests of each unit the scheduler ran, in the order it was handed out: the run-time tasks
   /// (calibrated methods), the pairs (sequential, exploitation), or the depth-first pieces below the
@@ -67,7 +67,7 @@ struct ScheduleRecord {
   /// up to sequential's exactly.
   std::uint64_t taboo_unreached_node_tests = 0;
   /// Depth-first node tests done by each worker thread (unordered; the weight-driven stage's tests
-  /// are in stage_task_node_tests).
+  /// are in stage_pair_node_tests).
   std::vector<std::uint64_t> thread_node_tests;
   double calibrate_ms = 0.0;  ///< calibrated methods: weights, keep/split/cart, weight-driven stage, cart
   /// Depth-first traversals of the run-time tasks (or pairs, or pieces), with the finalization of
@@ -92,8 +92,8 @@ struct ScheduleRecord {
 /// The load-balance simulation: the speed-up on `cores` virtual cores that the step's recorded
 /// work units (StepResult::schedule: a step run with EngineOptions::profile; caliber::Error without)
 /// predict for `method` (total node tests / simulated makespan). Calibrated methods: the
-/// weight-driven stage (each split task's levels in turn, a level's chunks list-scheduled, the split
-/// tasks side by side), then a barrier, then the run-time tasks in handout order. Exploitation: the
+/// weight-driven stage (each split pair's levels in turn, a level's chunks list-scheduled, the split
+/// pairs side by side), then a barrier, then the run-time tasks in handout order. Exploitation: the
 /// pairs in order. Stealing: its depth-first pieces, largest first, plus the splitting work spread
 /// evenly (an optimistic model of stealing). Sequential: 1.
 [[nodiscard]] CALIBER_EXPORT double simulated_speedup(const StepResult& step, Method method, int cores);
@@ -105,7 +105,7 @@ struct ScheduleRecord {
 /// timed undisturbed; EngineOptions::plan_threads = cores gives the cut made for that many).
 /// Replayed: each weight-driven stage's levels (a stage's time, less its serial part, shared among
 /// its levels' chunks by node tests, chunks list-scheduled, a barrier after each level, the serial
-/// part on its path; the split tasks side by side),
+/// part on its path; the split pairs side by side),
 /// then the traversal units list-scheduled in handout order (stealing: largest first), the
 /// traversal's time outside them (handing units out; stealing's splitting above the cut-off)
 /// spread evenly over the cores, then each pair's finalization list-scheduled (a pair with many

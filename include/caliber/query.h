@@ -99,7 +99,7 @@ struct Contact {
   double depth = 0.0;
 };
 
-/// Work counters: the parallel engine weighs tasks by them.
+/// Work counters: the parallel engine weighs pairs by them.
 struct QueryStats {
   std::uint64_t node_tests = 0;  ///< node-node tests (BVH node pairs examined)
   std::uint64_t leaf_tests = 0;  ///< triangle-pair tests

@@ -78,7 +78,7 @@ class CALIBER_EXPORT World {
   /// way from k to k + 1. Throws caliber::Error naming the object when a motion turns more than
   /// 4,096 quarter turns in a step.
   [[nodiscard]] std::vector<PairSweep> sweep(int step, Engine& engine, const SweepRequest& request = {}) const;
-  /// The query request every task runs (with the scene's group compatibility when it has one).
+  /// The query request every pair runs (with the scene's group compatibility when it has one).
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
 
  private:

@@ -1,4 +1,4 @@
-"""Pose sweeps over a Dask cluster (dask.distributed): caliber.query_many's answers, computed in
+"""Pose batches over a Dask cluster (dask.distributed): caliber.query_many's answers, computed in
 chunks of poses on the cluster's workers, gathered in input order.
 
     from dask.distributed import Client
@@ -9,9 +9,9 @@ chunks of poses on the cluster's workers, gathered in input order.
     batch = caliber.distributed.query_many(client, robot, caliber.Pose(), obstacle, poses, kind="distance")
 
 Each model goes to every worker once (client.scatter with broadcast), the poses in chunks of
-`chunk` entries, each chunk one task: caliber.query_many on the worker with `threads` threads.
+`chunk` entries, each chunk one Dask job: caliber.query_many on the worker with `threads` threads.
 The chunks' Batches come back and are joined in order into one Batch, equal bit for bit to
-caliber.query_many's on one machine. A worker that dies mid-sweep costs the chunks it held: the
+caliber.query_many's on one machine. A worker that dies mid-batch costs the chunks it held: the
 scheduler runs them again on the workers left (up to Dask's distributed.scheduler.allowed-failures
 times per chunk).
 """
@@ -39,7 +39,7 @@ def _positive_integer(value, name):
 
 
 def _run_chunk(a, poses_a, b, poses_b, first, request):
-    """One chunk on a worker; a bad pose's error names its row in the whole sweep."""
+    """One chunk on a worker; a bad pose's error names its row in the whole batch."""
     try:
         return caliber.query_many(a, poses_a, b, poses_b, **request)
     except caliber.Error as e:
@@ -74,7 +74,7 @@ def query_many(client, a, poses_a, b, poses_b, kind="interference", tolerance=No
                order="wxyz", lowest_ids=False, chunk=2500, threads=1):
     """caliber.query_many(a, poses_a, b, poses_b, ...) on the workers of `client` (a
     dask.distributed Client): the same arguments and the same Batch, bit for bit. `chunk`: poses
-    per task (a dead worker's chunks run again); `threads`: threads per chunk on its worker (1 fits
+    per Dask job (a dead worker's chunks run again); `threads`: threads per chunk on its worker (1 fits
     workers started with one thread per core)."""
     chunk = _positive_integer(chunk, "chunk")
     if not isinstance(a, caliber.Model) or not isinstance(b, caliber.Model):

@@ -1,7 +1,7 @@
-"""caliber.distributed on a LocalCluster of 2 worker processes: the sweep's Batch equals
+"""caliber.distributed on a LocalCluster of 2 worker processes: a pose batch's Batch equals
 caliber.query_many's bit for bit (every pose format, either side fixed, chunk sizes that do and do
-not divide the poses), bad sweeps are caliber.Error naming the row in the whole sweep, and a worker
-killed mid-sweep costs a re-run of its chunks, not the sweep. Run by scripts/test.sh (not by the
+not divide the poses), bad batches are caliber.Error naming the row in the whole batch, and a
+worker killed mid-batch costs a re-run of its chunks, not the batch. Run by scripts/test.sh (not by the
 sanitizer builds: the workers are separate interpreters)."""
 import os
 import signal
@@ -49,7 +49,7 @@ def expect_same(got, want):
 
 @pytest.mark.parametrize("kind,tolerance", [("interference", None), ("proximity", 0.05), ("distance", None)])
 @pytest.mark.parametrize("chunk", [7, 100, 1000])
-def test_sweep_equals_query_many(client, kind, tolerance, chunk):
+def test_batch_equals_query_many(client, kind, tolerance, chunk):
     values = rows(300, 3)
     want = caliber.query_many(TETRA, caliber.Pose(), FAN, values, kind=kind, tolerance=tolerance, threads=1)
     got = caliber.distributed.query_many(client, TETRA, caliber.Pose(), FAN, values, kind=kind, tolerance=tolerance,
@@ -80,7 +80,7 @@ def test_every_pose_format_and_either_side_fixed(client):
     assert len(caliber.distributed.query_many(client, TETRA, caliber.Pose(), FAN, [])) == 0
 
 
-def test_bad_sweeps_are_errors_naming_the_row(client):
+def test_bad_batches_are_errors_naming_the_row(client):
     values = rows(40, 7)
     values[33, 3:] = 0.0  # a zero quaternion, in the fourth chunk of 10
     with pytest.raises(caliber.Error, match=r"poses_b\[33\]"):
@@ -107,9 +107,9 @@ def torus(rings, sides):
     return caliber.Model(caliber.Mesh(vertices, faces))
 
 
-def test_a_killed_worker_costs_its_chunks_not_the_sweep(client):
-    # 20 chunks of a few tenths of a second each; one worker is killed once the sweep is under way
-    # (its nanny starts another), and the sweep still gives query_many's Batch.
+def test_a_killed_worker_costs_its_chunks_not_the_batch(client):
+    # 20 chunks of a few tenths of a second each; one worker is killed once the batch is under way
+    # (its nanny starts another), and the batch still gives query_many's Batch.
     a = torus(120, 60)
     values = rows(60000, 11, spread=1.2)
     want = caliber.query_many(a, caliber.Pose(), FAN, values, kind="distance", threads=1)
@@ -130,7 +130,7 @@ def test_a_killed_worker_costs_its_chunks_not_the_sweep(client):
     got = caliber.distributed.query_many(client, a, caliber.Pose(), FAN, values, kind="distance", chunk=len(values) // 20)
     finished = time.monotonic()
     killer.join()
-    assert killed and killed[0] < finished, "the worker was killed while the sweep ran"
+    assert killed and killed[0] < finished, "the worker was killed while the batch ran"
     expect_same(got, want)
     client.wait_for_workers(2, timeout=60)
     assert pids[victim] not in client.run(os.getpid).values(), "the killed worker was replaced"

@@ -93,7 +93,7 @@ void BoxTree::build_nodes(std::uint32_t first, std::uint32_t count) {
   const std::size_t index = mNodes.size();
   mNodes.push_back(Node{kEmpty, first, count, 0});
   if (count <= kLeaf) return;
-  // Split where the highest bit that differs between the run's first and last codes turns on (the
+  // Partition where the highest bit that differs between the run's first and last codes turns on (the
   // codes are sorted); a run of equal codes is halved.
   const auto code = [&](std::uint32_t p) { return mCodes[mOrder[p]]; };
   const std::uint32_t lo = code(first), hi = code(first + count - 1);

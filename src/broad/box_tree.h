@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The broad phase's structure: the objects' world boxes sorted along a Morton curve of their
-/// centres, a binary tree of boxes over that order split where the curve's codes split (as a linear
+/// centres, a binary tree of boxes over that order partitioned where the curve's codes differ (as a linear
 /// BVH's), and the pairs whose boxes overlap found by querying each leaf's boxes together against
 /// the part of the tree that lies after them in that order (so each pair is met once), in parallel
 /// on the executor the caller runs in. The order only steers the pruning:

@@ -1,4 +1,4 @@
-// Sphere-tree BVH build: top-down binned surface-area split (bvh/split.h), exact covering radii, normal cones and slabs, group masks.
+// Sphere-tree BVH build: top-down binned surface-area partition (bvh/partition.h), exact covering radii, normal cones and slabs, group masks.
 
 #include <numbers>
 #include <algorithm>
@@ -16,7 +16,7 @@
 #include "util/assert.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
-#include "bvh/split.h"
+#include "bvh/partition.h"
 #include "bvh/volume_origin.h"
 #include "util/float_round.h"
 #include "parallel/executor.h"
@@ -25,9 +25,9 @@ namespace caliber {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using bvh::split_binned;
-using bvh::split_items;
-using bvh::split_turn;
+using bvh::partition_binned;
+using bvh::partition_items;
+using bvh::partition_turn;
 using bvh::triangle_turn;
 using bvh::turned_axes;
 using bvh::unturned_axes;
@@ -85,7 +85,7 @@ class Builder {
     const std::size_t n = mesh.triangles.size();
     mOrder.resize(n);
     std::iota(mOrder.begin(), mOrder.end(), 0u);
-    mItems = split_items(mesh);
+    mItems = partition_items(mesh);
     mWork = std::make_unique_for_overwrite<WorkSlot[]>(2 * n - 1);
     mWorkCount = 2 * n - 1;
   }
@@ -126,13 +126,13 @@ class Builder {
     }
     bvh::CentroidBounds left, right;
     const std::uint32_t mid =
-        begin + split_binned(std::span<std::uint32_t>(mOrder.data() + begin, end - begin),
-                             std::span<bvh::SplitItem>(mItems.data() + begin, end - begin), bounds, left, right);
+        begin + partition_binned(std::span<std::uint32_t>(mOrder.data() + begin, end - begin),
+                                 std::span<bvh::PartitionItem>(mItems.data() + begin, end - begin), bounds, left, right);
     const std::uint32_t first = next;
     const std::uint32_t left_next = first + 2, right_next = left_next + 2 * (mid - begin) - 2;
     int hl = 0, hr = 0;
     if (end - begin > kParallelBuildCount) {
-      parallel::TaskGroup halves;
+      parallel::JobGroup halves;
       halves.run([&] { hl = build_range(first, left_next, begin, mid, left); });
       hr = build_range(first + 1, right_next, mid, end, right);
       halves.wait();
@@ -200,23 +200,23 @@ class Builder {
     node.first = position;
     node.lo = a.cwiseMin(b).cwiseMin(c);
     node.hi = a.cwiseMax(b).cwiseMax(c);
-    // Candidate centers: the box center, the circumcenter and the edge midpoints (the smallest
+    // Trial centers: the box center, the circumcenter and the edge midpoints (the smallest
     // enclosing sphere is one of the last four); keep whichever covers with the smallest radius.
     const Vec3 ab = b - a, ac = c - a, n = ab.cross(ac);
     const double n2 = n.squaredNorm();
-    Vec3 candidates[5] = {0.5 * (node.lo + node.hi), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), a};
+    Vec3 trials[5] = {0.5 * (node.lo + node.hi), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), a};
     int count = 4;
-    if (n2 > 0.0) candidates[count++] = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
+    if (n2 > 0.0) trials[count++] = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
     node.radius = std::numeric_limits<double>::infinity();
     for (int i = 0; i < count; ++i) {
-      if (!candidates[i].allFinite()) continue;
+      if (!trials[i].allFinite()) continue;
       // The largest of the three norms: one square root of the largest square (sqrt is monotone
       // and correctly rounded, as norm() takes it).
-      const double r = std::sqrt(
-          std::max({(a - candidates[i]).squaredNorm(), (b - candidates[i]).squaredNorm(), (c - candidates[i]).squaredNorm()}));
+      const double r =
+          std::sqrt(std::max({(a - trials[i]).squaredNorm(), (b - trials[i]).squaredNorm(), (c - trials[i]).squaredNorm()}));
       if (r < node.radius) {
         node.radius = r;
-        node.center = candidates[i];
+        node.center = trials[i];
       }
     }
     node.radius *= 1.0 + 1e-14;
@@ -272,7 +272,7 @@ class Builder {
     Vec3 u0 = Vec3::Zero(), v0 = Vec3::Zero();
     if (node.cone >= 0.0) {
       unturned_axes(node.axis, u0, v0);
-      split_turn(u0, v0, 0.5 * (r.lo + r.hi) - 0.5 * (l.lo + l.hi), node.turn);
+      partition_turn(u0, v0, 0.5 * (r.lo + r.hi) - 0.5 * (l.lo + l.hi), node.turn);
     }
 
     // Sphere: the merged child spheres' center or the box center, whichever covers tighter.
@@ -347,8 +347,8 @@ class Builder {
   const Mesh& mMesh;
   const std::vector<Vec3>& mNormals;
   std::vector<std::uint32_t> mOrder;
-  std::vector<bvh::SplitItem> mItems;  ///< what the split reads of triangle mOrder[i], in mItems[i]
-  std::unique_ptr<WorkSlot[]> mWork;   ///< node i in mWork[i].node, once made
+  std::vector<bvh::PartitionItem> mItems;  ///< what the partition reads of triangle mOrder[i], in mItems[i]
+  std::unique_ptr<WorkSlot[]> mWork;       ///< node i in mWork[i].node, once made
   std::size_t mWorkCount = 0;
 };
 

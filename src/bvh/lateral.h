@@ -67,8 +67,8 @@ inline void triangle_turn(const Vec3& u0, const Vec3& v0, const Vec3& a, const V
 }
 
 /// An internal node's turn: along the line between its children's box centers (across which
-/// the build split it), projected on the (u0, v0) plane.
-inline void split_turn(const Vec3& u0, const Vec3& v0, const Vec3& direction, double turn[2]) {
+/// the build partitioned it), projected on the (u0, v0) plane.
+inline void partition_turn(const Vec3& u0, const Vec3& v0, const Vec3& direction, double turn[2]) {
   turn_towards(direction.dot(u0), direction.dot(v0), turn);
 }
 

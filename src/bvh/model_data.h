@@ -68,7 +68,7 @@ static_assert(sizeof(BvhNodeFilter) == 32);
 /// rounded outward. With the slab, a box around the triangles below in the frame of the cone axis,
 /// tight where they are nearly coplanar. The lateral axes are turned about the cone axis to follow
 /// the patch (a leaf: its triangle's principal direction in the slab's plane; a parent: the line
-/// between its children, across which the build split it), so that an elongated patch gets a
+/// between its children, across which the build partitioned it), so that an elongated patch gets a
 /// narrow box whatever its direction. All 0 when the cone axis is 0.
 struct BvhNodeLateral {
   float lateral_lo[2], lateral_hi[2];

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
 /// Three-vectors in four AVX2 lanes for the triangle kernel (triangle_distance_avx2.cpp): a lane
-/// per candidate, each operation the IEEE operation the portable code does (no FMA), so that every
-/// lane computes its candidate's bits. Included only by code built for x86-64 with GNU C++; every
+/// per feature pair, each operation the IEEE operation the portable code does (no FMA), so that every
+/// lane computes its feature pair's bits. Included only by code built for x86-64 with GNU C++; every
 /// function is compiled for AVX2 alone, chosen at run time.
 
 #if defined(__x86_64__) && defined(__GNUC__)

@@ -60,12 +60,12 @@ CALIBER_AVX512 M edges_apart(const Triangle8& a, const Triangle8& b, D reach) {
       const D bmin = _mm512_min_pd(_mm512_min_pd(pb0, pb1), pb2), bmax = _mm512_max_pd(_mm512_max_pd(pb0, pb1), pb2);
       const D gap = _mm512_max_pd(sub(bmin, amax), sub(amin, bmax));
       const D len2 = dot(n, n);
-      const M candidates = gt(len2, all_lanes(kernel::kAxisLength2Floor)) & gt(gap, zero) & le(gap, all_lanes(DBL_MAX));
-      if (candidates == 0) continue;  // need >= 1e-300 > 0: no lane passes
+      const M live = gt(len2, all_lanes(kernel::kAxisLength2Floor)) & gt(gap, zero) & le(gap, all_lanes(DBL_MAX));
+      if (live == 0) continue;  // need >= 1e-300 > 0: no lane passes
       const D len = _mm512_sqrt_pd(len2);
       const D need =
           add(mul(mul(reach, len), all_lanes(1.0 + 1e-12)), add(mul(mul(all_lanes(1e-13), len), scale), all_lanes(1e-300)));
-      apart |= candidates & gt(gap, need);
+      apart |= live & gt(gap, need);
     }
   }
   return apart;

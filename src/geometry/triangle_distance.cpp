@@ -146,8 +146,8 @@ struct EdgeVectors {
   }
 };
 
-/// The last candidates of the triangle kernel, in its order. Intersecting triangles: an edge of one
-/// pierces the other; its crossing point is a candidate.
+/// The last feature pairs of the triangle kernel, in its order. Intersecting triangles: an edge of
+/// one pierces the other; its crossing point, on both triangles, is a feature pair.
 void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
   Vec3 x;
   for (int i = 0; i < 3; ++i) {

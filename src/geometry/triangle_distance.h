@@ -28,7 +28,7 @@ struct ClosestPoints {
 };
 
 /// Closest points between triangles A and B: the nearest of the edge-edge, vertex-face and
-/// edge-through-face candidates (the last ones find the crossing point of intersecting triangles).
+/// edge-through-face feature pairs (the last ones find the crossing point of intersecting triangles).
 /// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
@@ -72,7 +72,7 @@ struct ClosestPointsBatch {
 
 /// closest_points_triangles of every pair of `batch`: out.get(i) is exactly (the same bits) what
 /// closest_points_triangles returns for pair i. Where the CPU has AVX-512, one pair per lane (the
-/// kernel's candidates in its order, each lane's the same IEEE operations), else pair by pair.
+/// kernel's feature pairs in its order, each lane's the same IEEE operations), else pair by pair.
 /// Pads the batch (TriangleBatch::pad) first.
 void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out);
 

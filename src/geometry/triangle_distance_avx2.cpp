@@ -16,12 +16,12 @@ using kernel::Nearest;
 using kernel::TriangleFrame;
 using kernel::Vec3;
 
-// The same kernel, four candidates at a time in AVX2 registers (x86-64, chosen at run time where the CPU has AVX2). Each lane
-// computes exactly what the portable code computes for its candidate: the same IEEE operations in the same order (no FMA: this
+// The same kernel, four feature pairs at a time in AVX2 registers (x86-64, chosen at run time where the CPU has AVX2). Each lane
+// computes exactly what the portable code computes for its feature pair: the same IEEE operations in the same order (no FMA: this
 // file is built with -ffp-contract=off and only "avx2" is enabled here, not "fma"), every region and case of the branches
 // evaluated and the one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on NaN, as in
 // C++), and clamp01 is max then min with the operands in the order of the scalar maxsd/minsd of clamp01
-// (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The candidates are then taken by the same Nearest
+// (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The feature pairs are then taken by the same Nearest
 // in the portable order, so the same pair wins. Eigen computes a 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does
 // dot() (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
 namespace {
@@ -31,8 +31,8 @@ namespace {
 using namespace lanes4;
 using lanes4::pick;  // beside pick on Frame4 below, which would hide it
 
-/// Four candidates' points and squared distances, lane by lane, for Nearest.
-struct Candidates4 {
+/// Four feature pairs' points and squared distances, lane by lane, for Nearest.
+struct FeaturePairs4 {
   alignas(32) double px[4], py[4], pz[4], qx[4], qy[4], qz[4], d2[4], d[4];
   int swapped = 0;  ///< bit l: lane l holds (q, p), not (p, q)
 
@@ -58,7 +58,7 @@ struct Candidates4 {
 /// Offers the lanes of `c` in `offered` (bit l for lane l) to `nearest`, in lane order. Lanes whose
 /// squared distance is not below the best one at the start are left out: they would be refused,
 /// since the best squared distance only ever decreases.
-CALIBER_AVX2 __attribute__((always_inline)) inline void take(const Candidates4& c, int offered, Nearest& nearest) {
+CALIBER_AVX2 __attribute__((always_inline)) inline void take(const FeaturePairs4& c, int offered, Nearest& nearest) {
   int left = offered & _mm256_movemask_pd(lt(_mm256_load_pd(c.d2), _mm256_set1_pd(nearest.best_d2)));
   while (left != 0) {
     const int l = __builtin_ctz(static_cast<unsigned>(left));
@@ -69,7 +69,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void take(const Candidates4& 
 
 /// closest_points_edges in four lanes: every case computed, the branches' choice selected.
 CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m256d a, const Pack3& p2, const Pack3& d2,
-                                          __m256d e, Candidates4& out) {
+                                          __m256d e, FeaturePairs4& out) {
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
   const Pack3 r = p1 - p2;
   const __m256d f = dot(d2, r);
@@ -175,7 +175,7 @@ CALIBER_AVX2 Frame4 pick(__m256d mask, const Frame4& u, const Frame4& v) {
 /// The points the kernel projects onto the other triangle, in the portable order: a[0], b[0],
 /// a[1], b[1], a[2], b[2], then the crossing points of the edges that cross the other's plane
 /// (edge 0 of A, of B, edge 1 of A, ...). A point of A goes onto B, a point of B onto A; the
-/// candidate is (point, its projection) for A's, (projection, point) for B's.
+/// feature pair is (point, its projection) for A's, (projection, point) for B's.
 struct Projections {
   static constexpr int kMost = 12;  ///< 6 corners, 6 crossings
   alignas(32) double x[kMost], y[kMost], z[kMost];
@@ -198,7 +198,7 @@ struct Projections {
 /// Each projection of `points`, four at a time: batch k of `out` holds points 4k to 4k + 3 with
 /// their projections (the caller offers them to Nearest in that order).
 CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb,
-                          Candidates4 out[Projections::kMost / 4]) {
+                          FeaturePairs4 out[Projections::kMost / 4]) {
   const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
   for (int first = 0; first < points.count; first += 4) {
     const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
@@ -272,7 +272,7 @@ CALIBER_AVX2 inline bool edges_apart_x4(const TriangleFrame& fa, const Vec3 b[3]
   return (axes_apart_x4(gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(tb.e), pair, reach) & 1) != 0;
 }
 
-/// The kernel's candidates once the frames, the corners' lanes and their signed distances along
+/// The kernel's feature pairs once the frames, the corners' lanes and their signed distances along
 /// the other's normal (sa: A's corners against B's plane, sb: B's against A's) are known.
 CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(const Vec3 a[3], const Vec3 b[3], const Triangle4& ta,
                                                                             const Triangle4& tb, const TriangleFrame& fa,
@@ -282,9 +282,9 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
   // The third batch replaced a portable scalar call, which took longer than both batches together
   // (the kernel's measurements: bench/results/intel-xeon-2c/kernels/README.md).
-  // Every candidate is computed first and offered in order at the end, so that the batches do not
+  // Every feature pair is computed first and offered in order at the end, so that the batches do not
   // wait on one another.
-  Candidates4 edges[3];
+  FeaturePairs4 edges[3];
   closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
                           gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges[0]);
   closest_points_edges_x4(gather<1, 1, 2, 2>(ta.v), gather<1, 1, 2, 2>(ta.e), gather<1, 1, 2, 2>(ta.len2),
@@ -292,7 +292,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   closest_points_edges_x4(gather<2, 2, 2, 2>(ta.v), gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(ta.len2),
                           gather<2, 2, 2, 2>(tb.v), gather<2, 2, 2, 2>(tb.e), gather<2, 2, 2, 2>(tb.len2), edges[2]);
 
-  // Vertex-face candidates, then edge-plane crossings (edge i of A and of B against the other's
+  // Vertex-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
   Projections points;
   const Pack3 corners01 = interleave<0, 1>(ta.v, tb.v), corners2 = interleave<2, 2>(ta.v, tb.v);
@@ -307,7 +307,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   add_crossings(corners01, interleave<0, 1>(ta.e, tb.e), interleave<0, 1>(sa, sb), interleave<1, 2>(sa, sb), 4, points);
   add_crossings(corners2, interleave<2, 2>(ta.e, tb.e), interleave<2, 2>(sa, sb), interleave<0, 0>(sa, sb), 2, points);
   points.pad();
-  Candidates4 projected[Projections::kMost / 4];
+  FeaturePairs4 projected[Projections::kMost / 4];
   project(points, fa, fb, projected);
 
   take(edges[0], 0xF, nearest);
@@ -319,8 +319,8 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   return nearest.best;
 }
 
-/// A triangle pair's lanes, frames and signed distances: what the plane test and the candidates
-/// share. Each corner's signed distance along the other's normal is computed as crossing_point and
+/// A triangle pair's lanes, frames and signed distances: what the plane test and the feature
+/// pairs share. Each corner's signed distance along the other's normal is computed as crossing_point and
 /// beyond_plane compute it.
 struct Pair4 {
   Triangle4 ta, tb;

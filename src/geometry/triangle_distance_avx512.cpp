@@ -8,14 +8,14 @@ namespace caliber::geometry {
 
 // The triangle kernel on eight pairs at once, one pair per AVX-512 lane (x86-64, chosen at run
 // time where the CPU has AVX-512F). Each lane computes exactly what the portable kernel
-// (triangle_distance.cpp) computes for its pair: the same candidates in the same order, each with
+// (triangle_distance.cpp) computes for its pair: the same feature pairs in the same order, each with
 // the same IEEE operations (no FMA: this file is built with -ffp-contract=off and "avx512f" alone
 // is enabled, not "fma"), every branch evaluated and the one the scalar code would take selected
 // by masks; comparisons are the ordered, quiet ones (false on NaN, as in C++), and clamp01 is max
 // then min in the operand order of the scalar's maxsd/minsd. Two things differ in how, not what:
 //  - a lane that needs one of several divisions (the clamped parameter at either end of an edge,
 //    or the point-on-triangle region's quotient) divides the operands its case divides, once;
-//  - Nearest's square roots: a candidate whose squared distance is below the best one's by a
+//  - Nearest's square roots: a feature pair whose squared distance is below the best one's by a
 //    relative 2^-50 has the smaller correctly rounded root too (the proof is at `consider`), so
 //    the roots are taken only where that margin is missing, and for the winner at the end.
 // tests/geometry/triangle_distance_test.cpp compares this form with the 2a20389 kernel bit for

@@ -2,7 +2,7 @@
 /// \file
 /// What the two forms of the triangle kernel (closest_points_triangles: portable in
 /// triangle_distance.cpp, AVX2 in triangle_distance_avx2.cpp) share, so that both compute each
-/// candidate with the same operations and take the candidates in the same order: the same bits
+/// feature pair with the same operations and take the feature pairs in the same order: the same bits
 /// either way.
 
 #include <algorithm>

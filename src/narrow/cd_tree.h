@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The CD tree of a pair of objects (the product of their BVHs): its nodes, which of them split
+/// The CD tree of a pair of objects (the product of their BVHs): its nodes, which of them descend
 /// and into which children (the same for every method, schedule and pose), and the taboo lists
 /// with which the a posteriori method hands parts of it to sub-tasks.
 
@@ -51,13 +51,13 @@ inline bool on_taboo(TabooView taboo, NodePair child) {
   return true;
 }
 
-/// Which sides of CD-tree node n split: both (up to 4 children) unless one is a leaf or its
+/// Which sides of CD-tree node n descend: both (up to 4 children) unless one is a leaf or its
 /// sphere is more than `ratio` times the other's (PairContext::descend_alone_ratio), in which
-/// case only the larger one splits. Depends only on object-space radii and the query's kind, so
+/// case only the larger one descends. Depends only on object-space radii and the query's kind, so
 /// the CD tree's shape does not depend on the poses. n must not be a pair of leaves.
-inline void cd_split(const BvhNode& a, const BvhNode& b, double ratio, bool& split_a, bool& split_b) {
-  split_a = !a.is_leaf() && (b.is_leaf() || double(a.radius) * ratio >= double(b.radius));
-  split_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * ratio >= double(a.radius));
+inline void cd_descend(const BvhNode& a, const BvhNode& b, double ratio, bool& descend_a, bool& descend_b) {
+  descend_a = !a.is_leaf() && (b.is_leaf() || double(a.radius) * ratio >= double(b.radius));
+  descend_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * ratio >= double(a.radius));
 }
 
 /// The children of CD-tree node n of pair context ctx (not a pair of leaves), written to out;
@@ -65,19 +65,19 @@ inline void cd_split(const BvhNode& a, const BvhNode& b, double ratio, bool& spl
 inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
-  bool split_a, split_b;
-  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
+  bool descend_a, descend_b;
+  cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
   int count = 0;
-  for (std::uint32_t i = 0; i < (split_a ? 2u : 1u); ++i) {
-    for (std::uint32_t j = 0; j < (split_b ? 2u : 1u); ++j) {
-      out[count++] = NodePair{split_a ? a.index + i : n.a, split_b ? b.index + j : n.b};
+  for (std::uint32_t i = 0; i < (descend_a ? 2u : 1u); ++i) {
+    for (std::uint32_t j = 0; j < (descend_b ? 2u : 1u); ++j) {
+      out[count++] = NodePair{descend_a ? a.index + i : n.a, descend_b ? b.index + j : n.b};
     }
   }
   return count;
 }
 
 /// The node test that a visit of `parent` makes on `child` (one of its cd_children): with the
-/// disks where both sides split (PairContext::node_test_2x2_lane), node_test where one does. For
+/// disks where both sides descend (PairContext::node_test_2x2_lane), node_test where one does. For
 /// code that walks the CD tree its own way and must make the decisions narrow::visit makes (tests,
 /// benches).
 inline bool child_test(const PairContext& ctx, NodePair parent, NodePair child) {

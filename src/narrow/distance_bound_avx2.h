@@ -1,10 +1,10 @@
 #pragma once
 /// \file
 /// The distance bound (PairContext::gap, before groups) of a visit's four child pairs at once, in
-/// AVX2. Each stage is computed in every lane, with the scalar bound's operations in its order,
-/// and the next stage is skipped only once every lane is beyond the reach; so a lane gives the
+/// AVX2. Each tier is computed in every lane, with the scalar bound's operations in its order,
+/// and the next tier is skipped only once every lane is beyond the reach; so a lane gives the
 /// scalar's value, bit for bit, wherever that is within the reach the scalar was given, and beyond
-/// it both are some value beyond the reach (the scalar stops at the first stage that proves it).
+/// it both are some value beyond the reach (the scalar stops at the first tier that proves it).
 /// Tested against the scalar bound.
 
 #include "narrow/prepared.h"

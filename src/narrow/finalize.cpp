@@ -148,7 +148,7 @@ Contact world_contact(const PairContext& ctx, const Candidate& c, ObjectPair obj
   return contact;
 }
 
-/// A distance query's answer: each traversal (a whole pair, or one task of it) brought its closest
+/// A distance query's answer: each traversal (a whole pair, or one piece of it) brought its closest
 /// pair; the closest of those, ties to the lowest ids, is the pair's answer whatever the cut. At 0,
 /// pieces stopped at their own first intersecting pair: the traversal from the root finds its own
 /// again. (Its tests are not the pair's counters, which stay the sum of what its pieces did.)

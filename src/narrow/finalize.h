@@ -27,7 +27,7 @@ enum class ContactPair { as_found, from_root };
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
 /// object pair canonically (by triangle ids) and converts them to world coordinates, as contacts
 /// between `objects` (their ids in the frame; 0 and 1 for caliber::query). With
-/// `parallel`, a large candidate list is processed by several tasks of the current executor (same
+/// `parallel`, a large candidate list is processed by several jobs of the current executor (same
 /// result). A distance query's closest pair is the candidates' closest, ties to the lowest ids, but
 /// at distance 0 as `contact_pair` says (unless the request asks for the lowest ids).
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The geometric part of the node test of a visit where both sides split (PairContext::node_within
+/// The geometric part of the node test of a visit where both sides descend (PairContext::node_within
 /// and disks_beyond_slabs: spheres, boxes, slabs, disks) on its four child pairs at once, in AVX2:
 /// the same decisions as the scalar test, bit for bit (each lane does the scalar test's operations
 /// in its order).

@@ -213,7 +213,7 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   return true;
 }
 
-void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const {
+void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
   if (mKind == QueryKind::interference) {
     leaf_test(ta, tb, out);
     return;
@@ -222,22 +222,22 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
   Eigen::Vector3d a[3], b[3];
   corners(ta, tb, a, b);
-  stage.refusal.add(ta, tb, a, b);
-  if (stage.refusal.batch.full()) refuse_staged(stage, out);
+  buffer.refusal.add(ta, tb, a, b);
+  if (buffer.refusal.batch.full()) refuse_buffered(buffer, out);
 }
 
-void PairContext::refuse_staged(LeafStage& stage, std::vector<Candidate>& out) const {
-  const unsigned apart = geometry::triangles_apart_batch(stage.refusal.batch, mReach);
-  for (int l = 0; l < stage.refusal.batch.size; ++l) {
+void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
+  const unsigned apart = geometry::triangles_apart_batch(buffer.refusal.batch, mReach);
+  for (int l = 0; l < buffer.refusal.batch.size; ++l) {
     if ((apart >> l) & 1u) continue;
-    stage.closest.add(stage.refusal, l);
-    if (stage.closest.batch.full()) finish_staged(stage, out);
+    buffer.closest.add(buffer.refusal, l);
+    if (buffer.closest.batch.full()) finish_buffered(buffer, out);
   }
-  stage.refusal.batch.size = 0;
+  buffer.refusal.batch.size = 0;
 }
 
-void PairContext::finish_staged(LeafStage& stage, std::vector<Candidate>& out) const {
-  StagedPairs& waiting = stage.closest;
+void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
+  BufferedPairs& waiting = buffer.closest;
   geometry::ClosestPointsBatch closest;
   geometry::closest_points_triangles_batch(waiting.batch, closest);
   for (int l = 0; l < waiting.batch.size; ++l) {
@@ -249,10 +249,10 @@ void PairContext::finish_staged(LeafStage& stage, std::vector<Candidate>& out) c
   waiting.batch.size = 0;
 }
 
-void PairContext::flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const {
+void PairContext::flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const {
   // An empty batch appends nothing: skipped (a traversal that reached no leaf pays nothing).
-  if (stage.refusal.batch.size != 0) refuse_staged(stage, out);
-  if (stage.closest.batch.size != 0) finish_staged(stage, out);
+  if (buffer.refusal.batch.size != 0) refuse_buffered(buffer, out);
+  if (buffer.closest.batch.size != 0) finish_buffered(buffer, out);
 }
 
 bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {

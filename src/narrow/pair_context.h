@@ -21,7 +21,7 @@
 #include "narrow/disks.h"
 #include "narrow/distance_bound_avx2.h"
 #include "narrow/frames_apart.h"
-#include "narrow/leaf_stage.h"
+#include "narrow/leaf_buffer.h"
 #include "narrow/node_test_avx2.h"
 #include "narrow/prepared.h"
 
@@ -30,7 +30,7 @@ namespace caliber::narrow {
 /// A node whose sphere is more than this many times larger than its partner's descends alone (its
 /// partner waits): in the queries that collect pairs.
 inline constexpr double kDescendAloneRatio = 2.0;
-/// The same in the distance query, whose visits where one side splits cost nearly as much as
+/// The same in the distance query, whose visits where one side descends cost nearly as much as
 /// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance): 4
 /// was faster on the bunny at gap 1, as fast or a little faster on the armadillo and dragon, and
 /// faster on some cases, slower on others, on the turbine and blade and on the fandisk and rotor.
@@ -104,9 +104,9 @@ class PairContext {
     return true;
   }
 
-  /// The node test of a visit where both sides split: node_test, and neither node's disk beyond
+  /// The node test of a visit where both sides descend: node_test, and neither node's disk beyond
   /// the other's slab (disks_beyond_slabs; both nodes prepared with their disks). Visits where one
-  /// side splits use node_test alone: on the turbine and blade, whose visits mostly split one side,
+  /// side descends use node_test alone: on the turbine and blade, whose visits mostly descend on one side,
   /// the disks refused no pair and cost a noticeable part of the query.
   [[nodiscard]] bool node_test_2x2_lane(const SideA& a, const SideB& b) const {
     return node_test(a, b) && !narrow::disks_beyond_slabs(a, b, mSlabReach);
@@ -122,7 +122,7 @@ class PairContext {
   }
 
   /// node_test_2x2_lane on the four pairs of nodes a0 or a1 of A with b0 or b1 of B (the children
-  /// of a visit where both sides split): bit 2i + j is set where ai and bj pass. The preparation and
+  /// of a visit where both sides descend): bit 2i + j is set where ai and bj pass. The preparation and
   /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp), the same
   /// decisions.
   [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
@@ -158,7 +158,7 @@ class PairContext {
     return dist2 / std::max(square(double(na.radius) + double(nb.radius)), std::numeric_limits<double>::min());
   }
 
-  /// The CD tree's ratio for descending alone (cd_split): kDescendAloneRatioDistance in a
+  /// The CD tree's ratio for descending alone (cd_descend): kDescendAloneRatioDistance in a
   /// distance query, kDescendAloneRatio in the others.
   [[nodiscard]] double descend_alone_ratio() const { return mDescendAlone; }
 
@@ -230,7 +230,7 @@ class PairContext {
   }
 
   /// gap on the four pairs of prepared nodes a0 or a1 of A with b0 or b1 of B (a visit's children
-  /// where both sides split): out[2i + j] for ai and bj. The same value as gap(ai, bj, reach)
+  /// where both sides descend): out[2i + j] for ai and bj. The same value as gap(ai, bj, reach)
   /// wherever that is within `reach`, and beyond `reach` where that is; four lanes of AVX2 where the
   /// CPU has it (distance_bound_avx2.cpp).
   void gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1, double reach, double out[4]) const;
@@ -238,11 +238,11 @@ class PairContext {
   /// The leaf test on triangles (ta of A, tb of B); appends a Candidate when the pair is reported.
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
-  /// The same, the pair waiting in `stage` for the batch kernels: once they run (a full batch, or
+  /// The same, the pair waiting in `buffer` for the batch kernels: once they run (a full batch, or
   /// flush_leaves), `out` has what leaf_test would have appended, in the same order.
-  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafStage& stage) const;
-  /// Finishes the pairs waiting in `stage` (their candidates appended to `out`) and empties it.
-  void flush_leaves(LeafStage& stage, std::vector<Candidate>& out) const;
+  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
+  /// Finishes the pairs waiting in `buffer` (their candidates appended to `out`) and empties it.
+  void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const;
 
   /// The leaf test of a distance traversal: when the triangles are within `bound` (and allowed by
   /// groups), writes their distance and closest points to `out` and returns true. The arithmetic of
@@ -303,10 +303,10 @@ class PairContext {
   /// only place that calls it.
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
-  /// The staged refusal (the pairs it does not refuse move on), the staged closest points (the
+  /// The buffered refusal (the pairs it does not refuse move on), the buffered closest points (the
   /// kept pairs appended to `out`).
-  void refuse_staged(LeafStage& stage, std::vector<Candidate>& out) const;
-  void finish_staged(LeafStage& stage, std::vector<Candidate>& out) const;
+  void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
+  void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   /// The contact kind's normal test on a leaf pair (true for the other kinds).
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;

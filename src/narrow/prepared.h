@@ -78,7 +78,7 @@ struct NearB : BoxB {
 
 /// The nodes one distance traversal has prepared, kept as a tree that follows the BVH's: a
 /// prepared node links to its two children (adjacent in the BVH, so prepared together) once a
-/// visit has split it, and every later visit that splits it follows the link. So each node is
+/// visit has descended into it, and every later visit that descends into it follows the link. So each node is
 /// prepared once however many partners it meets (the traversal meets a node several times), with
 /// no lookup by index (a hash table by index made the distance query slower on every case of the
 /// bench). A node is only ever reached through its parent's link (or as the traversal's root), so

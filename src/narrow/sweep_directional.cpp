@@ -102,11 +102,11 @@ double local_advance(const PairContext& ctx, const LocalMotion& m, double cap, s
       continue;
     }
     if (node_advance(ctx, m, along_b, p.a, p.b) >= best) continue;
-    bool split_a, split_b;
-    cd_split(na, nb, ctx.descend_alone_ratio(), split_a, split_b);
-    for (std::uint32_t i = 0; i < (split_a ? 2u : 1u); ++i) {
-      for (std::uint32_t j = 0; j < (split_b ? 2u : 1u); ++j) {
-        stack.push_back(NodePair{split_a ? na.index + i : p.a, split_b ? nb.index + j : p.b});
+    bool descend_a, descend_b;
+    cd_descend(na, nb, ctx.descend_alone_ratio(), descend_a, descend_b);
+    for (std::uint32_t i = 0; i < (descend_a ? 2u : 1u); ++i) {
+      for (std::uint32_t j = 0; j < (descend_b ? 2u : 1u); ++j) {
+        stack.push_back(NodePair{descend_a ? na.index + i : p.a, descend_b ? nb.index + j : p.b});
       }
     }
   }

@@ -22,7 +22,7 @@
 namespace caliber::narrow {
 
 /// How a traversal's root is tested: not at all (it was tested, and passed, earlier), as a pair's
-/// root (node_test), or as a child of a visit where both sides split (node_test_2x2_lane: a root
+/// root (node_test), or as a child of a visit where both sides descend (node_test_2x2_lane: a root
 /// that its parent's visit would have tested with the disks, as narrow::child_test).
 enum class RootTest : std::uint8_t { done, as_root, with_disks };
 
@@ -43,21 +43,21 @@ std::uint32_t index_of(Side* side) {
   return side->index;
 }
 
-/// The children of CD-tree node n (not a pair of leaves; split_a and split_b from cd_split), each
+/// The children of CD-tree node n (not a pair of leaves; descend_a and descend_b from cd_descend), each
 /// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the
 /// distance bound's) for the (up to) four pairs it takes part in: calls test(side_a, side_b,
 /// child) for each in cd_children order, except those on the taboo list (skipped and marked
 /// reached), each counted in stats.node_tests. The one enumeration of children, for the node
 /// visit and the distance traversal.
 template <class PrepareA, class PrepareB, class Test>
-[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool split_a, bool split_b,
+[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool descend_a, bool descend_b,
                                                   QueryStats& stats, TabooView taboo, PrepareA&& prepare_a, PrepareB&& prepare_b,
                                                   Test&& test) {
   decltype(prepare_a(std::uint32_t{})) sa[2];
   decltype(prepare_b(std::uint32_t{})) sb[2];
-  const int na = split_a ? 2 : 1, nb = split_b ? 2 : 1;
-  for (int i = 0; i < na; ++i) sa[i] = prepare_a(split_a ? a.index + i : n.a);
-  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(split_b ? b.index + j : n.b);
+  const int na = descend_a ? 2 : 1, nb = descend_b ? 2 : 1;
+  for (int i = 0; i < na; ++i) sa[i] = prepare_a(descend_a ? a.index + i : n.a);
+  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(descend_b ? b.index + j : n.b);
   for (int i = 0; i < na; ++i) {
     for (int j = 0; j < nb; ++j) {
       const NodePair child{index_of(sa[i]), index_of(sb[j])};
@@ -68,7 +68,7 @@ template <class PrepareA, class PrepareB, class Test>
   }
 }
 
-/// The four children of a visit where both sides split (A's a0 and a0 + 1 against B's b0 and
+/// The four children of a visit where both sides descend (A's a0 and a0 + 1 against B's b0 and
 /// b0 + 1, in cd_children order) that are not on the taboo list (those marked reached), each
 /// counted in stats.node_tests: calls take(k, child) with k = 2i + j, the lane of the four-at-once
 /// tests that computed it.
@@ -89,29 +89,29 @@ template <class Take>
 /// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
 /// Each child node of A and of B is prepared once for the (up to) four pairs it takes part in.
-/// So every CD node below a root is tested exactly once, by its parent's visit. With a stage, a
-/// leaf pair may wait there for its closest points (PairContext::leaf_test with a stage): the
+/// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
+/// leaf pair may wait there for its closest points (PairContext::leaf_test with a buffer): the
 /// caller flushes it before reading `out`.
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
-                                        NodePair passed[4], TabooView taboo = {}, LeafStage* stage = nullptr) {
+                                        NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) {
     ++stats.leaf_tests;
-    if (stage != nullptr) {
-      ctx.leaf_test(a.index, b.index, out, *stage);
+    if (buffer != nullptr) {
+      ctx.leaf_test(a.index, b.index, out, *buffer);
     } else {
       ctx.leaf_test(a.index, b.index, out);
     }
     return -1;
   }
   int count = 0;
-  bool split_a, split_b;
-  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
-  if (split_a && split_b) {
-    // Both sides split: the four child pairs tested at once, then taken in cd_children order as
+  bool descend_a, descend_b;
+  cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
+  if (descend_a && descend_b) {
+    // Both sides descend: the four child pairs tested at once, then taken in cd_children order as
     // for_each_child takes them (a child on the taboo list marked reached, neither counted nor
-    // entered). (Where one side does not split, the scalar tests below were faster than four lanes
+    // entered). (Where one side does not descend, the scalar tests below were faster than four lanes
     // with two wasted, in the step and in the queries.)
     const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
@@ -120,7 +120,7 @@ template <class Take>
     return count;
   }
   for_each_child(
-      n, a, b, split_a, split_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); },
+      n, a, b, descend_a, descend_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); },
       [&](std::uint32_t j) { return ctx.prepare_b(j); },
       [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
         if (ctx.node_test(sa, sb)) passed[count++] = child;
@@ -183,10 +183,10 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
   // test's pair as it is kept).
-  LeafStage stage;
-  LeafStage* const staged = limit == nullptr ? &stage : nullptr;
+  LeafBuffer buffer;
+  LeafBuffer* const buffered = limit == nullptr ? &buffer : nullptr;
   while (top != base) {
-    const int count = visit(ctx, *--top, out, counted, passed, taboo, staged);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, buffered);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (limit != nullptr && count < 0) {
       if (out.size() != seen) {
@@ -205,7 +205,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     }
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
-  ctx.flush_leaves(stage, out);
+  ctx.flush_leaves(buffer, out);
   stats.node_tests += counted.node_tests;
   stats.leaf_tests += counted.leaf_tests;
 }
@@ -243,8 +243,8 @@ struct Nearest {
 /// The distance bounds of the children of CD-tree node r (prepared nodes of A and B; a and b its
 /// BVH nodes, not both leaves): calls wait(gap, child) for each in cd_children order, except those
 /// on the taboo list (skipped and marked reached), each counted in stats.node_tests. The
-/// children's prepared nodes are made by the first visit that splits a node, found by its link
-/// after that; a side that does not split brings its own node.
+/// children's prepared nodes are made by the first visit that descends into a node, found by its link
+/// after that; a side that does not descend brings its own node.
 template <class Wait>
 [[gnu::always_inline]] inline void near_children(const PairContext& ctx, TraversalScratch& scratch, TraversalScratch::Reached r,
                                                  const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats,
@@ -252,12 +252,12 @@ template <class Wait>
   using Reached = TraversalScratch::Reached;
   const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
   const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
-  bool split_a, split_b;
-  cd_split(a, b, ctx.descend_alone_ratio(), split_a, split_b);
-  TraversalScratch::NearA* const ka = split_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
-  TraversalScratch::NearB* const kb = split_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
-  if (split_a && split_b) {
-    // Both sides split: the four child pairs' bounds at once, then taken in cd_children order
+  bool descend_a, descend_b;
+  cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
+  TraversalScratch::NearA* const ka = descend_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
+  TraversalScratch::NearB* const kb = descend_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
+  if (descend_a && descend_b) {
+    // Both sides descend: the four child pairs' bounds at once, then taken in cd_children order
     // as for_each_child takes them (a child on the taboo list marked reached, not counted).
     double gaps[4];
     ctx.gaps_2x2(ka[0], ka[1], kb[0], kb[1], reach, gaps);
@@ -266,17 +266,17 @@ template <class Wait>
     });
     return;
   }
-  // One side splits: its two children against the other node twice in the four lanes (lanes
+  // One side descends: its two children against the other node twice in the four lanes (lanes
   // 0 and 2, or 0 and 1); the enumeration below takes these prepared nodes.
-  TraversalScratch::NearA* const a0 = split_a ? &ka[0] : r.a;
-  TraversalScratch::NearA* const a1 = split_a ? &ka[1] : r.a;
-  TraversalScratch::NearB* const b0 = split_b ? &kb[0] : r.b;
-  TraversalScratch::NearB* const b1 = split_b ? &kb[1] : r.b;
+  TraversalScratch::NearA* const a0 = descend_a ? &ka[0] : r.a;
+  TraversalScratch::NearA* const a1 = descend_a ? &ka[1] : r.a;
+  TraversalScratch::NearB* const b0 = descend_b ? &kb[0] : r.b;
+  TraversalScratch::NearB* const b1 = descend_b ? &kb[1] : r.b;
   double gaps[4];
   ctx.gaps_2x2(*a0, *a1, *b0, *b1, reach, gaps);
   const auto prepared_a = [&](std::uint32_t i) { return i == a0->index ? a0 : a1; };
   const auto prepared_b = [&](std::uint32_t j) { return j == b0->index ? b0 : b1; };
-  for_each_child(NodePair{r.a->index, r.b->index}, a, b, split_a, split_b, stats, taboo, prepared_a, prepared_b,
+  for_each_child(NodePair{r.a->index, r.b->index}, a, b, descend_a, descend_b, stats, taboo, prepared_a, prepared_b,
                  [&](TraversalScratch::NearA* sa, TraversalScratch::NearB* sb, NodePair) {
                    wait(gaps[(sa == a0 ? 0 : 2) + (sb == b0 ? 0 : 1)], Reached{sa, sb});
                  });

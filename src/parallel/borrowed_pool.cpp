@@ -96,8 +96,8 @@ void run_on_host(HostExecutor& host, int threads, const std::function<void()>& f
   const Membership member(&pool);
   const BorrowedScope outside(nullptr, -1);
   // The host's threads take the pool's jobs until it closes: one item each, after the caller's.
-  // The task outlives finish(): the host may keep a reference to it.
-  const HostExecutor::Task lent = [&pool](std::size_t begin, std::size_t end, int) {
+  // The job outlives finish(): the host may keep a reference to it.
+  const HostExecutor::Job lent = [&pool](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) pool.lend(static_cast<int>(i) + 1);
   };
   void* handle = threads > 1 ? host.enqueue(lent, static_cast<std::size_t>(threads - 1), 1) : nullptr;

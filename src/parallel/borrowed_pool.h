@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The threads a host lends for one Executor::execute (caliber/executor.h): one queue of jobs that
-/// the caller and the lent threads take from. A thread waiting on a TaskGroup runs queued jobs
+/// the caller and the lent threads take from. A thread waiting on a JobGroup runs queued jobs
 /// meanwhile (newest first, so it tends to finish its own children); a lent thread takes the
 /// oldest (the biggest pieces of a recursive split). Every hand-off goes through one mutex.
 
@@ -18,7 +18,7 @@ class HostExecutor;
 
 namespace caliber::parallel::detail {
 
-/// A TaskGroup's jobs in a borrowed pool; guarded by the pool's mutex.
+/// A JobGroup's jobs in a borrowed pool; guarded by the pool's mutex.
 struct BorrowedGroup {
   std::size_t pending = 0;
   std::exception_ptr error;  ///< the first error a job threw

@@ -41,14 +41,14 @@ int Executor::host_threads() const {
   return mHostThreads;
 }
 
-TaskGroup::~TaskGroup() {
+JobGroup::~JobGroup() {
   try {
     wait();
   } catch (...) {  // NOLINT(bugprone-empty-catch): an unwaited group's error has nowhere to go
   }
 }
 
-void TaskGroup::wait() {
+void JobGroup::wait() {
   if (mBorrowed != nullptr) {
     mBorrowed->wait(mBorrowedJobs);
     return;
@@ -68,7 +68,7 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
   if (end - begin <= grain) {
     body(begin, end);
   } else if (detail::t_borrowed != nullptr) {  // on the host's threads: chunks as jobs of the borrowed pool
-    TaskGroup group;
+    JobGroup group;
     detail::for_each_chunk(begin, end, grain,
                            [&](std::size_t lo, std::size_t hi) { group.run([&body, lo, hi] { body(lo, hi); }); });
     group.wait();
@@ -95,7 +95,7 @@ void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& bo
     }
   };
   const std::size_t helpers = std::min<std::size_t>(n, static_cast<std::size_t>(std::max(concurrency(), 1))) - (n > 0 ? 1 : 0);
-  TaskGroup group;
+  JobGroup group;
   for (std::size_t k = 0; k < helpers; ++k) group.run(drain);
   drain();
   group.wait();

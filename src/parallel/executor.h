@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// The one seam between "what tasks to run" and "how to run them": every parallel construct in
+/// The one seam between "what jobs to run" and "how to run them": every parallel construct in
 /// caliber goes through this header. The host owns the threads: caliber's parallel work runs only
 /// inside Executor::execute, and outside it every construct below runs on the calling thread (so
 /// caliber::query, and any call a host makes from its own threads, creates no thread).
@@ -40,7 +40,7 @@ namespace caliber::parallel {
 /// Where a piece of caliber's work runs: `threads` = 0, the backend's default (oneTBB: the arena
 /// execute() is called from; std::thread: the machine's hardware threads); 1, the calling thread
 /// alone; N > 1, N threads (oneTBB: an arena of its own, at most the process's limit). Parallel
-/// work started inside execute() (parallel_for, TaskGroup, ...) runs there and on no other thread.
+/// work started inside execute() (parallel_for, JobGroup, ...) runs there and on no other thread.
 class Executor {
  public:
   /// `threads` >= 0 (see the class comment). Throws caliber::Error on a negative count. With a
@@ -55,7 +55,7 @@ class Executor {
   [[nodiscard]] int threads() const;
 
   /// Runs `f` on the calling thread, joined by the executor's other threads until it returns.
-  /// Exceptions thrown by `f` (or by tasks it waits for) propagate to the caller.
+  /// Exceptions thrown by `f` (or by jobs it waits for) propagate to the caller.
   void execute(const std::function<void()>& f);
 
  private:
@@ -69,16 +69,16 @@ class Executor {
   std::unique_ptr<native::Workers> mWorkers;  ///< without a host only
 };
 
-/// A set of tasks run in parallel (on the executor the caller runs in) and waited for together.
-/// Outside any executor (or in a one-thread executor), run() calls the task at once.
-class TaskGroup {
+/// A set of jobs run in parallel (on the executor the caller runs in) and waited for together.
+/// Outside any executor (or in a one-thread executor), run() calls the job at once.
+class JobGroup {
  public:
-  TaskGroup() = default;
-  ~TaskGroup();
-  TaskGroup(const TaskGroup&) = delete;
-  TaskGroup& operator=(const TaskGroup&) = delete;
+  JobGroup() = default;
+  ~JobGroup();
+  JobGroup(const JobGroup&) = delete;
+  JobGroup& operator=(const JobGroup&) = delete;
 
-  /// Queues `f` (or runs it now, serially); the first exception a task throws is rethrown by wait().
+  /// Queues `f` (or runs it now, serially); the first exception a job throws is rethrown by wait().
   template <class F>
   void run(F&& f) {
     if (mBorrowed != nullptr) {
@@ -93,14 +93,14 @@ class TaskGroup {
       }
     }
   }
-  /// Waits for every task run() so far (helping to run them meanwhile).
+  /// Waits for every job run() so far (helping to run them meanwhile).
   void wait();
 
  private:
   detail::BorrowedPool* mBorrowed = detail::t_borrowed;  ///< the host's threads' pool it was made in, or null
   detail::BorrowedGroup mBorrowedJobs;
   native::Group mGroup;
-  std::exception_ptr mError;  ///< of a task run serially
+  std::exception_ptr mError;  ///< of a job run serially
 };
 
 /// The calling thread's index in the executor it works for (0 .. threads-1 for threads of its own;
@@ -119,7 +119,7 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
 /// Greedy list scheduling: calls body(i) for i = 0, 1, ..., n-1, each i taken by whichever of the
 /// executor's threads is free next, in that order. Given items sorted heaviest first this is the
 /// LPT schedule that the load-balance simulation replays. parallel_for is not: its recursive halving
-/// hands each thread a contiguous block (on 2 threads, tasks {0, 1} to one and {2, 3} to the other).
+/// hands each thread a contiguous block (on 2 threads, items {0, 1} to one and {2, 3} to the other).
 /// The first exception a body throws is rethrown once every thread has stopped; items not yet
 /// taken are then skipped.
 void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& body);
@@ -141,16 +141,16 @@ void parallel_for_each(std::size_t begin, std::size_t end, F&& f) {
 }
 
 namespace detail {
-/// Sorts [first, last): halves sorted as tasks of a TaskGroup, `depth` levels deep, then merged.
+/// Sorts [first, last): halves sorted as jobs of a JobGroup, `depth` levels deep, then merged.
 template <class It, class Less>
 void sort_in_halves(It first, It last, Less less, int depth) {
-  constexpr std::ptrdiff_t kSmall = 4096;  // below this a task costs more than it saves
+  constexpr std::ptrdiff_t kSmall = 4096;  // below this a job costs more than it saves
   if (depth <= 0 || last - first < kSmall) {
     std::sort(first, last, less);
     return;
   }
   const It middle = first + (last - first) / 2;
-  TaskGroup group;
+  JobGroup group;
   group.run([&] { sort_in_halves(first, middle, less, depth - 1); });
   sort_in_halves(middle, last, less, depth - 1);
   group.wait();

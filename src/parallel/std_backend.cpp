@@ -33,8 +33,8 @@ class ThreadPoolHost final : public HostExecutor {
 
   [[nodiscard]] int thread_count() const override { return mThreads; }
 
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
-    auto call = std::make_unique<Call>(Call{&task, 0});
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
+    auto call = std::make_unique<Call>(Call{&job, 0});
     {
       const std::lock_guard<std::mutex> lock(mMutex);
       for (std::size_t begin = 0; begin < count; begin += grain, ++call->left) {
@@ -62,7 +62,7 @@ class ThreadPoolHost final : public HostExecutor {
 
  private:
   struct Call {
-    const Task* task;
+    const Job* job;
     std::size_t left;  ///< ranges not yet done
   };
   struct Range {
@@ -73,7 +73,7 @@ class ThreadPoolHost final : public HostExecutor {
   /// Runs `range` with the lock released; signs it off in its call.
   void run(std::unique_lock<std::mutex>& lock, const Range& range, int worker) {
     lock.unlock();
-    (*range.call->task)(range.begin, range.end, worker);
+    (*range.call->job)(range.begin, range.end, worker);
     lock.lock();
     if (--range.call->left == 0) mChanged.notify_all();
   }

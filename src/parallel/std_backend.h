@@ -51,7 +51,7 @@ class Workers {
   std::unique_ptr<ThreadPoolHost> mHost;
 };
 
-/// Tasks outside any pool: run at once, on the calling thread.
+/// Jobs outside any pool: run at once, on the calling thread.
 class Group {
  public:
   template <class F>

@@ -36,7 +36,7 @@ void Workers::execute(const std::function<void()>& f) {
     });
     return;
   }
-  // The caller's arena (the tasks oneTBB runs go to it), or the calling thread alone.
+  // The caller's arena (the jobs oneTBB runs go to it), or the calling thread alone.
   const ConcurrencyScope scope(concurrency);
   f();
 }

@@ -5,7 +5,7 @@
 /// process's limit), or on the calling thread alone (threads = 1). It never changes process-wide
 /// settings (no tbb::global_control). tbb::parallel_for, tbb::task_group and
 /// tbb::enumerable_thread_specific underneath; these wrappers add nothing on hot paths but a
-/// thread-local flag per task.
+/// thread-local flag per job.
 
 #include <algorithm>
 #include <cstddef>
@@ -27,7 +27,7 @@ inline constexpr std::string_view kName = "oneTBB";
 inline constexpr std::string_view kZeroThreads = "0: the arena caliber is called from";
 
 /// The concurrency of the executor whose work the calling thread is doing; 0 outside any. Set by
-/// Workers::execute and carried into every task the wrappers below hand to oneTBB, on whatever
+/// Workers::execute and carried into every job the wrappers below hand to oneTBB, on whatever
 /// thread runs it (a worker of the host's arena knows nothing of caliber otherwise).
 inline thread_local int t_concurrency = 0;
 
@@ -71,7 +71,7 @@ class Workers {
   std::unique_ptr<tbb::task_arena> mArena;  ///< threads > 1 only
 };
 
-/// A TaskGroup's tasks on oneTBB (inside an executor of more than one thread).
+/// A JobGroup's jobs on oneTBB (inside an executor of more than one thread).
 class Group {
  public:
   template <class F>

@@ -175,7 +175,7 @@ std::vector<StageItem> gather_level(const std::vector<StageItem>& level, const s
 
 }  // namespace
 
-SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
+SplitResult split_pair(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
                        double eps, const NodeCounts* measured) {
   const auto weight_of = [&](narrow::NodePair n) {
     if (measured != nullptr) {
@@ -271,7 +271,7 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   summary[slot].children = children;
   summary.resize(summary.size() + children);
   std::uint32_t next = at;
-  const bool both = count == 4;  // both sides split: the visit tests the children with the disks
+  const bool both = count == 4;  // both sides descend: the visit tests the children with the disks
   for (int k = 0; k < count; ++k) {
     if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], both, bounds[k], bounds[k + 1], summary);
   }

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// Task calibration (docs/design.md section 3): from the step's initial tasks and their weights, a
+/// Task calibration (docs/design.md section 3): from the step's pairs and their weights, a
 /// run-time task list whose tasks all have about the same weight, the caliber Omega.
-///   Omega = sum of weights / (beta * threads); a task within [Omega - eps, Omega + eps] runs as is,
+///   Omega = sum of weights / (beta * threads); a pair within [Omega - eps, Omega + eps] runs as is,
 ///   a heavier one is split by the weight-driven stage, a lighter one goes to the cart; the cart is
 ///   sorted and its heaviest item is merged with the lightest ones until the merge reaches Omega.
 
@@ -20,7 +20,7 @@ namespace caliber::plans {
 /// A piece of work for one thread: a CD-tree node of one pair, and whether the weight-driven stage
 /// already tested it (then the depth-first traversal starts below it, so no node is tested twice).
 struct Root {
-  std::uint32_t pair;       ///< index of the initial task (object pair)
+  std::uint32_t pair;       ///< index of the object pair (in the frame's pairs)
   narrow::NodePair node;    ///< CD-tree node
   bool tested;              ///< already tested (and passed) in the weight-driven stage
   double weight;            ///< its estimated weight
@@ -28,7 +28,7 @@ struct Root {
   std::int32_t owner = -1;  ///< a posteriori: the taboo list this root is on (sub-tasks)
   std::int32_t slot = -1;   ///< a posteriori: its place on that list
   std::int32_t stage = -1;  ///< weight-driven stage: index of its record in SplitResult::stage
-  bool disks = false;       ///< untested, its CD parent splits both sides: tested with the disks
+  bool disks = false;       ///< untested, its CD parent descends on both sides: tested with the disks
 
   /// How its traversal tests it (narrow::RootTest), as its parent's visit would.
   [[nodiscard]] narrow::RootTest root_test() const {
@@ -77,7 +77,7 @@ struct RunTask {
   double weight = 0.0;  ///< sum of the roots' weights
 };
 
-/// What calibration does with an initial task or a node of the weight-driven stage.
+/// What calibration does with a pair or a node of the weight-driven stage.
 enum class Verdict { keep, split, cart };
 
 /// keep when weight is in [omega - eps, omega + eps], split above, cart below.
@@ -106,7 +106,7 @@ struct StageRecord {
 /// Measured node tests of CD subtrees at the previous step, per CD node, sorted by node.
 using NodeCounts = std::vector<std::pair<narrow::NodePair, std::uint64_t>>;
 
-/// The weight-driven stage's output for one split task.
+/// The weight-driven stage's output for one split pair.
 struct SplitResult {
   std::vector<Root> roots;                    ///< sub-task roots whose weight meets omega
   std::vector<Root> cart;                     ///< lighter tested nodes, for the cart
@@ -118,7 +118,7 @@ struct SplitResult {
   /// is not in them).
   std::vector<std::vector<std::uint64_t>> levels;
   /// Wall time of the stage outside its levels' parallel parts (adding up each level's chunk
-  /// tallies in order, sizing the outputs, the final sort): serial within the split task.
+  /// tallies in order, sizing the outputs, the final sort): serial within the split pair.
   double serial_ms = 0.0;
 };
 
@@ -131,7 +131,7 @@ struct SplitResult {
 /// a node does not depend on when, this runs the same cut level by level, each level's nodes in
 /// parallel on the current executor (one heavy pair's stage is no longer serial work), with the
 /// same result whatever the thread count.
-SplitResult split_task(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
+SplitResult split_pair(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale, double omega,
                        double eps, const NodeCounts* measured = nullptr);
 
 /// After a step: the node tests of every subtree the stage tested, from its records and the
@@ -142,18 +142,18 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 /// the previous step, each weighted by how many of them lie below it. Children are contiguous.
 struct SummaryNode {
   narrow::NodePair node;       ///< the CD-tree node
-  std::uint32_t contacts = 0;  ///< reported pairs below it
+  std::uint32_t contacts = 0;  ///< reported triangle pairs below it
   std::uint32_t first = 0;     ///< index of its first child in the summary
   std::uint32_t children = 0;  ///< how many children (only those with contacts below)
-  bool disks = false;          ///< its parent splits both sides (its node test has the disks)
+  bool disks = false;          ///< its parent descends on both sides (its node test has the disks)
 };
 
-/// Builds the summary tree of pair context ctx's CD tree from the previous step's reported pairs
-/// (empty if there were none).
+/// Builds the summary tree of pair context ctx's CD tree from the previous step's reported triangle
+/// pairs (empty if there were none).
 std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std::vector<TrianglePair>& reported);
 
-/// The a posteriori split of one heavy task: sub-task roots chosen on its summary tree by weight
-/// (a node's weight is the task's weight times its share of the contacts), the original task keeping
+/// The a posteriori split of one heavy pair: sub-task roots chosen on its summary tree by weight
+/// (a node's weight is the pair's weight times its share of the contacts), the original task keeping
 /// the rest of the tree with those roots on its taboo list (at most `taboo_cap` of them).
 struct PosterioriSplit {
   std::vector<Root> roots;              ///< sub-task roots meeting omega (untested)

@@ -127,7 +127,7 @@ void split_by_stage(const EngineOptions& options, const std::vector<ObjectPair>&
     const std::size_t i = to_split[s];
     const NodeCounts* measured = node_history ? history.node_counts.find(pairs[i]) : nullptr;
     const auto stage = [&] {
-      plan.splits[s] = split_task(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], scale_of(w, contexts, i), plan.omega,
+      plan.splits[s] = split_pair(contexts[i], static_cast<std::uint32_t>(i), w.weight[i], scale_of(w, contexts, i), plan.omega,
                                   options.epsilon * plan.omega, measured);
     };
     if (around_stage) {

@@ -82,8 +82,8 @@ struct Plan {
   std::vector<narrow::Taboo> taboos;       ///< a posteriori taboo lists (Root::taboo and Root::owner index them)
   bool weighted = false;                   ///< the tasks carry weight estimates (calibrated methods)
   double omega = 0.0;                      ///< the caliber (0 for a plan of whole pairs)
-  std::size_t kept = 0;                    ///< initial tasks run as they are
-  std::size_t split = 0;                   ///< initial tasks split
+  std::size_t kept = 0;                    ///< pairs run as they are
+  std::size_t split = 0;                   ///< pairs split
   std::size_t carted = 0;                  ///< items merged in the cart
   std::size_t taboo_nodes = 0;             ///< a posteriori: sub-task roots handed out
 };
@@ -91,7 +91,7 @@ struct Plan {
 /// Sequential and exploitation: one run-time task per pair, whole, in pair order.
 [[nodiscard]] Plan plan_pairs(std::size_t pairs);
 
-/// The weights of the initial tasks (docs/design.md section 3): the root's a priori estimate times a
+/// The weights of the pairs (docs/design.md section 3): the root's a priori estimate times a
 /// per-pair scale. A priori: scale 1. Hybrid and a posteriori: a pair with history weighs its node
 /// tests at the previous step (its scale: those over its estimate); a pair with none takes the ratio
 /// measured over the pairs that have one (over an evenly spaced sample of kRatioSample of them when
@@ -104,7 +104,7 @@ struct InitialWeights {
 };
 inline constexpr std::size_t kRatioSample = 4096;
 /// What a pair costs beside its node tests (starting its traversal, its finalization), in node
-/// tests: added to every initial task's weight. Set on a scene of thousands of light pairs
+/// tests: added to every pair's weight. Set on a scene of thousands of light pairs
 /// (grid_32768, hybrid): in a merged task of whole pairs, the time a pair took beside its node
 /// tests, over the time one of its node tests took.
 inline constexpr double kPairWeight = 4.0;
@@ -120,7 +120,7 @@ inline constexpr std::size_t kCartFiner = 16;
 
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
 /// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
-/// each initial task, merge the cart, and hand the run-time tasks out heaviest first. `around_stage`,
+/// each pair, merge the cart, and hand the run-time tasks out heaviest first. `around_stage`,
 /// if set, is called with each split pair's index and its weight-driven stage, and must run it
 /// (the engine times it).
 using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;

@@ -21,8 +21,8 @@ namespace {
 /// wait for its last entries, is a small part of it.
 constexpr std::size_t kChunk = 8192;
 
-/// Entries traversed whole: at most this many to a task (few enough to balance heavy entries,
-/// enough that a light entry's task costs little beside it).
+/// Entries traversed whole: at most this many to a job (few enough to balance heavy entries,
+/// enough that a light entry's job costs little beside it).
 constexpr std::size_t kWholeGrain = 4;
 
 void validate_poses(std::span<const Pose> poses, const char* side) {

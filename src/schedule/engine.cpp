@@ -2,7 +2,7 @@
 //   sequential    the pairs one after another, on one thread          (plan: whole pairs)
 //   exploitation  the pairs handed out in order to the threads         (plan: whole pairs)
 //   aposteriori, apriori, hybrid   task calibration                    (plan: plans/plan.h)
-//   stealing      every pair's CD tree split recursively into tasks    (its own runner)
+//   stealing      every pair's CD tree split recursively into jobs     (its own runner)
 // Every plan goes through one runner (schedule/runner.h); threads are reached only through
 // parallel/executor.h. All methods end with the same per-pair finalization and the same
 // reduction, so the contacts do not depend on the method or the thread count.
@@ -145,9 +145,9 @@ void reset_keeping_storage(ScheduleRecord& r) {
     from.clear();
     to = std::move(from);
   };
-  keep(r.stage_task_node_tests, fresh.stage_task_node_tests);
+  keep(r.stage_pair_node_tests, fresh.stage_pair_node_tests);
   keep(r.stage_levels, fresh.stage_levels);
-  keep(r.stage_level_task, fresh.stage_level_task);
+  keep(r.stage_level_pair, fresh.stage_level_pair);
   keep(r.stage_serial_ms, fresh.stage_serial_ms);
   keep(r.task_node_tests, fresh.task_node_tests);
   keep(r.task_weights, fresh.task_weights);
@@ -221,7 +221,7 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
       run.stage_root_tests = schedule::run_plan(run.plan, state, record);
     }
     // Each thread's node tests: its slots summed, in parallel when there are many (threads x pairs
-    // counts in all; a task per thread costs more than a few thousand additions).
+    // counts in all; a job per thread costs more than a few thousand additions).
     const std::vector<schedule::WorkerSlots*> slots = workers.all();
     std::vector<std::uint64_t> tests(slots.size(), 0);
     const auto sum = [&](std::size_t k) {

@@ -131,7 +131,7 @@ inline std::size_t entry_count(std::size_t na, std::size_t nb, const char* items
 }
 
 /// A sweep the engine runs: its two models and its advancement (done once it is over).
-struct SweepJob {
+struct ActiveSweep {
   const Model* a;
   const Model* b;
   narrow::SweepAdvance advance;
@@ -180,7 +180,7 @@ struct Engine::Impl {
   /// caliber::query's answer, so every sweep is caliber::sweep's whatever the method and threads.
   /// `groups`: the sweeps' SweepRequest::groups.
   [[gnu::visibility("hidden")]] void run_sweeps(const EngineOptions& options, Method method,
-                                                std::vector<schedule::SweepJob>& jobs, const GroupCompatibility* groups);
+                                                std::vector<schedule::ActiveSweep>& sweeps, const GroupCompatibility* groups);
 };
 
 }  // namespace caliber

@@ -36,14 +36,14 @@ constexpr std::size_t kSweepChunk = 8192;
 
 }  // namespace
 
-void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::SweepJob>& jobs,
+void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::vector<schedule::ActiveSweep>& sweeps,
                               const GroupCompatibility* groups) {
   const QueryRequest distance = narrow::sweep_distance_request(groups);
   const int threads = executor.threads();
   timeline.begin(false);  // (a split query's spans are not recorded)
   // Exploitation runs a pair whole, as the loop over sweeps does: only the other methods cut one.
   const bool can_split = threads > 1 && method != Method::sequential && method != Method::exploitation;
-  std::vector<std::size_t> active(jobs.size()), whole, split;
+  std::vector<std::size_t> active(sweeps.size()), whole, split;
   std::iota(active.begin(), active.end(), std::size_t{0});
   const plans::History no_history;
   std::vector<QueryResult> results;
@@ -53,7 +53,7 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
     split.clear();
     const bool few = can_split && active.size() < schedule::kEntriesPerThread * static_cast<std::size_t>(threads);
     for (const std::size_t i : active) {
-      (few && jobs[i].advance.last_node_tests() >= kSplitNodeTests ? split : whole).push_back(i);
+      (few && sweeps[i].advance.last_node_tests() >= kSplitNodeTests ? split : whole).push_back(i);
     }
     // Whole queries, a sweep to a thread: until it is over, or (when queries can be split) until
     // one of them was heavy, to be looked at again with the sweeps left.
@@ -63,11 +63,11 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
       started = true;
       executor.execute([&] {
         parallel::parallel_for_each(first, std::min(whole.size(), first + kSweepChunk), [&](std::size_t k) {
-          schedule::SweepJob& job = jobs[whole[k]];
+          schedule::ActiveSweep& sweep = sweeps[whole[k]];
           do {
-            const narrow::PairContext ctx(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance);
-            job.done = job.advance.take(narrow::query_whole(ctx), ctx);
-          } while (!job.done && !(can_split && job.advance.last_node_tests() >= kSplitNodeTests));
+            const narrow::PairContext ctx(*sweep.a, sweep.advance.pose_a(), *sweep.b, sweep.advance.pose_b(), distance);
+            sweep.done = sweep.advance.take(narrow::query_whole(ctx), ctx);
+          } while (!sweep.done && !(can_split && sweep.advance.last_node_tests() >= kSplitNodeTests));
         });
       });
     }
@@ -83,28 +83,28 @@ void Engine::Impl::run_sweeps(const EngineOptions& options, Method method, std::
       // The last closest pair, at the new poses: a distance the pieces prune by from the start.
       std::vector<double> nearest(split.size(), std::numeric_limits<double>::infinity());
       for (std::size_t k = 0; k < split.size(); ++k) {
-        const schedule::SweepJob& job = jobs[split[k]];
+        const schedule::ActiveSweep& sweep = sweeps[split[k]];
         std::uint32_t ta, tb;
         narrow::Candidate c;
-        if (job.advance.last_pair(ta, tb) &&
-            narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance)
+        if (sweep.advance.last_pair(ta, tb) &&
+            narrow::PairContext(*sweep.a, sweep.advance.pose_a(), *sweep.b, sweep.advance.pose_b(), distance)
                 .leaf_distance(ta, tb, kUnbounded, c)) {
           nearest[k] = c.distance;
         }
       }
       const auto make = [&](std::size_t k, void* where) {
-        const schedule::SweepJob& job = jobs[split[k]];
-        new (where) narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance);
+        const schedule::ActiveSweep& sweep = sweeps[split[k]];
+        new (where) narrow::PairContext(*sweep.a, sweep.advance.pose_a(), *sweep.b, sweep.advance.pose_b(), distance);
       };
       run_pairs(run, method, ids, distance, no_history, make, results, record, nearest);
       for (std::size_t k = 0; k < split.size(); ++k) {
-        schedule::SweepJob& job = jobs[split[k]];
-        job.done = job.advance.take(results[k],
-                                    narrow::PairContext(*job.a, job.advance.pose_a(), *job.b, job.advance.pose_b(), distance));
+        schedule::ActiveSweep& sweep = sweeps[split[k]];
+        sweep.done = sweep.advance.take(
+            results[k], narrow::PairContext(*sweep.a, sweep.advance.pose_a(), *sweep.b, sweep.advance.pose_b(), distance));
       }
       schedule::g_split_sweep_queries.fetch_add(split.size(), std::memory_order_relaxed);
     }
-    std::erase_if(active, [&](std::size_t i) { return jobs[i].done; });
+    std::erase_if(active, [&](std::size_t i) { return sweeps[i].done; });
   }
 }
 
@@ -146,16 +146,16 @@ std::vector<PairSweep> Engine::sweep(const std::vector<std::shared_ptr<const Mod
     broad::BoxTree tree;
     tree.pairs(boxes, filter, pairs);
   });
-  std::vector<schedule::SweepJob> jobs;
-  jobs.reserve(pairs.size());
+  std::vector<schedule::ActiveSweep> sweeps;
+  sweeps.reserve(pairs.size());
   for (const ObjectPair& p : pairs) {
-    jobs.push_back({models[p.a].get(), models[p.b].get(),
-                    narrow::SweepAdvance(radius[p.a], {from[p.a], to[p.a]}, radius[p.b], {from[p.b], to[p.b]}, request)});
+    sweeps.push_back({models[p.a].get(), models[p.b].get(),
+                      narrow::SweepAdvance(radius[p.a], {from[p.a], to[p.a]}, radius[p.b], {from[p.b], to[p.b]}, request)});
   }
-  mImpl->run_sweeps(mOptions, mOptions.method, jobs, request.groups);
+  mImpl->run_sweeps(mOptions, mOptions.method, sweeps, request.groups);
   std::vector<PairSweep> out;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    if (jobs[k].advance.result().status != SweepStatus::free) out.push_back(PairSweep{pairs[k], jobs[k].advance.result()});
+    if (sweeps[k].advance.result().status != SweepStatus::free) out.push_back(PairSweep{pairs[k], sweeps[k].advance.result()});
   }
   return out;
 }
@@ -176,15 +176,15 @@ std::vector<SweepResult> Engine::sweep_many(const Model& a, std::span<const Swep
   check(motions_b, "B");
   validate_sweep_request(request);
   const double ra = narrow::radius_about_origin(a), rb = narrow::radius_about_origin(b);
-  std::vector<schedule::SweepJob> jobs;
-  jobs.reserve(n);
+  std::vector<schedule::ActiveSweep> sweeps;
+  sweeps.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    jobs.push_back({&a, &b, narrow::SweepAdvance(ra, motions_a[na == 1 ? 0 : i], rb, motions_b[nb == 1 ? 0 : i], request)});
+    sweeps.push_back({&a, &b, narrow::SweepAdvance(ra, motions_a[na == 1 ? 0 : i], rb, motions_b[nb == 1 ? 0 : i], request)});
   }
-  mImpl->run_sweeps(mOptions, mOptions.method, jobs, request.groups);
+  mImpl->run_sweeps(mOptions, mOptions.method, sweeps, request.groups);
   std::vector<SweepResult> out;
   out.reserve(n);
-  for (const schedule::SweepJob& job : jobs) out.push_back(job.advance.result());
+  for (const schedule::ActiveSweep& sweep : sweeps) out.push_back(sweep.advance.result());
   return out;
 }
 

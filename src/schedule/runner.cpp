@@ -102,11 +102,11 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
     split_of[plan.split_pairs[s]] = s;
     stage_root_tests[s].assign(plan.splits[s].stage.size(), 0);
     record.stage_node_tests += plan.splits[s].stats.node_tests;
-    record.stage_task_node_tests.push_back(plan.splits[s].stats.node_tests);
+    record.stage_pair_node_tests.push_back(plan.splits[s].stats.node_tests);
     record.stage_serial_ms.push_back(plan.splits[s].serial_ms);
     for (const std::vector<std::uint64_t>& level : plan.splits[s].levels) {
       record.stage_levels.push_back(level);
-      record.stage_level_task.push_back(static_cast<std::uint32_t>(s));
+      record.stage_level_pair.push_back(static_cast<std::uint32_t>(s));
     }
     record.queue_peak = std::max(record.queue_peak, plan.splits[s].queue_peak);
   }

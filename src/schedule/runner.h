@@ -23,7 +23,7 @@ namespace caliber::schedule {
 std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record);
 
 /// Stealing: the CD tree of every heavy pair (a priori weight at least 1 / (64 x threads) of
-/// the total) split recursively into tasks down to `depth`, the other pairs whole, then each subtree
+/// the total) split recursively into jobs down to `depth`, the other pairs whole, then each subtree
 /// traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
 /// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.

@@ -56,21 +56,21 @@ double list_schedule_makespan(const std::vector<std::uint64_t>& costs, int cores
 
 namespace {
 
-/// The weight-driven stage's makespan, each node test of split task s costing `unit[s]`: each
-/// split task's levels one after another (a level's chunks list-scheduled on the cores, a barrier
-/// after it, plus `serial[s]`, the task's stage work outside its levels' visits), the split tasks
-/// side by side; at least the stage's cost spread evenly (the cores are shared by the split tasks).
+/// The weight-driven stage's makespan, each node test of split pair s costing `unit[s]`: each
+/// split pair's levels one after another (a level's chunks list-scheduled on the cores, a barrier
+/// after it, plus `serial[s]`, the pair's stage work outside its levels' visits), the split pairs
+/// side by side; at least the stage's cost spread evenly (the cores are shared by the split pairs).
 double stage_makespan(const ScheduleRecord& r, const std::vector<double>& unit, const std::vector<double>& serial, int cores) {
-  const std::size_t splits = r.stage_task_node_tests.size();
+  const std::size_t splits = r.stage_pair_node_tests.size();
   double total = 0.0;
   std::vector<double> span(splits);
   for (std::size_t s = 0; s < splits; ++s) {
-    total += unit[s] * static_cast<double>(r.stage_task_node_tests[s]) + serial[s];
-    span[s] = unit[s] + serial[s];  // the root's test, and the task's serial part
+    total += unit[s] * static_cast<double>(r.stage_pair_node_tests[s]) + serial[s];
+    span[s] = unit[s] + serial[s];  // the root's test, and the pair's serial part
   }
   if (total <= 0.0) return 0.0;
-  for (std::size_t l = 0; l < r.stage_levels.size() && l < r.stage_level_task.size(); ++l) {
-    const std::uint32_t s = r.stage_level_task[l];
+  for (std::size_t l = 0; l < r.stage_levels.size() && l < r.stage_level_pair.size(); ++l) {
+    const std::uint32_t s = r.stage_level_pair[l];
     if (s < splits) span[s] += unit[s] * list_schedule(r.stage_levels[l], cores);
   }
   return std::max(total / cores, *std::max_element(span.begin(), span.end()));
@@ -96,8 +96,8 @@ double simulated_speedup(const StepResult& step, Method method, int cores) {
     case Method::aposteriori:
     case Method::apriori:
     case Method::hybrid:
-      makespan = stage_makespan(r, std::vector<double>(r.stage_task_node_tests.size(), 1.0),
-                                std::vector<double>(r.stage_task_node_tests.size(), 0.0), cores) +
+      makespan = stage_makespan(r, std::vector<double>(r.stage_pair_node_tests.size(), 1.0),
+                                std::vector<double>(r.stage_pair_node_tests.size(), 0.0), cores) +
                  list_schedule_makespan(r.task_node_tests, cores);
       break;
   }
@@ -135,17 +135,17 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
     return x->unit != y->unit ? x->unit < y->unit : x->start_ms < y->start_ms;
   };
   const auto length = [](const TaskSpan* t) { return t->end_ms - t->start_ms; };
-  // The stage: split tasks in pair order, as the stage spans' units (pairs) sort.
+  // The stage: split pairs in pair order, as the stage spans' units (pairs) sort.
   std::sort(stage.begin(), stage.end(), by_unit);
   double stage_ms = 0.0;
   if (!stage.empty()) {
-    std::vector<double> unit(r.stage_task_node_tests.size(), 0.0);
+    std::vector<double> unit(r.stage_pair_node_tests.size(), 0.0);
     std::vector<double> serial(unit.size(), 0.0);
     if (stage.size() == unit.size()) {
       for (std::size_t s = 0; s < unit.size(); ++s) {
         if (r.stage_serial_ms.size() == unit.size()) serial[s] = std::min(r.stage_serial_ms[s], length(stage[s]));
         const double visits = length(stage[s]) - serial[s];
-        unit[s] = r.stage_task_node_tests[s] > 0 ? visits / static_cast<double>(r.stage_task_node_tests[s]) : 0.0;
+        unit[s] = r.stage_pair_node_tests[s] > 0 ? visits / static_cast<double>(r.stage_pair_node_tests[s]) : 0.0;
       }
       stage_ms = stage_makespan(r, unit, serial, cores);
     } else {  // not the stage's records (a step not from the engine): its spans one after another

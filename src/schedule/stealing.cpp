@@ -19,7 +19,7 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
 }
 
 /// Above the cut-off depth, visits CD-tree node n of pair `pair` (it passed its test, made by its
-/// parent's visit or before the first call) and spawns one task per child that passes; from the
+/// parent's visit or before the first call) and spawns one job per child that passes; from the
 /// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
 /// exactly those of a single depth-first traversal of the tree (for a distance query, those of its
 /// pieces, which depend on what the others have found by then).
@@ -45,7 +45,7 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
     count = narrow::visit(ctx, n, w.candidates[pair], w.stats[pair], kids);
     w.split_node_tests += w.stats[pair].node_tests - before;
   }
-  parallel::TaskGroup group;
+  parallel::JobGroup group;
   for (int i = 1; i < count; ++i) {
     const narrow::NodePair kid = kids[i];
     group.run([&state, pair, kid, depth, cutoff] { steal(state, pair, kid, depth + 1, cutoff, true); });
@@ -76,7 +76,7 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
   } else {
     for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
   }
-  parallel::TaskGroup group;
+  parallel::JobGroup group;
   for (const std::uint32_t i : heavy) {
     group.run([&state, i, depth] {
       // The root is tested above the cut-off: splitting work.

@@ -12,18 +12,18 @@
 #include "caliber/error.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
-#include "bvh/split.h"
+#include "bvh/partition.h"
 #include "parallel/executor.h"
 
 namespace caliber {
 namespace {
 
 /// The largest height the build's balance rule allows over n triangles: each cut leaves each side
-/// at least max(1, n / kSplitBalance) of them (bvh/split.h).
+/// at least max(1, n / kPartitionBalance) of them (bvh/partition.h).
 int height_bound(std::uint32_t n) {
   int height = 1;
   while (n > 1) {
-    n -= std::max<std::uint32_t>(1, n / bvh::kSplitBalance);
+    n -= std::max<std::uint32_t>(1, n / bvh::kPartitionBalance);
     ++height;
   }
   return height;

@@ -160,15 +160,20 @@ tmp=$(mktemp -d)
 check run 0 "$cli" run "$data/scenes/tetras.json" --json "$tmp/report.json" --contacts "$tmp/contacts.jsonl"
 contains run "summary over 12 steps"
 contains run "heaviest pair"
+contains run "distinct pairs over the run"
 contains run "method stealing on"  # the default: caliber::kDefaultMethod on the hardware threads
 python3 - "$tmp/report.json" "$tmp/contacts.jsonl" <<'PY' || { echo "FAIL run-files"; failures=$((failures + 1)); }
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["scene"] == "tetras" and len(r["steps"]) == 12
 s = r["steps"][0]
-for key in ("broad_ms", "narrow_ms", "reduce_ms", "node_tests", "contacts", "tasks"):
+for key in ("broad_ms", "narrow_ms", "reduce_ms", "node_tests", "contacts", "pairs"):
     assert key in s, key
+assert r["schema_version"] == 2
+assert all(set(p) == {"a", "b", "node_tests", "leaf_tests", "contacts", "limit_reached"} for st in r["steps"] for p in st["pairs"])
+assert sum(p["contacts"] for p in s["pairs"]) == s["contacts"] or s["limit_reached"]
 assert r["summary"]["steps_with_contacts"] > 0
+assert r["summary"]["distinct_pairs"] >= max(len(st["pairs"]) for st in r["steps"])
 lines = open(sys.argv[2]).read().splitlines()
 assert len(lines) == 12
 counts = [len(json.loads(l)["contacts"]) for l in lines]

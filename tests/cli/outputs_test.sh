@@ -18,7 +18,7 @@ check schema-query 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "
 python3 - "$tmp/report.json" "$tmp/contacts.jsonl" "$out" <<'PY' || { echo "FAIL schema"; failures=$((failures + 1)); }
 import json, sys
 r = json.load(open(sys.argv[1]))
-assert r["schema_version"] == 1
+assert r["schema_version"] == 2  # the run report; the others are at 1
 assert [o["name"] for o in r["objects"]] == ["fixed", "mover", "third"] and r["objects"][1]["id"] == 1
 names = {o["id"]: o["name"] for o in r["objects"]}
 seen = 0

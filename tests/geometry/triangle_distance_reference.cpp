@@ -1,4 +1,4 @@
-// The closest-point kernel as it was at 2a20389 (per-query edge terms, a square root per candidate),
+// The closest-point kernel as it was at 2a20389 (per-query edge terms, a square root per feature pair),
 // kept verbatim as the reference: the optimized kernel in src/geometry/triangle_distance.cpp must
 // return the same bits (points and distance) on every input, so that every contact stays
 // byte-identical to the results of earlier versions.
@@ -128,7 +128,7 @@ ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
     consider(best, a[i], closest_point_on_triangle(a[i], b[0], b[1], b[2]));
     consider(best, closest_point_on_triangle(b[i], a[0], a[1], a[2]), b[i]);
   }
-  // Intersecting triangles: an edge of one pierces the other; its crossing point is a candidate.
+  // Intersecting triangles: an edge of one pierces the other; its crossing point, on both triangles, is a feature pair.
   const Vec3 na = (a[1] - a[0]).cross(a[2] - a[0]);
   const Vec3 nb = (b[1] - b[0]).cross(b[2] - b[0]);
   Vec3 x;

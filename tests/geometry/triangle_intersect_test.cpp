@@ -203,7 +203,7 @@ TEST(TriangleIntersect, PlanesCrossingTestAgreesWithEdgeTestsOnAGrid) {
     if (!planes_cross(a, b)) continue;
     const bool hit = tri_tri(a, b);
     (hit ? crossing_yes : crossing_no) += 1;
-    bool coplanar_edges = false;  // an edge of A and an edge of B on one plane: a touching candidate
+    bool coplanar_edges = false;  // an edge of A and an edge of B on one plane: they may touch
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
         coplanar_edges |= orient3d(a[i].data(), a[(i + 1) % 3].data(), b[j].data(), b[(j + 1) % 3].data()) == 0;

@@ -36,7 +36,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
         const BvhNode& na = data(*a).nodes[work[w].first];
         const BvhNode& nb = data(*b).nodes[work[w].second];
         if (na.is_leaf() || nb.is_leaf()) continue;
-        // Both sides split, then only A's, then only B's (the other side's node given twice).
+        // Both sides descend, then only A's, then only B's (the other side's node given twice).
         const std::uint32_t wa = work[w].first, wb = work[w].second;
         const std::uint32_t cases[3][4] = {
             {na.index, na.index + 1, nb.index, nb.index + 1}, {na.index, na.index + 1, wb, wb}, {wa, wa, nb.index, nb.index + 1}};

@@ -1,5 +1,5 @@
 // The distance traversal's store of prepared nodes: each node prepared once per traversal (its
-// children made by the first visit that splits it, found again by every later one), entries that
+// children made by the first visit that descends into it, found again by every later one), entries that
 // stay put while others are added, and nothing left over after clear().
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // The executor seam (src/parallel/executor.h), whichever backend this build has: every index once,
-// nested task groups, exceptions reaching wait(), never more threads at once than asked for, and
+// nested job groups, exceptions reaching wait(), never more threads at once than asked for, and
 // (oneTBB) never more than the process allows, in the host's arena, with no thread of its own.
 
 #include <algorithm>
@@ -60,14 +60,14 @@ TEST(Executor, ParallelForCoversEveryIndexOnce) {
 long fib(int n) {
   if (n < 2) return n;
   long a = 0, b = 0;
-  TaskGroup group;
+  JobGroup group;
   group.run([&] { a = fib(n - 1); });
   b = fib(n - 2);
   group.wait();
   return a + b;
 }
 
-TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
+TEST(Executor, NestedJobGroupsAndAtMostNThreads) {
   for (const int threads : {1, 2, 3, 8}) {
     Executor executor(threads);
 #ifdef CALIBER_EXECUTOR_STD
@@ -91,12 +91,12 @@ TEST(Executor, NestedTaskGroupsAndAtMostNThreads) {
     EXPECT_LE(occupancy.peak.load(), threads);
     EXPECT_GE(occupancy.peak.load(), 1);
   }
-  EXPECT_EQ(fib(12), 144) << "task groups work outside any executor too";
+  EXPECT_EQ(fib(12), 144) << "job groups work outside any executor too";
 }
 
 #ifdef CALIBER_EXECUTOR_STD
 TEST(Executor, AllNThreadsRunEvenBeyondTheHardwareThreads) {
-  // N tasks that each wait (up to 20 s) until all N are running: they can only all finish early if
+  // N jobs that each wait (up to 20 s) until all N are running: they can only all finish early if
   // N distinct threads run them at once, hardware threads or not (the std backend's pool has N).
   const int threads = static_cast<int>(std::max(2u, std::thread::hardware_concurrency())) + 2;
   Executor executor(threads);
@@ -118,7 +118,7 @@ TEST(Executor, AllNThreadsRunEvenBeyondTheHardwareThreads) {
       }
     });
   });
-  EXPECT_TRUE(all_met.load()) << "the " << threads << " tasks never ran on " << threads << " threads at once (waited 20 s)";
+  EXPECT_TRUE(all_met.load()) << "the " << threads << " jobs never ran on " << threads << " threads at once (waited 20 s)";
   for (int t = 0; t < threads; ++t) EXPECT_EQ(seen[static_cast<std::size_t>(t)].load(), 1) << "thread index " << t;
 }
 #else
@@ -162,7 +162,7 @@ TEST(Executor, ZeroRunsInTheArenaItIsCalledFrom) {
     executor.execute([&] {
       std::atomic<int> outside{0};
       parallel_for(0, 256, 1, [&](std::size_t, std::size_t) {
-        if (tbb::this_task_arena::max_concurrency() != 2) ++outside;  // a task run in another arena
+        if (tbb::this_task_arena::max_concurrency() != 2) ++outside;  // a job run in another arena
       });
       EXPECT_EQ(outside.load(), 0);
       EXPECT_EQ(fib(16), 987);
@@ -177,7 +177,7 @@ TEST(Executor, OneThreadAndNoExecutorRunOnTheCallingThread) {
   const auto work = [&] {
     parallel_for(0, 100, 1, [&](std::size_t, std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
     parallel_for_each(0, 100, [&](std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
-    TaskGroup group;
+    JobGroup group;
     for (int i = 0; i < 10; ++i) group.run([&] { elsewhere += std::this_thread::get_id() != caller; });
     group.wait();
     for_each_in_order(10, [&](std::size_t) { elsewhere += std::this_thread::get_id() != caller; });
@@ -193,10 +193,10 @@ TEST(Executor, OneThreadAndNoExecutorRunOnTheCallingThread) {
 TEST(Executor, ExceptionsReachTheWaiter) {
   Executor executor(3);
   EXPECT_THROW(executor.execute([] {
-    TaskGroup group;
+    JobGroup group;
     for (int i = 0; i < 20; ++i)
       group.run([i] {
-        if (i == 7) throw std::runtime_error("task 7");
+        if (i == 7) throw std::runtime_error("job 7");
       });
     group.wait();
   }),

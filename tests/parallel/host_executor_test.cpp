@@ -38,11 +38,11 @@ class PoolHost final : public HostExecutor {
     for (std::thread& t : mThreads) t.join();
   }
   int thread_count() const override { return static_cast<int>(mThreads.size()) + 1; }
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
     auto* left = new std::size_t(0);
     {
       const std::lock_guard<std::mutex> lock(mMutex);
-      for (std::size_t b = 0; b < count; b += grain, ++*left) mQueue.push_back({&task, left, b, std::min(count, b + grain)});
+      for (std::size_t b = 0; b < count; b += grain, ++*left) mQueue.push_back({&job, left, b, std::min(count, b + grain)});
     }
     mChanged.notify_all();
     return left;
@@ -67,7 +67,7 @@ class PoolHost final : public HostExecutor {
 
  private:
   struct Range {
-    const Task* task;
+    const Job* job;
     std::size_t* left;
     std::size_t begin, end;
   };
@@ -76,7 +76,7 @@ class PoolHost final : public HostExecutor {
     mQueue.pop_front();
     mRan.insert(std::this_thread::get_id());
     lock.unlock();
-    (*r.task)(r.begin, r.end, worker);
+    (*r.job)(r.begin, r.end, worker);
     lock.lock();
     if (--*r.left == 0) mChanged.notify_all();
   }
@@ -100,17 +100,17 @@ class PoolHost final : public HostExecutor {
 class InlineHost final : public HostExecutor {
  public:
   int thread_count() const override { return 3; }
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
-    for (std::size_t b = 0; b < count; b += grain) task(b, std::min(count, b + grain), 0);
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
+    for (std::size_t b = 0; b < count; b += grain) job(b, std::min(count, b + grain), 0);
     return nullptr;
   }
   void finish(void*) override { ADD_FAILURE() << "finish() of a call that ran inline"; }
 };
 
-/// Sums i over [0, n) through nested task groups and parallel_for; records the threads that ran.
+/// Sums i over [0, n) through nested job groups and parallel_for; records the threads that ran.
 long long busy_sum(std::size_t n, std::mutex& m, std::set<std::thread::id>& seen, std::set<int>& indices) {
   std::atomic<long long> sum{0};
-  parallel::TaskGroup group;
+  parallel::JobGroup group;
   for (int part = 0; part < 4; ++part) {
     group.run([&, part] {
       parallel::parallel_for(part * n / 4, (part + 1) * n / 4, 64, [&](std::size_t lo, std::size_t hi) {
@@ -166,10 +166,10 @@ TEST(HostExecutor, ExceptionsReachTheWaiter) {
   PoolHost host(3);
   parallel::Executor executor(0, &host);
   EXPECT_THROW(executor.execute([] {
-    parallel::TaskGroup group;
+    parallel::JobGroup group;
     for (int i = 0; i < 16; ++i)
       group.run([i] {
-        if (i == 11) throw std::runtime_error("task 11");
+        if (i == 11) throw std::runtime_error("job 11");
       });
     group.wait();
   }),

@@ -189,7 +189,7 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
       const int count = s.children == 0 ? 0 : narrow::cd_children(kind_ctx, s.node, kids);
       for (std::uint32_t c = 0; c < s.children; ++c) {
         EXPECT_NE(std::find(kids, kids + count, kind_summary[s.first + c].node), kids + count) << to_string(kind);
-        // A child of a visit where both sides split is tested with the disks (narrow::child_test).
+        // A child of a visit where both sides descend is tested with the disks (narrow::child_test).
         EXPECT_EQ(kind_summary[s.first + c].disks, count == 4) << to_string(kind);
         both_and_one[count == 4] += 1;
       }
@@ -231,7 +231,7 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   }
 }
 
-/// The paper's alternate traversal as written (and as split_task ran it until it went level by
+/// The paper's alternate traversal as written (and as split_pair ran it until it went level by
 /// level): a max-heap of untested nodes keyed by weight; pop the heaviest, test it, leaf-test a leaf
 /// pair, push the children of a heavy node, keep or cart a light one. The reference for the cut.
 SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t pair, double root_weight, double scale,
@@ -305,7 +305,7 @@ TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
     for (const int threads : {1, 2, 4}) {
       parallel::Executor executor(threads);
       SplitResult got;
-      executor.execute([&] { got = split_task(ctx, 0, root, scale, omega, 0.25 * omega); });
+      executor.execute([&] { got = split_pair(ctx, 0, root, scale, omega, 0.25 * omega); });
       EXPECT_EQ(keys(got.roots), keys(want.roots)) << "omega " << omega << ", " << threads << " threads";
       // The cart in any order (merge_cart sorts it by weight, pair and node, a total order).
       std::vector<RootKey> got_cart = keys(got.cart), want_cart = keys(want.cart);
@@ -325,7 +325,7 @@ TEST(Calibration, LevelStageCutsAsThePriorityQueueDoesAtAnyThreadCount) {
       if (threads == 1) continue;
       SplitResult one;
       parallel::Executor single(1);
-      single.execute([&] { one = split_task(ctx, 0, root, scale, omega, 0.25 * omega); });
+      single.execute([&] { one = split_pair(ctx, 0, root, scale, omega, 0.25 * omega); });
       ASSERT_EQ(one.stage.size(), got.stage.size());
       for (std::size_t k = 0; k < one.stage.size(); ++k) {
         EXPECT_EQ(one.stage[k].node, got.stage[k].node);

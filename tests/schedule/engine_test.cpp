@@ -28,10 +28,10 @@ void expect_same_step(const StepResult& got, const StepResult& want, const std::
   for (std::size_t i = 0; i < want.pair_records.size(); ++i) {
     ASSERT_EQ(got.pair_records[i].pair, want.pair_records[i].pair) << what;
     if (exact_work) {
-      EXPECT_EQ(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " task " << i;
-      EXPECT_EQ(got.pair_records[i].stats.leaf_tests, want.pair_records[i].stats.leaf_tests) << what << " task " << i;
+      EXPECT_EQ(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " pair " << i;
+      EXPECT_EQ(got.pair_records[i].stats.leaf_tests, want.pair_records[i].stats.leaf_tests) << what << " pair " << i;
     } else {
-      EXPECT_GE(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " task " << i;
+      EXPECT_GE(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " pair " << i;
     }
   }
   ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
@@ -78,7 +78,7 @@ void expect_all_methods_identical(const World& world, int steps) {
         if (::testing::Test::HasFatalFailure()) return;
         std::uint64_t units = got.schedule->split_node_tests;
         for (const std::uint64_t t : got.schedule->task_node_tests) units += t;
-        for (const std::uint64_t t : got.schedule->stage_task_node_tests) units += t;
+        for (const std::uint64_t t : got.schedule->stage_pair_node_tests) units += t;
         EXPECT_EQ(units, got.stats.node_tests) << what << ": the recorded work units must add up";
         // Conservation: every node sequential tests is tested once; a posteriori may add the work of
         // sub-tasks whose root the original task never reached, and says how much.
@@ -86,13 +86,13 @@ void expect_all_methods_identical(const World& world, int steps) {
         for (const PairRecord& t : got.pair_records)
           EXPECT_GE(t.candidates, t.contacts) << what << ": reported pairs are candidates";
         if (method == Method::apriori || method == Method::hybrid) {
-          // The stage's levels hold its node tests (all but each split task's root test).
-          std::uint64_t levels = got.schedule->stage_task_node_tests.size();
+          // The stage's levels hold its node tests (all but each split pair's root test).
+          std::uint64_t levels = got.schedule->stage_pair_node_tests.size();
           for (const std::vector<std::uint64_t>& level : got.schedule->stage_levels) {
             for (const std::uint64_t chunk : level) levels += chunk;
           }
           EXPECT_EQ(levels, got.schedule->stage_node_tests) << what;
-          EXPECT_EQ(got.schedule->stage_levels.size(), got.schedule->stage_level_task.size()) << what;
+          EXPECT_EQ(got.schedule->stage_levels.size(), got.schedule->stage_level_pair.size()) << what;
           // Conservation: the weight-driven stage and the run-time tasks test every node once.
           std::uint64_t cut = got.schedule->stage_node_tests;
           for (const std::uint64_t t : got.schedule->task_node_tests) cut += t;
@@ -148,7 +148,7 @@ TEST(EngineRealScenes, PaperScenesFirstSteps) {
 }
 
 TEST_F(EngineScenes, ThreeHundredTinyPairsAndOnePair) {
-  // 25 tetrahedra (4 triangles each) crowded together: 300 candidate pairs, all light.
+  // 25 tetrahedra (4 triangles each) crowded together: 300 pairs, all light.
   const std::string tetra = (std::filesystem::path(CALIBER_TEST_DATA) / "tetra.off").string();
   std::string json = R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [)";
   for (int i = 0; i < 25; ++i) {
@@ -225,16 +225,16 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
   EXPECT_NEAR(simulated_speedup(step, Method::exploitation, 8), 100.0 / 60.0, 1e-12) << "bound by the heaviest pair";
   EXPECT_EQ(simulated_speedup(step, Method::sequential, 8), 1.0);
   record->task_node_tests = {20, 20, 20, 20};
-  // One split task: its root's test, then levels of 4 and 15 node tests (chunks 8 and 7: one core
+  // One split pair: its root's test, then levels of 4 and 15 node tests (chunks 8 and 7: one core
   // each at most), 20 in all: a span of 1 + 4 + 8 = 13 on 4 cores, above 20 / 4.
-  record->stage_task_node_tests = {20};
+  record->stage_pair_node_tests = {20};
   record->stage_levels = {{4}, {8, 7}};
-  record->stage_level_task = {0, 0};
+  record->stage_level_pair = {0, 0};
   EXPECT_NEAR(simulated_speedup(step, Method::hybrid, 4), 100.0 / (13.0 + 20.0), 1e-12) << "stage, barrier, then the tasks";
-  // Wide levels: the stage's tests spread evenly bound it (two split tasks sharing the cores).
-  record->stage_task_node_tests = {35, 35};
+  // Wide levels: the stage's tests spread evenly bound it (two split pairs sharing the cores).
+  record->stage_pair_node_tests = {35, 35};
   record->stage_levels = {{2}, {4, 4, 4, 4, 4, 4, 4, 4}, {2}, {4, 4, 4, 4, 4, 4, 4, 4}};
-  record->stage_level_task = {0, 0, 1, 1};
+  record->stage_level_pair = {0, 0, 1, 1};
   step.stats.node_tests = 150;
   EXPECT_NEAR(simulated_speedup(step, Method::apriori, 4), 150.0 / (70.0 / 4 + 20.0), 1e-12) << "each span 1 + 2 + 8";
   for (const int cores : {0, -3, 1 << 30}) {
@@ -244,7 +244,7 @@ TEST(LoadBalanceSimulation, ListSchedulingAndTheExploitationBound) {
 
 TEST(EngineRealScenes, HeavyPairFinalizedInParallel) {
   // two_large's one pair keeps thousands of candidates: its sort, local minima and transforms run
-  // as parallel tasks in the calibrated and stealing methods; the contacts must not change.
+  // as parallel jobs in the calibrated and stealing methods; the contacts must not change.
   if (!std::filesystem::exists(std::filesystem::path(CALIBER_MESH_DATA) / "dragknob.off")) {
     GTEST_SKIP() << "run scripts/fetch_meshes.sh first";
   }
@@ -365,7 +365,7 @@ TEST_F(EngineScenes, PlanThreadsCutsForThatManyThreadsOnOne) {
       expect_same_step(b, a, what);
       EXPECT_EQ(b.schedule->omega, a.schedule->omega) << what;
       EXPECT_EQ(b.schedule->task_node_tests, a.schedule->task_node_tests) << what << ": the same tasks, in the same order";
-      EXPECT_EQ(b.schedule->stage_task_node_tests, a.schedule->stage_task_node_tests) << what;
+      EXPECT_EQ(b.schedule->stage_pair_node_tests, a.schedule->stage_pair_node_tests) << what;
       EXPECT_EQ(b.schedule->stage_levels, a.schedule->stage_levels) << what;
       split = split || a.schedule->split > 0;
     }
@@ -429,9 +429,9 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   auto record = std::make_shared<ScheduleRecord>();
   ScheduleRecord& r = *record;
   step.schedule = record;
-  r.stage_task_node_tests = {20};
+  r.stage_pair_node_tests = {20};
   r.stage_levels = {{4}, {8, 7}};
-  r.stage_level_task = {0, 0};
+  r.stage_level_pair = {0, 0};
   r.task_node_tests = {20, 20, 20, 20};
   r.timeline.push_back(TaskSpan{0, 0.0, 2.0, TaskSpan::Phase::stage, 0});
   for (std::uint32_t t = 0; t < 4; ++t) r.timeline.push_back(TaskSpan{0, 2.0 + t, 3.0 + t, TaskSpan::Phase::traverse, t});

@@ -1,7 +1,7 @@
 // The broad phase over models and poses held in memory (caliber/broad_phase.h, Engine::find_pairs):
 // every object pair that the exact query finds within reach is kept, fixed pairs and ignored pairs
 // are not, the pairs are exactly those whose boxes overlap (against every pair of boxes, and against
-// a plain sweep along x on the paper's scenes), the engine's tree kept from frame to frame gives the
+// a plain sort along x on the paper's scenes), the engine's tree kept from frame to frame gives the
 // same pairs, and bad input is an error naming the problem.
 
 #include <algorithm>
@@ -23,14 +23,14 @@
 #include "caliber/scene.h"
 #include "caliber/world.h"
 #include "support/random_poses.h"
-#include "support/sweep_and_prune.h"
+#include "support/x_sort_pairs.h"
 
 namespace caliber {
 namespace {
 
 using broad::world_box;
 using broad::WorldBox;
-using test::sweep_along_x;
+using test::pairs_by_x_sort;
 
 /// Every pair of boxes compared: the pairs the broad phase must give, no more, no less.
 std::vector<ObjectPair> every_overlap(const std::vector<std::shared_ptr<const Model>>& models, const std::vector<Pose>& poses,
@@ -93,7 +93,7 @@ TEST(BroadPhase, PairsAreExactlyThoseWhoseBoxesOverlapFrameAfterFrame) {
   }
 }
 
-TEST(BroadPhase, SamePairsAsASweepAlongXOnThePaperScenes) {
+TEST(BroadPhase, SamePairsAsAnXSortOnThePaperScenes) {
   if (!std::filesystem::exists(std::filesystem::path(CALIBER_MESH_DATA) / "dragknob.off")) {
     GTEST_SKIP() << "run scripts/fetch_meshes.sh first";
   }
@@ -108,7 +108,7 @@ TEST(BroadPhase, SamePairsAsASweepAlongXOnThePaperScenes) {
         boxes.push_back({lo, hi});
       }
       std::vector<ObjectPair> want;
-      for (const ObjectPair& p : sweep_along_x(boxes)) {
+      for (const ObjectPair& p : pairs_by_x_sort(boxes)) {
         if (!(world.scene().objects[p.a].motion.type == Motion::Type::fixed &&
               world.scene().objects[p.b].motion.type == Motion::Type::fixed)) {
           want.push_back(p);

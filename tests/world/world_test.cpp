@@ -126,10 +126,10 @@ TEST_F(WorldFiles, SharedModelsGiveTheSameContactsAsSeparateOnes) {
 class CountingHost final : public HostExecutor {
  public:
   int thread_count() const override { return 2; }
-  void* enqueue(const Task& task, std::size_t count, std::size_t grain) override {
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
     ++calls;
     callers.insert(std::this_thread::get_id());
-    for (std::size_t b = 0; b < count; b += grain) task(b, std::min(count, b + grain), 1);
+    for (std::size_t b = 0; b < count; b += grain) job(b, std::min(count, b + grain), 1);
     return nullptr;
   }
   void finish(void*) override { ADD_FAILURE() << "finish() of a call that ran inline"; }
@@ -190,7 +190,7 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
     json += "]}";
     const World world(scene(json));
     const std::vector<Pose> poses = world.poses_at(0);
-    const std::vector<ObjectPair> tasks = world.broad_phase(poses);
+    const std::vector<ObjectPair> pairs = world.broad_phase(poses);
     std::vector<ObjectPair> want;
     for (std::uint32_t a = 0; a < n; ++a) {
       for (std::uint32_t b = a + 1; b < n; ++b) {
@@ -202,11 +202,11 @@ TEST_F(WorldFiles, BroadPhaseEqualsTheAllPairsCheckAndKeepsEveryTouchingPair) {
         if (overlap && !both_fixed && !ignored) want.push_back(ObjectPair{a, b});
         if (!both_fixed && !ignored &&
             !query_brute_force(world.model(a), poses[a], world.model(b), poses[b], world.request()).contacts.empty()) {
-          EXPECT_TRUE(std::find(tasks.begin(), tasks.end(), ObjectPair{a, b}) != tasks.end()) << "touching pair dropped";
+          EXPECT_TRUE(std::find(pairs.begin(), pairs.end(), ObjectPair{a, b}) != pairs.end()) << "touching pair dropped";
         }
       }
     }
-    EXPECT_EQ(tasks, want) << "trial " << trial;
+    EXPECT_EQ(pairs, want) << "trial " << trial;
   }
 }
 

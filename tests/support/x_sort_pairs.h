@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// A plain sweep and prune along x over world boxes: the reference the broad phase's tree is
+/// A plain sort and prune along x over world boxes: the reference the broad phase's tree is
 /// checked against (tests/world/broad_phase_test.cpp) and measured against (bench/broad_phase.cpp).
 /// Not part of the library.
 
@@ -20,7 +20,7 @@ inline bool boxes_overlap(const broad::WorldBox& x, const broad::WorldBox& y) {
 
 /// The pairs (a < b, sorted) whose boxes overlap: sorted by low x, each box against those that
 /// start before it ends along x.
-inline std::vector<ObjectPair> sweep_along_x(const std::vector<broad::WorldBox>& boxes) {
+inline std::vector<ObjectPair> pairs_by_x_sort(const std::vector<broad::WorldBox>& boxes) {
   std::vector<std::uint32_t> order(boxes.size());
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {

@@ -1,7 +1,7 @@
 // A planner's question, many times at once: does B, moved along a path, touch A, and how far apart
 // are they? One batch call per query, on every thread the process allows; each entry is what
 // caliber::query answers at its pose (checked here for a few).
-//   pose_sweep A.off B.off
+//   pose_batch A.off B.off
 
 #include <cstdio>
 #include <vector>
@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < path.size(); i += 250) {
       const caliber::QueryResult one = caliber::query(*a, caliber::Pose{}, *b, path[i], distance);
       if (one.contacts.front().distance != gaps.contacts_of(i).front().distance) {
-        std::fprintf(stderr, "pose_sweep: entry %zu differs from the single query\n", i);
+        std::fprintf(stderr, "pose_batch: entry %zu differs from the single query\n", i);
         return 1;
       }
     }
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
                 gaps.contacts_of(0).front().distance);
     return 0;
   } catch (const caliber::Error& e) {
-    std::fprintf(stderr, "pose_sweep: %s\n", e.what());
+    std::fprintf(stderr, "pose_batch: %s\n", e.what());
     return 2;
   }
 }

@@ -1,4 +1,4 @@
-// The BVH build's cut (bvh/split.h): a partition of the range, the cheaper side of a clear gap,
+// The BVH build's cut (bvh/partition.h): a partition of the range, the cheaper side of a clear gap,
 // the balance rule, and the same cut whatever the order the triangles come in.
 
 #include <algorithm>
@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh/split.h"
+#include "bvh/partition.h"
 
 namespace caliber::bvh {
 namespace {
@@ -29,20 +29,20 @@ struct Cut {
 };
 
 Cut cut(const Mesh& mesh, std::vector<std::uint32_t> order) {
-  const std::vector<SplitItem> all = split_items(mesh);
-  std::vector<SplitItem> items;  // in the places of `order`, as the build keeps them
+  const std::vector<PartitionItem> all = partition_items(mesh);
+  std::vector<PartitionItem> items;  // in the places of `order`, as the build keeps them
   for (const std::uint32_t t : order) items.push_back(all[t]);
   const CentroidBounds bounds = centroid_bounds(items);
   CentroidBounds a, b;
   Cut c;
-  c.first = split_binned(std::span<std::uint32_t>(order), std::span<SplitItem>(items), bounds, a, b);
+  c.first = partition_binned(std::span<std::uint32_t>(order), std::span<PartitionItem>(items), bounds, a, b);
   c.order = std::move(order);
   for (std::size_t i = 0; i < c.order.size(); ++i) {  // the items moved with their ids
     for (int k = 0; k < 3; ++k) EXPECT_EQ(items[i].centroid[k], all[c.order[i]].centroid[k]);
   }
   // The boxes returned are those of each part's centroids.
-  const CentroidBounds want_a = centroid_bounds(std::span<const SplitItem>(items).first(c.first));
-  const CentroidBounds want_b = centroid_bounds(std::span<const SplitItem>(items).subspan(c.first));
+  const CentroidBounds want_a = centroid_bounds(std::span<const PartitionItem>(items).first(c.first));
+  const CentroidBounds want_b = centroid_bounds(std::span<const PartitionItem>(items).subspan(c.first));
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(a.lo[k], want_a.lo[k]);
     EXPECT_EQ(a.hi[k], want_a.hi[k]);
@@ -58,7 +58,7 @@ std::vector<std::uint32_t> identity(std::size_t n) {
   return order;
 }
 
-TEST(Split, TwoClustersAreCutApart) {
+TEST(Partition, TwoClustersAreCutApart) {
   Mesh mesh;
   for (int i = 0; i < 40; ++i) add_triangle(mesh, 0.01 * i, 0.0);         // ids 0..39 near x = 0
   for (int i = 0; i < 24; ++i) add_triangle(mesh, 10.0 + 0.01 * i, 0.0);  // ids 40..63 near x = 10
@@ -71,20 +71,20 @@ TEST(Split, TwoClustersAreCutApart) {
   EXPECT_EQ(sorted, identity(64));  // a permutation of the range
 }
 
-TEST(Split, ALoneOutlierIsNotCutOffAlone) {
+TEST(Partition, ALoneOutlierIsNotCutOffAlone) {
   // 100 small triangles in [0, 1] and one far away: every plane between the bins leaves the
-  // outlier alone, under the 1/kSplitBalance share, so the range is cut at its median.
+  // outlier alone, under the 1/kPartitionBalance share, so the range is cut at its median.
   Mesh mesh;
   for (int i = 0; i < 100; ++i) add_triangle(mesh, 0.01 * i, 0.0);
   add_triangle(mesh, 100.0, 0.0);
   const Cut c = cut(mesh, identity(101));
-  const std::uint32_t least = 101 / kSplitBalance;
+  const std::uint32_t least = 101 / kPartitionBalance;
   EXPECT_GE(c.first, least);
   EXPECT_LE(c.first, 101 - least);
   EXPECT_EQ(c.first, 50u);  // the median
 }
 
-TEST(Split, TheCutDoesNotDependOnTheOrderGiven) {
+TEST(Partition, TheCutDoesNotDependOnTheOrderGiven) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Mesh mesh;

@@ -1,6 +1,6 @@
-// The BVH build's cut of a node's triangles: a binned surface-area heuristic (split.h).
+// The BVH build's cut of a node's triangles: a binned surface-area heuristic (partition.h).
 
-#include "bvh/split.h"
+#include "bvh/partition.h"
 
 #include <algorithm>
 #include <array>
@@ -82,7 +82,7 @@ struct Bin {
   }
 };
 
-/// Each axis's bin of a centroid: (c - lo) times the axis's scale, within [0, kSplitBins - 1],
+/// Each axis's bin of a centroid: (c - lo) times the axis's scale, within [0, kPartitionBins - 1],
 /// truncated (an axis without extent has scale 0: every centroid in bin 0).
 class Binning {
  public:
@@ -91,14 +91,14 @@ class Binning {
     for (int k = 0; k < 3; ++k) {
       const double extent = double(b.hi[k]) - b.lo[k];
       const double max_scale = std::numeric_limits<float>::max();
-      scale[k] = extent > 0.0 ? static_cast<float>(std::min(kSplitBins / extent, max_scale)) : 0.0f;
+      scale[k] = extent > 0.0 ? static_cast<float>(std::min(kPartitionBins / extent, max_scale)) : 0.0f;
       mExtent[k] = extent;
     }
     mScale = load(scale);
   }
-  void bins(const SplitItem& item, std::int32_t out[4]) const {
+  void bins(const PartitionItem& item, std::int32_t out[4]) const {
     const F4 t = mul(sub(load(item.centroid), mLo), mScale);
-    truncate(lane_min(lane_max(t, splat(0.0f)), splat(float(kSplitBins - 1))), out);
+    truncate(lane_min(lane_max(t, splat(0.0f)), splat(float(kPartitionBins - 1))), out);
   }
   [[nodiscard]] double extent(int k) const { return mExtent[k]; }
 
@@ -108,7 +108,7 @@ class Binning {
 };
 
 /// Adds a centroid to a box of centroids.
-void grow(CentroidBounds& b, const SplitItem& item) {
+void grow(CentroidBounds& b, const PartitionItem& item) {
   store(b.lo, lane_min(load(b.lo), load(item.centroid)));
   store(b.hi, lane_max(load(b.hi), load(item.centroid)));
 }
@@ -123,11 +123,11 @@ CentroidBounds empty_bounds() {
 }
 
 /// The median cut along `axis` (ties by id), both arrays reordered alike.
-std::uint32_t split_at_median(std::span<std::uint32_t> order, std::span<SplitItem> items, int axis) {
+std::uint32_t partition_at_median(std::span<std::uint32_t> order, std::span<PartitionItem> items, int axis) {
   struct Entry {
     float key;
     std::uint32_t id;
-    SplitItem item;
+    PartitionItem item;
   };
   std::vector<Entry> entries(order.size());
   for (std::size_t i = 0; i < order.size(); ++i) entries[i] = {items[i].centroid[axis], order[i], items[i]};
@@ -145,7 +145,7 @@ std::uint32_t split_at_median(std::span<std::uint32_t> order, std::span<SplitIte
 /// partition: the same result for the same input) and returns how many, with the boxes of the
 /// two parts' centroids grown as the items are placed.
 template <class First>
-std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem> items, First&& first, CentroidBounds& front,
+std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<PartitionItem> items, First&& first, CentroidBounds& front,
                              CentroidBounds& back) {
   std::size_t lo = 0, hi = order.size();
   for (;;) {
@@ -162,7 +162,7 @@ std::uint32_t partition_both(std::span<std::uint32_t> order, std::span<SplitItem
 
 }  // namespace
 
-std::vector<SplitItem> split_items(const Mesh& mesh) {
+std::vector<PartitionItem> partition_items(const Mesh& mesh) {
   // Coordinates relative to the vertices' box, over its largest extent, before they are rounded to
   // floats: scaling a mesh by a power of two scales the differences and the extent alike, so the
   // items, and the tree, are the same bit for bit (tests/narrow/scale_test.cpp: the same prunes).
@@ -177,7 +177,7 @@ std::vector<SplitItem> split_items(const Mesh& mesh) {
   }
   const double largest = (hi - lo).maxCoeff();
   const double extent = largest > 0.0 ? largest : 1.0;
-  std::vector<SplitItem> items(mesh.triangles.size());
+  std::vector<PartitionItem> items(mesh.triangles.size());
   parallel::parallel_for(0, items.size(), kItemGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t != end; ++t) {
       const auto& tri = mesh.triangles[t];
@@ -185,7 +185,7 @@ std::vector<SplitItem> split_items(const Mesh& mesh) {
       const Eigen::Vector3d q = (mesh.vertices[tri[1]] - lo) / extent;
       const Eigen::Vector3d r = (mesh.vertices[tri[2]] - lo) / extent;
       const Eigen::Vector3d c = (p + q + r) / 3.0;
-      SplitItem& item = items[t];
+      PartitionItem& item = items[t];
       for (int k = 0; k < 3; ++k) {
         item.centroid[k] = static_cast<float>(c[k]);
         item.lo[k] = static_cast<float>(std::min({p[k], q[k], r[k]}));
@@ -197,14 +197,14 @@ std::vector<SplitItem> split_items(const Mesh& mesh) {
   return items;
 }
 
-CentroidBounds centroid_bounds(std::span<const SplitItem> items) {
+CentroidBounds centroid_bounds(std::span<const PartitionItem> items) {
   CentroidBounds b = empty_bounds();
-  for (const SplitItem& item : items) grow(b, item);
+  for (const PartitionItem& item : items) grow(b, item);
   return b;
 }
 
-std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> items, const CentroidBounds& bounds,
-                           CentroidBounds& first, CentroidBounds& second) {
+std::uint32_t partition_binned(std::span<std::uint32_t> order, std::span<PartitionItem> items, const CentroidBounds& bounds,
+                               CentroidBounds& first, CentroidBounds& second) {
   const auto count = static_cast<std::uint32_t>(order.size());
   if (count == 2) {  // only one cut (the children's order aside)
     first = centroid_bounds(items.first(1));
@@ -212,8 +212,8 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> 
     return 1;
   }
   const Binning binning(bounds);
-  std::array<std::array<Bin, kSplitBins>, 3> bins;
-  for (const SplitItem& item : items) {
+  std::array<std::array<Bin, kPartitionBins>, 3> bins;
+  for (const PartitionItem& item : items) {
     std::int32_t b[4];
     binning.bins(item, b);
     for (int k = 0; k < 3; ++k) {
@@ -221,23 +221,23 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> 
       ++bins[k][b[k]].count;
     }
   }
-  // Each axis's planes: the cost of the bins below a plane and of those above it, from a sweep
+  // Each axis's planes: the cost of the bins below a plane and of those above it, from a pass
   // each way; the cheapest plane that leaves both sides their share.
-  const std::uint32_t least = std::max<std::uint32_t>(1, count / kSplitBalance);
+  const std::uint32_t least = std::max<std::uint32_t>(1, count / kPartitionBalance);
   double best = std::numeric_limits<double>::infinity();
   int best_axis = -1, best_plane = 0;  // the first part: bins 0 .. best_plane
   for (int k = 0; k < 3; ++k) {
     if (!(binning.extent(k) > 0.0)) continue;
-    std::array<double, kSplitBins> above_cost{};
-    std::array<std::uint32_t, kSplitBins> above_count{};
+    std::array<double, kPartitionBins> above_cost{};
+    std::array<std::uint32_t, kPartitionBins> above_count{};
     Bin above;
-    for (int b = kSplitBins - 1; b > 0; --b) {
+    for (int b = kPartitionBins - 1; b > 0; --b) {
       above.add(bins[k][b]);
       above_cost[b] = above.half_area() * above.count;
       above_count[b] = above.count;
     }
     Bin below;
-    for (int b = 0; b + 1 < kSplitBins; ++b) {
+    for (int b = 0; b + 1 < kPartitionBins; ++b) {
       below.add(bins[k][b]);
       if (below.count < least || above_count[b + 1] < least) continue;
       const double cost = below.half_area() * below.count + above_cost[b + 1];
@@ -253,7 +253,7 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> 
     first = second = empty_bounds();
     return partition_both(
         order, items,
-        [&](const SplitItem& item) {
+        [&](const PartitionItem& item) {
           std::int32_t b[4];
           binning.bins(item, b);
           return b[k] <= best_plane;
@@ -262,7 +262,7 @@ std::uint32_t split_binned(std::span<std::uint32_t> order, std::span<SplitItem> 
   }
   int longest = 0;
   for (int k = 1; k < 3; ++k) longest = binning.extent(k) > binning.extent(longest) ? k : longest;
-  const std::uint32_t cut = split_at_median(order, items, longest);
+  const std::uint32_t cut = partition_at_median(order, items, longest);
   first = centroid_bounds(items.first(cut));
   second = centroid_bounds(items.subspan(cut));
   return cut;

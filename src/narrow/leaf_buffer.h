@@ -3,7 +3,7 @@
 /// Leaf tests waiting for the batch kernels: the pairs of one traversal that passed the leaf
 /// test's first checks wait for the refusal test (geometry::triangles_apart_batch), those it does
 /// not refuse for their closest points (geometry::closest_points_triangles_batch), eight at a time
-/// (PairContext::leaf_test with a stage, PairContext::flush_leaves).
+/// (PairContext::leaf_test with a buffer, PairContext::flush_leaves).
 
 #include <cstdint>
 
@@ -12,7 +12,7 @@
 namespace caliber::narrow {
 
 /// Triangle pairs with their ids, in the order they came.
-struct StagedPairs {
+struct BufferedPairs {
   geometry::TriangleBatch batch;                      ///< the corners (B's in A's frame)
   std::uint32_t ta[geometry::TriangleBatch::kLanes];  ///< the triangles of A
   std::uint32_t tb[geometry::TriangleBatch::kLanes];  ///< the triangles of B
@@ -23,16 +23,17 @@ struct StagedPairs {
     batch.add(a, b);
   }
   /// Appends pair `lane` of `from`.
-  void add(const StagedPairs& from, int lane) {
+  void add(const BufferedPairs& from, int lane) {
     ta[batch.size] = from.ta[lane];
     tb[batch.size] = from.tb[lane];
     batch.add(from.batch, lane);
   }
 };
 
-struct LeafStage {
-  StagedPairs refusal;  ///< waiting for the refusal test
-  StagedPairs closest;  ///< not refused, waiting for their closest points
+/// One traversal's leaf pairs on their way through the batch kernels.
+struct LeafBuffer {
+  BufferedPairs refusal;  ///< waiting for the refusal test
+  BufferedPairs closest;  ///< not refused, waiting for their closest points
 };
 
 }  // namespace caliber::narrow
