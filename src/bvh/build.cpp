@@ -384,7 +384,7 @@ std::shared_ptr<const Model> build_model(Mesh mesh, const BuildOptions& options)
   std::shared_ptr<ModelData> out;
   // Inside an executor already (a step, a World being built on the host's arena), its threads
   // are this build's too; otherwise the build runs where BuildOptions::threads says.
-  if (parallel::current_thread_index() >= 0 && options.threads == 0) {
+  if (parallel::in_executor() && options.threads == 0) {
     out = build_on_this_thread(std::move(mesh), options);
   } else {
     parallel::Executor executor(options.threads, options.host);

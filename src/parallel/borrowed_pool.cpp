@@ -8,7 +8,7 @@
 
 namespace caliber::parallel::detail {
 
-Membership::Membership(BorrowedPool* p) : pool(p), outer(t_membership) { t_membership = this; }
+Membership::Membership(BorrowedPool* p, int i) : pool(p), outer(t_membership), index(i) { t_membership = this; }
 Membership::~Membership() { t_membership = outer; }
 
 void BorrowedPool::run_job(Job& job) {
@@ -63,10 +63,11 @@ void BorrowedPool::wait(BorrowedGroup& group) {
 }
 
 void BorrowedPool::lend(int index) {
-  for (const Membership* m = t_membership; m != nullptr; m = m->outer) {
-    if (m->pool == this) return;  // already works for this pool, further up its stack
-  }
-  const Membership member(this);
+  // A thread that already works for a caliber call, further up its stack (this pool's or another's:
+  // a range of another call that a host runs inside finish()) does not join: it would stay until
+  // that call is over, and the two calls could wait on each other.
+  if (t_membership != nullptr) return;
+  const Membership member(this, index);
   const BorrowedScope scope(this, index);
   std::unique_lock<std::mutex> lock(mMutex);
   for (;;) {
@@ -89,7 +90,16 @@ void BorrowedPool::close() {
 }
 
 void run_on_host(HostExecutor& host, int threads, const std::function<void()>& f) {
-  BorrowedPool pool(threads);
+  // Already working for a pool of this host's threads, of the same size (an executor used inside
+  // its own work): its work goes to that pool, whose threads are all lent already.
+  for (const Membership* m = t_membership; m != nullptr; m = m->outer) {
+    if (m->pool->host() == &host && m->pool->threads() == threads) {
+      const BorrowedScope scope(m->pool, m->index);
+      f();
+      return;
+    }
+  }
+  BorrowedPool pool(threads, &host);
   // The caller works for the pool from here on: a range the host runs here (inline, or inside
   // finish()) returns at once. Its constructs go to the pool only while `f` runs: the host's own
   // code in enqueue() and finish() runs as it would outside caliber.

@@ -30,23 +30,26 @@ class BorrowedPool;
 /// thread's stack: a thread lent to a pool it already works for (a host that runs a queued range
 /// while the thread waits inside that pool's call) must not take its jobs again.
 struct Membership {
-  explicit Membership(BorrowedPool* pool);
+  explicit Membership(BorrowedPool* pool, int index = 0);
   ~Membership();
   Membership(const Membership&) = delete;
   Membership& operator=(const Membership&) = delete;
 
   BorrowedPool* pool;
   Membership* outer;
+  int index;  ///< the thread's index in `pool`
 };
 
 class BorrowedPool {
  public:
   /// A pool of `threads` (the caller included).
-  explicit BorrowedPool(int threads) : mThreads(threads) {}
+  explicit BorrowedPool(int threads, const HostExecutor* host = nullptr) : mThreads(threads), mHost(host) {}
   BorrowedPool(const BorrowedPool&) = delete;
   BorrowedPool& operator=(const BorrowedPool&) = delete;
 
   [[nodiscard]] int threads() const { return mThreads; }
+  /// The host whose threads it borrows (null: none named).
+  [[nodiscard]] const HostExecutor* host() const { return mHost; }
   /// Queues `fn` for `group`.
   void submit(std::function<void()> fn, BorrowedGroup& group);
   /// Waits until every job of `group` has run, running queued jobs meanwhile; rethrows the first
@@ -72,6 +75,7 @@ class BorrowedPool {
   std::condition_variable mChanged;  ///< a job was queued, a group finished, or the pool closed
   std::deque<Job> mQueue;
   bool mClosed = false;
+  const HostExecutor* const mHost;  ///< the host whose threads it borrows
 };
 
 /// The borrowed pool whose constructs the calling thread's work goes to, and its index there; null

@@ -27,18 +27,24 @@ int Executor::threads() const { return mHost != nullptr ? host_threads() : mWork
 void Executor::execute(const std::function<void()>& f) {
   if (mHost != nullptr) {
     // The count read for this call (threads() at its start), or read now.
-    detail::run_on_host(*mHost, mHostThreads > 0 ? std::exchange(mHostThreads, 0) : host_threads(), f);
+    const int read = mHostThreads.exchange(0);
+    detail::run_on_host(*mHost, read > 0 ? read : offered_threads(), f);
     return;
   }
   const detail::BorrowedScope outside(nullptr, -1);  // its constructs go to the backend, not a borrowed pool
   mWorkers->execute(f);
 }
 
-int Executor::host_threads() const {
+int Executor::offered_threads() const {
   // At most 1024, as EngineOptions::threads; at most the threads asked for, when asked.
   const int offered = std::clamp(mHost->thread_count(), 1, 1024);
-  mHostThreads = mRequested > 0 ? std::min(mRequested, offered) : offered;
-  return mHostThreads;
+  return mRequested > 0 ? std::min(mRequested, offered) : offered;
+}
+
+int Executor::host_threads() const {
+  const int n = offered_threads();
+  mHostThreads.store(n);
+  return n;
 }
 
 JobGroup::~JobGroup() {
@@ -58,6 +64,8 @@ void JobGroup::wait() {
 }
 
 int current_thread_index() { return detail::t_borrowed != nullptr ? detail::t_borrowed_index : native::thread_index(); }
+
+bool in_executor() { return detail::t_borrowed != nullptr || native::in_executor(); }
 
 int concurrency() { return detail::t_borrowed != nullptr ? detail::t_borrowed->threads() : native::concurrency(); }
 
@@ -81,14 +89,16 @@ void parallel_for(std::size_t begin, std::size_t end, std::size_t grain,
 
 void for_each_in_order(std::size_t n, const std::function<void(std::size_t)>& body) {
   std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
   std::mutex error_mutex;
   std::exception_ptr error;
   const auto drain = [&] {
-    for (std::size_t i = next.fetch_add(1, std::memory_order_relaxed); i < n; i = next.fetch_add(1, std::memory_order_relaxed)) {
+    for (std::size_t i = next.fetch_add(1, std::memory_order_relaxed); i < n && !failed.load(std::memory_order_relaxed);
+         i = next.fetch_add(1, std::memory_order_relaxed)) {
       try {
         body(i);
       } catch (...) {
-        next.store(n, std::memory_order_relaxed);  // nobody takes another item
+        failed.store(true, std::memory_order_relaxed);  // nobody takes another item
         const std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();
       }

@@ -15,6 +15,7 @@
 /// Results never depend on the backend or on the schedule (tested in both builds).
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <functional>
@@ -62,10 +63,12 @@ class Executor {
   /// The host's threads for a call: thread_count() in [1, 1024], at most the threads asked for;
   /// kept for the next execute(), so that a call's cut and its pool agree.
   int host_threads() const;
+  /// thread_count() in [1, 1024], at most the threads asked for; stores nothing.
+  int offered_threads() const;
 
   int mRequested;
   HostExecutor* mHost;
-  mutable int mHostThreads = 0;               ///< read by threads() for the coming execute(), 0 when not
+  mutable std::atomic<int> mHostThreads{0};   ///< read by threads() for the coming execute(), 0 when not
   std::unique_ptr<native::Workers> mWorkers;  ///< without a host only
 };
 
@@ -106,6 +109,9 @@ class JobGroup {
 /// The calling thread's index in the executor it works for (0 .. threads-1 for threads of its own;
 /// the slot in the host's arena otherwise), or -1 outside any.
 [[nodiscard]] int current_thread_index();
+
+/// Whether the caller is doing an executor's work (inside Executor::execute, or a task it started).
+[[nodiscard]] bool in_executor();
 
 /// The number of threads of the executor the caller runs in; 1 outside any executor.
 [[nodiscard]] int concurrency();

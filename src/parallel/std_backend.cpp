@@ -18,16 +18,14 @@ namespace caliber::parallel::native {
 class ThreadPoolHost final : public HostExecutor {
  public:
   explicit ThreadPoolHost(int threads) : mThreads(threads) {
-    for (int t = 1; t < threads; ++t) mWorkers.emplace_back([this, t] { work(t); });
-  }
-  ~ThreadPoolHost() override {
-    {
-      const std::lock_guard<std::mutex> lock(mMutex);
-      mStop = true;
+    try {
+      for (int t = 1; t < threads; ++t) mWorkers.emplace_back([this, t] { work(t); });
+    } catch (...) {  // a thread that could not be made: stop those that were, then report it
+      stop();
+      throw;
     }
-    mChanged.notify_all();
-    for (std::thread& t : mWorkers) t.join();
   }
+  ~ThreadPoolHost() override { stop(); }
   ThreadPoolHost(const ThreadPoolHost&) = delete;
   ThreadPoolHost& operator=(const ThreadPoolHost&) = delete;
 
@@ -69,6 +67,16 @@ class ThreadPoolHost final : public HostExecutor {
     Call* call;
     std::size_t begin, end;
   };
+
+  /// Stops the workers made so far and joins them.
+  void stop() {
+    {
+      const std::lock_guard<std::mutex> lock(mMutex);
+      mStop = true;
+    }
+    mChanged.notify_all();
+    for (std::thread& t : mWorkers) t.join();
+  }
 
   /// Runs `range` with the lock released; signs it off in its call.
   void run(std::unique_lock<std::mutex>& lock, const Range& range, int worker) {

@@ -31,6 +31,7 @@ inline constexpr std::string_view kZeroThreads = "0: the machine's hardware thre
 constexpr bool parallel_here() { return false; }
 inline int thread_index() { return -1; }
 inline int concurrency() { return 1; }
+inline bool in_executor() { return false; }
 
 class ThreadPoolHost;
 

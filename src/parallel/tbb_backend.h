@@ -49,6 +49,9 @@ inline bool parallel_here() { return t_concurrency > 1; }
 /// The calling thread's slot in the arena of the executor it works for, or -1 outside any.
 int thread_index();
 
+/// Whether the caller works for an executor of this backend.
+inline bool in_executor() { return t_concurrency > 0; }
+
 /// The concurrency of the executor the caller works for; 1 outside any.
 inline int concurrency() { return std::max(t_concurrency, 1); }
 

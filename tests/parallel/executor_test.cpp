@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <numeric>
+#include <tuple>
+#include <utility>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -299,6 +302,53 @@ TEST(Executor, PerThreadSlotsAreDistinct) {
   parallel_sort(v.begin(), v.end(), std::less<>());
   EXPECT_TRUE(std::is_sorted(v.begin(), v.end()));
   EXPECT_FALSE(backend().empty());
+}
+
+TEST(Executor, AnExecutorUsedInsideItsOwnWorkKeepsItsThreads) {
+  // Four items that each wait (up to 20 s) until two of them run at once: only parallel work meets.
+  Executor executor(2);
+  std::atomic<int> running{0};
+  std::atomic<bool> met{false};
+  const auto body = [&](std::size_t, std::size_t) {
+    ++running;
+    for (const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+         running.load() < 2 && std::chrono::steady_clock::now() < deadline;) {}
+    if (running.load() >= 2) met = true;
+  };
+  executor.execute([&] { executor.execute([&] { parallel_for(0, 4, 1, body); }); });
+  EXPECT_TRUE(met.load()) << "the nested call ran on one thread";
+}
+
+TEST(Executor, ChunksOfRangesNearTheLargestSize) {
+  const std::size_t top = std::numeric_limits<std::size_t>::max();
+  for (const auto& [begin, end, grain] :
+       {std::tuple{std::size_t{0}, top, top / 2}, std::tuple{std::size_t{0}, std::size_t{1} << 62, std::size_t{1} << 60},
+        std::tuple{top - 10, top, std::size_t{3}}}) {
+    std::vector<std::pair<std::size_t, std::size_t>> chunks;
+    parallel_for(begin, end, grain, [&](std::size_t lo, std::size_t hi) { chunks.emplace_back(lo, hi); });
+    ASSERT_FALSE(chunks.empty()) << "grain " << grain;
+    EXPECT_EQ(chunks.front().first, begin);
+    EXPECT_EQ(chunks.back().second, end);
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      EXPECT_LT(chunks[k].first, chunks[k].second);
+      EXPECT_LE(chunks[k].second - chunks[k].first, grain);
+      if (k > 0) EXPECT_EQ(chunks[k].first, chunks[k - 1].second);
+    }
+  }
+}
+
+TEST(Executor, ParallelSortOnAnyExecutorSortsAndKeepsEveryElement) {
+  for (const int threads : {1, 2, 4}) {
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{4095}, std::size_t{4097}, std::size_t{100000}}) {
+      std::vector<std::uint64_t> v(n);
+      for (std::size_t i = 0; i < n; ++i) v[i] = (i * 2654435761u) % 1000003u;
+      std::vector<std::uint64_t> want = v;
+      std::sort(want.begin(), want.end());
+      Executor executor(threads);
+      executor.execute([&] { parallel_sort(v.begin(), v.end(), std::less<>()); });
+      EXPECT_EQ(v, want) << n << " items, " << threads << " threads";
+    }
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
@@ -178,6 +179,88 @@ TEST(HostExecutor, ExceptionsReachTheWaiter) {
   int after = 0;
   executor.execute([&] { after = parallel::concurrency(); });
   EXPECT_EQ(after, 3) << "the executor still works after an error";
+}
+
+/// A host with no thread of its own whose finish() runs whatever range is queued, another call's
+/// too (as the example's pool does when its threads are busy).
+class HelpAnyHost final : public HostExecutor {
+ public:
+  int thread_count() const override { return 3; }
+  void* enqueue(const Job& job, std::size_t count, std::size_t grain) override {
+    auto* call = new Call{&job, 0};
+    const std::lock_guard<std::mutex> lock(mMutex);
+    for (std::size_t b = 0; b < count; b += grain, ++call->left) mQueue.push_back({call, b, std::min(count, b + grain)});
+    return call;
+  }
+  void finish(void* handle) override {
+    auto* call = static_cast<Call*>(handle);
+    std::unique_lock<std::mutex> lock(mMutex);
+    while (call->left > 0) {
+      if (mQueue.empty()) {
+        lock.unlock();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        lock.lock();
+        continue;
+      }
+      const Range r = mQueue.front();
+      mQueue.pop_front();
+      lock.unlock();
+      (*r.call->job)(r.begin, r.end, 0);
+      lock.lock();
+      --r.call->left;
+    }
+    delete call;
+  }
+
+ private:
+  struct Call {
+    const Job* job;
+    std::size_t left;
+  };
+  struct Range {
+    Call* call;
+    std::size_t begin, end;
+  };
+  std::mutex mMutex;
+  std::deque<Range> mQueue;
+};
+
+TEST(HostExecutor, TwoCallersNestingCallsOnOneHostFinish) {
+  // Each caller's job nests another call; the second caller's finish() meets the first caller's
+  // ranges. A thread that already works for one call must not join another, or the two calls
+  // would wait on each other for ever.
+  HelpAnyHost host;
+  parallel::Executor e1(0, &host), e2(0, &host), e3(2, &host), e4(2, &host);  // nested calls of another size: pools of their own
+  std::atomic<int> done{0};
+  std::thread first([&] {
+    e1.execute([&] {
+      parallel::JobGroup group;
+      group.run([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        e3.execute([&] { ++done; });
+      });
+      group.wait();
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));  // once the first call's ranges wait
+  e2.execute([&] {
+    parallel::JobGroup group;
+    group.run([&] { e4.execute([&] { ++done; }); });
+    group.wait();
+  });
+  first.join();
+  EXPECT_EQ(done.load(), 2);
+}
+
+TEST(HostExecutor, ParallelSortOnLentThreads) {
+  PoolHost host(3);
+  parallel::Executor executor(0, &host);
+  std::vector<std::uint64_t> v(50000);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = (i * 2654435761u) % 100003u;
+  std::vector<std::uint64_t> want = v;
+  std::sort(want.begin(), want.end());
+  executor.execute([&] { parallel::parallel_sort(v.begin(), v.end(), std::less<>()); });
+  EXPECT_EQ(v, want);
 }
 
 TEST(HostExecutor, EngineGivesTheDefaultEnginesContactsForEveryMethod) {
