@@ -114,6 +114,16 @@ template <class Take>
     // entered). (Where one side does not descend, the scalar tests below were faster than four lanes
     // with two wasted, in the step and in the queries.)
     const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
+    if (taboo.taboo == nullptr) {
+      // Without a taboo list: the four counted at once, the passed ones taken by their bits in
+      // lane order (a branch per passed child, not one per lane).
+      stats.node_tests += 4;
+      for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0; bits &= bits - 1) {
+        const unsigned k = static_cast<unsigned>(__builtin_ctz(bits));
+        passed[count++] = NodePair{a.index + k / 2, b.index + k % 2};
+      }
+      return count;
+    }
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
     });
