@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "geometry/predicates.h"
+#include "geometry/triangle_distance.h"
 
 namespace caliber::geometry {
 namespace {
@@ -198,7 +199,27 @@ bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
   return edges_meet(a, b, sa, sb);
 }
 
+unsigned triangles_intersect_batch(TriangleBatch& batch) {
+  static const detail::IntersectBatch chosen = [] {
+    const detail::IntersectBatch avx512 = detail::triangles_intersect_batch_avx512_if_supported();
+    return avx512 != nullptr ? avx512 : &detail::triangles_intersect_batch_by_pair;
+  }();
+  if (batch.size == 0) return 0;
+  batch.pad();
+  return chosen(batch);
+}
+
 namespace detail {
+
+unsigned triangles_intersect_batch_by_pair(const TriangleBatch& batch) {
+  unsigned meet = 0;
+  for (int l = 0; l < batch.size; ++l) {
+    Vec3 a[3], b[3];
+    batch.get(l, a, b);
+    meet |= static_cast<unsigned>(triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) << l;
+  }
+  return meet;
+}
 
 bool triangles_intersect_by_edges(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
                                   const Vec3& b2) {

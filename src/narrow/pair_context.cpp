@@ -176,6 +176,13 @@ bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3],
   keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
   return true;
 }
+
+/// Whether interference leaf tests wait for triangles_intersect_batch: where it has eight lanes
+/// (pair by pair, the batch would only add copies).
+bool intersect_in_batches() {
+  static const bool lanes = geometry::detail::triangles_intersect_batch_avx512_if_supported() != nullptr;
+  return lanes;
+}
 }  // namespace
 
 template <class Keep>
@@ -214,11 +221,12 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
 }
 
 void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
-  if (mKind == QueryKind::interference) {
+  if (mKind == QueryKind::interference && !intersect_in_batches()) {
     leaf_test(ta, tb, out);
     return;
   }
-  // leaf_within's steps up to the refusal, which waits for the batch.
+  // leaf_within's steps up to the refusal (interference: up to the exact test), which waits for
+  // the batch.
   if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
   Eigen::Vector3d a[3], b[3];
   corners(ta, tb, a, b);
@@ -227,6 +235,10 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
 }
 
 void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
+  if (mKind == QueryKind::interference) {
+    intersect_buffered(buffer.refusal, out);
+    return;
+  }
   const unsigned apart = geometry::triangles_apart_batch(buffer.refusal.batch, mReach);
   for (int l = 0; l < buffer.refusal.batch.size; ++l) {
     if ((apart >> l) & 1u) continue;
@@ -234,6 +246,15 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
     if (buffer.closest.batch.full()) finish_buffered(buffer, out);
   }
   buffer.refusal.batch.size = 0;
+}
+
+void PairContext::intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const {
+  const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
+  for (int l = 0; l < waiting.batch.size; ++l) {
+    if ((meet >> l) & 1u)
+      out.push_back(Candidate{waiting.ta[l], waiting.tb[l], 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  }
+  waiting.batch.size = 0;
 }
 
 void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
