@@ -221,12 +221,21 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
 }
 
 void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
-  if (mKind == QueryKind::interference && !intersect_in_batches()) {
-    leaf_test(ta, tb, out);
+  if (mKind == QueryKind::interference) {
+    if (!intersect_in_batches()) {
+      leaf_test(ta, tb, out);
+      return;
+    }
+    // leaf_test's steps up to the exact test, which waits for the batch; the corners are read
+    // when it is full (gather_corners), eight pairs' at once.
+    if (!groups_allow(ta, tb)) return;
+    BufferedPairs& waiting = buffer.refusal;
+    waiting.ta[waiting.batch.size] = ta;
+    waiting.tb[waiting.batch.size] = tb;
+    if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
     return;
   }
-  // leaf_within's steps up to the refusal (interference: up to the exact test), which waits for
-  // the batch.
+  // leaf_within's steps up to the refusal, which waits for the batch.
   if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
   Eigen::Vector3d a[3], b[3];
   corners(ta, tb, a, b);
@@ -248,7 +257,32 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
   buffer.refusal.batch.size = 0;
 }
 
+void PairContext::gather_corners(BufferedPairs& waiting) const {
+  const int n = waiting.batch.size;
+  // The triangles' corner ids, then their corners, asked of memory for every pair before any is
+  // read: the misses overlap rather than follow one another.
+  for (int l = 0; l < n; ++l) {
+    __builtin_prefetch(&mA.mesh.triangles[waiting.ta[l]]);
+    __builtin_prefetch(&mB.mesh.triangles[waiting.tb[l]]);
+  }
+  for (int l = 0; l < n; ++l) {
+    for (int k = 0; k < 3; ++k) {
+      __builtin_prefetch(&mA.mesh.vertices[mA.mesh.triangles[waiting.ta[l]][k]]);
+      __builtin_prefetch(&mB.mesh.vertices[mB.mesh.triangles[waiting.tb[l]][k]]);
+    }
+  }
+  geometry::TriangleBatch& batch = waiting.batch;
+  for (int l = 0; l < n; ++l) {
+    const auto& tri = mA.mesh.triangles[waiting.ta[l]];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = mA.mesh.vertices[tri[k]], b = b_vertex(waiting.tb[l], k);
+      for (int c = 0; c < 3; ++c) batch.a[k][c][l] = a[c], batch.b[k][c][l] = b[c];
+    }
+  }
+}
+
 void PairContext::intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const {
+  gather_corners(waiting);
   const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
   for (int l = 0; l < waiting.batch.size; ++l) {
     if ((meet >> l) & 1u)

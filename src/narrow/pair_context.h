@@ -307,8 +307,10 @@ class PairContext {
   /// kept pairs appended to `out`).
   void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
-  /// The buffered interference tests (triangles_intersect_batch): the pairs that meet to `out`.
+  /// The buffered interference tests (their corners gathered, triangles_intersect_batch): the
+  /// pairs that meet to `out`. gather_corners reads the waiting pairs' corners into the batch.
   void intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const;
+  void gather_corners(BufferedPairs& waiting) const;
   /// The contact kind's normal test on a leaf pair (true for the other kinds).
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
