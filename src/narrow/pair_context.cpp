@@ -163,6 +163,17 @@ bool PairContext::groups_allow(std::uint32_t ta, std::uint32_t tb) const {
 }
 
 namespace {
+/// The pair at its closest points (at 0 where the triangles meet) if within `bound`:
+/// keep(candidate), true.
+template <class Keep>
+bool keep_within(std::uint32_t ta, std::uint32_t tb, const geometry::ClosestPoints& closest, bool intersecting, double bound,
+                 Keep&& keep) {
+  const double distance = intersecting ? 0.0 : closest.distance;
+  if (!(distance <= bound)) return false;
+  keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
+  return true;
+}
+
 /// The leaf test after the closest points: whether the pair intersects (the exact test decides; a
 /// plane between the closest points that certifiably separates the triangles says "no" without
 /// it), then whether it is within `bound`; keep(candidate) where it is.
@@ -171,14 +182,12 @@ bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3],
                  const geometry::ClosestPoints& closest, double bound, Keep&& keep) {
   const bool intersecting = !geometry::certainly_separated(closest.on_b - closest.on_a, a, b) &&
                             geometry::triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2]);
-  const double distance = intersecting ? 0.0 : closest.distance;
-  if (!(distance <= bound)) return false;
-  keep(Candidate{ta, tb, distance, closest.on_a, closest.on_b});
-  return true;
+  return keep_within(ta, tb, closest, intersecting, bound, keep);
 }
 
-/// Whether interference leaf tests wait for triangles_intersect_batch: where it has eight lanes
-/// (pair by pair, the batch would only add copies).
+/// Whether leaf tests decide "do they meet" with triangles_intersect_batch (interference pairs
+/// waiting for it, buffered closest points): where it has eight lanes (pair by pair, the batch
+/// would only add copies).
 bool intersect_in_batches() {
   static const bool lanes = geometry::detail::triangles_intersect_batch_avx512_if_supported() != nullptr;
   return lanes;
@@ -295,11 +304,21 @@ void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
   BufferedPairs& waiting = buffer.closest;
   geometry::ClosestPointsBatch closest;
   geometry::closest_points_triangles_batch(waiting.batch, closest);
+  const auto keep = [&](Candidate&& c) { out.push_back(std::move(c)); };
+  if (intersect_in_batches()) {
+    // finish_leaf's verdict on whether the triangles meet, eight lanes at once (exact, as
+    // triangles_intersect; certainly_separated only ever spares it a "no").
+    const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
+    for (int l = 0; l < waiting.batch.size; ++l) {
+      keep_within(waiting.ta[l], waiting.tb[l], closest.get(l), ((meet >> l) & 1u) != 0, mRequest.tolerance, keep);
+    }
+    waiting.batch.size = 0;
+    return;
+  }
   for (int l = 0; l < waiting.batch.size; ++l) {
     Eigen::Vector3d a[3], b[3];
     waiting.batch.get(l, a, b);
-    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest.get(l), mRequest.tolerance,
-                [&](Candidate&& c) { out.push_back(std::move(c)); });
+    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest.get(l), mRequest.tolerance, keep);
   }
   waiting.batch.size = 0;
 }
