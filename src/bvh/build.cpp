@@ -96,7 +96,6 @@ class Builder {
     model.nodes.resize(mWorkCount);
     model.filters.resize(mWorkCount);
     model.laterals.resize(mWorkCount);
-    model.first_leaf.resize(mWorkCount);
     if (!mMesh.groups.empty()) model.group_masks.resize(mWorkCount);
     if (oriented_boxes) model.oriented_boxes.resize(mWorkCount);
     model.leaf_position.resize(mOrder.size());
@@ -104,7 +103,6 @@ class Builder {
       for (std::size_t i = lo; i != hi; ++i) {
         convert(mWork[i].node, model.nodes[i], model.filters[i], model.laterals[i]);
         if (oriented_boxes) node_oriented_box(model.nodes[i], model.filters[i], model.laterals[i], model.oriented_boxes[i]);
-        model.first_leaf[i] = mWork[i].node.first;
         if (!model.group_masks.empty()) model.group_masks[i] = mWork[i].node.groups;
       }
     });

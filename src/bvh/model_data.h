@@ -193,19 +193,24 @@ struct ModelData : Model {
   /// oriented_boxes[i]: the oriented box of nodes[i], as node_oriented_box computes it from the
   /// three above; empty unless built with BuildOptions::oriented_boxes.
   std::vector<BvhNodeOrientedBox> oriented_boxes;
-  /// The triangles below node i are those whose leaf_position lies in
-  /// [first_leaf[i], first_leaf[i] + nodes[i].count): every subtree is a run of the leaf order.
-  std::vector<std::uint32_t> first_leaf;
-  /// Position of each triangle in the leaf order (see first_leaf).
+  /// Position of each triangle in the leaf order. Every subtree is a run of it: the triangles below
+  /// node i are those whose position lies in [first, first + nodes[i].count), where the root's
+  /// first is 0 and a node's first child's is its own, its second child's its own plus the first
+  /// child's count (first_leaf_of).
   std::vector<std::uint32_t> leaf_position;
 
   /// The group mask of node i (read only by queries with a group table).
   [[nodiscard]] std::uint64_t group_mask(std::uint32_t i) const { return group_masks.empty() ? 1 : group_masks[i]; }
 
-  /// Whether triangle t lies below node i.
-  [[nodiscard]] bool holds(std::uint32_t node, std::uint32_t triangle) const {
+  /// Whether `triangle` lies below `node`, whose run of leaves starts at `first`.
+  [[nodiscard]] bool holds(std::uint32_t node, std::uint32_t first, std::uint32_t triangle) const {
     const std::uint32_t p = leaf_position[triangle];
-    return p >= first_leaf[node] && p < first_leaf[node] + nodes[node].count;
+    return p >= first && p < first + nodes[node].count;
+  }
+  /// Where the run of leaves of `node` starts, given that of `parent` (`first`): node is parent
+  /// itself, or one of its two children.
+  [[nodiscard]] std::uint32_t first_leaf_of(std::uint32_t node, std::uint32_t parent, std::uint32_t first) const {
+    return node == parent || node == nodes[parent].index ? first : first + nodes[nodes[parent].index].count;
   }
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
   std::vector<Eigen::Vector3d> normals;

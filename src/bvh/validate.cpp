@@ -2,6 +2,7 @@
 
 #include "bvh/validate.h"
 
+#include <utility>
 #include <vector>
 
 namespace caliber::bvh {
@@ -34,9 +35,6 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   if (n.index <= i || n.index + 1 >= size) return "node " + std::to_string(i) + ": children out of range or before it";
   const BvhNode &a = m.nodes[n.index], &b = m.nodes[n.index + 1];
   if (a.count + b.count != n.count) return "node " + std::to_string(i) + ": its children's counts do not add up";
-  if (m.first_leaf[n.index] != m.first_leaf[i] || m.first_leaf[n.index + 1] != m.first_leaf[i] + a.count) {
-    return "node " + std::to_string(i) + ": its children are not the two halves of its run of leaves";
-  }
   if ((m.group_mask(n.index) | m.group_mask(n.index + 1)) != m.group_mask(i)) {
     return "node " + std::to_string(i) + ": its group mask is not its children's";
   }
@@ -48,31 +46,31 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
 std::string bvh_problem(const ModelData& m) {
   const std::size_t triangles = m.mesh.triangles.size(), size = m.nodes.size();
   if (triangles == 0) return "no triangle";
-  if (size != 2 * triangles - 1 || m.filters.size() != size || m.laterals.size() != size || m.first_leaf.size() != size ||
-      m.leaf_position.size() != triangles) {
+  if (size != 2 * triangles - 1 || m.filters.size() != size || m.laterals.size() != size || m.leaf_position.size() != triangles) {
     return "the node arrays do not have 2n - 1 entries for n triangles";
   }
   if (m.group_masks.size() != (m.mesh.groups.empty() ? 0 : size)) {
     return "the group masks are not one a node (a mesh with groups) or none (a mesh without)";
   }
-  if (m.nodes[0].count != triangles || m.first_leaf[0] != 0) return "the root does not hold every triangle";
+  if (m.nodes[0].count != triangles) return "the root does not hold every triangle";
   std::vector<std::uint8_t> reached(size, 0), placed(triangles, 0);
-  std::vector<std::uint32_t> stack{0};
+  // Each node with where its run of leaves starts (ModelData::first_leaf_of).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
   while (!stack.empty()) {
-    const std::uint32_t i = stack.back();
+    const auto [i, first] = stack.back();
     stack.pop_back();
     if (reached[i]++ != 0) return "node " + std::to_string(i) + " is reached twice";
     const BvhNode& n = m.nodes[i];
     if (n.is_leaf()) {
       if (n.index >= triangles || placed[n.index]++ != 0) return "leaf " + std::to_string(i) + ": a bad or repeated triangle";
-      if (m.leaf_position[n.index] != m.first_leaf[i]) return "leaf " + std::to_string(i) + ": not at its triangle's place";
+      if (m.leaf_position[n.index] != first) return "leaf " + std::to_string(i) + ": not at its triangle's place";
       if (std::string p = leaf_problem(m, i); !p.empty()) return p;
       continue;
     }
     if (n.count < 2) return "node " + std::to_string(i) + ": an inner node of fewer than two triangles";
     if (std::string p = children_problem(m, i); !p.empty()) return p;
-    stack.push_back(n.index);
-    stack.push_back(n.index + 1);
+    stack.emplace_back(n.index, first);
+    stack.emplace_back(n.index + 1, first + m.nodes[n.index].count);
   }
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";

@@ -12,7 +12,7 @@ namespace caliber::bvh {
 
 /// The first broken invariant of `model`'s BVH, in words (empty when none): the node arrays of one
 /// size (2n - 1 for n triangles); every node reached once from the root, children after their
-/// parent; counts that add up; every subtree a run of the leaf order (first_leaf, leaf_position);
+/// parent; counts that add up; every subtree a run of the leaf order (leaf_position);
 /// every triangle in one leaf; each leaf's sphere, box and slab around its triangle's vertices
 /// (relative to ModelData::origin); group masks the union of their children's.
 [[nodiscard]] std::string bvh_problem(const ModelData& model);

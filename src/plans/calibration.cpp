@@ -246,11 +246,12 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 
 namespace {
 
-/// Fills summary[slot] for CD node n with the reported pairs in [first, last) below it, then its
-/// children. The pairs are partitioned in place (each goes to the first child that holds both
-/// triangles, as a traversal would meet it), so the tree costs no allocation per node.
-void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, bool disks, TrianglePair* first,
-                  TrianglePair* last, std::vector<SummaryNode>& summary) {
+/// Fills summary[slot] for CD node n (its nodes' runs of leaves starting at `leaves`) with the
+/// reported pairs in [first, last) below it, then its children. The pairs are partitioned in place
+/// (each goes to the first child that holds both triangles, as a traversal would meet it), so the
+/// tree costs no allocation per node.
+void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, narrow::NodePair leaves, bool disks,
+                  TrianglePair* first, TrianglePair* last, std::vector<SummaryNode>& summary) {
   const ModelData& a = ctx.a();
   const ModelData& b = ctx.b();
   summary[slot].node = n;
@@ -260,9 +261,12 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   narrow::NodePair kids[4];
   const int count = narrow::cd_children(ctx, n, kids);
   TrianglePair* bounds[5] = {first};
+  narrow::NodePair kid_leaves[4];
   for (int k = 0; k < count; ++k) {
-    bounds[k + 1] = std::partition(
-        bounds[k], last, [&](const TrianglePair& p) { return a.holds(kids[k].a, p.tri_a) && b.holds(kids[k].b, p.tri_b); });
+    kid_leaves[k] = {a.first_leaf_of(kids[k].a, n.a, leaves.a), b.first_leaf_of(kids[k].b, n.b, leaves.b)};
+    bounds[k + 1] = std::partition(bounds[k], last, [&](const TrianglePair& p) {
+      return a.holds(kids[k].a, kid_leaves[k].a, p.tri_a) && b.holds(kids[k].b, kid_leaves[k].b, p.tri_b);
+    });
   }
   const auto at = static_cast<std::uint32_t>(summary.size());
   std::uint32_t children = 0;
@@ -273,7 +277,7 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   std::uint32_t next = at;
   const bool both = count == 4;  // both sides descend: the visit tests the children with the disks
   for (int k = 0; k < count; ++k) {
-    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], both, bounds[k], bounds[k + 1], summary);
+    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], kid_leaves[k], both, bounds[k], bounds[k + 1], summary);
   }
 }
 
@@ -293,7 +297,7 @@ std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std
   if (items.empty()) return summary;
   summary.reserve(2 * items.size() + 1);
   summary.resize(1);
-  fill_summary(ctx, 0, narrow::NodePair{0, 0}, false, items.data(), items.data() + items.size(), summary);
+  fill_summary(ctx, 0, narrow::NodePair{0, 0}, narrow::NodePair{0, 0}, false, items.data(), items.data() + items.size(), summary);
   return summary;
 }
 

@@ -269,7 +269,6 @@ TEST(BuildModel, ParallelBuildIsTheSameBytesAtAnyThreadCount) {
     EXPECT_EQ(bytes(data(*many).nodes), bytes(data(*one).nodes)) << threads << " threads";
     EXPECT_EQ(bytes(data(*many).filters), bytes(data(*one).filters)) << threads << " threads";
     EXPECT_EQ(bytes(data(*many).laterals), bytes(data(*one).laterals)) << threads << " threads";
-    EXPECT_EQ(data(*many).first_leaf, data(*one).first_leaf);
     EXPECT_EQ(data(*many).leaf_position, data(*one).leaf_position);
     EXPECT_EQ(bytes(many->normals()), bytes(one->normals()));
     EXPECT_EQ(data(*many).corner_vertex, data(*one).corner_vertex);

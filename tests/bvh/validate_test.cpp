@@ -31,14 +31,13 @@ TEST(BvhProblem, EachBreakIsFound) {
   const auto broken = [&](auto&& change) {
     const std::vector<BvhNode> nodes = m.nodes;
     const std::vector<BvhNodeFilter> filters = m.filters;
-    const std::vector<std::uint32_t> first_leaf = m.first_leaf, leaf_position = m.leaf_position;
+    const std::vector<std::uint32_t> leaf_position = m.leaf_position;
     const std::vector<std::uint64_t> group_masks = m.group_masks;
     const std::vector<std::uint8_t> groups = m.mesh.groups;
     change();
     const std::string problem = bvh::bvh_problem(m);
     m.nodes = nodes;
     m.filters = filters;
-    m.first_leaf = first_leaf;
     m.leaf_position = leaf_position;
     m.group_masks = group_masks;
     m.mesh.groups = groups;
@@ -52,7 +51,7 @@ TEST(BvhProblem, EachBreakIsFound) {
   EXPECT_NE(broken([&] { m.filters[leaf].slab_hi = m.filters[leaf].slab_lo - 1.0f; }), "");
   EXPECT_NE(broken([&] { m.nodes[inner].count += 1; }), "");
   EXPECT_NE(broken([&] { m.nodes[inner].index = inner; }), "") << "a child before its parent";
-  EXPECT_NE(broken([&] { m.first_leaf[m.nodes[inner].index + 1] += 1; }), "");
+  EXPECT_NE(broken([&] { std::swap(m.leaf_position[0], m.leaf_position[1]); }), "") << "triangles out of leaf order";
   EXPECT_NE(broken([&] { m.group_masks.assign(m.nodes.size(), 1); }), "") << "masks for a mesh without groups";
   EXPECT_EQ(broken([&] {
               m.mesh.groups.assign(m.mesh.triangles.size(), 0);

@@ -205,7 +205,12 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
   EXPECT_EQ(summary[0].contacts, reported.size());
   for (const SummaryNode& s : summary) {
     if (s.children == 0) {
-      EXPECT_TRUE(data(*a).nodes[s.node.a].is_leaf() && data(*b).nodes[s.node.b].is_leaf()) << "only leaf pairs end the summary";
+      const BvhNode &la = data(*a).nodes[s.node.a], &lb = data(*b).nodes[s.node.b];
+      EXPECT_TRUE(la.is_leaf() && lb.is_leaf()) << "only leaf pairs end the summary";
+      // Each reported pair ends at the leaves of its own two triangles.
+      const auto own = std::count_if(reported.begin(), reported.end(),
+                                     [&](const TrianglePair& p) { return p.tri_a == la.index && p.tri_b == lb.index; });
+      EXPECT_EQ(static_cast<std::uint32_t>(own), s.contacts);
       continue;
     }
     std::uint32_t below = 0;
