@@ -3,7 +3,9 @@
 /// Leaf tests waiting for the batch kernels: the pairs of one traversal that passed the leaf
 /// test's first checks wait for the refusal test (geometry::triangles_apart_batch), those it does
 /// not refuse for their closest points (geometry::closest_points_triangles_batch), eight at a time
-/// (PairContext::leaf_test with a buffer, PairContext::flush_leaves).
+/// (PairContext::leaf_test with a buffer, PairContext::flush_leaves). Interference pairs wait in
+/// `refusal` as ids alone for geometry::triangles_intersect_batch, their corners read when the
+/// batch is full (PairContext::gather_corners).
 
 #include <cstdint>
 

@@ -280,13 +280,11 @@ void PairContext::gather_corners(BufferedPairs& waiting) const {
       __builtin_prefetch(&mB.mesh.vertices[mB.mesh.triangles[waiting.tb[l]][k]]);
     }
   }
-  geometry::TriangleBatch& batch = waiting.batch;
+  waiting.batch.size = 0;
   for (int l = 0; l < n; ++l) {
-    const auto& tri = mA.mesh.triangles[waiting.ta[l]];
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d a = mA.mesh.vertices[tri[k]], b = b_vertex(waiting.tb[l], k);
-      for (int c = 0; c < 3; ++c) batch.a[k][c][l] = a[c], batch.b[k][c][l] = b[c];
-    }
+    Eigen::Vector3d a[3], b[3];
+    corners(waiting.ta[l], waiting.tb[l], a, b);
+    waiting.batch.add(a, b);
   }
 }
 
