@@ -42,13 +42,17 @@ void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint
     return a < b;
   };
   parallel::parallel_sort(order.begin(), order.end(), less);  // distinct keys (ties by index)
+  // Each vertex's representative: the first vertex (least index) at its position. Welded vertices
+  // are numbered in the order of their representatives, so that a mesh without repeated positions
+  // keeps its own numbering and needs no corner_vertex.
   std::vector<std::uint32_t> weld(nv);
-  std::uint32_t next = 0;
   for (std::size_t i = 0; i < nv; ++i) {
-    if (i > 0 && mesh.vertices[order[i]] != mesh.vertices[order[i - 1]]) ++next;
-    weld[order[i]] = next;
+    const bool repeats = i > 0 && mesh.vertices[order[i]] == mesh.vertices[order[i - 1]];
+    weld[order[i]] = repeats ? weld[order[i - 1]] : order[i];
   }
-  const std::size_t nw = nv == 0 ? 0 : std::size_t{next} + 1;
+  std::uint32_t next = 0;
+  for (std::size_t v = 0; v < nv; ++v) weld[v] = weld[v] == v ? next++ : weld[weld[v]];
+  const std::size_t nw = next;
   const std::size_t nt = mesh.triangles.size();
   corner_vertex.resize(3 * nt);
   for (std::size_t t = 0; t < nt; ++t) {
@@ -62,6 +66,7 @@ void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint
   triangles.resize(corner_vertex.size());
   std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
   for (std::size_t c = 0; c < corner_vertex.size(); ++c) triangles[fill[corner_vertex[c]]++] = static_cast<std::uint32_t>(c / 3);
+  if (nw == nv) std::vector<std::uint32_t>().swap(corner_vertex);  // every corner is its own vertex
 }
 
 }  // namespace caliber::bvh

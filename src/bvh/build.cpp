@@ -335,10 +335,11 @@ class Builder {
     const double slab_pad = 1e-13 * (box_center.cwiseAbs().maxCoeff() + box_half.maxCoeff());
     filter.slab_lo = w.cone >= 0.0 ? round_down(w.slab_lo - slab_pad) : 0.0f;
     filter.slab_hi = w.cone >= 0.0 ? round_up(w.slab_hi + slab_pad) : 0.0f;
-    for (int k = 0; k < 2; ++k) {
-      lateral.lateral_lo[k] = w.cone >= 0.0 ? round_down(w.lateral_lo[k] - slab_pad) : 0.0f;
-      lateral.lateral_hi[k] = w.cone >= 0.0 ? round_up(w.lateral_hi[k] + slab_pad) : 0.0f;
-      lateral.turn[k] = static_cast<std::int16_t>(w.turn[k]);  // already integers within 32767
+    for (int k = 0; k < 2; ++k) lateral.turn[k] = static_cast<std::int16_t>(w.turn[k]);  // already integers within 32767
+    if (w.cone >= 0.0) {
+      bvh::lateral_steps(node, filter, w.lateral_lo, w.lateral_hi, slab_pad, lateral);
+    } else {
+      lateral.lo[0] = lateral.lo[1] = lateral.hi[0] = lateral.hi[1] = 0;
     }
   }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 
 #include <Eigen/Core>
 
@@ -70,6 +71,28 @@ inline void triangle_turn(const Vec3& u0, const Vec3& v0, const Vec3& a, const V
 /// the build partitioned it), projected on the (u0, v0) plane.
 inline void partition_turn(const Vec3& u0, const Vec3& v0, const Vec3& direction, double turn[2]) {
   turn_towards(direction.dot(u0), direction.dot(v0), turn);
+}
+
+/// A node's lateral ranges lo[k] .. hi[k] (along its lateral axes as the query computes them from
+/// the stored axis and turn, `lateral.turn` set already), grown by `pad`, in steps
+/// (caliber::lateral_range): the outermost whose decoded ends hold them.
+inline void lateral_steps(const BvhNode& node, const BvhNodeFilter& filter, const double lo[2], const double hi[2], double pad,
+                          BvhNodeLateral& lateral) {
+  for (int k = 0; k < 2; ++k) lateral.lo[k] = lateral.hi[k] = 0;
+  double axes[2][3];
+  lateral_axes(filter.cone_axis, lateral.turn, axes[0], axes[1]);
+  const double step = lateral_step(node);
+  if (!(step > 0.0)) return;  // a box of size 0 at the origin: every range is [0, 0]
+  for (int k = 0; k < 2; ++k) {
+    const double mid = lateral_middle(node, axes[k]), low = lo[k] - pad, high = hi[k] + pad;
+    double q_lo = std::floor((low - mid) / step), q_hi = std::ceil((high - mid) / step);
+    while (mid + q_lo * step > low) q_lo -= 1.0;
+    while (mid + q_hi * step < high) q_hi += 1.0;
+    // The ranges lie within the box, which a unit axis sees within 32000 steps of the middle.
+    if (!(q_lo >= -32767.0 && q_hi <= 32767.0)) throw std::logic_error("caliber: a lateral range outside its node's box");
+    lateral.lo[k] = static_cast<std::int16_t>(q_lo);
+    lateral.hi[k] = static_cast<std::int16_t>(q_hi);
+  }
 }
 
 }  // namespace caliber::bvh

@@ -4,6 +4,7 @@
 /// the normals, the adjacency and the leaf order. The public caliber::Model is this, seen through
 /// read-only accessors (data() gives this view to caliber's own code).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -64,18 +65,50 @@ struct BvhNodeFilter {
 static_assert(sizeof(BvhNodeFilter) == 32);
 
 /// What only the distance query reads of a node: the ranges along the two lateral axes of its cone
-/// axis (lateral_axes), every vertex v below having lateral_lo[k] <= axis_k . v <= lateral_hi[k],
-/// rounded outward. With the slab, a box around the triangles below in the frame of the cone axis,
-/// tight where they are nearly coplanar. The lateral axes are turned about the cone axis to follow
-/// the patch (a leaf: its triangle's principal direction in the slab's plane; a parent: the line
-/// between its children, across which the build partitioned it), so that an elongated patch gets a
-/// narrow box whatever its direction. All 0 when the cone axis is 0.
+/// axis (lateral_axes), every vertex v below having lo[k] <= axis_k . v <= hi[k] as lateral_range
+/// decodes them, rounded outward. With the slab, a box around the triangles below in the frame of
+/// the cone axis, tight where they are nearly coplanar. The lateral axes are turned about the cone
+/// axis to follow the patch (a leaf: its triangle's principal direction in the slab's plane; a
+/// parent: the line between its children, across which the build partitioned it), so that an
+/// elongated patch gets a narrow box whatever its direction. All 0 when the cone axis is 0.
+/// 12 bytes: the ranges are stored in steps of lateral_step about the node's box center.
 struct BvhNodeLateral {
-  float lateral_lo[2], lateral_hi[2];
+  /// The ranges, in steps (lateral_range).
+  std::int16_t lo[2], hi[2];
   /// (cos, sin) of the turn, up to scale, as integers of at most 32767 in magnitude (normalized
   /// in double where used).
   std::int16_t turn[2];
 };
+static_assert(sizeof(BvhNodeLateral) == 12);
+
+/// The step of node n's lateral ranges: 1/32000 of what a unit axis can see of its box (at most
+/// sqrt(3) times its largest half-extent), with a hair of its distance from the origin for the
+/// rounding of the ranges' ends.
+inline double lateral_step(const BvhNode& n) {
+  double h = 0.0, c = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    h = std::max(h, static_cast<double>(n.box_half[k]));
+    c = std::max(c, std::abs(static_cast<double>(n.box_center[k])));
+  }
+  return (1.7320508075688772 * h + 1e-12 * (c + h)) / 32000.0;
+}
+
+/// Where node n's range along the axis a is measured from: a . (its box center).
+inline double lateral_middle(const BvhNode& n, const double a[3]) {
+  return (a[0] * n.box_center[0] + a[1] * n.box_center[1]) + a[2] * n.box_center[2];
+}
+
+/// Node n's lateral ranges along its lateral axes u and v (lateral_axes), decoded from l:
+/// lateral_middle + q lateral_step, in double.
+inline void lateral_range(const BvhNode& n, const BvhNodeLateral& l, const double u[3], const double v[3], double lo[2],
+                          double hi[2]) {
+  const double step = lateral_step(n);
+  const double mid[2] = {lateral_middle(n, u), lateral_middle(n, v)};
+  for (int k = 0; k < 2; ++k) {
+    lo[k] = mid[k] + l.lo[k] * step;
+    hi[k] = mid[k] + l.hi[k] * step;
+  }
+}
 
 /// The two axes that complete a unit axis (nx, ny, nz) to an orthonormal frame (Duff et al. 2017's
 /// branchless basis), up to double rounding.
@@ -153,8 +186,10 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
     double u[3], v[3];
     lateral_axes_of_unit(axis[0], axis[1], axis[2], u, v);
     turn_lateral_axes(l.turn, u, v);
-    const double lo[3] = {f.slab_lo / len, l.lateral_lo[0], l.lateral_lo[1]};
-    const double hi[3] = {f.slab_hi / len, l.lateral_hi[0], l.lateral_hi[1]};
+    double lateral_lo[2], lateral_hi[2];
+    lateral_range(n, l, u, v, lateral_lo, lateral_hi);
+    const double lo[3] = {f.slab_lo / len, lateral_lo[0], lateral_lo[1]};
+    const double hi[3] = {f.slab_hi / len, lateral_hi[0], lateral_hi[1]};
     double mid[3], half[3];
     for (int k = 0; k < 3; ++k) {
       mid[k] = 0.5 * (lo[k] + hi[k]);
@@ -216,7 +251,9 @@ struct ModelData : Model {
   std::vector<Eigen::Vector3d> normals;
   /// Vertex adjacency (BuildOptions::adjacency), linear in the corners whatever a vertex's degree:
   /// the welded vertex of each corner (corner t*3 + k of triangle t; vertices are welded by exact
-  /// position, so files that repeat vertices per face still get their topology) ...
+  /// position, so files that repeat vertices per face still get their topology), or nothing where
+  /// no two vertices share a position (the welded vertices are then the mesh's own: welded_corners)
+  /// ...
   std::vector<std::uint32_t> corner_vertex;
   /// ... and the triangles around each welded vertex w, ascending:
   /// vertex_triangles[vertex_offsets[w] .. vertex_offsets[w + 1]).
@@ -225,12 +262,17 @@ struct ModelData : Model {
   std::vector<std::uint32_t> vertex_triangles;
   /// Whether the vertex adjacency was built.
   [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }
+  /// The welded vertices of triangle t's three corners.
+  [[nodiscard]] const std::uint32_t* welded_corners(std::uint32_t t) const {
+    return corner_vertex.empty() ? mesh.triangles[t].data() : &corner_vertex[std::size_t{t} * 3];
+  }
   /// Calls f(u) for every triangle u that shares a vertex position with triangle t (u != t; a
   /// triangle sharing two or three positions with t comes two or three times).
   template <class F>
   void for_each_neighbour(std::uint32_t t, F&& f) const {
+    const std::uint32_t* corners = welded_corners(t);
     for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint32_t w = corner_vertex[std::size_t{t} * 3 + k];
+      const std::uint32_t w = corners[k];
       for (std::uint64_t i = vertex_offsets[w]; i < vertex_offsets[w + 1]; ++i) {
         if (vertex_triangles[i] != t) f(vertex_triangles[i]);
       }
@@ -240,8 +282,8 @@ struct ModelData : Model {
   /// a vertex position with it.
   [[nodiscard]] bool are_neighbours(std::uint32_t t, std::uint32_t u) const {
     if (t == u) return false;
-    const std::uint32_t* vt = &corner_vertex[std::size_t{t} * 3];
-    const std::uint32_t* vu = &corner_vertex[std::size_t{u} * 3];
+    const std::uint32_t* vt = welded_corners(t);
+    const std::uint32_t* vu = welded_corners(u);
     bool shared = false;
     for (int k = 0; k < 3; ++k) shared |= (vt[k] == vu[0]) | (vt[k] == vu[1]) | (vt[k] == vu[2]);
     return shared;

@@ -52,8 +52,9 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const Eigen::Vector3d bh(node.box_half[0], node.box_half[1], node.box_half[2]);
   const Eigen::Vector3d stored_axis(filter.cone_axis[0], filter.cone_axis[1], filter.cone_axis[2]);
   const Eigen::Vector3d axis = stored_axis.normalized();
-  double lateral[2][3];
+  double lateral[2][3], lateral_lo[2], lateral_hi[2];
   lateral_axes(filter.cone_axis, lateral_range.turn, lateral[0], lateral[1]);
+  caliber::lateral_range(node, lateral_range, lateral[0], lateral[1], lateral_lo, lateral_hi);
   bool any_normal = false;
   for (const std::uint32_t t : below) {
     for (const std::uint32_t v : m.mesh().triangles[t]) {
@@ -66,9 +67,9 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
           << " <= " << filter.slab_hi << " (triangle " << t << ")";
       for (int k = 0; k < 2; ++k) {
         const double at = lateral[k][0] * p.x() + lateral[k][1] * p.y() + lateral[k][2] * p.z();
-        EXPECT_TRUE(lateral_range.lateral_lo[k] <= at && at <= lateral_range.lateral_hi[k])
-            << "node " << index << " lateral range " << k << " must cover its vertices: " << lateral_range.lateral_lo[k]
-            << " <= " << at << " <= " << lateral_range.lateral_hi[k] << " (triangle " << t << ")";
+        EXPECT_TRUE(lateral_lo[k] <= at && at <= lateral_hi[k])
+            << "node " << index << " lateral range " << k << " must cover its vertices: " << lateral_lo[k] << " <= " << at
+            << " <= " << lateral_hi[k] << " (triangle " << t << ")";
       }
     }
     if (m.normals()[t].squaredNorm() > 0.0) {
@@ -99,8 +100,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   if (!any_normal) {
     EXPECT_TRUE(filter.slab_lo == 0.0f && filter.slab_hi == 0.0f) << "node " << index << ": no axis, no slab";
     for (int k = 0; k < 2; ++k)
-      EXPECT_TRUE(lateral_range.lateral_lo[k] == 0.0f && lateral_range.lateral_hi[k] == 0.0f)
-          << "node " << index << ": no axis, no lateral range";
+      EXPECT_TRUE(lateral_range.lo[k] == 0 && lateral_range.hi[k] == 0) << "node " << index << ": no axis, no lateral range";
   } else {
     // The frame is orthonormal: the lateral axes unit, orthogonal to each other and to the axis.
     const Eigen::Vector3d u(lateral[0][0], lateral[0][1], lateral[0][2]), w(lateral[1][0], lateral[1][1], lateral[1][2]);
@@ -208,8 +208,11 @@ TEST(BuildModel, LateralAxesFollowAnElongatedPatch) {
   }
   const auto model = build_model(mesh);
   check_model(*model);
-  const BvhNodeLateral& root = data(*model).laterals[0];
-  const double width[2] = {double(root.lateral_hi[0]) - root.lateral_lo[0], double(root.lateral_hi[1]) - root.lateral_lo[1]};
+  const ModelData& m = data(*model);
+  double axes[2][3], lo[2], hi[2];
+  lateral_axes(m.filters[0].cone_axis, m.laterals[0].turn, axes[0], axes[1]);
+  lateral_range(m.nodes[0], m.laterals[0], axes[0], axes[1], lo, hi);
+  const double width[2] = {hi[0] - lo[0], hi[1] - lo[1]};
   EXPECT_LT(std::min(width[0], width[1]), 0.011) << width[0] << " " << width[1];
   EXPECT_GT(std::max(width[0], width[1]), 0.99) << width[0] << " " << width[1];
 }
@@ -246,6 +249,42 @@ TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
   EXPECT_EQ(neighbors(0), std::vector<std::uint32_t>{1});
   EXPECT_EQ(neighbors(1), std::vector<std::uint32_t>{0});
   EXPECT_TRUE(neighbors(2).empty());
+  EXPECT_EQ(data(*model).corner_vertex.size(), 9u) << "repeated positions: the welded corners are kept";
+  EXPECT_TRUE(data(*model).are_neighbours(0, 1));
+  EXPECT_FALSE(data(*model).are_neighbours(0, 2));
+}
+
+// A mesh whose vertices are all at distinct positions keeps no welded corners (its own are the
+// welded ones) and has the same neighbours as the same mesh with its vertices repeated per face.
+TEST(BuildModel, AdjacencyOfADistinctMeshNeedsNoWeldedCorners) {
+  // The torus with its seam's repeated vertices merged.
+  const Mesh torus = make_torus(1.0, 0.35, 10, 7);
+  Mesh welded;
+  std::vector<std::uint32_t> index(torus.vertices.size());
+  for (std::size_t v = 0; v < torus.vertices.size(); ++v) {
+    const auto same = std::find(welded.vertices.begin(), welded.vertices.end(), torus.vertices[v]);
+    index[v] = static_cast<std::uint32_t>(same - welded.vertices.begin());
+    if (same == welded.vertices.end()) welded.vertices.push_back(torus.vertices[v]);
+  }
+  for (const auto& tri : torus.triangles) welded.triangles.push_back({index[tri[0]], index[tri[1]], index[tri[2]]});
+  ASSERT_LT(welded.vertices.size(), torus.vertices.size()) << "the seam repeats vertices";
+  Mesh soup;
+  for (const auto& tri : welded.triangles) {
+    const auto first = static_cast<std::uint32_t>(soup.vertices.size());
+    for (const std::uint32_t v : tri) soup.vertices.push_back(welded.vertices[v]);
+    soup.triangles.push_back({first, first + 1, first + 2});
+  }
+  const auto a = build_model(welded), b = build_model(soup);
+  EXPECT_TRUE(data(*a).corner_vertex.empty());
+  EXPECT_EQ(data(*b).corner_vertex.size(), 3 * soup.triangles.size());
+  EXPECT_LT(a->memory_bytes(), b->memory_bytes());
+  for (std::uint32_t t = 0; t < welded.triangles.size(); ++t) {
+    EXPECT_EQ(neighbours(*a, t), neighbours(*b, t)) << "triangle " << t;
+    EXPECT_GE(neighbours(*a, t).size(), 9u) << "a torus triangle touches twelve others";
+    for (std::uint32_t u = 0; u < welded.triangles.size(); u += 7) {
+      EXPECT_EQ(data(*a).are_neighbours(t, u), data(*b).are_neighbours(t, u)) << t << " " << u;
+    }
+  }
 }
 
 /// The bytes of a vector, to compare two builds exactly.
@@ -318,7 +357,7 @@ TEST(BuildModel, AdjacencyIsLinearInTheCornersOfAHugeFan) {
   for (std::uint32_t i = 1; i + 1 <= static_cast<std::uint32_t>(n); ++i) mesh.triangles.push_back({0, i, i + 1});
   const auto model = build_model(mesh);
   EXPECT_EQ(data(*model).vertex_triangles.size(), 3 * mesh.triangles.size());
-  EXPECT_EQ(data(*model).corner_vertex.size(), 3 * mesh.triangles.size());
+  EXPECT_TRUE(data(*model).corner_vertex.empty()) << "no repeated positions";
   EXPECT_EQ(neighbours(*model, 5).size(), mesh.triangles.size() - 1) << "the hub: every other triangle";
 }
 
