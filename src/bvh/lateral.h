@@ -75,7 +75,7 @@ inline void partition_turn(const Vec3& u0, const Vec3& v0, const Vec3& direction
 
 /// A node's lateral ranges lo[k] .. hi[k] (along its lateral axes as the query computes them from
 /// the stored axis and turn, `lateral.turn` set already), grown by `pad`, in steps
-/// (caliber::lateral_range): the outermost whose decoded ends hold them.
+/// (caliber::lateral_range): the nearest steps whose decoded ends still hold them.
 inline void lateral_steps(const BvhNode& node, const BvhNodeFilter& filter, const double lo[2], const double hi[2], double pad,
                           BvhNodeLateral& lateral) {
   for (int k = 0; k < 2; ++k) lateral.lo[k] = lateral.hi[k] = 0;
@@ -89,7 +89,9 @@ inline void lateral_steps(const BvhNode& node, const BvhNodeFilter& filter, cons
     while (mid + q_lo * step > low) q_lo -= 1.0;
     while (mid + q_hi * step < high) q_hi += 1.0;
     // The ranges lie within the box, which a unit axis sees within 32000 steps of the middle.
-    if (!(q_lo >= -32767.0 && q_hi <= 32767.0)) throw std::logic_error("caliber: a lateral range outside its node's box");
+    if (!(q_lo >= -32767.0 && q_lo <= 32767.0 && q_hi >= -32767.0 && q_hi <= 32767.0)) {
+      throw std::logic_error("caliber: a lateral range outside its node's box");
+    }
     lateral.lo[k] = static_cast<std::int16_t>(q_lo);
     lateral.hi[k] = static_cast<std::int16_t>(q_hi);
   }
