@@ -201,8 +201,8 @@ bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const V
 
 unsigned triangles_intersect_batch(TriangleBatch& batch) {
   static const detail::IntersectBatch chosen = [] {
-    const detail::IntersectBatch avx512 = detail::triangles_intersect_batch_avx512_if_supported();
-    return avx512 != nullptr ? avx512 : &detail::triangles_intersect_batch_by_pair;
+    const detail::IntersectBatch lanes = detail::triangles_intersect_batch_lanes_if_supported();
+    return lanes != nullptr ? lanes : &detail::triangles_intersect_batch_by_pair;
   }();
   if (batch.size == 0) return 0;
   batch.pad();
@@ -210,6 +210,11 @@ unsigned triangles_intersect_batch(TriangleBatch& batch) {
 }
 
 namespace detail {
+
+IntersectBatch triangles_intersect_batch_lanes_if_supported() {
+  const IntersectBatch avx512 = triangles_intersect_batch_avx512_if_supported();
+  return avx512 != nullptr ? avx512 : triangles_intersect_batch_avx2_if_supported();
+}
 
 unsigned triangles_intersect_batch_by_pair(const TriangleBatch& batch) {
   unsigned meet = 0;

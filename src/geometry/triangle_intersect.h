@@ -44,17 +44,22 @@ inline bool certainly_separated(const Eigen::Vector3d& n, const Eigen::Vector3d 
 struct TriangleBatch;
 
 /// triangles_intersect of every pair of `batch` (triangle_distance.h): bit i set where pair i's
-/// triangles meet. Eight AVX-512 lanes where the CPU has them (its filters in every lane, a lane
-/// they cannot decide through triangles_intersect), else pair by pair: the same verdicts either
-/// way, since every sign either uses is exact. Pads the batch first.
+/// triangles meet. Eight AVX-512 lanes where the CPU has them, else four AVX2 lanes twice (the
+/// filters in every lane, a lane they cannot decide through triangles_intersect), else pair by
+/// pair: the same verdicts every way, since every sign any form uses is exact. Pads the batch
+/// first.
 unsigned triangles_intersect_batch(TriangleBatch& batch);
 
 namespace detail {
 using IntersectBatch = unsigned (*)(const TriangleBatch& batch);
-/// triangles_intersect_batch pair by pair, and its AVX-512 form (nullptr where this build or this
-/// CPU has none).
+/// triangles_intersect_batch pair by pair, and its AVX-512 and AVX2 forms (nullptr where this
+/// build or this CPU has none).
 unsigned triangles_intersect_batch_by_pair(const TriangleBatch& batch);
 IntersectBatch triangles_intersect_batch_avx512_if_supported();
+IntersectBatch triangles_intersect_batch_avx2_if_supported();
+/// The form triangles_intersect_batch runs: AVX-512 where the CPU has it, else AVX2, else nullptr
+/// (pair by pair).
+IntersectBatch triangles_intersect_batch_lanes_if_supported();
 
 /// triangles_intersect by the edge tests alone (every sign from orient3d, then each edge of one
 /// triangle against the other), the form it takes where a corner lies in the other's plane: the

@@ -186,10 +186,10 @@ bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3],
 }
 
 /// Whether leaf tests decide "do they meet" with triangles_intersect_batch (interference pairs
-/// waiting for it, buffered closest points): where it has eight lanes (pair by pair, the batch
-/// would only add copies).
+/// waiting for it, buffered closest points): where it has lanes, AVX-512 or AVX2 (pair by pair,
+/// the batch would only add copies).
 bool intersect_in_batches() {
-  static const bool lanes = geometry::detail::triangles_intersect_batch_avx512_if_supported() != nullptr;
+  static const bool lanes = geometry::detail::triangles_intersect_batch_lanes_if_supported() != nullptr;
   return lanes;
 }
 }  // namespace

@@ -24,7 +24,7 @@ struct Pair {
 bool scalar(const Pair& p) { return triangles_intersect(p.a[0], p.a[1], p.a[2], p.b[0], p.b[1], p.b[2]); }
 
 /// The batch forms this build and CPU have: the public one (the best), the pair-by-pair one, and
-/// the AVX-512 one where there is one.
+/// the AVX-512 and AVX2 ones where there are.
 std::vector<std::pair<std::string, std::function<unsigned(TriangleBatch&)>>> forms() {
   std::vector<std::pair<std::string, std::function<unsigned(TriangleBatch&)>>> out;
   out.emplace_back("public", [](TriangleBatch& b) { return triangles_intersect_batch(b); });
@@ -36,6 +36,12 @@ std::vector<std::pair<std::string, std::function<unsigned(TriangleBatch&)>>> for
     out.emplace_back("avx512", [avx512](TriangleBatch& b) {
       b.pad();
       return avx512(b);
+    });
+  }
+  if (const detail::IntersectBatch avx2 = detail::triangles_intersect_batch_avx2_if_supported()) {
+    out.emplace_back("avx2", [avx2](TriangleBatch& b) {
+      b.pad();
+      return avx2(b);
     });
   }
   return out;
