@@ -304,8 +304,9 @@ void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
   geometry::closest_points_triangles_batch(waiting.batch, closest);
   const auto keep = [&](Candidate&& c) { out.push_back(std::move(c)); };
   if (intersect_in_batches()) {
-    // finish_leaf's verdict on whether the triangles meet, eight lanes at once (exact, as
-    // triangles_intersect; certainly_separated only ever spares it a "no").
+    // finish_leaf's verdict on whether the triangles meet, in lanes (eight AVX-512 lanes, or four
+    // AVX2 lanes twice; exact, as triangles_intersect; certainly_separated only ever spares it a
+    // "no").
     const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
     for (int l = 0; l < waiting.batch.size; ++l) {
       keep_within(waiting.ta[l], waiting.tb[l], closest.get(l), ((meet >> l) & 1u) != 0, mRequest.tolerance, keep);
