@@ -1,5 +1,6 @@
 // The node test of a visit's child pairs, four at a time (AVX2, chosen at run time where the CPU has it):
-// the same decisions as PairContext::node_within and disks_beyond_slabs on each pair, bit for bit.
+// the same decisions as PairContext::node_within's geometry and disks_beyond_slabs on each pair
+// (without the disks for a visit where one side descends), bit for bit.
 
 #include "narrow/node_test_avx2.h"
 
@@ -92,7 +93,9 @@ CALIBER_AVX2 inline __m256d disk_beyond_slab(__m256d at, __m256d disk_lo, __m256
 
 /// PairContext::prepare_a / prepare_b (with their disks) and node_within with disks_beyond_slabs
 /// on the four node pairs, lane by lane the scalar code's operations in its order (fill_a, fill_b,
-/// box_beyond_slab, disk_beyond_slab). Inlined into the two forms below.
+/// box_beyond_slab, disk_beyond_slab); without the disks (kDisks false), node_within alone.
+/// Inlined into the forms below.
+template <bool kDisks>
 CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(const NodeTestFrame& f, std::uint32_t a0,
                                                                              std::uint32_t a1, std::uint32_t b0,
                                                                              std::uint32_t b1) {
@@ -146,6 +149,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   const __m256d b_lo = bf[6], b_hi = bf[7];
   apart = either(apart, beyond_slab(a_axis, a_slab_on_b, a_lo, a_hi, b_box_in_a, b_half, slab_reach));
   apart = either(apart, beyond_slab(b_axis, b_slab_on_a, b_lo, b_hi, a_box_in_b, a_half, slab_reach));
+  if constexpr (!kDisks) return ~_mm256_movemask_pd(apart) & 0xF;
   // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs).
   __m256d center_from_b[3];
   for (int k = 0; k < 3; ++k) center_from_b[k] = sub(a_center[k], _mm256_set1_pd(f.trans[k]));
@@ -164,31 +168,44 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
 
 CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                                       std::uint32_t b1) {
-  return node_within_2x2_lanes(f, a0, a1, b0, b1);
+  return node_within_2x2_lanes<true>(f, a0, a1, b0, b1);
+}
+CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                                           std::uint32_t b1) {
+  return node_within_2x2_lanes<false>(f, a0, a1, b0, b1);
 }
 
 /// The same code with AVX-512VL's 32 vector registers (the test holds about 50 four-lane values;
 /// with 16 registers, many of its instructions were spills). The same operations (no FMA: this
 /// file is built with -ffp-contract=off), so the same decisions.
-__attribute__((target("avx2,avx512f,avx512vl"))) int node_within_2x2_avx512vl(const NodeTestFrame& f, std::uint32_t a0,
-                                                                              std::uint32_t a1, std::uint32_t b0,
-                                                                              std::uint32_t b1) {
-  return node_within_2x2_lanes(f, a0, a1, b0, b1);
+#define CALIBER_AVX512VL __attribute__((target("avx2,avx512f,avx512vl")))
+CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                                              std::uint32_t b1) {
+  return node_within_2x2_lanes<true>(f, a0, a1, b0, b1);
 }
+CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                                                   std::uint32_t b1) {
+  return node_within_2x2_lanes<false>(f, a0, a1, b0, b1);
+}
+#undef CALIBER_AVX512VL
 
 #undef CALIBER_AVX2
 
 }  // namespace
 
-NodeWithin2x2 node_within_2x2_form(bool wide_registers) {
+NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks) {
   __builtin_cpu_init();
-  if (wide_registers) return __builtin_cpu_supports("avx512vl") ? &node_within_2x2_avx512vl : nullptr;
-  return __builtin_cpu_supports("avx2") ? &node_within_2x2_avx2 : nullptr;
+  if (wide_registers) {
+    if (!__builtin_cpu_supports("avx512vl")) return nullptr;
+    return disks ? &node_within_2x2_avx512vl : &node_within_one_side_avx512vl;
+  }
+  if (!__builtin_cpu_supports("avx2")) return nullptr;
+  return disks ? &node_within_2x2_avx2 : &node_within_one_side_avx2;
 }
 
-NodeWithin2x2 node_within_2x2_avx2_if_supported() {
-  const NodeWithin2x2 wide = node_within_2x2_form(true);
-  return wide != nullptr ? wide : node_within_2x2_form(false);
+NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks) {
+  const NodeWithin2x2 wide = node_within_2x2_form(true, disks);
+  return wide != nullptr ? wide : node_within_2x2_form(false, disks);
 }
 
 }  // namespace caliber::narrow::detail
@@ -196,8 +213,8 @@ NodeWithin2x2 node_within_2x2_avx2_if_supported() {
 #else
 
 namespace caliber::narrow::detail {
-NodeWithin2x2 node_within_2x2_form(bool) { return nullptr; }
-NodeWithin2x2 node_within_2x2_avx2_if_supported() { return nullptr; }
+NodeWithin2x2 node_within_2x2_form(bool, bool) { return nullptr; }
+NodeWithin2x2 node_within_2x2_avx2_if_supported(bool) { return nullptr; }
 }  // namespace caliber::narrow::detail
 
 #endif

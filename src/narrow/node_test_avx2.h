@@ -1,9 +1,10 @@
 #pragma once
 /// \file
-/// The geometric part of the node test of a visit where both sides descend (PairContext::node_within
-/// and disks_beyond_slabs: spheres, boxes, slabs, disks) on its four child pairs at once, in AVX2:
-/// the same decisions as the scalar test, bit for bit (each lane does the scalar test's operations
-/// in its order).
+/// The geometric part of the node test on four node pairs at once, in AVX2: of a visit where both
+/// sides descend (PairContext::node_within's spheres, boxes and slabs, and disks_beyond_slabs), or
+/// without the disks of one where one side descends (its two children against the other node, that
+/// node given twice). The same decisions as the scalar test, bit for bit (each lane does the
+/// scalar test's operations in its order).
 
 #include <cstdint>
 
@@ -22,18 +23,19 @@ struct NodeTestFrame {
   double hair, reach, slab_reach;
 };
 
-/// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes, slabs and disks:
-/// PairContext::node_within and !disks_beyond_slabs on prepare_a(ai) and prepare_b(bj) with their
-/// disks.
+/// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes, slabs and (in the forms
+/// with them) disks: PairContext::node_within's geometry (not its groups) and !disks_beyond_slabs
+/// on prepare_a(ai) and prepare_b(bj) with their disks.
 using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1);
 
 /// The four-lane form compiled for AVX2 (`wide_registers` false) or for AVX-512VL (true: the same
 /// code and operations with 32 vector registers, so fewer spills), or nullptr where this build or
-/// this CPU has none.
-NodeWithin2x2 node_within_2x2_form(bool wide_registers);
+/// this CPU has none. With `disks` false, the form without the disks (the test of a visit where
+/// one side descends).
+NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks = true);
 
 /// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else
 /// nullptr.
-NodeWithin2x2 node_within_2x2_avx2_if_supported();
+NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks = true);
 
 }  // namespace caliber::narrow::detail

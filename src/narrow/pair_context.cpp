@@ -72,12 +72,29 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   return facing >= cos_total - kConeCosMargin;
 }
 
+bool PairContext::node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
+  SideA a = prepare_a(ia);
+  SideB b = prepare_b(ib);
+  prepare_disk_a(a);
+  prepare_disk_b(b);
+  return node_test_2x2_lane(a, b);
+}
+
 int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
   if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
-  const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
-  int pass = within(mNodeFrame, a0, a1, b0, b1);
+  return groups_and_cones(within(mNodeFrame, a0, a1, b0, b1), a0, a1, b0, b1);
+}
+
+int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
+  static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported(false);
+  if (within == nullptr) return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
+  return groups_and_cones(within(mNodeFrame, a0, a1, b0, b1) & 0b1001, a0, a1, b0, b1);
+}
+
+int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
   if (mGroups == nullptr && mKind != QueryKind::contact) return pass;
+  const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
     const int k = __builtin_ctz(static_cast<unsigned>(left));

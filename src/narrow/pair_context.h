@@ -113,20 +113,18 @@ class PairContext {
   }
 
   /// The same on node ia of A and node ib of B, prepared here.
-  [[nodiscard]] bool node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
-    SideA a = prepare_a(ia);
-    SideB b = prepare_b(ib);
-    prepare_disk_a(a);
-    prepare_disk_b(b);
-    return node_test_2x2_lane(a, b);
-  }
+  [[nodiscard]] bool node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const;
 
   /// node_test_2x2_lane on the four pairs of nodes a0 or a1 of A with b0 or b1 of B (the children
   /// of a visit where both sides descend): bit 2i + j is set where ai and bj pass. The preparation and
   /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp), the same
   /// decisions.
   [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
-  /// What node_tests_2x2's four-lane forms read of this context (detail::node_within_2x2_form).
+  /// node_test on the two children of a visit where one side descends: a0 of A with b0 of B (bit 0),
+  /// a1 with b1 (bit 3), the side that stays given twice. In node_tests_2x2's lanes without the
+  /// disks where the CPU has AVX2 (lanes 1 and 2 repeat a pair, cleared), else pair by pair.
+  [[nodiscard]] int node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
+  /// What the four-lane forms of node_tests_2x2 and node_tests_one_side read of this context.
   [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
   /// The same, one pair at a time: what node_tests_2x2 runs where the CPU has no AVX2.
   [[nodiscard]] int node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
@@ -273,6 +271,8 @@ class PairContext {
   /// of 1e-12 of it, a thousand times the few ulps (~1e-15 relative) its rounding costs.
   static constexpr double kAbsoluteShare = 1e-3;
 
+  /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse.
+  [[nodiscard]] int groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
   /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
   [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
     double dist2 = 0.0;

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <compare>
 #include <utility>
 #include <cstdint>
 #include <limits>
@@ -47,8 +46,8 @@ std::uint32_t index_of(Side* side) {
 /// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the
 /// distance bound's) for the (up to) four pairs it takes part in: calls test(side_a, side_b,
 /// child) for each in cd_children order, except those on the taboo list (skipped and marked
-/// reached), each counted in stats.node_tests. The one enumeration of children, for the node
-/// visit and the distance traversal.
+/// reached), each counted in stats.node_tests: the node visit's where one side descends and a
+/// taboo list is given, and the distance traversal's.
 template <class PrepareA, class PrepareB, class Test>
 [[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool descend_a, bool descend_b,
                                                   QueryStats& stats, TabooView taboo, PrepareA&& prepare_a, PrepareB&& prepare_b,
@@ -88,10 +87,9 @@ template <class Take>
 /// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
 /// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
-/// Each child node of A and of B is prepared once for the (up to) four pairs it takes part in.
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
-/// leaf pair may wait there for its closest points (PairContext::leaf_test with a buffer): the
-/// caller flushes it before reading `out`.
+/// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
+/// reading `out`.
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
                                         NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr) {
   const BvhNode& a = ctx.a().nodes[n.a];
@@ -108,22 +106,26 @@ template <class Take>
   int count = 0;
   bool descend_a, descend_b;
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
-  if (descend_a && descend_b) {
-    // Both sides descend: the four child pairs tested at once, then taken in cd_children order as
-    // for_each_child takes them (a child on the taboo list marked reached, neither counted nor
-    // entered). (Where one side does not descend, the scalar tests below were faster than four lanes
-    // with two wasted, in the step and in the queries.)
-    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
-    if (taboo.taboo == nullptr) {
-      // Without a taboo list: the four counted at once, the passed ones taken by their bits in
-      // lane order (a branch per passed child, not one per lane).
-      stats.node_tests += 4;
-      for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0; bits &= bits - 1) {
-        const unsigned k = static_cast<unsigned>(__builtin_ctz(bits));
-        passed[count++] = NodePair{a.index + k / 2, b.index + k % 2};
-      }
-      return count;
+  const bool both = descend_a && descend_b;
+  if (taboo.taboo == nullptr) {
+    // Without a taboo list, the children tested at once in lanes and counted at once, the passed
+    // ones taken by their bits in lane order (a branch per passed child, not one per lane): the
+    // four where both sides descend (lane 2i + j: A's child i, B's child j), else the two of the
+    // side that descends against the other node (PairContext::node_tests_one_side: lanes 0, 3).
+    const std::uint32_t a0 = descend_a ? a.index : n.a, a1 = descend_a ? a.index + 1 : n.a;
+    const std::uint32_t b0 = descend_b ? b.index : n.b, b1 = descend_b ? b.index + 1 : n.b;
+    const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1) : ctx.node_tests_one_side(a0, a1, b0, b1);
+    stats.node_tests += both ? 4 : 2;
+    for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0; bits &= bits - 1) {
+      const unsigned k = static_cast<unsigned>(__builtin_ctz(bits));
+      passed[count++] = NodePair{k / 2 != 0 ? a1 : a0, k % 2 != 0 ? b1 : b0};
     }
+    return count;
+  }
+  if (both) {
+    // With a taboo list: the four at once, taken in cd_children order (one on the list is marked
+    // reached, neither counted nor entered); where one side descends, pair by pair below.
+    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
     });

@@ -1,6 +1,7 @@
 // PairContext::node_tests_2x2 (the four child pairs of a visit prepared and tested at once, AVX2
-// where the CPU has it) against prepare_a, prepare_b (with their disks) and node_test_2x2_lane on each pair: the same decision for every pair, on overlapping and nearby
-// objects, for every depth-first kind.
+// where the CPU has it) against prepare_a, prepare_b (with their disks) and node_test_2x2_lane on
+// each pair, and node_tests_one_side (a visit where one side descends) against node_test: the
+// same decision for every pair, on overlapping and nearby objects, for every depth-first kind.
 
 #include <random>
 #include <utility>
@@ -12,7 +13,9 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
+#include "narrow/traversal.h"
 #include "support/random_poses.h"
 
 namespace caliber::narrow {
@@ -22,7 +25,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
   std::mt19937_64 rng(20261125);
-  long passed = 0, failed = 0, differing = 0, by_disks = 0, forms_checked = 0;
+  long passed = 0, failed = 0, differing = 0, by_disks = 0, forms_checked = 0, one_side_passed = 0;
   for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
     QueryRequest request;
     request.kind = kind;
@@ -60,6 +63,27 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
               }
             }
           }
+          if (c != 0) {
+            // One side descends: node_tests_one_side's bits 0 and 3 are node_test's on the two
+            // children, and the forms without the disks give node_test's geometry on every lane.
+            const int want = (ctx.node_test(sa[0], sb[0]) ? 1 : 0) | (ctx.node_test(sa[1], sb[1]) ? 8 : 0);
+            one_side_passed += want != 0;
+            if (ctx.node_tests_one_side(a0, a1, b0, b1) != want && ++differing <= 5) {
+              ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": one side";
+            }
+            int lanes = 0;
+            for (std::uint32_t k = 0; k < 4; ++k) lanes |= ctx.node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
+            for (const bool wide : {false, true}) {
+              if (const auto form = detail::node_within_2x2_form(wide, false)) {
+                const int geometric = form(ctx.node_test_frame(), a0, a1, b0, b1);
+                ++forms_checked;
+                if ((kind == QueryKind::contact ? (geometric & lanes) != lanes : geometric != lanes) && ++differing <= 5) {
+                  ADD_FAILURE() << "form " << wide << " without disks, kind " << static_cast<int>(kind) << " pose " << p
+                                << " case " << c;
+                }
+              }
+            }
+          }
           if (ctx.node_tests_2x2_scalar(a0, a1, b0, b1) != mask && ++differing <= 5) {
             ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": the scalar form differs";
           }
@@ -83,7 +107,57 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   EXPECT_GT(passed, 10000);
   EXPECT_GT(failed, 10000);
   EXPECT_GT(by_disks, 1000) << "the disks refuse some pairs the rest of the test lets through";
+  EXPECT_GT(one_side_passed, 1000) << "visits where one side descends pass some children";
   if (detail::node_within_2x2_form(false) != nullptr) EXPECT_GT(forms_checked, 10000);
+}
+
+// narrow::visit takes a node's children that pass in cd_children order, each decided as child_test
+// decides it and counted once: with no taboo list (the lanes, one side or both descending) and
+// with one (pair by pair where one side descends), on models whose spheres differ in size, so
+// that many visits descend on one side, a leaf against an inner node among them.
+TEST(NodeTests2x2, VisitTakesThePassingChildrenInTreeOrder) {
+  const auto a = build_model(make_torus(1.0, 0.35, 48, 24));
+  const auto b = build_model(make_box(0.3, 0.2, 0.15, 3));
+  std::mt19937_64 rng(20261201);
+  long one_side = 0, both = 0, taken = 0;
+  for (const QueryKind kind : {QueryKind::interference, QueryKind::contact}) {
+    QueryRequest request;
+    request.kind = kind;
+    request.tolerance = kind == QueryKind::interference ? 0.0 : 0.05;
+    for (int p = 0; p < 12; ++p) {
+      const PairContext ctx(*a, test::random_pose(rng, 0.3), *b, test::random_pose(rng, 1.0), request);
+      // A taboo list that names no node of this tree: the taboo path, skipping nothing.
+      const Taboo elsewhere{{NodePair{0xFFFFFFF0u, 0xFFFFFFF0u}}};
+      char reached[1] = {0};
+      std::vector<NodePair> work{{0, 0}};
+      for (std::size_t w = 0; w < work.size() && w < 50000; ++w) {
+        const NodePair n = work[w];
+        if (ctx.a().nodes[n.a].is_leaf() && ctx.b().nodes[n.b].is_leaf()) continue;
+        NodePair kids[4], want[4];
+        const int count = cd_children(ctx, n, kids);
+        int wanted = 0;
+        for (int k = 0; k < count; ++k) {
+          if (child_test(ctx, n, kids[k])) want[wanted++] = kids[k];
+        }
+        (count == 2 ? one_side : both) += 1;
+        for (const bool with_taboo : {false, true}) {
+          std::vector<Candidate> out;
+          QueryStats stats;
+          NodePair passed[4];
+          const TabooView taboo = with_taboo ? TabooView{&elsewhere, reached} : TabooView{};
+          const int got = visit(ctx, n, out, stats, passed, taboo);
+          ASSERT_EQ(got, wanted) << "kind " << static_cast<int>(kind) << " pose " << p << " taboo " << with_taboo;
+          EXPECT_EQ(stats.node_tests, static_cast<std::uint64_t>(count));
+          for (int k = 0; k < wanted; ++k) EXPECT_EQ(passed[k], want[k]) << "child " << k << " taboo " << with_taboo;
+        }
+        taken += wanted;
+        work.insert(work.end(), want, want + wanted);
+      }
+    }
+  }
+  EXPECT_GT(one_side, 500) << "many visits descend on one side";
+  EXPECT_GT(both, 1000);
+  EXPECT_GT(taken, 2000);
 }
 
 }  // namespace
