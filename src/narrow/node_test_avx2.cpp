@@ -15,40 +15,13 @@ namespace {
 #define CALIBER_AVX2 __attribute__((target("avx2")))
 
 /// Lanes of the four node pairs (a0 b0, a0 b1, a1 b0, a1 b1): A's nodes a0 a0 a1 a1, B's b0 b1 b0 b1.
-/// The records' floats come in blocks of four (a vector load of each record, then shuffles), each
-/// float converted to double (exactly). The blocks' positions in BvhNode and BvhNodeFilter:
+/// The four records' floats come in blocks of four (a vector load of each record, a transpose: a
+/// node per lane, a0 a1 b0 b1), each float converted to double (exactly). The blocks' positions in
+/// BvhNode and BvhNodeFilter:
 static_assert(offsetof(BvhNode, center) == 0 && offsetof(BvhNode, radius) == 12 && offsetof(BvhNode, box_center) == 16 &&
               offsetof(BvhNode, box_half) == 28 && sizeof(BvhNode) == 48);
 static_assert(offsetof(BvhNodeFilter, cone_axis) == 0 && offsetof(BvhNodeFilter, slab_lo) == 24 &&
               offsetof(BvhNodeFilter, slab_hi) == 28);
-
-/// Floats 4 block .. 4 block + 3 of two records, in A's lane order (r0 r0 r1 r1).
-template <class Record>
-CALIBER_AVX2 inline void block_a(const Record& r0, const Record& r1, int block, __m256d out[4]) {
-  const __m128 x0 = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
-  const __m128 x1 = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
-  out[0] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(0, 0, 0, 0)));
-  out[1] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(1, 1, 1, 1)));
-  out[2] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(2, 2, 2, 2)));
-  out[3] = _mm256_cvtps_pd(_mm_shuffle_ps(x0, x1, _MM_SHUFFLE(3, 3, 3, 3)));
-}
-/// The same in B's lane order (r0 r1 r0 r1).
-template <class Record>
-CALIBER_AVX2 inline void block_b(const Record& r0, const Record& r1, int block, __m256d out[4]) {
-  const __m128 x0 = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
-  const __m128 x1 = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
-  const __m128 lo = _mm_unpacklo_ps(x0, x1), hi = _mm_unpackhi_ps(x0, x1);
-  out[0] = _mm256_cvtps_pd(_mm_movelh_ps(lo, lo));
-  out[1] = _mm256_cvtps_pd(_mm_movehl_ps(lo, lo));
-  out[2] = _mm256_cvtps_pd(_mm_movelh_ps(hi, hi));
-  out[3] = _mm256_cvtps_pd(_mm_movehl_ps(hi, hi));
-}
-/// A node's floats 0..11 (center, radius, box center, box half-extents; the last two are the
-/// index and count, unused) and a filter's 0..7 (cone axis, angle, cos, sin, slab lo and hi).
-template <bool kA, class Record>
-CALIBER_AVX2 inline void blocks(const Record& r0, const Record& r1, int count, __m256d* out) {
-  for (int b = 0; b < count; ++b) kA ? block_a(r0, r1, b, out + 4 * b) : block_b(r0, r1, b, out + 4 * b);
-}
 
 CALIBER_AVX2 inline __m256d add(__m256d u, __m256d v) { return _mm256_add_pd(u, v); }
 CALIBER_AVX2 inline __m256d sub(__m256d u, __m256d v) { return _mm256_sub_pd(u, v); }
@@ -61,15 +34,6 @@ CALIBER_AVX2 inline __m256d magnitude(__m256d u) { return _mm256_andnot_pd(_mm25
 CALIBER_AVX2 inline __m256d dot3(const __m256d u[3], const __m256d v[3]) {
   return add(add(mul(u[0], v[0]), mul(u[1], v[1])), mul(u[2], v[2]));
 }
-/// Row i of m (m[i][0], m[i][1], m[i][2]) dotted with v, m's entries the same in every lane.
-CALIBER_AVX2 inline __m256d row_dot(const double m[3][3], int i, const __m256d v[3]) {
-  return add(add(mul(_mm256_set1_pd(m[i][0]), v[0]), mul(_mm256_set1_pd(m[i][1]), v[1])), mul(_mm256_set1_pd(m[i][2]), v[2]));
-}
-/// Column j of m dotted with v.
-CALIBER_AVX2 inline __m256d column_dot(const double m[3][3], int j, const __m256d v[3]) {
-  return add(add(mul(_mm256_set1_pd(m[0][j]), v[0]), mul(_mm256_set1_pd(m[1][j]), v[1])), mul(_mm256_set1_pd(m[2][j]), v[2]));
-}
-
 /// PairContext::box_beyond_slab in four lanes.
 CALIBER_AVX2 inline __m256d beyond_slab(const __m256d axis[3], const __m256d on[3], __m256d lo, __m256d hi,
                                         const __m256d center[3], const __m256d half[3], __m256d slab_reach) {
@@ -91,101 +55,142 @@ CALIBER_AVX2 inline __m256d disk_beyond_slab(__m256d at, __m256d disk_lo, __m256
                 _mm256_and_pd(gt(below, zero), gt(mul(below, below), rim2)));
 }
 
+/// The floats 4 block .. 4 block + 3 of four records (a0, a1, b0, b1), a record per lane: out[i]
+/// holds float 4 block + i of each.
+template <class Record>
+CALIBER_AVX2 inline void packed_block(const Record& r0, const Record& r1, const Record& r2, const Record& r3, int block,
+                                      __m256d out[4]) {
+  __m128 x0 = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
+  __m128 x1 = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
+  __m128 x2 = _mm_loadu_ps(reinterpret_cast<const float*>(&r2) + 4 * block);
+  __m128 x3 = _mm_loadu_ps(reinterpret_cast<const float*>(&r3) + 4 * block);
+  _MM_TRANSPOSE4_PS(x0, x1, x2, x3);
+  out[0] = _mm256_cvtps_pd(x0);
+  out[1] = _mm256_cvtps_pd(x1);
+  out[2] = _mm256_cvtps_pd(x2);
+  out[3] = _mm256_cvtps_pd(x3);
+}
+
+/// From lanes (a0, a1, b0, b1): A's nodes in the four pairs' lanes (a0 a0 a1 a1), and B's (b0 b1 b0 b1).
+CALIBER_AVX2 inline __m256d lanes_a(__m256d p) { return _mm256_permute4x64_pd(p, 0b01010000); }
+CALIBER_AVX2 inline __m256d lanes_b(__m256d p) { return _mm256_permute4x64_pd(p, 0b11101110); }
+
+/// Coordinate k of m x (m one of NodeLanes' matrices), (m[k][0] x[0] + m[k][1] x[1]) + m[k][2] x[2]:
+/// in A's lanes column k of the pose's matrix dotted with x (fill_a's order), in B's row k (fill_b's).
+CALIBER_AVX2 inline __m256d lane_dot(const double m[3][3][4], int k, const __m256d x[3]) {
+  return add(add(mul(_mm256_loadu_pd(m[k][0]), x[0]), mul(_mm256_loadu_pd(m[k][1]), x[1])), mul(_mm256_loadu_pd(m[k][2]), x[2]));
+}
+
 /// PairContext::prepare_a / prepare_b (with their disks) and node_within with disks_beyond_slabs
 /// on the four node pairs, lane by lane the scalar code's operations in its order (fill_a, fill_b,
-/// box_beyond_slab, disk_beyond_slab); without the disks (kDisks false), node_within alone.
-/// Inlined into the forms below.
+/// box_beyond_slab, disk_beyond_slab); without the disks (kDisks false), node_within's geometry
+/// alone. What each node brings into the other's frame is computed once, for a0, a1, b0 and b1 in
+/// four lanes (NodeLanes), then spread to the pairs' lanes where it is read. Inlined into the forms
+/// below.
 template <bool kDisks>
-CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(const NodeTestFrame& f, std::uint32_t a0,
-                                                                             std::uint32_t a1, std::uint32_t b0,
+CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(const NodeTestFrame& f, const NodeLanes& l,
+                                                                             std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                                                                              std::uint32_t b1) {
   const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
   const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
-  const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach);
-  const __m256d hair = _mm256_set1_pd(f.hair);
-  __m256d a_center[3], a_box[3], a_half[3], a_rel[3], a_axis[3], a_box_in_b[3], a_reach_on_b[3], a_slab_on_b[3];
-  __m256d b_c[3], b_box[3], b_half[3], b_axis[3], b_center[3], b_box_in_a[3], b_reach_on_a[3], b_slab_on_a[3], b_axis_in_a[3];
-  __m256d an[12], bn[12], af[8], bf[8];  // the records' floats, in lanes
-  blocks<true>(na0, na1, 3, an);
-  blocks<false>(nb0, nb1, 3, bn);
-  blocks<true>(fa0, fa1, 2, af);
-  blocks<false>(fb0, fb1, 2, bf);
-  for (int k = 0; k < 3; ++k) {
-    a_center[k] = an[k];
-    a_box[k] = an[4 + k];
-    a_half[k] = an[7 + k];
-    a_rel[k] = sub(a_box[k], _mm256_set1_pd(f.trans[k]));
-    a_axis[k] = af[k];
-    b_c[k] = bn[k];
-    b_box[k] = bn[4 + k];
-    b_half[k] = bn[7 + k];
-    b_axis[k] = bf[k];
-  }
-  for (int k = 0; k < 3; ++k) {
-    // A's box seen from B: x_b = R^T (x_a - T); B's node brought into A's frame: R x_b + T.
-    a_box_in_b[k] = column_dot(f.rot, k, a_rel);
-    a_reach_on_b[k] = column_dot(f.abs_rot, k, a_half);
-    a_slab_on_b[k] = add(magnitude(column_dot(f.rot, k, a_axis)), hair);
-    const __m256d t = _mm256_set1_pd(f.trans[k]);
-    b_center[k] = add(row_dot(f.rot, k, b_c), t);
-    b_box_in_a[k] = add(row_dot(f.rot, k, b_box), t);
-    b_reach_on_a[k] = row_dot(f.abs_rot, k, b_half);
-    b_axis_in_a[k] = row_dot(f.rot, k, b_axis);
-    b_slab_on_a[k] = add(magnitude(b_axis_in_a[k]), hair);
-  }
+  const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach), hair = _mm256_set1_pd(f.hair);
+  // The four nodes' floats, a node per lane: center and radius; box center and half-extents;
+  // cone axis; slab.
+  __m256d n0[4], n1[4], n2[4], f0[4], f1[4];
+  packed_block(na0, na1, nb0, nb1, 0, n0);
+  packed_block(na0, na1, nb0, nb1, 1, n1);
+  packed_block(na0, na1, nb0, nb1, 2, n2);
+  packed_block(fa0, fa1, fb0, fb1, 0, f0);
+  packed_block(fa0, fa1, fb0, fb1, 1, f1);
+  const __m256d center[3] = {n0[0], n0[1], n0[2]}, radius = n0[3];
+  const __m256d box[3] = {n1[0], n1[1], n1[2]}, half[3] = {n1[3], n2[0], n2[1]};
+  const __m256d axis[3] = {f0[0], f0[1], f0[2]}, lo = f1[2], hi = f1[3];
+  // Each node in the other's frame (A's: x_b = R^T (x_a - T); B's: R x_b + T), each part just
+  // before the tests that read it (shorter lives, fewer spills): B's sphere center (and A's center
+  // less T, the disk's), then box center and reach of the half-extents, then slab axis.
+  __m256d center_rel[3], center_in[3], box_rel[3], box_in[3], reach_on[3], axis_in[3], slab_on[3];
+  for (int k = 0; k < 3; ++k) center_rel[k] = sub(center[k], _mm256_loadu_pd(l.pre[k]));
+  for (int k = 0; k < 3; ++k) center_in[k] = add(lane_dot(l.rot, k, center_rel), _mm256_loadu_pd(l.post[k]));
   // Spheres: dist2 accumulates from 0 (0 + x is x), the radii summed before the reach is added.
   __m256d d[3];
-  for (int k = 0; k < 3; ++k) d[k] = sub(a_center[k], b_center[k]);
+  for (int k = 0; k < 3; ++k) d[k] = sub(lanes_a(center[k]), lanes_b(center_in[k]));
   const __m256d dist2 = add(add(mul(d[0], d[0]), mul(d[1], d[1])), mul(d[2], d[2]));
-  const __m256d spheres = add(add(an[3], bn[3]), reach);
+  const __m256d spheres = add(add(lanes_a(radius), lanes_b(radius)), reach);
   __m256d apart = gt(dist2, mul(spheres, spheres));
+  for (int k = 0; k < 3; ++k) box_rel[k] = sub(box[k], _mm256_loadu_pd(l.pre[k]));
+  for (int k = 0; k < 3; ++k) {
+    box_in[k] = add(lane_dot(l.rot, k, box_rel), _mm256_loadu_pd(l.post[k]));
+    reach_on[k] = lane_dot(l.abs_rot, k, half);
+  }
   for (int k = 0; k < 3; ++k) {  // A's axes, then B's
-    apart = either(apart, gt(magnitude(sub(b_box_in_a[k], a_box[k])), add(add(a_half[k], b_reach_on_a[k]), reach)));
+    apart = either(
+        apart, gt(magnitude(sub(lanes_b(box_in[k]), lanes_a(box[k]))), add(add(lanes_a(half[k]), lanes_b(reach_on[k])), reach)));
   }
   for (int k = 0; k < 3; ++k) {
-    apart = either(apart, gt(magnitude(sub(b_box[k], a_box_in_b[k])), add(add(b_half[k], a_reach_on_b[k]), reach)));
+    apart = either(
+        apart, gt(magnitude(sub(lanes_b(box[k]), lanes_a(box_in[k]))), add(add(lanes_b(half[k]), lanes_a(reach_on[k])), reach)));
   }
-  const __m256d a_lo = af[6], a_hi = af[7];
-  const __m256d b_lo = bf[6], b_hi = bf[7];
+  for (int k = 0; k < 3; ++k) {
+    axis_in[k] = lane_dot(l.rot, k, axis);
+    slab_on[k] = add(magnitude(axis_in[k]), hair);
+  }
+  __m256d a_axis[3], b_axis[3], a_box_in_b[3], b_box_in_a[3], a_half[3], b_half[3], a_slab_on_b[3], b_slab_on_a[3];
+  for (int k = 0; k < 3; ++k) {
+    a_axis[k] = lanes_a(axis[k]);
+    b_axis[k] = lanes_b(axis[k]);
+    a_box_in_b[k] = lanes_a(box_in[k]);
+    b_box_in_a[k] = lanes_b(box_in[k]);
+    a_half[k] = lanes_a(half[k]);
+    b_half[k] = lanes_b(half[k]);
+    a_slab_on_b[k] = lanes_a(slab_on[k]);
+    b_slab_on_a[k] = lanes_b(slab_on[k]);
+  }
+  const __m256d a_lo = lanes_a(lo), a_hi = lanes_a(hi), b_lo = lanes_b(lo), b_hi = lanes_b(hi);
   apart = either(apart, beyond_slab(a_axis, a_slab_on_b, a_lo, a_hi, b_box_in_a, b_half, slab_reach));
   apart = either(apart, beyond_slab(b_axis, b_slab_on_a, b_lo, b_hi, a_box_in_b, a_half, slab_reach));
   if constexpr (!kDisks) return ~_mm256_movemask_pd(apart) & 0xF;
-  // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs).
-  __m256d center_from_b[3];
-  for (int k = 0; k < 3; ++k) center_from_b[k] = sub(a_center[k], _mm256_set1_pd(f.trans[k]));
-  const __m256d a_mid = dot3(a_axis, a_center), b_mid = dot3(b_axis, b_c);
+  // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs): each
+  // node's slab about its own sphere's center, and its axis's squared length.
+  const __m256d mid = dot3(axis, center), len2 = dot3(axis, axis);
+  const __m256d disk_lo = sub(lo, mid), disk_hi = sub(hi, mid);
+  __m256d b_axis_in_a[3], b_center[3], center_from_b[3];
+  for (int k = 0; k < 3; ++k) {
+    b_axis_in_a[k] = lanes_b(axis_in[k]);
+    b_center[k] = lanes_b(center_in[k]);
+    center_from_b[k] = lanes_a(center_rel[k]);
+  }
   const __m256d along = dot3(a_axis, b_axis_in_a);
   const __m256d x = sub(mul(a_axis[1], b_axis_in_a[2]), mul(a_axis[2], b_axis_in_a[1]));
   const __m256d y = sub(mul(a_axis[2], b_axis_in_a[0]), mul(a_axis[0], b_axis_in_a[2]));
   const __m256d z = sub(mul(a_axis[0], b_axis_in_a[1]), mul(a_axis[1], b_axis_in_a[0]));
   const __m256d cross2 = add(add(mul(x, x), mul(y, y)), mul(z, z));
-  apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), sub(b_lo, b_mid), sub(b_hi, b_mid), along, bn[3],
-                                         dot3(b_axis, b_axis), cross2, a_lo, a_hi, slab_reach));
-  apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), sub(a_lo, a_mid), sub(a_hi, a_mid), along, an[3],
-                                         dot3(a_axis, a_axis), cross2, b_lo, b_hi, slab_reach));
+  apart = either(apart, disk_beyond_slab(dot3(a_axis, b_center), lanes_b(disk_lo), lanes_b(disk_hi), along, lanes_b(radius),
+                                         lanes_b(len2), cross2, a_lo, a_hi, slab_reach));
+  apart = either(apart, disk_beyond_slab(dot3(b_axis_in_a, center_from_b), lanes_a(disk_lo), lanes_a(disk_hi), along,
+                                         lanes_a(radius), lanes_a(len2), cross2, b_lo, b_hi, slab_reach));
   return ~_mm256_movemask_pd(apart) & 0xF;
 }
 
-CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                      std::uint32_t b1) {
-  return node_within_2x2_lanes<true>(f, a0, a1, b0, b1);
+CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                      std::uint32_t b0, std::uint32_t b1) {
+  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
 }
-CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                           std::uint32_t b1) {
-  return node_within_2x2_lanes<false>(f, a0, a1, b0, b1);
+CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                           std::uint32_t b0, std::uint32_t b1) {
+  return node_within_2x2_lanes<false>(f, l, a0, a1, b0, b1);
 }
 
 /// The same code with AVX-512VL's 32 vector registers (the test holds about 50 four-lane values;
 /// with 16 registers, many of its instructions were spills). The same operations (no FMA: this
 /// file is built with -ffp-contract=off), so the same decisions.
 #define CALIBER_AVX512VL __attribute__((target("avx2,avx512f,avx512vl")))
-CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                              std::uint32_t b1) {
-  return node_within_2x2_lanes<true>(f, a0, a1, b0, b1);
+CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                              std::uint32_t b0, std::uint32_t b1) {
+  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
 }
-CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                                   std::uint32_t b1) {
-  return node_within_2x2_lanes<false>(f, a0, a1, b0, b1);
+CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                                   std::uint32_t b0, std::uint32_t b1) {
+  return node_within_2x2_lanes<false>(f, l, a0, a1, b0, b1);
 }
 #undef CALIBER_AVX512VL
 

@@ -23,10 +23,39 @@ struct NodeTestFrame {
   double hair, reach, slab_reach;
 };
 
+/// B's pose for four lanes that hold nodes a0, a1 of A and b0, b1 of B, in that order, so that one
+/// product moves A's nodes into B's frame and B's into A's: rot[k][j] is the frame's rot[j][k] in
+/// A's lanes and rot[k][j] in B's (abs_rot likewise); a point x goes to rot (x - pre) + post, pre
+/// being the frame's trans in A's lanes and 0 in B's, post 0 in A's and trans in B's (each lane
+/// the scalar test's operations: x - 0 and y + 0 are x and y). Made by make_lanes, once per
+/// traversal (768 bytes: not kept in the pair context, which the engine holds for every pair).
+struct NodeLanes {
+  double rot[3][3][4], abs_rot[3][3][4], pre[3][4], post[3][4];
+};
+
+/// The lanes of frame f's pose.
+inline NodeLanes make_lanes(const NodeTestFrame& f) {
+  NodeLanes l;
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        l.rot[k][j][i] = i < 2 ? f.rot[j][k] : f.rot[k][j];
+        l.abs_rot[k][j][i] = i < 2 ? f.abs_rot[j][k] : f.abs_rot[k][j];
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      l.pre[k][i] = i < 2 ? f.trans[k] : 0.0;
+      l.post[k][i] = i < 2 ? 0.0 : f.trans[k];
+    }
+  }
+  return l;
+}
+
 /// Bit 2i + j set where node ai of A and node bj of B pass spheres, boxes, slabs and (in the forms
 /// with them) disks: PairContext::node_within's geometry (not its groups) and !disks_beyond_slabs
 /// on prepare_a(ai) and prepare_b(bj) with their disks.
-using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1);
+using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,
+                              std::uint32_t b0, std::uint32_t b1);
 
 /// The four-lane form compiled for AVX2 (`wide_registers` false) or for AVX-512VL (true: the same
 /// code and operations with 32 vector registers, so fewer spills), or nullptr where this build or

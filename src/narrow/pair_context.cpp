@@ -80,16 +80,21 @@ bool PairContext::node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
   return node_test_2x2_lane(a, b);
 }
 
-int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
+int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
+                                const detail::NodeLanes* lanes) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
   if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
-  return groups_and_cones(within(mNodeFrame, a0, a1, b0, b1), a0, a1, b0, b1);
+  if (lanes == nullptr) return groups_and_cones(within(mNodeFrame, node_lanes(), a0, a1, b0, b1), a0, a1, b0, b1);
+  return groups_and_cones(within(mNodeFrame, *lanes, a0, a1, b0, b1), a0, a1, b0, b1);
 }
 
-int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
+int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
+                                     const detail::NodeLanes* lanes) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported(false);
   if (within == nullptr) return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
-  return groups_and_cones(within(mNodeFrame, a0, a1, b0, b1) & 0b1001, a0, a1, b0, b1);
+  const int pass =
+      lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1) : within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  return groups_and_cones(pass & 0b1001, a0, a1, b0, b1);
 }
 
 int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {

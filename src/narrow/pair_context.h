@@ -114,21 +114,21 @@ class PairContext {
 
   /// The same on node ia of A and node ib of B, prepared here.
   [[nodiscard]] bool node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const;
-
   /// node_test_2x2_lane on the four pairs of nodes a0 or a1 of A with b0 or b1 of B (the children
-  /// of a visit where both sides descend): bit 2i + j is set where ai and bj pass. The preparation and
-  /// the geometric part four at a time in AVX2 where the CPU has it (node_test_avx2.cpp), the same
-  /// decisions.
-  [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
-  /// node_test on the two children of a visit where one side descends: a0 of A with b0 of B (bit 0),
-  /// a1 with b1 (bit 3), the side that stays given twice. In node_tests_2x2's lanes without the
-  /// disks where the CPU has AVX2 (lanes 1 and 2 repeat a pair, cleared), else pair by pair.
-  [[nodiscard]] int node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
-  /// What the four-lane forms of node_tests_2x2 and node_tests_one_side read of this context.
-  [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
+  /// of a visit where both sides descend): bit 2i + j set where ai and bj pass; four at a time in
+  /// AVX2 where the CPU has it (node_test_avx2.cpp), the same decisions. `lanes`: node_lanes(),
+  /// made once by a traversal (else made here).
+  [[nodiscard]] int node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
+                                   const detail::NodeLanes* lanes = nullptr) const;
   /// The same, one pair at a time: what node_tests_2x2 runs where the CPU has no AVX2.
   [[nodiscard]] int node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
-
+  /// node_test on a one-sided visit's children: a0 with b0 (bit 0), a1 with b1 (bit 3), the node that
+  /// stays given twice; node_tests_2x2's lanes without disks (1 and 2 cleared), else pair by pair.
+  [[nodiscard]] int node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
+                                        const detail::NodeLanes* lanes = nullptr) const;
+  /// What the four-lane forms read of this context, and its pose in their lanes (make_lanes).
+  [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
+  [[nodiscard]] detail::NodeLanes node_lanes() const { return detail::make_lanes(mNodeFrame); }
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <utility>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -89,9 +88,10 @@ template <class Take>
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
 /// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
-/// reading `out`.
+/// reading `out`. `lanes`: ctx.node_lanes(), made once by the traversal.
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
-                                        NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr) {
+                                        NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
+                                        const detail::NodeLanes* lanes = nullptr) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) {
@@ -108,13 +108,12 @@ template <class Take>
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
   const bool both = descend_a && descend_b;
   if (taboo.taboo == nullptr) {
-    // Without a taboo list, the children tested at once in lanes and counted at once, the passed
-    // ones taken by their bits in lane order (a branch per passed child, not one per lane): the
+    // No taboo list: the children tested and counted at once, taken by their bits in lane order:
     // four where both sides descend (lane 2i + j: A's child i, B's child j), else the two of the
-    // side that descends against the other node (PairContext::node_tests_one_side: lanes 0, 3).
+    // side that descends against the other node (node_tests_one_side: lanes 0 and 3).
     const std::uint32_t a0 = descend_a ? a.index : n.a, a1 = descend_a ? a.index + 1 : n.a;
     const std::uint32_t b0 = descend_b ? b.index : n.b, b1 = descend_b ? b.index + 1 : n.b;
-    const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1) : ctx.node_tests_one_side(a0, a1, b0, b1);
+    const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1, lanes) : ctx.node_tests_one_side(a0, a1, b0, b1, lanes);
     stats.node_tests += both ? 4 : 2;
     for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0; bits &= bits - 1) {
       const unsigned k = static_cast<unsigned>(__builtin_ctz(bits));
@@ -125,7 +124,7 @@ template <class Take>
   if (both) {
     // With a taboo list: the four at once, taken in cd_children order (one on the list is marked
     // reached, neither counted nor entered); where one side descends, pair by pair below.
-    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1);
+    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1, lanes);
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
     });
@@ -192,13 +191,14 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   QueryStats counted;
   if (root_test == RootTest::done || test_root(ctx, root, counted, root_test)) *top++ = root;
   NodePair passed[4];
+  const detail::NodeLanes lanes = ctx.node_lanes();
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
   // test's pair as it is kept).
   LeafBuffer buffer;
   LeafBuffer* const buffered = limit == nullptr ? &buffer : nullptr;
   while (top != base) {
-    const int count = visit(ctx, *--top, out, counted, passed, taboo, buffered);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, buffered, &lanes);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (limit != nullptr && count < 0) {
       if (out.size() != seen) {

@@ -56,7 +56,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
           // geometric mask is the node test's, less groups and cones (none here but contact's).
           for (const bool wide : {false, true}) {
             if (const auto form = detail::node_within_2x2_form(wide)) {
-              const int geometric = form(ctx.node_test_frame(), a0, a1, b0, b1);
+              const int geometric = form(ctx.node_test_frame(), ctx.node_lanes(), a0, a1, b0, b1);
               ++forms_checked;
               if ((kind == QueryKind::contact ? (geometric & mask) != mask : geometric != mask) && ++differing <= 5) {
                 ADD_FAILURE() << "form " << wide << " kind " << static_cast<int>(kind) << " pose " << p << " case " << c;
@@ -75,7 +75,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
             for (std::uint32_t k = 0; k < 4; ++k) lanes |= ctx.node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
             for (const bool wide : {false, true}) {
               if (const auto form = detail::node_within_2x2_form(wide, false)) {
-                const int geometric = form(ctx.node_test_frame(), a0, a1, b0, b1);
+                const int geometric = form(ctx.node_test_frame(), ctx.node_lanes(), a0, a1, b0, b1);
                 ++forms_checked;
                 if ((kind == QueryKind::contact ? (geometric & lanes) != lanes : geometric != lanes) && ++differing <= 5) {
                   ADD_FAILURE() << "form " << wide << " without disks, kind " << static_cast<int>(kind) << " pose " << p
