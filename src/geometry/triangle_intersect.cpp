@@ -217,8 +217,13 @@ IntersectBatch triangles_intersect_batch_lanes_if_supported() {
 }
 
 unsigned triangles_intersect_batch_by_pair(const TriangleBatch& batch) {
+  return triangles_intersect_lanes(batch, (1u << batch.size) - 1u);
+}
+
+unsigned triangles_intersect_lanes(const TriangleBatch& batch, unsigned lanes) {
   unsigned meet = 0;
-  for (int l = 0; l < batch.size; ++l) {
+  for (unsigned left = lanes; left != 0; left &= left - 1) {
+    const int l = __builtin_ctz(left);
     Vec3 a[3], b[3];
     batch.get(l, a, b);
     meet |= static_cast<unsigned>(triangles_intersect(a[0], a[1], a[2], b[0], b[1], b[2])) << l;

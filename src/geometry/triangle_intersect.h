@@ -55,6 +55,9 @@ using IntersectBatch = unsigned (*)(const TriangleBatch& batch);
 /// triangles_intersect_batch pair by pair, and its AVX-512 and AVX2 forms (nullptr where this
 /// build or this CPU has none).
 unsigned triangles_intersect_batch_by_pair(const TriangleBatch& batch);
+/// triangles_intersect of the pairs of `batch` whose bits `lanes` has: bit i set where pair i's
+/// triangles meet (what the lane forms run where their filters decide nothing).
+unsigned triangles_intersect_lanes(const TriangleBatch& batch, unsigned lanes);
 IntersectBatch triangles_intersect_batch_avx512_if_supported();
 IntersectBatch triangles_intersect_batch_avx2_if_supported();
 /// The form triangles_intersect_batch runs: AVX-512 where the CPU has it, else AVX2, else nullptr

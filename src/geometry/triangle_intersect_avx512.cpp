@@ -122,13 +122,7 @@ CALIBER_AVX512 unsigned intersect_avx512(const TriangleBatch& batch) {
   unsigned out = static_cast<unsigned>(crossing & sure & meet);
   // The lanes no filter decided: triangles_intersect itself.
   const unsigned lanes = (1u << batch.size) - 1u;
-  for (unsigned left = static_cast<unsigned>(~apart & ~(crossing & sure)) & lanes; left != 0; left &= left - 1) {
-    const int l = __builtin_ctz(left);
-    Eigen::Vector3d pa[3], pb[3];
-    batch.get(l, pa, pb);
-    if (triangles_intersect(pa[0], pa[1], pa[2], pb[0], pb[1], pb[2])) out |= 1u << l;
-  }
-  return out & lanes;
+  return (out | detail::triangles_intersect_lanes(batch, static_cast<unsigned>(~apart & ~(crossing & sure)) & lanes)) & lanes;
 }
 
 #undef CALIBER_AVX512
