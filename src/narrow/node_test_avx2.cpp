@@ -180,8 +180,8 @@ CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLan
   return node_within_2x2_lanes<false>(f, l, a0, a1, b0, b1);
 }
 
-/// The same code with AVX-512VL's 32 vector registers (the test holds about 50 four-lane values;
-/// with 16 registers, many of its instructions were spills). The same operations (no FMA: this
+/// The same code with AVX-512VL's 32 vector registers (the test holds dozens of four-lane values;
+/// with 16 registers, some of its instructions are spills). The same operations (no FMA: this
 /// file is built with -ffp-contract=off), so the same decisions.
 #define CALIBER_AVX512VL __attribute__((target("avx2,avx512f,avx512vl")))
 CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,

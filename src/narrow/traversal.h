@@ -88,7 +88,7 @@ template <class Take>
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
 /// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
-/// reading `out`. `lanes`: ctx.node_lanes(), made once by the traversal.
+/// reading `out`. `lanes`: ctx.node_lanes(), made once by the traversal (null: by each test).
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
                                         NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
                                         const detail::NodeLanes* lanes = nullptr) {
@@ -174,10 +174,9 @@ struct TraversalScratch {
   }
 };
 
-/// Depth-first traversal of the CD subtree rooted at `root`: tests root as `root_test` says (not
-/// when RootTest::done: it was tested, and passed, earlier), then visits every node that passes (narrow::visit): leaf tests
-/// on passing leaf pairs, the kept pairs appended to `out`, every node and leaf test counted in
-/// `stats`. With a taboo list, a child on the list is neither tested nor entered, only marked.
+/// Depth-first traversal of the CD subtree at `root`: tests root as `root_test` says, then visits every
+/// node that passes (narrow::visit), the kept pairs appended to `out`, every node and leaf test
+/// counted in `stats`. With a taboo list, a child on it is neither tested nor entered, only marked.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                                  QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
                                  PairShared* limit = nullptr) {
@@ -191,7 +190,8 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   QueryStats counted;
   if (root_test == RootTest::done || test_root(ctx, root, counted, root_test)) *top++ = root;
   NodePair passed[4];
-  const detail::NodeLanes lanes = ctx.node_lanes();
+  detail::NodeLanes lanes;  // made only where the root passes: a pair refused at its root pays nothing
+  if (top != base) lanes = ctx.node_lanes();
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
   // test's pair as it is kept).
