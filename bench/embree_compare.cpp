@@ -32,6 +32,7 @@
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/query.h"
+#include "geometry/rigid_move.h"
 #include "geometry/triangle_distance.h"
 #include "geometry/triangle_intersect.h"
 #include "bench_support.h"
@@ -62,11 +63,12 @@ caliber::Pose place(const Case& c, const caliber::Mesh& a, const caliber::Mesh& 
 }
 
 /// B's vertices in A's frame (A is at the identity), computed as caliber's leaf test computes them
-/// (PairContext::b_vertex: the rotation matrix, then the translation), so both test the same bits.
+/// (PairContext::b_vertex: geometry::RigidMove of the rotation matrix and the translation), so both
+/// test the same bits.
 Vertices posed(const caliber::Mesh& m, const caliber::Pose& pose) {
-  const Eigen::Matrix3d r = pose.rotation_matrix();
+  const caliber::geometry::RigidMove move(pose.rotation_matrix(), pose.translation);
   Vertices out(m.vertices.size());
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = r * m.vertices[i] + pose.translation;
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = move(m.vertices[i]);
   return out;
 }
 

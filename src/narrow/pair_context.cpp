@@ -7,6 +7,10 @@
 
 #include <Eigen/Geometry>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "geometry/triangle_distance.h"
 #include "geometry/triangle_intersect.h"
 
@@ -84,8 +88,9 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
                                 const detail::NodeLanes* lanes) const {
   static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
   if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
-  if (lanes == nullptr) return groups_and_cones(within(mNodeFrame, node_lanes(), a0, a1, b0, b1), a0, a1, b0, b1);
-  return groups_and_cones(within(mNodeFrame, *lanes, a0, a1, b0, b1), a0, a1, b0, b1);
+  const int pass =
+      lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1) : within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  return refuses_by_groups_or_cones() ? groups_and_cones(pass, a0, a1, b0, b1) : pass;
 }
 
 int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
@@ -94,11 +99,10 @@ int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::ui
   if (within == nullptr) return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
   const int pass =
       lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1) : within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return groups_and_cones(pass & 0b1001, a0, a1, b0, b1);
+  return refuses_by_groups_or_cones() ? groups_and_cones(pass & 0b1001, a0, a1, b0, b1) : pass & 0b1001;
 }
 
 int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
-  if (mGroups == nullptr && mKind != QueryKind::contact) return pass;
   const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
@@ -302,11 +306,40 @@ void PairContext::gather_corners(BufferedPairs& waiting) const {
       __builtin_prefetch(&mB.mesh.vertices[mB.mesh.triangles[waiting.tb[l]][k]]);
     }
   }
-  waiting.batch.size = 0;
-  for (int l = 0; l < n; ++l) {
-    Eigen::Vector3d a[3], b[3];
-    corners(waiting.ta[l], waiting.tb[l], a, b);
-    waiting.batch.add(a, b);
+  // The corners straight into the batch's lanes (the lanes past n as lane 0, as TriangleBatch::pad
+  // fills them), then B's moved into A's frame in all eight lanes, two at a time with SSE2, with
+  // b_vertex's formula (geometry::RigidMove): the same operations, so the same bits as corners().
+  geometry::TriangleBatch& batch = waiting.batch;
+  constexpr int kLanes = geometry::TriangleBatch::kLanes;
+  for (int l = 0; l < kLanes; ++l) {
+    const auto& tri_a = mA.mesh.triangles[waiting.ta[l < n ? l : 0]];
+    const auto& tri_b = mB.mesh.triangles[waiting.tb[l < n ? l : 0]];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& va = mA.mesh.vertices[tri_a[k]];
+      const Eigen::Vector3d& vb = mB.mesh.vertices[tri_b[k]];
+      for (int c = 0; c < 3; ++c) {
+        batch.a[k][c][l] = va[c];
+        batch.b[k][c][l] = vb[c];
+      }
+    }
+  }
+  const geometry::RigidMove move(mRot, mTrans);
+  for (int k = 0; k < 3; ++k) {
+#if defined(__SSE2__)
+    for (int l = 0; l < kLanes; l += 2) {
+      const __m128d x = _mm_load_pd(&batch.b[k][0][l]), y = _mm_load_pd(&batch.b[k][1][l]), z = _mm_load_pd(&batch.b[k][2][l]);
+      for (int c = 0; c < 3; ++c) {
+        const __m128d xy = _mm_add_pd(_mm_mul_pd(_mm_set1_pd(move.r[c][0]), x), _mm_mul_pd(_mm_set1_pd(move.r[c][1]), y));
+        const __m128d xyz = _mm_add_pd(xy, _mm_mul_pd(_mm_set1_pd(move.r[c][2]), z));
+        _mm_store_pd(&batch.b[k][c][l], _mm_add_pd(xyz, _mm_set1_pd(move.t[c])));
+      }
+    }
+#else
+    for (int l = 0; l < kLanes; ++l) {
+      const double x = batch.b[k][0][l], y = batch.b[k][1][l], z = batch.b[k][2][l];
+      for (int c = 0; c < 3; ++c) batch.b[k][c][l] = geometry::rigid_move_row(move.r[c], move.t[c], x, y, z);
+    }
+#endif
   }
 }
 

@@ -21,6 +21,7 @@
 #include "narrow/disks.h"
 #include "narrow/distance_bound_avx2.h"
 #include "narrow/frames_apart.h"
+#include "geometry/rigid_move.h"
 #include "narrow/leaf_buffer.h"
 #include "narrow/node_test_avx2.h"
 #include "narrow/prepared.h"
@@ -99,9 +100,8 @@ class PairContext {
   /// cones able to face each other (contact only). (node_test_2x2_lane adds the disks.)
   /// Conservative: every bound carries the safety margin (see the constructor).
   [[nodiscard]] bool node_test(const SideA& a, const SideB& b) const {
-    if (!node_within(a, b, mReach, mSlabReach)) return false;
-    if (mKind == QueryKind::contact && !cones_can_face(mA.filters[a.index], mB.filters[b.index])) return false;
-    return true;
+    return node_within(a, b, mReach, mSlabReach) &&
+           (mKind != QueryKind::contact || cones_can_face(mA.filters[a.index], mB.filters[b.index]));
   }
 
   /// The node test of a visit where both sides descend: node_test, and neither node's disk beyond
@@ -111,7 +111,6 @@ class PairContext {
   [[nodiscard]] bool node_test_2x2_lane(const SideA& a, const SideB& b) const {
     return node_test(a, b) && !narrow::disks_beyond_slabs(a, b, mSlabReach);
   }
-
   /// The same on node ia of A and node ib of B, prepared here.
   [[nodiscard]] bool node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const;
   /// node_test_2x2_lane on the four pairs of nodes a0 or a1 of A with b0 or b1 of B (the children
@@ -247,20 +246,21 @@ class PairContext {
   /// leaf_test, so a pair has the same distance whichever of the two computed it.
   bool leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const;
 
-  /// Model A.
-  [[nodiscard]] const ModelData& a() const { return mA; }
-  /// Model B.
-  [[nodiscard]] const ModelData& b() const { return mB; }
+  [[nodiscard]] const ModelData& a() const { return mA; }  ///< Model A.
+  [[nodiscard]] const ModelData& b() const { return mB; }  ///< Model B.
   /// The query.
   [[nodiscard]] const QueryRequest& request() const { return mRequest; }
   /// Pose of A (to bring results to world coordinates).
   [[nodiscard]] const Pose& pose_a() const { return mPoseA; }
   /// Rotation taking B's object frame to A's.
   [[nodiscard]] const Eigen::Matrix3d& rotation_b_to_a() const { return mRot; }
-  /// Vertex k of triangle tb of B, in A's frame (the one formula every test uses).
+  /// Vertex k of triangle tb of B, in A's frame (the one formula every test uses: geometry::RigidMove).
   [[nodiscard]] Eigen::Vector3d b_vertex(std::uint32_t tb, int k) const {
-    return mRot * mB.mesh.vertices[mB.mesh.triangles[tb][k]] + mTrans;
+    return geometry::RigidMove(mRot, mTrans)(mB.mesh.vertices[mB.mesh.triangles[tb][k]]);
   }
+  /// Reads the corners of the pairs waiting in `waiting` (their ids, batch.size of them) into its
+  /// batch, B's moved into A's frame with b_vertex's arithmetic: the same bits as corners().
+  void gather_corners(BufferedPairs& waiting) const;
 
  private:
   /// Relative safety margin on every bound: rounding in the transformed centers and vertices is a
@@ -271,8 +271,10 @@ class PairContext {
   /// of 1e-12 of it, a thousand times the few ulps (~1e-15 relative) its rounding costs.
   static constexpr double kAbsoluteShare = 1e-3;
 
-  /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse.
+  /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse: called only
+  /// where some can (checked inline by the callers, so that a visit without them makes no call).
   [[nodiscard]] int groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
+  [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }
   /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
   [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
     double dist2 = 0.0;
@@ -307,10 +309,8 @@ class PairContext {
   /// kept pairs appended to `out`).
   void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
-  /// The buffered interference tests (their corners gathered, triangles_intersect_batch): the
-  /// pairs that meet to `out`. gather_corners reads the waiting pairs' corners into the batch.
+  /// The buffered interference tests (gather_corners, triangles_intersect_batch): the pairs that meet to `out`.
   void intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const;
-  void gather_corners(BufferedPairs& waiting) const;
   /// The contact kind's normal test on a leaf pair (true for the other kinds).
   [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;

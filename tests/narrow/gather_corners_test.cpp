@@ -1,0 +1,60 @@
+// PairContext::gather_corners (a leaf batch's corners read straight into its lanes, B's moved into
+// A's frame there) against A's vertices and b_vertex (what the unbuffered leaf test reads): the same bits, on random poses (rotations and
+// translations of every size, far from the origin too) and batches of every size.
+
+#include <cstdint>
+#include <cstring>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "narrow/pair_context.h"
+#include "support/random_poses.h"
+
+namespace caliber::narrow {
+namespace {
+
+bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
+
+TEST(GatherCorners, SameBitsAsCorners) {
+  const auto a = build_model(make_torus(1.0, 0.35, 24, 16));
+  const auto b = build_model(make_box(0.6, 0.4, 0.3, 6));
+  std::mt19937_64 rng(20261202);
+  std::uniform_int_distribution<std::uint32_t> pick_a(0, static_cast<std::uint32_t>(a->triangle_count() - 1));
+  std::uniform_int_distribution<std::uint32_t> pick_b(0, static_cast<std::uint32_t>(b->triangle_count() - 1));
+  long compared = 0;
+  for (int p = 0; p < 64; ++p) {
+    // Translations from a fraction of the meshes' size to 1e6 of it: b_vertex's products and sums
+    // round differently at each, so a different order of operations would show.
+    const double far = p % 4 == 0 ? 1e6 : (p % 4 == 1 ? 1e3 : 1.0);
+    Pose pose_b = test::random_pose(rng, far);
+    const PairContext ctx(*a, test::random_pose(rng, 0.5), *b, pose_b, QueryRequest{});
+    BufferedPairs waiting;
+    waiting.batch.size = 1 + p % geometry::TriangleBatch::kLanes;
+    for (int l = 0; l < waiting.batch.size; ++l) {
+      waiting.ta[l] = pick_a(rng);
+      waiting.tb[l] = pick_b(rng);
+    }
+    ctx.gather_corners(waiting);
+    for (int l = 0; l < waiting.batch.size; ++l) {
+      Eigen::Vector3d ga[3], gb[3];
+      waiting.batch.get(l, ga, gb);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d ca = ctx.a().mesh.vertices[ctx.a().mesh.triangles[waiting.ta[l]][k]];
+        const Eigen::Vector3d cb = ctx.b_vertex(waiting.tb[l], k);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_TRUE(same_bits(ca[c], ga[k][c])) << "pose " << p << ", lane " << l << ": A's corner " << k;
+          ASSERT_TRUE(same_bits(cb[c], gb[k][c])) << "pose " << p << ", lane " << l << ": B's corner " << k;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 64 * 9);
+}
+
+}  // namespace
+}  // namespace caliber::narrow
