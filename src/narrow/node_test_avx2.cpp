@@ -171,13 +171,76 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   return ~_mm256_movemask_pd(apart) & 0xF;
 }
 
+/// From lanes (x0, x1, x2, x3): (x2, x3, x0, x1), the halves swapped.
+CALIBER_AVX2 inline __m256d swap_halves(__m256d p) { return _mm256_permute2f128_pd(p, p, 0x01); }
+
+/// node_within_2x2_lanes<false> on a visit where one side descends (a0 = a1 or b0 = b1): its two
+/// pairs P0 = (a0, b0) and P1 = (a1, b1), bits 0 and 3. The nodes are moved as there; each test
+/// that has a side of A's and one of B's (the boxes' axes, the slabs) then runs in one set of
+/// lanes for both sides, where the four-pair form runs two: lanes 0 and 1 hold P0's and P1's test
+/// on A's side, lanes 2 and 3 the same pairs' test on B's side, each lane the four-pair form's
+/// operations on the same values (so the same decisions). The spheres fill P0, P1, P0, P1.
+CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_one_side_lanes(const NodeTestFrame& f, const NodeLanes& l,
+                                                                                  std::uint32_t a0, std::uint32_t a1,
+                                                                                  std::uint32_t b0, std::uint32_t b1) {
+  const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
+  const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
+  const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach), hair = _mm256_set1_pd(f.hair);
+  __m256d n0[4], n1[4], n2[4], f0[4], f1[4];
+  packed_block(na0, na1, nb0, nb1, 0, n0);
+  packed_block(na0, na1, nb0, nb1, 1, n1);
+  packed_block(na0, na1, nb0, nb1, 2, n2);
+  packed_block(fa0, fa1, fb0, fb1, 0, f0);
+  packed_block(fa0, fa1, fb0, fb1, 1, f1);
+  const __m256d center[3] = {n0[0], n0[1], n0[2]}, radius = n0[3];
+  const __m256d box[3] = {n1[0], n1[1], n1[2]}, half[3] = {n1[3], n2[0], n2[1]};
+  const __m256d axis[3] = {f0[0], f0[1], f0[2]}, lo = f1[2], hi = f1[3];
+  // Spheres: A's nodes (lanes 0, 1) against B's moved into A's frame (lanes 2, 3), each half
+  // spread over both halves.
+  __m256d center_rel[3], center_in[3];
+  for (int k = 0; k < 3; ++k) center_rel[k] = sub(center[k], _mm256_loadu_pd(l.pre[k]));
+  for (int k = 0; k < 3; ++k) center_in[k] = add(lane_dot(l.rot, k, center_rel), _mm256_loadu_pd(l.post[k]));
+  __m256d d[3];
+  for (int k = 0; k < 3; ++k) {
+    d[k] = sub(_mm256_permute2f128_pd(center[k], center[k], 0x00), _mm256_permute2f128_pd(center_in[k], center_in[k], 0x11));
+  }
+  const __m256d dist2 = add(add(mul(d[0], d[0]), mul(d[1], d[1])), mul(d[2], d[2]));
+  const __m256d spheres =
+      add(add(_mm256_permute2f128_pd(radius, radius, 0x00), _mm256_permute2f128_pd(radius, radius, 0x11)), reach);
+  __m256d apart = gt(dist2, mul(spheres, spheres));
+  // Boxes: axis k of A (lanes 0, 1: B's box moved into A's frame less A's) and of B (lanes 2, 3:
+  // B's box less A's moved into B's frame), the half-extents as the four-pair form adds them.
+  __m256d box_rel[3], box_in[3], reach_on[3];
+  for (int k = 0; k < 3; ++k) box_rel[k] = sub(box[k], _mm256_loadu_pd(l.pre[k]));
+  for (int k = 0; k < 3; ++k) {
+    box_in[k] = add(lane_dot(l.rot, k, box_rel), _mm256_loadu_pd(l.post[k]));
+    reach_on[k] = lane_dot(l.abs_rot, k, half);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const __m256d from = _mm256_permute2f128_pd(box_in[k], box[k], 0x31), to = _mm256_permute2f128_pd(box[k], box_in[k], 0x20);
+    apart = either(apart, gt(magnitude(sub(from, to)), add(add(half[k], swap_halves(reach_on[k])), reach)));
+  }
+  // Slabs: each node's own slab (lanes 0, 1: A's; 2, 3: B's) against the other pair node's box
+  // moved into its frame.
+  __m256d slab_on[3], other_box[3], other_half[3];
+  for (int k = 0; k < 3; ++k) {
+    slab_on[k] = add(magnitude(lane_dot(l.rot, k, axis)), hair);
+    other_box[k] = swap_halves(box_in[k]);
+    other_half[k] = swap_halves(half[k]);
+  }
+  apart = either(apart, beyond_slab(axis, slab_on, lo, hi, other_box, other_half, slab_reach));
+  const int refused = _mm256_movemask_pd(apart);
+  const int pass = ~(refused | (refused >> 2)) & 0b11;  // bit 0: P0, bit 1: P1
+  return (pass & 1) | ((pass & 2) << 2);
+}
+
 CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                       std::uint32_t b0, std::uint32_t b1) {
   return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
 }
 CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                            std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes<false>(f, l, a0, a1, b0, b1);
+  return node_within_one_side_lanes(f, l, a0, a1, b0, b1);
 }
 
 /// The same code with AVX-512VL's 32 vector registers (the test holds dozens of four-lane values;
@@ -190,7 +253,7 @@ CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, const Node
 }
 CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                                    std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes<false>(f, l, a0, a1, b0, b1);
+  return node_within_one_side_lanes(f, l, a0, a1, b0, b1);
 }
 #undef CALIBER_AVX512VL
 

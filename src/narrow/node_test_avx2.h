@@ -2,8 +2,8 @@
 /// \file
 /// The geometric part of the node test on four node pairs at once, in AVX2: of a visit where both
 /// sides descend (PairContext::node_within's spheres, boxes and slabs, and disks_beyond_slabs), or
-/// without the disks of one where one side descends (its two children against the other node, that
-/// node given twice). The same decisions as the scalar test, bit for bit (each lane does the
+/// without the disks on the two pairs of one where one side descends (its two children against the
+/// other node, that node given twice). The same decisions as the scalar test, bit for bit (each lane does the
 /// scalar test's operations in its order).
 
 #include <cstdint>
@@ -59,8 +59,8 @@ using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, const NodeLanes& lanes
 
 /// The four-lane form compiled for AVX2 (`wide_registers` false) or for AVX-512VL (true: the same
 /// code and operations with 32 vector registers, so fewer spills), or nullptr where this build or
-/// this CPU has none. With `disks` false, the form without the disks (the test of a visit where
-/// one side descends).
+/// this CPU has none. With `disks` false, the test of a visit where one side descends (a0 = a1 or
+/// b0 = b1), without the disks: bits 0 (a0 with b0) and 3 (a1 with b1) alone.
 NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks = true);
 
 /// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else

@@ -65,19 +65,17 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
           }
           if (c != 0) {
             // One side descends: node_tests_one_side's bits 0 and 3 are node_test's on the two
-            // children, and the forms without the disks give node_test's geometry on every lane.
+            // children, and so are the forms' without the disks (those two bits alone).
             const int want = (ctx.node_test(sa[0], sb[0]) ? 1 : 0) | (ctx.node_test(sa[1], sb[1]) ? 8 : 0);
             one_side_passed += want != 0;
             if (ctx.node_tests_one_side(a0, a1, b0, b1) != want && ++differing <= 5) {
               ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": one side";
             }
-            int lanes = 0;
-            for (std::uint32_t k = 0; k < 4; ++k) lanes |= ctx.node_test(sa[k / 2], sb[k % 2]) ? 1 << k : 0;
             for (const bool wide : {false, true}) {
               if (const auto form = detail::node_within_2x2_form(wide, false)) {
                 const int geometric = form(ctx.node_test_frame(), ctx.node_lanes(), a0, a1, b0, b1);
                 ++forms_checked;
-                if ((kind == QueryKind::contact ? (geometric & lanes) != lanes : geometric != lanes) && ++differing <= 5) {
+                if ((kind == QueryKind::contact ? (geometric & want) != want : geometric != want) && ++differing <= 5) {
                   ADD_FAILURE() << "form " << wide << " without disks, kind " << static_cast<int>(kind) << " pose " << p
                                 << " case " << c;
                 }
