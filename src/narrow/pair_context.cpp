@@ -84,22 +84,42 @@ bool PairContext::node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
   return node_test_2x2_lane(a, b);
 }
 
+namespace {
+/// The four-lane forms this CPU runs (with and without the disks), chosen when the library loads:
+/// a function's own static would be checked, behind a frame, at every call. (Null before that, or
+/// where the CPU has no AVX2: the scalar forms, the same decisions.)
+const detail::NodeWithin2x2 kWithin2x2 = detail::node_within_2x2_avx2_if_supported();
+const detail::NodeWithin2x2 kWithinOneSide = detail::node_within_2x2_avx2_if_supported(false);
+
+}  // namespace
+
 int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
                                 const detail::NodeLanes* lanes) const {
-  static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported();
-  if (within == nullptr) return node_tests_2x2_scalar(a0, a1, b0, b1);
-  const int pass =
-      lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1) : within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return refuses_by_groups_or_cones() ? groups_and_cones(pass, a0, a1, b0, b1) : pass;
+  // Without groups or cones (a traversal's common case), the form's bits are the answer: a tail
+  // call, the other cases out of line so that this path sets up no frame.
+  const detail::NodeWithin2x2 within = kWithin2x2;
+  if (within != nullptr && lanes != nullptr && !refuses_by_groups_or_cones()) return within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  return node_tests_otherwise(within, a0, a1, b0, b1, lanes);
 }
 
 int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
                                      const detail::NodeLanes* lanes) const {
-  static const detail::NodeWithin2x2 within = detail::node_within_2x2_avx2_if_supported(false);
-  if (within == nullptr) return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
-  const int pass =
-      lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1) : within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return refuses_by_groups_or_cones() ? groups_and_cones(pass & 0b1001, a0, a1, b0, b1) : pass & 0b1001;
+  // The form sets bits 0 and 3 alone. As node_tests_2x2.
+  const detail::NodeWithin2x2 within = kWithinOneSide;
+  if (within != nullptr && lanes != nullptr && !refuses_by_groups_or_cones()) return within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  return node_tests_otherwise(within, a0, a1, b0, b1, lanes);
+}
+
+[[gnu::noinline]] int PairContext::node_tests_otherwise(detail::NodeWithin2x2 within, std::uint32_t a0, std::uint32_t a1,
+                                                        std::uint32_t b0, std::uint32_t b1,
+                                                        const detail::NodeLanes* lanes) const {
+  if (within == nullptr) {
+    if (a0 != a1 && b0 != b1) return node_tests_2x2_scalar(a0, a1, b0, b1);
+    return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
+  }
+  const int pass = lanes == nullptr ? within(mNodeFrame, detail::make_lanes(mNodeFrame), a0, a1, b0, b1)
+                                    : within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  return refuses_by_groups_or_cones() ? groups_and_cones(pass, a0, a1, b0, b1) : pass;
 }
 
 int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {

@@ -74,7 +74,6 @@ class PairContext {
     s.slab_hi = f.slab_hi;
     return s;
   }
-
   /// Prepares node ib of B for node tests.
   [[nodiscard]] SideB prepare_b(std::uint32_t ib) const {
     SideB s;
@@ -89,12 +88,10 @@ class PairContext {
     s.slab_hi = f.slab_hi;
     return s;
   }
-
   /// Adds its disk to a prepared node of A (for node_test_2x2_lane).
   void prepare_disk_a(SideA& s) const;
   /// Adds its disk to a prepared node of B (its sphere's center in B's own frame).
   void prepare_disk_b(SideB& s) const;
-
   /// The node-node test on prepared nodes: spheres within the tolerance, boxes not separated by a
   /// face axis, each box not separated from the other node's slab, some compatible groups, normal
   /// cones able to face each other (contact only). (node_test_2x2_lane adds the disks.)
@@ -179,7 +176,6 @@ class PairContext {
     s.frame = own_frame(mA, ia, computed);
     return s;
   }
-
   /// Prepares node ib of B for the distance bound.
   [[nodiscard]] NearB near_b(std::uint32_t ib) const {
     NearB s;
@@ -271,10 +267,13 @@ class PairContext {
   /// of 1e-12 of it, a thousand times the few ulps (~1e-15 relative) its rounding costs.
   static constexpr double kAbsoluteShare = 1e-3;
 
-  /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse: called only
-  /// where some can (checked inline by the callers, so that a visit without them makes no call).
+  /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse (where some can).
   [[nodiscard]] int groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
   [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }
+  /// node_tests_2x2 or node_tests_one_side (a0 = a1 or b0 = b1) with its form `within` (or none) where
+  /// the lanes are not given or groups or cones may refuse.
+  [[nodiscard]] int node_tests_otherwise(detail::NodeWithin2x2 within, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
+                                         std::uint32_t b1, const detail::NodeLanes* lanes) const;
   /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
   [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
     double dist2 = 0.0;
