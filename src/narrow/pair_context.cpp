@@ -234,10 +234,8 @@ bool finish_leaf(std::uint32_t ta, std::uint32_t tb, const Eigen::Vector3d a[3],
 /// Whether leaf tests decide "do they meet" with triangles_intersect_batch (interference pairs
 /// waiting for it, buffered closest points): where it has lanes, AVX-512 or AVX2 (pair by pair,
 /// the batch would only add copies).
-bool intersect_in_batches() {
-  static const bool lanes = geometry::detail::triangles_intersect_batch_lanes_if_supported() != nullptr;
-  return lanes;
-}
+const bool kIntersectInBatches = geometry::detail::triangles_intersect_batch_lanes_if_supported() != nullptr;
+bool intersect_in_batches() { return kIntersectInBatches; }
 }  // namespace
 
 template <class Keep>
@@ -283,7 +281,7 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     }
     // leaf_test's steps up to the exact test, which waits for the batch; the corners are read
     // when it is full (gather_corners), eight pairs' at once.
-    if (!groups_allow(ta, tb)) return;
+    if (mGroups != nullptr && !groups_allow(ta, tb)) return;
     BufferedPairs& waiting = buffer.refusal;
     waiting.ta[waiting.batch.size] = ta;
     waiting.tb[waiting.batch.size] = tb;
