@@ -81,6 +81,35 @@ CALIBER_AVX2 inline __m256d lane_dot(const double m[3][3][4], int k, const __m25
   return add(add(mul(_mm256_loadu_pd(m[k][0]), x[0]), mul(_mm256_loadu_pd(m[k][1]), x[1])), mul(_mm256_loadu_pd(m[k][2]), x[2]));
 }
 
+/// The four nodes' floats (a0, a1, b0, b1: a node per lane): sphere center and radius; box center
+/// and half-extents; cone axis; slab.
+struct FourNodes {
+  __m256d center[3], radius, box[3], half[3], axis[3], lo, hi;
+
+  CALIBER_AVX2 __attribute__((always_inline))
+  FourNodes(const NodeTestFrame& f, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) {
+    const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
+    const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
+    __m256d n0[4], n1[4], n2[4], f0[4], f1[4];
+    packed_block(na0, na1, nb0, nb1, 0, n0);
+    packed_block(na0, na1, nb0, nb1, 1, n1);
+    packed_block(na0, na1, nb0, nb1, 2, n2);
+    packed_block(fa0, fa1, fb0, fb1, 0, f0);
+    packed_block(fa0, fa1, fb0, fb1, 1, f1);
+    for (int k = 0; k < 3; ++k) {
+      center[k] = n0[k];
+      box[k] = n1[k];
+      axis[k] = f0[k];
+    }
+    radius = n0[3];
+    half[0] = n1[3];
+    half[1] = n2[0];
+    half[2] = n2[1];
+    lo = f1[2];
+    hi = f1[3];
+  }
+};
+
 /// PairContext::prepare_a / prepare_b (with their disks) and node_within with disks_beyond_slabs
 /// on the four node pairs, lane by lane the scalar code's operations in its order (fill_a, fill_b,
 /// box_beyond_slab, disk_beyond_slab); without the disks (kDisks false), node_within's geometry
@@ -91,20 +120,10 @@ template <bool kDisks>
 CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(const NodeTestFrame& f, const NodeLanes& l,
                                                                              std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                                                                              std::uint32_t b1) {
-  const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
-  const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
   const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach), hair = _mm256_set1_pd(f.hair);
-  // The four nodes' floats, a node per lane: center and radius; box center and half-extents;
-  // cone axis; slab.
-  __m256d n0[4], n1[4], n2[4], f0[4], f1[4];
-  packed_block(na0, na1, nb0, nb1, 0, n0);
-  packed_block(na0, na1, nb0, nb1, 1, n1);
-  packed_block(na0, na1, nb0, nb1, 2, n2);
-  packed_block(fa0, fa1, fb0, fb1, 0, f0);
-  packed_block(fa0, fa1, fb0, fb1, 1, f1);
-  const __m256d center[3] = {n0[0], n0[1], n0[2]}, radius = n0[3];
-  const __m256d box[3] = {n1[0], n1[1], n1[2]}, half[3] = {n1[3], n2[0], n2[1]};
-  const __m256d axis[3] = {f0[0], f0[1], f0[2]}, lo = f1[2], hi = f1[3];
+  const FourNodes nodes(f, a0, a1, b0, b1);
+  const __m256d(&center)[3] = nodes.center, radius = nodes.radius, (&box)[3] = nodes.box, (&half)[3] = nodes.half;
+  const __m256d(&axis)[3] = nodes.axis, lo = nodes.lo, hi = nodes.hi;
   // Each node in the other's frame (A's: x_b = R^T (x_a - T); B's: R x_b + T), each part just
   // before the tests that read it (shorter lives, fewer spills): B's sphere center (and A's center
   // less T, the disk's), then box center and reach of the half-extents, then slab axis.
@@ -183,18 +202,10 @@ CALIBER_AVX2 inline __m256d swap_halves(__m256d p) { return _mm256_permute2f128_
 CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_one_side_lanes(const NodeTestFrame& f, const NodeLanes& l,
                                                                                   std::uint32_t a0, std::uint32_t a1,
                                                                                   std::uint32_t b0, std::uint32_t b1) {
-  const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
-  const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
   const __m256d reach = _mm256_set1_pd(f.reach), slab_reach = _mm256_set1_pd(f.slab_reach), hair = _mm256_set1_pd(f.hair);
-  __m256d n0[4], n1[4], n2[4], f0[4], f1[4];
-  packed_block(na0, na1, nb0, nb1, 0, n0);
-  packed_block(na0, na1, nb0, nb1, 1, n1);
-  packed_block(na0, na1, nb0, nb1, 2, n2);
-  packed_block(fa0, fa1, fb0, fb1, 0, f0);
-  packed_block(fa0, fa1, fb0, fb1, 1, f1);
-  const __m256d center[3] = {n0[0], n0[1], n0[2]}, radius = n0[3];
-  const __m256d box[3] = {n1[0], n1[1], n1[2]}, half[3] = {n1[3], n2[0], n2[1]};
-  const __m256d axis[3] = {f0[0], f0[1], f0[2]}, lo = f1[2], hi = f1[3];
+  const FourNodes nodes(f, a0, a1, b0, b1);
+  const __m256d(&center)[3] = nodes.center, radius = nodes.radius, (&box)[3] = nodes.box, (&half)[3] = nodes.half;
+  const __m256d(&axis)[3] = nodes.axis, lo = nodes.lo, hi = nodes.hi;
   // Spheres: A's nodes (lanes 0, 1) against B's moved into A's frame (lanes 2, 3), each half
   // spread over both halves.
   __m256d center_rel[3], center_in[3];
