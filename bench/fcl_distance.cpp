@@ -29,6 +29,7 @@
 
 #include "caliber/model.h"
 #include "caliber/query.h"
+#include "geometry/rigid_move.h"
 #include "geometry/triangle_distance.h"
 #include "fcl_support.h"
 #include "machine.h"
@@ -129,11 +130,10 @@ Row run(const Case& c, double gap, const Model& a, const Model& b, const std::sh
   // lowest ids: FCL's pair agrees when our kernel gives it our distance.
   const auto& ta = a.mesh().triangles[static_cast<std::size_t>(fres.b1)];
   const auto& tb = b.mesh().triangles[static_cast<std::size_t>(fres.b2)];
-  const Eigen::Matrix3d rb = pose_b.rotation_matrix();
+  // B's corners in A's frame (A at the identity) as the query moves them (PairContext::b_vertex).
+  const geometry::RigidMove move(pose_b.rotation_matrix(), pose_b.translation);
   const Eigen::Vector3d va[3] = {a.mesh().vertices[ta[0]], a.mesh().vertices[ta[1]], a.mesh().vertices[ta[2]]};
-  const Eigen::Vector3d vb[3] = {rb * b.mesh().vertices[tb[0]] + pose_b.translation,
-                                 rb * b.mesh().vertices[tb[1]] + pose_b.translation,
-                                 rb * b.mesh().vertices[tb[2]] + pose_b.translation};
+  const Eigen::Vector3d vb[3] = {move(b.mesh().vertices[tb[0]]), move(b.mesh().vertices[tb[1]]), move(b.mesh().vertices[tb[2]])};
   row.same_pair = geometry::closest_points_triangles(va, vb).distance == row.ours;
   fcl_counts(*fa, *fb, pose_b, freq, row);
   return row;

@@ -99,7 +99,7 @@ int PairContext::node_tests_2x2(std::uint32_t a0, std::uint32_t a1, std::uint32_
   // call, the other cases out of line so that this path sets up no frame.
   const detail::NodeWithin2x2 within = kWithin2x2;
   if (within != nullptr && lanes != nullptr && !refuses_by_groups_or_cones()) return within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return node_tests_otherwise(within, a0, a1, b0, b1, lanes);
+  return node_tests_otherwise(within, false, a0, a1, b0, b1, lanes);
 }
 
 int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
@@ -107,14 +107,14 @@ int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::ui
   // The form sets bits 0 and 3 alone. As node_tests_2x2.
   const detail::NodeWithin2x2 within = kWithinOneSide;
   if (within != nullptr && lanes != nullptr && !refuses_by_groups_or_cones()) return within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return node_tests_otherwise(within, a0, a1, b0, b1, lanes);
+  return node_tests_otherwise(within, true, a0, a1, b0, b1, lanes);
 }
 
-[[gnu::noinline]] int PairContext::node_tests_otherwise(detail::NodeWithin2x2 within, std::uint32_t a0, std::uint32_t a1,
-                                                        std::uint32_t b0, std::uint32_t b1,
+[[gnu::noinline]] int PairContext::node_tests_otherwise(detail::NodeWithin2x2 within, bool one_side, std::uint32_t a0,
+                                                        std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
                                                         const detail::NodeLanes* lanes) const {
   if (within == nullptr) {
-    if (a0 != a1 && b0 != b1) return node_tests_2x2_scalar(a0, a1, b0, b1);
+    if (!one_side) return node_tests_2x2_scalar(a0, a1, b0, b1);
     return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
   }
   const int pass = lanes == nullptr ? within(mNodeFrame, detail::make_lanes(mNodeFrame), a0, a1, b0, b1)
@@ -312,6 +312,7 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
 
 void PairContext::gather_corners(BufferedPairs& waiting) const {
   const int n = waiting.batch.size;
+  if (n == 0) return;  // no ids to read (the lanes past n repeat lane 0's)
   // The triangles' corner ids, then their corners, asked of memory for every pair before any is
   // read: the misses overlap rather than follow one another.
   for (int l = 0; l < n; ++l) {

@@ -270,10 +270,10 @@ class PairContext {
   /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse (where some can).
   [[nodiscard]] int groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
   [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }
-  /// node_tests_2x2 or node_tests_one_side (a0 = a1 or b0 = b1) with its form `within` (or none) where
-  /// the lanes are not given or groups or cones may refuse.
-  [[nodiscard]] int node_tests_otherwise(detail::NodeWithin2x2 within, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
-                                         std::uint32_t b1, const detail::NodeLanes* lanes) const;
+  /// node_tests_2x2 (or, `one_side`, node_tests_one_side) with its form `within` (or none) where the
+  /// lanes are not given or groups or cones may refuse.
+  [[nodiscard]] int node_tests_otherwise(detail::NodeWithin2x2 within, bool one_side, std::uint32_t a0, std::uint32_t a1,
+                                         std::uint32_t b0, std::uint32_t b1, const detail::NodeLanes* lanes) const;
   /// Spheres, boxes, slabs and groups within `reach` (slabs: `slab_reach`).
   [[nodiscard]] bool node_within(const SideA& a, const SideB& b, double reach, double slab_reach) const {
     double dist2 = 0.0;

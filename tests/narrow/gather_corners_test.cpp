@@ -56,5 +56,16 @@ TEST(GatherCorners, SameBitsAsCorners) {
   EXPECT_GT(compared, 64 * 9);
 }
 
+TEST(GatherCorners, AnEmptyBatchReadsNothing) {
+  const auto a = build_model(make_box(1.0, 1.0, 1.0, 2));
+  const PairContext ctx(*a, Pose{}, *a, Pose{}, QueryRequest{});
+  BufferedPairs waiting;
+  // Ids no mesh has: an empty batch must not read them (ASan would see the read).
+  for (int l = 0; l < geometry::TriangleBatch::kLanes; ++l) waiting.ta[l] = waiting.tb[l] = 0xFFFFFFF0u;
+  waiting.batch.size = 0;
+  ctx.gather_corners(waiting);
+  EXPECT_EQ(waiting.batch.size, 0);
+}
+
 }  // namespace
 }  // namespace caliber::narrow

@@ -52,6 +52,12 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
             ctx.prepare_disk_b(sb[i]);
           }
           const int mask = ctx.node_tests_2x2(a0, a1, b0, b1);
+          // With the lanes a traversal makes once (the call without groups or cones goes straight
+          // to the form): the same bits.
+          const detail::NodeLanes lanes = ctx.node_lanes();
+          if (ctx.node_tests_2x2(a0, a1, b0, b1, &lanes) != mask && ++differing <= 5) {
+            ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": with lanes";
+          }
           // Both four-lane forms (AVX2, AVX-512VL registers) where this CPU has them: their
           // geometric mask is the node test's, less groups and cones (none here but contact's).
           for (const bool wide : {false, true}) {
@@ -68,7 +74,8 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
             // children, and so are the forms' without the disks (those two bits alone).
             const int want = (ctx.node_test(sa[0], sb[0]) ? 1 : 0) | (ctx.node_test(sa[1], sb[1]) ? 8 : 0);
             one_side_passed += want != 0;
-            if (ctx.node_tests_one_side(a0, a1, b0, b1) != want && ++differing <= 5) {
+            if ((ctx.node_tests_one_side(a0, a1, b0, b1) != want || ctx.node_tests_one_side(a0, a1, b0, b1, &lanes) != want) &&
+                ++differing <= 5) {
               ADD_FAILURE() << "kind " << static_cast<int>(kind) << " pose " << p << " case " << c << ": one side";
             }
             for (const bool wide : {false, true}) {
