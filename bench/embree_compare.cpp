@@ -62,9 +62,7 @@ caliber::Pose place(const Case& c, const caliber::Mesh& a, const caliber::Mesh& 
   return caliber::Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
 }
 
-/// B's vertices in A's frame (A is at the identity), computed as caliber's leaf test computes them
-/// (PairContext::b_vertex: geometry::RigidMove of the rotation matrix and the translation), so both
-/// test the same bits.
+/// B's vertices in A's frame (A at the identity) as the leaf test moves them (b_vertex): the same bits.
 Vertices posed(const caliber::Mesh& m, const caliber::Pose& pose) {
   const caliber::geometry::RigidMove move(pose.rotation_matrix(), pose.translation);
   Vertices out(m.vertices.size());
