@@ -3,9 +3,9 @@
 /// Leaf tests waiting for the batch kernels: the pairs of one traversal that passed the leaf
 /// test's first checks wait for the refusal test (geometry::triangles_apart_batch), those it does
 /// not refuse for their closest points (geometry::closest_points_triangles_batch), eight at a time
-/// (PairContext::leaf_test with a buffer, PairContext::flush_leaves). Interference pairs wait in
-/// `refusal` as ids alone for geometry::triangles_intersect_batch, their corners read when the
-/// batch is full (PairContext::gather_corners).
+/// (PairContext::leaf_test with a buffer, PairContext::flush_leaves). Pairs wait in `refusal` as
+/// ids alone, their corners read when the batch is full (PairContext::gather_corners), for
+/// geometry::triangles_intersect_batch (interference) or the refusal test.
 
 #include <cstdint>
 
@@ -19,11 +19,6 @@ struct BufferedPairs {
   std::uint32_t ta[geometry::TriangleBatch::kLanes];  ///< the triangles of A
   std::uint32_t tb[geometry::TriangleBatch::kLanes];  ///< the triangles of B
 
-  void add(std::uint32_t a_id, std::uint32_t b_id, const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]) {
-    ta[batch.size] = a_id;
-    tb[batch.size] = b_id;
-    batch.add(a, b);
-  }
   /// Appends pair `lane` of `from`.
   void add(const BufferedPairs& from, int lane) {
     ta[batch.size] = from.ta[lane];

@@ -284,12 +284,13 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
     return;
   }
-  // leaf_within's steps up to the refusal, which waits for the batch.
-  if (!normals_allow(ta, tb) || !groups_allow(ta, tb)) return;
-  Eigen::Vector3d a[3], b[3];
-  corners(ta, tb, a, b);
-  buffer.refusal.add(ta, tb, a, b);
-  if (buffer.refusal.batch.full()) refuse_buffered(buffer, out);
+  // leaf_within's steps up to the refusal, which waits for the batch; the corners are read when it
+  // is full, as above.
+  if (!normals_allow(ta, tb) || (mGroups != nullptr && !groups_allow(ta, tb))) return;
+  BufferedPairs& waiting = buffer.refusal;
+  waiting.ta[waiting.batch.size] = ta;
+  waiting.tb[waiting.batch.size] = tb;
+  if (++waiting.batch.size == geometry::TriangleBatch::kLanes) refuse_buffered(buffer, out);
 }
 
 void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
@@ -297,6 +298,7 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
     intersect_buffered(buffer.refusal, out);
     return;
   }
+  gather_corners(buffer.refusal);
   const unsigned apart = geometry::triangles_apart_batch(buffer.refusal.batch, mReach);
   for (int l = 0; l < buffer.refusal.batch.size; ++l) {
     if ((apart >> l) & 1u) continue;
