@@ -268,9 +268,14 @@ CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, const
 }
 #undef CALIBER_AVX512VL
 
-#undef CALIBER_AVX2
-
 }  // namespace
+
+CALIBER_AVX2 int node_within_2x2_double(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                        std::uint32_t b0, std::uint32_t b1) {
+  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
+}
+
+#undef CALIBER_AVX2
 
 NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks) {
   __builtin_cpu_init();
@@ -283,6 +288,7 @@ NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks) {
 }
 
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks) {
+  if (disks && node_within_2x2_float_form() != nullptr) return node_within_2x2_float_form();
   const NodeWithin2x2 wide = node_within_2x2_form(true, disks);
   return wide != nullptr ? wide : node_within_2x2_form(false, disks);
 }
@@ -293,6 +299,9 @@ NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks) {
 
 namespace caliber::narrow::detail {
 NodeWithin2x2 node_within_2x2_form(bool, bool) { return nullptr; }
+int node_within_2x2_double(const NodeTestFrame&, const NodeLanes&, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t) {
+  return 0xF;
+}
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool) { return nullptr; }
 }  // namespace caliber::narrow::detail
 

@@ -28,13 +28,37 @@ struct NodeTestFrame {
 /// A's lanes and rot[k][j] in B's (abs_rot likewise); a point x goes to rot (x - pre) + post, pre
 /// being the frame's trans in A's lanes and 0 in B's, post 0 in A's and trans in B's (each lane
 /// the scalar test's operations: x - 0 and y + 0 are x and y). Made by make_lanes, once per
-/// traversal (768 bytes: not kept in the pair context, which the engine holds for every pair).
+/// traversal (1,600 bytes: not kept in the pair context, which the engine holds for every pair).
 struct NodeLanes {
   double rot[3][3][4], abs_rot[3][3][4], pre[3][4], post[3][4];
+  /// The float pre-decision (node_test_float.cpp): eight lanes that move [sphere centers | box
+  /// centers] (`move`: rot's lanes twice, with pre8 and post8) and turn [half-extents | slab axes]
+  /// (`turn`: abs_rot's lanes, then rot's), each value the double one rounded to float.
+  alignas(32) float move[3][3][8];
+  alignas(32) float turn[3][3][8];
+  alignas(32) float pre8[3][8];
+  alignas(32) float post8[3][8];
+  /// The thresholds of the float comparisons, each the double one less (lo) and plus (hi) a slack
+  /// far above the float rounding (FloatSlack): the boxes' reach, the slabs' slab_reach, the
+  /// spheres' reach (twice the slack); then slab_reach, the disks' slack on their gaps and on the
+  /// squared sine between slab axes (cross), and hair. `floats` is false where the scale is too
+  /// large or small for float's range: the double form alone.
+  float reach_lo, reach_hi, slab_lo, slab_hi, sphere_lo, sphere_hi, slab, disk_slack, cross_slack, hair;
+  bool floats;
 };
 
-/// The lanes of frame f's pose.
-inline NodeLanes make_lanes(const NodeTestFrame& f) {
+/// The float pre-decision's slacks: 2^-15 of the scale on every linear quantity (512 times
+/// float's unit roundoff of the scale; the rounding of the quantities compared adds up to about
+/// 160 of it at most), twice that on the spheres' and the disks' distances, 2^-14 on the squared
+/// sine (the rounding: about 100 unit roundoffs); the range of scales where floats are used.
+struct FloatSlack {
+  static constexpr double kShare = 0x1p-15, kCross = 0x1p-14, kLeast = 1e-12, kMost = 1e12;
+};
+
+/// The lanes of frame f's pose. `scale`: a bound on the magnitude of every coordinate, extent,
+/// reach and slab bound the test computes with (the extents about the volume origins, the distance
+/// between those, the slab reach), which sets the float pre-decision's slack.
+inline NodeLanes make_lanes(const NodeTestFrame& f, double scale) {
   NodeLanes l;
   for (int k = 0; k < 3; ++k) {
     for (int j = 0; j < 3; ++j) {
@@ -48,6 +72,30 @@ inline NodeLanes make_lanes(const NodeTestFrame& f) {
       l.post[k][i] = i < 2 ? 0.0 : f.trans[k];
     }
   }
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 8; ++i) {
+        l.move[k][j][i] = static_cast<float>(l.rot[k][j][i % 4]);
+        l.turn[k][j][i] = static_cast<float>(i < 4 ? l.abs_rot[k][j][i] : l.rot[k][j][i - 4]);
+      }
+    }
+    for (int i = 0; i < 8; ++i) {
+      l.pre8[k][i] = static_cast<float>(l.pre[k][i % 4]);
+      l.post8[k][i] = static_cast<float>(l.post[k][i % 4]);
+    }
+  }
+  const double slack = FloatSlack::kShare * scale;
+  l.floats = scale >= FloatSlack::kLeast && scale <= FloatSlack::kMost;
+  l.reach_lo = static_cast<float>(f.reach - slack);
+  l.reach_hi = static_cast<float>(f.reach + slack);
+  l.slab_lo = static_cast<float>(f.slab_reach - slack);
+  l.slab_hi = static_cast<float>(f.slab_reach + slack);
+  l.sphere_lo = static_cast<float>(f.reach - 2.0 * slack);
+  l.sphere_hi = static_cast<float>(f.reach + 2.0 * slack);
+  l.slab = static_cast<float>(f.slab_reach);
+  l.disk_slack = static_cast<float>(2.0 * slack);
+  l.cross_slack = static_cast<float>(FloatSlack::kCross);
+  l.hair = static_cast<float>(f.hair);
   return l;
 }
 
@@ -66,5 +114,20 @@ NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks = true);
 /// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else
 /// nullptr.
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks = true);
+
+/// The four-pair form with the disks in AVX2, double precision (node_within_2x2_form(false)'s).
+int node_within_2x2_double(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,
+                           std::uint32_t b0, std::uint32_t b1);
+
+/// The float pre-decision of the four-pair form with the disks (node_test_float.cpp): sets bit k
+/// of `pass` where pair k surely passes, of `unsure` where the float rounding leaves the double
+/// form's decision in doubt (neither bit: it surely fails). Needs AVX2 and lanes.floats.
+void node_within_2x2_float_bits(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,
+                                std::uint32_t b0, std::uint32_t b1, int& pass, int& unsure);
+
+/// The four-pair form the node test runs on an AVX2 CPU without AVX-512VL: the float pre-decision,
+/// and the double form where some pair is in doubt (or lanes.floats is false). The double form's
+/// decisions, bit for bit. nullptr where the CPU has no AVX2.
+NodeWithin2x2 node_within_2x2_float_form();
 
 }  // namespace caliber::narrow::detail

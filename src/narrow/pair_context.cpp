@@ -113,7 +113,7 @@ int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::ui
     if (!one_side) return node_tests_2x2_scalar(a0, a1, b0, b1);
     return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
   }
-  const int pass = lanes == nullptr ? within(mNodeFrame, detail::make_lanes(mNodeFrame), a0, a1, b0, b1)
+  const int pass = lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1)
                                     : within(mNodeFrame, *lanes, a0, a1, b0, b1);
   return refuses_by_groups_or_cones() ? groups_and_cones(pass, a0, a1, b0, b1) : pass;
 }

@@ -26,6 +26,7 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
   std::mt19937_64 rng(20261125);
   long passed = 0, failed = 0, differing = 0, by_disks = 0, forms_checked = 0, one_side_passed = 0;
+  long float_sure = 0, float_unsure = 0;
   for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity, QueryKind::contact}) {
     QueryRequest request;
     request.kind = kind;
@@ -67,6 +68,17 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
               if ((kind == QueryKind::contact ? (geometric & mask) != mask : geometric != mask) && ++differing <= 5) {
                 ADD_FAILURE() << "form " << wide << " kind " << static_cast<int>(kind) << " pose " << p << " case " << c;
               }
+            }
+          }
+          // The float pre-decision: where it is sure, the double form's bits.
+          if (c == 0 && lanes.floats && detail::node_within_2x2_float_form() != nullptr) {
+            int pass = 0, unsure = 0;
+            detail::node_within_2x2_float_bits(ctx.node_test_frame(), lanes, a0, a1, b0, b1, pass, unsure);
+            const int geometric = detail::node_within_2x2_double(ctx.node_test_frame(), lanes, a0, a1, b0, b1);
+            float_unsure += unsure != 0;
+            float_sure += 4 - __builtin_popcount(static_cast<unsigned>(unsure));
+            if ((pass & ~unsure) != (geometric & ~unsure) && ++differing <= 5) {
+              ADD_FAILURE() << "float pre-decision, kind " << static_cast<int>(kind) << " pose " << p;
             }
           }
           if (c != 0) {
@@ -114,6 +126,27 @@ TEST(NodeTests2x2, SameDecisionsAsNodeTest) {
   EXPECT_GT(by_disks, 1000) << "the disks refuse some pairs the rest of the test lets through";
   EXPECT_GT(one_side_passed, 1000) << "visits where one side descends pass some children";
   if (detail::node_within_2x2_form(false) != nullptr) EXPECT_GT(forms_checked, 10000);
+  if (detail::node_within_2x2_float_form() != nullptr) {
+    // The float test decides most pairs, and leaves some visits to the double form.
+    EXPECT_GT(float_sure, 10000);
+    EXPECT_GT(float_unsure, 0);
+  }
+}
+
+// Beyond the scales float's range covers, the lanes leave every visit to the double form, whose
+// decisions the traversal then gets (pairs 1e13 apart in a scene of 1e13: the same bits as the
+// scalar test).
+TEST(NodeTests2x2, FarScalesUseTheDoubleForm) {
+  const auto a = build_model(make_torus(1.0, 0.35, 16, 12));
+  QueryRequest request;
+  const PairContext near(*a, Pose{}, *a, Pose::from_values(0.5, 0, 0, 1, 0, 0, 0), request);
+  EXPECT_TRUE(near.node_lanes().floats);
+  const PairContext far(*a, Pose{}, *a, Pose::from_values(1e13, 0, 0, 1, 0, 0, 0), request);
+  const detail::NodeLanes lanes = far.node_lanes();
+  EXPECT_FALSE(lanes.floats);
+  const BvhNode& root = data(*a).nodes[0];
+  const std::uint32_t c = root.index;
+  EXPECT_EQ(far.node_tests_2x2(c, c + 1, c, c + 1, &lanes), far.node_tests_2x2_scalar(c, c + 1, c, c + 1));
 }
 
 // narrow::visit takes a node's children that pass in cd_children order, each decided as child_test
