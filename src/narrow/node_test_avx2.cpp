@@ -8,6 +8,7 @@
 #include <immintrin.h>
 
 #include <cstddef>
+#include <numbers>
 
 namespace caliber::narrow::detail {
 namespace {
@@ -112,11 +113,9 @@ struct FourNodes {
 
 /// PairContext::prepare_a / prepare_b (with their disks) and node_within with disks_beyond_slabs
 /// on the four node pairs, lane by lane the scalar code's operations in its order (fill_a, fill_b,
-/// box_beyond_slab, disk_beyond_slab); without the disks (kDisks false), node_within's geometry
-/// alone. What each node brings into the other's frame is computed once, for a0, a1, b0 and b1 in
-/// four lanes (NodeLanes), then spread to the pairs' lanes where it is read. Inlined into the forms
-/// below.
-template <bool kDisks>
+/// box_beyond_slab, disk_beyond_slab). What each node brings into the other's frame is computed
+/// once, for a0, a1, b0 and b1 in four lanes (NodeLanes), then spread to the pairs' lanes where it
+/// is read. Inlined into the forms below.
 CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(const NodeTestFrame& f, const NodeLanes& l,
                                                                              std::uint32_t a0, std::uint32_t a1, std::uint32_t b0,
                                                                              std::uint32_t b1) {
@@ -167,7 +166,6 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
   const __m256d a_lo = lanes_a(lo), a_hi = lanes_a(hi), b_lo = lanes_b(lo), b_hi = lanes_b(hi);
   apart = either(apart, beyond_slab(a_axis, a_slab_on_b, a_lo, a_hi, b_box_in_a, b_half, slab_reach));
   apart = either(apart, beyond_slab(b_axis, b_slab_on_a, b_lo, b_hi, a_box_in_b, a_half, slab_reach));
-  if constexpr (!kDisks) return ~_mm256_movemask_pd(apart) & 0xF;
   // The disks (PairContext::prepare_disk_a, prepare_disk_b, narrow::disks_beyond_slabs): each
   // node's slab about its own sphere's center, and its axis's squared length.
   const __m256d mid = dot3(axis, center), len2 = dot3(axis, axis);
@@ -193,7 +191,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
 /// From lanes (x0, x1, x2, x3): (x2, x3, x0, x1), the halves swapped.
 CALIBER_AVX2 inline __m256d swap_halves(__m256d p) { return _mm256_permute2f128_pd(p, p, 0x01); }
 
-/// node_within_2x2_lanes<false> on a visit where one side descends (a0 = a1 or b0 = b1): its two
+/// node_within_2x2_lanes without the disks on a visit where one side descends (a0 = a1 or b0 = b1): its two
 /// pairs P0 = (a0, b0) and P1 = (a1, b1), bits 0 and 3. The nodes are moved as there; each test
 /// that has a side of A's and one of B's (the boxes' axes, the slabs) then runs in one set of
 /// lanes for both sides, where the four-pair form runs two: lanes 0 and 1 hold P0's and P1's test
@@ -247,7 +245,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_one_side_lane
 
 CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                       std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
+  return node_within_2x2_lanes(f, l, a0, a1, b0, b1);
 }
 CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                            std::uint32_t b0, std::uint32_t b1) {
@@ -260,7 +258,7 @@ CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLan
 #define CALIBER_AVX512VL __attribute__((target("avx2,avx512f,avx512vl")))
 CALIBER_AVX512VL int node_within_2x2_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                               std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
+  return node_within_2x2_lanes(f, l, a0, a1, b0, b1);
 }
 CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                                    std::uint32_t b0, std::uint32_t b1) {
@@ -268,11 +266,36 @@ CALIBER_AVX512VL int node_within_one_side_avx512vl(const NodeTestFrame& f, const
 }
 #undef CALIBER_AVX512VL
 
+/// PairContext::cones_can_face on the four pairs (a0 b0, a0 b1, a1 b0, a1 b1), its operations in
+/// its order in each lane: B's axis moved into A's frame (row k of the pose, left to right), its
+/// dot product with A's, the angles' sum and the cosine of the widest angle that can face.
+CALIBER_AVX2 int cones_face_2x2_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
+                                     std::uint32_t b0, std::uint32_t b1, const ConeAngle& angle) {
+  __m256d f0[4], f1[4];
+  packed_block(f.filters_a[a0], f.filters_a[a1], f.filters_b[b0], f.filters_b[b1], 0, f0);  // axis, angle
+  packed_block(f.filters_a[a0], f.filters_a[a1], f.filters_b[b0], f.filters_b[b1], 1, f1);  // cos, sin
+  __m256d axis_a[3], moved_b[3];
+  for (int k = 0; k < 3; ++k) {
+    axis_a[k] = lanes_a(f0[k]);
+    moved_b[k] = lanes_b(lane_dot(l.rot, k, f0));  // in B's lanes, row k of the pose
+  }
+  const __m256d facing = _mm256_xor_pd(dot3(axis_a, moved_b), _mm256_set1_pd(-0.0));
+  const __m256d angle_a = lanes_a(f0[3]), angle_b = lanes_b(f0[3]), zero = _mm256_setzero_pd();
+  const __m256d degenerate = either(lt(angle_a, zero), lt(angle_b, zero));
+  const __m256d total = add(add(angle_a, angle_b), _mm256_set1_pd(angle.theta));
+  const __m256d wide = _mm256_cmp_pd(total, _mm256_set1_pd(std::numbers::pi), _CMP_GE_OQ);
+  const __m256d ca = lanes_a(f1[0]), sa = lanes_a(f1[1]), cb = lanes_b(f1[0]), sb = lanes_b(f1[1]);
+  const __m256d cos_ab = sub(mul(ca, cb), mul(sa, sb)), sin_ab = add(mul(sa, cb), mul(ca, sb));
+  const __m256d cos_total = sub(mul(cos_ab, _mm256_set1_pd(angle.cos)), mul(sin_ab, _mm256_set1_pd(angle.sin)));
+  const __m256d faces = _mm256_cmp_pd(facing, sub(cos_total, _mm256_set1_pd(angle.margin)), _CMP_GE_OQ);
+  return _mm256_movemask_pd(_mm256_andnot_pd(degenerate, either(wide, faces)));
+}
+
 }  // namespace
 
 CALIBER_AVX2 int node_within_2x2_double(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                         std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes<true>(f, l, a0, a1, b0, b1);
+  return node_within_2x2_lanes(f, l, a0, a1, b0, b1);
 }
 
 #undef CALIBER_AVX2
@@ -287,6 +310,11 @@ NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks) {
   return disks ? &node_within_2x2_avx2 : &node_within_one_side_avx2;
 }
 
+ConesFace2x2 cones_face_2x2_avx2_if_supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? &cones_face_2x2_avx2 : nullptr;
+}
+
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks) {
   if (disks && node_within_2x2_float_form() != nullptr) return node_within_2x2_float_form();
   const NodeWithin2x2 wide = node_within_2x2_form(true, disks);
@@ -299,6 +327,7 @@ NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks) {
 
 namespace caliber::narrow::detail {
 NodeWithin2x2 node_within_2x2_form(bool, bool) { return nullptr; }
+ConesFace2x2 cones_face_2x2_avx2_if_supported() { return nullptr; }
 int node_within_2x2_double(const NodeTestFrame&, const NodeLanes&, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t) {
   return 0xF;
 }

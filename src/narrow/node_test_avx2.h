@@ -28,15 +28,15 @@ struct NodeTestFrame {
 /// A's lanes and rot[k][j] in B's (abs_rot likewise); a point x goes to rot (x - pre) + post, pre
 /// being the frame's trans in A's lanes and 0 in B's, post 0 in A's and trans in B's (each lane
 /// the scalar test's operations: x - 0 and y + 0 are x and y). Made by make_lanes, once per
-/// traversal (1,600 bytes: not kept in the pair context, which the engine holds for every pair).
+/// traversal (1,504 bytes: not kept in the pair context, which the engine holds for every pair).
 struct NodeLanes {
   double rot[3][3][4], abs_rot[3][3][4], pre[3][4], post[3][4];
   /// The float pre-decision (node_test_float.cpp): eight lanes that move [sphere centers | box
-  /// centers] (`move`: rot's lanes twice, with pre8 and post8) and turn [half-extents | slab axes]
-  /// (`turn`: abs_rot's lanes, then rot's), each value the double one rounded to float.
+  /// centers] (`move`: rot's lanes twice, then post8: -R^T T in A's lanes, T in B's, computed in
+  /// double) and turn [half-extents | slab axes] (`turn`: abs_rot's lanes, then rot's), each value
+  /// rounded to float once.
   alignas(32) float move[3][3][8];
   alignas(32) float turn[3][3][8];
-  alignas(32) float pre8[3][8];
   alignas(32) float post8[3][8];
   /// The thresholds of the float comparisons, each the double one less (lo) and plus (hi) a slack
   /// far above the float rounding (FloatSlack): the boxes' reach, the slabs' slab_reach, the
@@ -80,8 +80,9 @@ inline NodeLanes make_lanes(const NodeTestFrame& f, double scale) {
       }
     }
     for (int i = 0; i < 8; ++i) {
-      l.pre8[k][i] = static_cast<float>(l.pre[k][i % 4]);
-      l.post8[k][i] = static_cast<float>(l.post[k][i % 4]);
+      const int n = i % 4;
+      const double moved_trans = (l.rot[k][0][n] * l.pre[0][n] + l.rot[k][1][n] * l.pre[1][n]) + l.rot[k][2][n] * l.pre[2][n];
+      l.post8[k][i] = static_cast<float>(l.post[k][n] - moved_trans);
     }
   }
   const double slack = FloatSlack::kShare * scale;
@@ -114,6 +115,21 @@ NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks = true);
 /// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else
 /// nullptr.
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks = true);
+
+/// The contact angle as the cone test reads it (PairContext::cones_can_face): theta, its cosine
+/// and sine, and the margin on the cosine.
+struct ConeAngle {
+  double theta, cos, sin, margin;
+};
+
+/// Bit 2i + j set where the normal cones of node ai of A and node bj of B can face within the
+/// angle: PairContext::cones_can_face on the four pairs at once, the same operations lane by lane
+/// (so the same decisions).
+using ConesFace2x2 = int (*)(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,
+                             std::uint32_t b0, std::uint32_t b1, const ConeAngle& angle);
+
+/// The AVX2 form of ConesFace2x2, or nullptr where the CPU has no AVX2.
+ConesFace2x2 cones_face_2x2_avx2_if_supported();
 
 /// The four-pair form with the disks in AVX2, double precision (node_within_2x2_form(false)'s).
 int node_within_2x2_double(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,

@@ -1,20 +1,22 @@
 // The four-pair node test's float pre-decision (AVX2): node_within_2x2_lanes's comparisons (spheres,
 // boxes, slabs, disks; node_test_avx2.cpp) made in float, each against two thresholds: the double
-// form's widened by a slack (FloatSlack) that bounds, with a wide margin, how far the float
+// form's less and plus a slack (FloatSlack) that bounds, with a wide margin, how far the float
 // quantity lies from the double one. Past the upper threshold the double form surely refuses the
-// pair, below the lower one that comparison surely does not refuse it. A pair that no comparison
+// pair; below the lower one, that comparison surely does not refuse it. A pair that no comparison
 // surely refuses and some comparison may refuse is in doubt, and the whole visit goes to the
-// double form: the decisions are the double form's, bit for bit, at about half its instructions
-// (eight float lanes where it has four doubles: each test of A's side and of B's side in one
-// instruction, no conversions, fewer spills).
+// double form: the decisions are the double form's, bit for bit (eight float lanes where it has
+// four doubles: each test of A's side and of B's side in one instruction, no conversions).
 //
 // Why the slack holds: every value is a short sum of products of stored floats (exact in both),
-// pose entries (|R| <= 1, rounded once to float) and coordinates at most `scale` in magnitude
-// (NodeTestFrame::scale). A moved center is within about 40 unit roundoffs of the scale of the
-// double one, a box gap within about 80, a slab's gap within about 160, a disk's gap (scaled by
-// the squared length of its axis) within about 210 and its squared sine within about 100 unit
-// roundoffs; the slack is 512 unit roundoffs of the scale (1024 on the spheres' and disks' gaps,
-// 2^-14 on the sine). The squares compare squared thresholds moved by the slack before squaring.
+// pose entries (|R| <= 1, each rounded once to float, -R^T T computed in double, then rounded)
+// and coordinates at most the scale in magnitude (make_lanes). A moved center lies within about
+// 40 unit roundoffs of the scale of the double one, a box gap within about 80, a slab's gap within
+// about 160, a disk's gap (scaled by the squared length of its axis) within about 210, its
+// squared sine (|m|^2 |n|^2 - (m . n)^2 here, the cross product there) within about 100 unit
+// roundoffs. A's center along B's slab axis is taken in B's frame here (m . R^T (x - T)), in A's
+// there ((R m) . (x - T)): the same number but for the pose's rounding, some 1e-16 of the scale.
+// The slack is 512 unit roundoffs of the scale (1024 on the spheres' and the disks' gaps, 2^-14
+// on the squared sine); squared comparisons move the threshold by the slack before squaring.
 
 #include "narrow/node_test_avx2.h"
 
@@ -87,44 +89,47 @@ CALIBER_AVX2 inline void compare_disk(Verdict& v, V gap, V slack, V rim_lo, V ri
   v.maybe = either(v.maybe, both(gt(high, zero), gt(mul(high, high), rim_lo)));
 }
 
-/// The disks (lanes 0-3: B's disk against A's slab, A's axis and B's center moved in; 4-7: A's
-/// disk against B's slab, B's axis moved in and A's center less B's origin), from float_bits's
-/// node lanes and moved values, lo and hi the slabs' bounds in those lanes.
-CALIBER_AVX2 __attribute__((always_inline)) inline void compare_disks(Verdict& v, const NodeLanes& l, const Q n0[4], const Q f0[4],
-                                                                      const Q f1[4], const V rel[3], const V moved[3],
-                                                                      const V ha[3], const V turned[3], V lo, V hi) {
-  const __m256i u_i = lanes(0, 0, 1, 1, 6, 7, 6, 7), c_i = lanes(6, 7, 6, 7, 0, 0, 1, 1);
+/// The disks, from what float_bits gathered: at, each disk's center along the other's slab axis
+/// (lanes 0-3: A's axis dotted with B's center moved in; 4-7: B's axis with A's center moved into
+/// B's frame); along and nn per pair (A's axis dotted with B's moved into A's frame, and the
+/// latter's squared length); [slab lo | slab hi], [disk lo | disk hi], [radius | len2] per node.
+CALIBER_AVX2 __attribute__((always_inline)) inline void compare_disks(Verdict& v, const NodeLanes& l, V at, Q along4, Q nn, V bounds,
+                                                                      V disk, V shape) {
+  const __m256i own_i = lanes(0, 0, 1, 1, 2, 3, 2, 3), axis_i = lanes(4, 4, 5, 5, 6, 7, 6, 7);
   const __m256i disk_i = lanes(2, 3, 2, 3, 0, 0, 1, 1), disk_hi_i = lanes(6, 7, 6, 7, 4, 4, 5, 5);
-  V u[3], c[3];
-  Q m[3], n[3];
-  for (int k = 0; k < 3; ++k) {
-    u[k] = pick(_mm256_permute2f128_ps(ha[k], turned[k], 0x31), u_i);   // [axis | axis_in]
-    c[k] = pick(_mm256_permute2f128_ps(rel[k], moved[k], 0x20), c_i);   // [center_rel | center_in]
-    m[k] = _mm256_castps256_ps128(u[k]);
-    n[k] = _mm256_extractf128_ps(u[k], 1);
-  }
-  const Q along4 = dot3(m, n);
-  const Q x = _mm_sub_ps(_mm_mul_ps(m[1], n[2]), _mm_mul_ps(m[2], n[1]));
-  const Q y = _mm_sub_ps(_mm_mul_ps(m[2], n[0]), _mm_mul_ps(m[0], n[2]));
-  const Q z = _mm_sub_ps(_mm_mul_ps(m[0], n[1]), _mm_mul_ps(m[1], n[0]));
-  const Q xyz[3] = {x, y, z};
-  const Q cross4 = dot3(xyz, xyz);
-  const Q mid = dot3(f0, n0), len2 = dot3(f0, f0);
-  const V disk = pair(_mm_sub_ps(f1[2], mid), _mm_sub_ps(f1[3], mid));  // [disk lo | disk hi]
-  const V shape = pair(n0[3], len2);                                     // [radius | len2]
+  // |m x n|^2 = |m|^2 |n|^2 - (m . n)^2 (m: A's axis, its len2 in the pair's lanes).
+  const Q len2_a = pairs_a(_mm256_extractf128_ps(shape, 1));
+  const Q cross4 = _mm_sub_ps(_mm_mul_ps(len2_a, nn), _mm_mul_ps(along4, along4));
   const V along = pair(along4, along4), cross = pair(cross4, cross4);
   const V len8 = pick(shape, disk_hi_i), r = pick(shape, disk_i);
   const V s0 = mul(pick(disk, disk_i), along), s1 = mul(pick(disk, disk_hi_i), along);
-  const V at2 = mul(dot3(u, c), len8);
+  const V at2 = mul(at, len8);
   const V low = add(at2, _mm256_min_ps(s0, s1)), high = add(at2, _mm256_max_ps(s0, s1));
   const V slab = _mm256_set1_ps(l.slab), cross_slack = _mm256_set1_ps(l.cross_slack);
   const V rim = mul(mul(r, r), len8);
   const V rim_lo = mul(rim, sub(cross, cross_slack)), rim_hi = mul(rim, add(cross, cross_slack));
   const V slack = mul(_mm256_set1_ps(l.disk_slack), len8);
+  const V lo = pick(bounds, own_i), hi = pick(bounds, axis_i);  // the other's slab
   compare_disk(v, sub(low, mul(add(hi, slab), len8)), slack, rim_lo, rim_hi);
   compare_disk(v, sub(mul(sub(lo, slab), len8), high), slack, rim_lo, rim_hi);
 }
 
+/// The spheres (four pair lanes): the distance of the centers against the summed radii and reach,
+/// moved by twice the slack before squaring (lo * |lo|: a negative lower threshold is below any
+/// squared distance). Sets bits of sure and maybe.
+CALIBER_AVX2 inline void compare_spheres(const NodeLanes& l, Q dist2, Q radius, int& sure, int& maybe) {
+  const Q radii = _mm_add_ps(pairs_a(radius), pairs_b(radius));
+  const Q s_hi = _mm_add_ps(radii, _mm_set1_ps(l.sphere_hi)), s_lo = _mm_add_ps(radii, _mm_set1_ps(l.sphere_lo));
+  const Q s_lo2 = _mm_mul_ps(s_lo, _mm_andnot_ps(_mm_set1_ps(-0.0f), s_lo));
+  sure = _mm_movemask_ps(_mm_cmpgt_ps(dist2, _mm_mul_ps(s_hi, s_hi)));
+  maybe = _mm_movemask_ps(_mm_cmpgt_ps(dist2, s_lo2));
+}
+
+/// The pre-decision. The nodes come in node lanes (a0, a1, b0, b1); [sphere center | box center]
+/// is moved into the other's frame (A's: R^T x - R^T T, B's: R x + T) and [half-extents | slab
+/// axis] turned ([reach_on | axis_in]) one coordinate k at a time, and each test takes its part
+/// of coordinate k at once (so that few values live across the loop): the boxes' axis k in eight
+/// lanes (A's in 0-3, B's in 4-7), the sums of the spheres', slabs' and disks' dot products.
 CALIBER_AVX2 __attribute__((always_inline)) inline void float_bits(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0,
                                                                    std::uint32_t a1, std::uint32_t b0, std::uint32_t b1, int& pass,
                                                                    int& unsure) {
@@ -137,55 +142,51 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void float_bits(const NodeTes
   packed_block(fa0, fa1, fb0, fb1, 0, f0);  // cone axis
   packed_block(fa0, fa1, fb0, fb1, 1, f1);  // ..., slab lo, slab hi
   const Q half[3] = {n1[3], n2[0], n2[1]};
-  // Moved into the other's frame, [sphere center | box center] and turned [half-extents | axis]:
-  // rel, moved = [center_rel | box_rel], [center_in | box_in]; turned = [reach_on | axis_in].
-  V rel[3], moved[3], ha[3], turned[3];
-  for (int k = 0; k < 3; ++k) rel[k] = sub(pair(n0[k], n1[k]), _mm256_load_ps(l.pre8[k]));
-  for (int k = 0; k < 3; ++k) moved[k] = add(row(l.move, k, rel), _mm256_load_ps(l.post8[k]));
-  for (int k = 0; k < 3; ++k) ha[k] = pair(half[k], f0[k]);
-  for (int k = 0; k < 3; ++k) turned[k] = row(l.turn, k, ha);
-  // Spheres (four pair lanes): the distance of the centers against the summed radii and reach,
-  // moved by twice the slack before squaring (lo * |lo|: a negative lower threshold is below any
-  // squared distance).
-  Q d[3];
-  for (int k = 0; k < 3; ++k) d[k] = _mm_sub_ps(pairs_a(n0[k]), pairs_b(_mm256_castps256_ps128(moved[k])));
-  const Q dist2 = dot3(d, d);
-  const Q radii = _mm_add_ps(pairs_a(n0[3]), pairs_b(n0[3]));
-  const Q s_hi = _mm_add_ps(radii, _mm_set1_ps(l.sphere_hi)), s_lo = _mm_add_ps(radii, _mm_set1_ps(l.sphere_lo));
-  const Q s_lo2 = _mm_mul_ps(s_lo, _mm_andnot_ps(_mm_set1_ps(-0.0f), s_lo));
-  const int sphere_sure = _mm_movemask_ps(_mm_cmpgt_ps(dist2, _mm_mul_ps(s_hi, s_hi)));
-  const int sphere_maybe = _mm_movemask_ps(_mm_cmpgt_ps(dist2, s_lo2));
-  Verdict v;
-  // Boxes: lanes 0-3 A's axis k (B's box moved in, less A's), 4-7 B's (B's box less A's moved in).
-  const __m256i from_i = lanes(6, 7, 6, 7, 2, 3, 2, 3), to_i = lanes(0, 0, 1, 1, 4, 4, 5, 5);
-  const __m256i own_i = lanes(0, 0, 1, 1, 2, 3, 2, 3), other_i = lanes(6, 7, 6, 7, 4, 4, 5, 5);
-  const V reach_lo = _mm256_set1_ps(l.reach_lo), reach_hi = _mm256_set1_ps(l.reach_hi);
-  V boxes[3];  // [box | box_in]
+  V places[3], sizes[3];  // [center | box], [half | axis]
   for (int k = 0; k < 3; ++k) {
-    boxes[k] = _mm256_permute2f128_ps(_mm256_castps128_ps256(n1[k]), moved[k], 0x30);
-    const V extents = _mm256_permute2f128_ps(ha[k], turned[k], 0x20);  // [half | reach_on]
-    const V gap = sub(magnitude(sub(pick(boxes[k], from_i), pick(boxes[k], to_i))),
+    places[k] = pair(n0[k], n1[k]);
+    sizes[k] = pair(half[k], f0[k]);
+  }
+  const Q mid = dot3(f0, n0), len2 = dot3(f0, f0);
+  const V bounds = pair(f1[2], f1[3]);                                   // [slab lo | slab hi]
+  const V disk = pair(_mm_sub_ps(f1[2], mid), _mm_sub_ps(f1[3], mid));  // [disk lo | disk hi]
+  const V shape = pair(n0[3], len2);                                     // [radius | len2]
+  const __m256i from_i = lanes(6, 7, 6, 7, 2, 3, 2, 3), own_i = lanes(0, 0, 1, 1, 2, 3, 2, 3);
+  const __m256i other_i = lanes(6, 7, 6, 7, 4, 4, 5, 5), axis_i = lanes(4, 4, 5, 5, 6, 7, 6, 7);
+  const __m256i other_half_i = lanes(2, 3, 2, 3, 0, 0, 1, 1), center_i = lanes(2, 3, 2, 3, 0, 0, 1, 1);
+  const V reach_lo = _mm256_set1_ps(l.reach_lo), reach_hi = _mm256_set1_ps(l.reach_hi), hair = _mm256_set1_ps(l.hair);
+  Verdict v;
+  V slab_at = _mm256_setzero_ps(), slab_reach = slab_at, disk_at = slab_at;
+  Q dist2 = _mm_setzero_ps(), along = dist2, nn = dist2;
+  for (int k = 0; k < 3; ++k) {
+    const V moved = add(row(l.move, k, places), _mm256_load_ps(l.post8[k]));  // [center_in | box_in]
+    const V turned = row(l.turn, k, sizes);                                   // [reach_on | axis_in]
+    // Spheres: A's center less B's moved in.
+    const Q d = _mm_sub_ps(pairs_a(n0[k]), pairs_b(_mm256_castps256_ps128(moved)));
+    dist2 = _mm_add_ps(dist2, _mm_mul_ps(d, d));
+    // Boxes, axis k: lanes 0-3 A's (B's box moved in, less A's), 4-7 B's (B's box less A's moved in).
+    const V boxes = _mm256_permute2f128_ps(places[k], moved, 0x31);    // [box | box_in]
+    const V extents = _mm256_permute2f128_ps(sizes[k], turned, 0x20);  // [half | reach_on]
+    const V gap = sub(magnitude(sub(pick(boxes, from_i), _mm256_unpacklo_ps(boxes, boxes))),
                       add(pick(extents, own_i), pick(extents, other_i)));
     v.compare(gap, reach_lo, reach_hi);
+    // Slabs: lanes 0-3 A's slab against B's box moved in, 4-7 B's against A's.
+    const V axis = pick(sizes[k], axis_i);
+    slab_at = add(slab_at, mul(axis, pick(boxes, other_i)));
+    slab_reach = add(slab_reach, mul(pick(add(magnitude(turned), hair), axis_i), pick(sizes[k], other_half_i)));
+    // Disks: lanes 0-3 A's axis against B's center moved in, 4-7 B's axis against A's.
+    disk_at = add(disk_at, mul(axis, pick(moved, center_i)));
+    const Q n = pairs_b(_mm256_extractf128_ps(turned, 1));
+    along = _mm_add_ps(along, _mm_mul_ps(_mm256_castps256_ps128(axis), n));
+    nn = _mm_add_ps(nn, _mm_mul_ps(n, n));
   }
-  // Slabs: lanes 0-3 A's slab against B's box moved in, 4-7 B's against A's.
-  const __m256i axis_i = lanes(4, 4, 5, 5, 6, 7, 6, 7), other_box_i = lanes(6, 7, 6, 7, 4, 4, 5, 5);
-  const __m256i other_half_i = lanes(2, 3, 2, 3, 0, 0, 1, 1);
-  const V hair = _mm256_set1_ps(l.hair);
-  V axis[3], other_box[3], on[3], other_half[3];
-  for (int k = 0; k < 3; ++k) {
-    axis[k] = pick(ha[k], axis_i);
-    other_box[k] = pick(boxes[k], other_box_i);
-    on[k] = pick(add(magnitude(turned[k]), hair), axis_i);
-    other_half[k] = pick(ha[k], other_half_i);
-  }
-  const V at = dot3(axis, other_box), reach = dot3(on, other_half);
-  const V bounds = pair(f1[2], f1[3]);  // [lo | hi]
+  int sphere_sure, sphere_maybe;
+  compare_spheres(l, dist2, n0[3], sphere_sure, sphere_maybe);
   const V lo = pick(bounds, own_i), hi = pick(bounds, axis_i);
   const V slab_lo = _mm256_set1_ps(l.slab_lo), slab_hi = _mm256_set1_ps(l.slab_hi);
-  v.compare(sub(sub(at, reach), hi), slab_lo, slab_hi);
-  v.compare(sub(lo, add(at, reach)), slab_lo, slab_hi);
-  compare_disks(v, l, n0, f0, f1, rel, moved, ha, turned, lo, hi);
+  v.compare(sub(sub(slab_at, slab_reach), hi), slab_lo, slab_hi);
+  v.compare(sub(lo, add(slab_at, slab_reach)), slab_lo, slab_hi);
+  compare_disks(v, l, disk_at, along, nn, bounds, disk, shape);
   const int sure8 = _mm256_movemask_ps(v.sure), maybe8 = _mm256_movemask_ps(v.maybe);
   const int sure = (sure8 | (sure8 >> 4) | sphere_sure) & 0xF, maybe = (maybe8 | (maybe8 >> 4) | sphere_maybe) & 0xF;
   pass = ~maybe & 0xF;

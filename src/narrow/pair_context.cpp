@@ -61,9 +61,15 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   if (na.cone_angle < 0.0f || nb.cone_angle < 0.0f) return false;  // only degenerate triangles below
   const double total = static_cast<double>(na.cone_angle) + static_cast<double>(nb.cone_angle) + mTheta;
   if (total >= std::numbers::pi) return true;
-  const Eigen::Vector3d axis_a(na.cone_axis[0], na.cone_axis[1], na.cone_axis[2]);
-  const Eigen::Vector3d axis_b(nb.cone_axis[0], nb.cone_axis[1], nb.cone_axis[2]);
-  const double facing = -axis_a.dot(mRot * axis_b);
+  // B's axis in A's frame and its dot product with A's, each sum left to right (as the lanes of
+  // detail::cones_face_2x2 make them).
+  double facing = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double* r = mNodeFrame.rot[i];
+    const double moved = (r[0] * nb.cone_axis[0] + r[1] * nb.cone_axis[1]) + r[2] * nb.cone_axis[2];
+    facing = i == 0 ? na.cone_axis[0] * moved : facing + na.cone_axis[i] * moved;
+  }
+  facing = -facing;
   // cos(alpha_a + alpha_b + theta) by the angle-sum formulas on the stored cosines and sines
   // (float-rounded: about 2.4e-7 of error at most, inside the 1e-6 margin).
   const double ca = na.cone_cos, sa = na.cone_sin, cb = nb.cone_cos, sb = nb.cone_sin;
@@ -86,6 +92,7 @@ namespace {
 /// where the CPU has no AVX2: the scalar forms, the same decisions.)
 const detail::NodeWithin2x2 kWithin2x2 = detail::node_within_2x2_avx2_if_supported();
 const detail::NodeWithin2x2 kWithinOneSide = detail::node_within_2x2_avx2_if_supported(false);
+const detail::ConesFace2x2 kConesFace = detail::cones_face_2x2_avx2_if_supported();
 
 }  // namespace
 
@@ -113,9 +120,19 @@ int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::ui
     if (!one_side) return node_tests_2x2_scalar(a0, a1, b0, b1);
     return (node_test(a0, b0) ? 1 : 0) | (node_test(a1, b1) ? 8 : 0);
   }
-  const int pass = lanes == nullptr ? within(mNodeFrame, node_lanes(), a0, a1, b0, b1)
-                                    : within(mNodeFrame, *lanes, a0, a1, b0, b1);
-  return refuses_by_groups_or_cones() ? groups_and_cones(pass, a0, a1, b0, b1) : pass;
+  detail::NodeLanes made;
+  if (lanes == nullptr) {
+    made = node_lanes();
+    lanes = &made;
+  }
+  const int pass = within(mNodeFrame, *lanes, a0, a1, b0, b1);
+  if (!refuses_by_groups_or_cones() || pass == 0) return pass;
+  // A contact query without groups: the four pairs' cones at once (the one-sided form's bits 0
+  // and 3 are its pairs a0 b0 and a1 b1).
+  if (mGroups == nullptr && kConesFace != nullptr) {
+    return pass & kConesFace(mNodeFrame, *lanes, a0, a1, b0, b1, detail::ConeAngle{mTheta, mCosTheta, mSinTheta, kConeCosMargin});
+  }
+  return groups_and_cones(pass, a0, a1, b0, b1);
 }
 
 int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
