@@ -1,6 +1,7 @@
 // PairContext::gather_corners (a leaf batch's corners read straight into its lanes, B's moved into
-// A's frame there) against A's vertices and b_vertex (what the unbuffered leaf test reads): the same bits, on random poses (rotations and
-// translations of every size, far from the origin too) and batches of every size.
+// A's frame there) against A's vertices and b_vertex (what the unbuffered leaf test reads): the
+// same bits, on random poses (rotations and translations of every size, far from the origin too)
+// and batches of every size.
 
 #include <cstdint>
 #include <cstring>
