@@ -12,6 +12,7 @@
 
 #include "caliber/query.h"
 #include "narrow/cd_tree.h"
+#include "narrow/child_pairs.h"
 #include "narrow/pair_context.h"
 #include "narrow/visit_order.h"
 #include "util/assert.h"
@@ -31,56 +32,6 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
   return how == RootTest::with_disks ? ctx.node_test_2x2_lane(n.a, n.b) : ctx.node_test(n.a, n.b);
 }
 
-/// The node index of a prepared node, held or pointed to.
-template <class Side>
-std::uint32_t index_of(const Side& side) {
-  return side.index;
-}
-template <class Side>
-std::uint32_t index_of(Side* side) {
-  return side->index;
-}
-
-/// The children of CD-tree node n (not a pair of leaves; descend_a and descend_b from cd_descend), each
-/// child node of A and of B prepared once (by prepare_a / prepare_b: the node test's sides, or the
-/// distance bound's) for the (up to) four pairs it takes part in: calls test(side_a, side_b,
-/// child) for each in cd_children order, except those on the taboo list (skipped and marked
-/// reached), each counted in stats.node_tests: the node visit's where one side descends and a
-/// taboo list is given, and the distance traversal's.
-template <class PrepareA, class PrepareB, class Test>
-[[gnu::always_inline]] inline void for_each_child(NodePair n, const BvhNode& a, const BvhNode& b, bool descend_a, bool descend_b,
-                                                  QueryStats& stats, TabooView taboo, PrepareA&& prepare_a, PrepareB&& prepare_b,
-                                                  Test&& test) {
-  decltype(prepare_a(std::uint32_t{})) sa[2];
-  decltype(prepare_b(std::uint32_t{})) sb[2];
-  const int na = descend_a ? 2 : 1, nb = descend_b ? 2 : 1;
-  for (int i = 0; i < na; ++i) sa[i] = prepare_a(descend_a ? a.index + i : n.a);
-  for (int j = 0; j < nb; ++j) sb[j] = prepare_b(descend_b ? b.index + j : n.b);
-  for (int i = 0; i < na; ++i) {
-    for (int j = 0; j < nb; ++j) {
-      const NodePair child{index_of(sa[i]), index_of(sb[j])};
-      if (on_taboo(taboo, child)) continue;
-      ++stats.node_tests;
-      test(sa[i], sb[j], child);
-    }
-  }
-}
-
-/// The four children of a visit where both sides descend (A's a0 and a0 + 1 against B's b0 and
-/// b0 + 1, in cd_children order) that are not on the taboo list (those marked reached), each
-/// counted in stats.node_tests: calls take(k, child) with k = 2i + j, the lane of the four-at-once
-/// tests that computed it.
-template <class Take>
-[[gnu::always_inline]] inline void for_each_child_2x2(std::uint32_t a0, std::uint32_t b0, QueryStats& stats, TabooView taboo,
-                                                      Take&& take) {
-  for (std::uint32_t k = 0; k < 4; ++k) {
-    const NodePair child{a0 + k / 2, b0 + k % 2};
-    if (on_taboo(taboo, child)) continue;
-    ++stats.node_tests;
-    take(k, child);
-  }
-}
-
 /// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
 /// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
 /// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
@@ -89,6 +40,9 @@ template <class Take>
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
 /// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
 /// reading `out`. `lanes`: ctx.node_lanes(), made once by the traversal (null: by each test).
+/// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
+/// so, the first child on top).
+template <bool kReversed = false>
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
                                         NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
                                         const detail::NodeLanes* lanes = nullptr) {
@@ -115,8 +69,9 @@ template <class Take>
     const std::uint32_t b0 = descend_b ? b.index : n.b, b1 = descend_b ? b.index + 1 : n.b;
     const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1, lanes) : ctx.node_tests_one_side(a0, a1, b0, b1, lanes);
     stats.node_tests += both ? 4 : 2;
-    for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0; bits &= bits - 1) {
-      const unsigned k = static_cast<unsigned>(__builtin_ctz(bits));
+    for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0;) {
+      const unsigned k = kReversed ? 31u - static_cast<unsigned>(__builtin_clz(bits)) : static_cast<unsigned>(__builtin_ctz(bits));
+      bits ^= 1u << k;
       passed[count++] = NodePair{k / 2 != 0 ? a1 : a0, k % 2 != 0 ? b1 : b0};
     }
     return count;
@@ -128,6 +83,7 @@ template <class Take>
     for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
       if ((pass >> k) & 1) passed[count++] = child;
     });
+    if constexpr (kReversed) std::reverse(passed, passed + count);
     return count;
   }
   for_each_child(
@@ -136,6 +92,7 @@ template <class Take>
       [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
         if (ctx.node_test(sa, sb)) passed[count++] = child;
       });
+  if constexpr (kReversed) std::reverse(passed, passed + count);
   return count;
 }
 
@@ -193,14 +150,22 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   detail::NodeLanes lanes;  // made only where the root passes: a pair refused at its root pays nothing
   if (top != base) lanes = ctx.node_lanes();
   std::size_t seen = out.size();
-  // Without a limit, the leaf pairs' closest points eight at a time (a limit counts each leaf
-  // test's pair as it is kept).
+  // Without a limit, the leaf pairs wait in a buffer for the batch kernels, and the children that
+  // pass are written straight onto the stack, the first one on top (the order of cd_children).
+  // With one, each leaf test's pair is counted as it is kept.
   LeafBuffer buffer;
-  LeafBuffer* const buffered = limit == nullptr ? &buffer : nullptr;
+  if (limit == nullptr) {
+    while (top != base) {
+      const NodePair n = *--top;
+      const int count = visit<true>(ctx, n, out, counted, top, taboo, &buffer, &lanes);
+      top += count > 0 ? count : 0;
+      CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
+    }
+  }
   while (top != base) {
-    const int count = visit(ctx, *--top, out, counted, passed, taboo, buffered, &lanes);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, &lanes);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
-    if (limit != nullptr && count < 0) {
+    if (count < 0) {
       if (out.size() != seen) {
         seen = out.size();
         if (limit->add()) break;
@@ -208,13 +173,8 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
         break;
       }
     }
-    // Pushed in reverse so that the first child is popped first (the order of cd_children); with a
-    // limit, nearest spheres first (push_nearest_first).
-    if (limit != nullptr) {
-      top = push_nearest_first(ctx, passed, count, top);
-    } else {
-      for (int k = count - 1; k >= 0; --k) *top++ = passed[k];
-    }
+    // Nearest spheres first (push_nearest_first).
+    top = push_nearest_first(ctx, passed, count, top);
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
   ctx.flush_leaves(buffer, out);
