@@ -49,10 +49,10 @@ struct NodeLanes {
 
 /// The float pre-decision's slacks: 2^-15 of the scale on every linear quantity (512 times
 /// float's unit roundoff of the scale; the rounding of the quantities compared adds up to about
-/// 160 of it at most), twice that on the spheres' and the disks' distances, 2^-14 on the squared
+/// 160 of it at most), twice that on the spheres' and the disks' distances, 2^-16 on the squared
 /// sine (the rounding: about 100 unit roundoffs); the range of scales where floats are used.
 struct FloatSlack {
-  static constexpr double kShare = 0x1p-15, kCross = 0x1p-14, kLeast = 1e-12, kMost = 1e12;
+  static constexpr double kShare = 0x1p-15, kCross = 0x1p-16, kLeast = 1e-12, kMost = 1e12;
 };
 
 /// The lanes of frame f's pose. `scale`: a bound on the magnitude of every coordinate, extent,
@@ -112,8 +112,9 @@ using NodeWithin2x2 = int (*)(const NodeTestFrame& frame, const NodeLanes& lanes
 /// b0 = b1), without the disks: bits 0 (a0 with b0) and 3 (a1 with b1) alone.
 NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks = true);
 
-/// The form the node test runs: the AVX-512VL one where the CPU has it, else the AVX2 one, else
-/// nullptr.
+/// The form the node test runs: with the disks, the float pre-decision wherever the CPU has AVX2
+/// (node_within_2x2_float_form); without them, the AVX-512VL form where the CPU has it, else the
+/// AVX2 one; else nullptr.
 NodeWithin2x2 node_within_2x2_avx2_if_supported(bool disks = true);
 
 /// The contact angle as the cone test reads it (PairContext::cones_can_face): theta, its cosine
@@ -141,8 +142,8 @@ int node_within_2x2_double(const NodeTestFrame& frame, const NodeLanes& lanes, s
 void node_within_2x2_float_bits(const NodeTestFrame& frame, const NodeLanes& lanes, std::uint32_t a0, std::uint32_t a1,
                                 std::uint32_t b0, std::uint32_t b1, int& pass, int& unsure);
 
-/// The four-pair form the node test runs on an AVX2 CPU without AVX-512VL: the float pre-decision,
-/// and the double form where some pair is in doubt (or lanes.floats is false). The double form's
+/// The four-pair form the node test runs on an AVX2 CPU: the float pre-decision, and the AVX2
+/// double form where some pair is in doubt (or lanes.floats is false). The double form's
 /// decisions, bit for bit. nullptr where the CPU has no AVX2.
 NodeWithin2x2 node_within_2x2_float_form();
 

@@ -15,8 +15,8 @@
 // squared sine (|m|^2 |n|^2 - (m . n)^2 here, the cross product there) within about 100 unit
 // roundoffs. A's center along B's slab axis is taken in B's frame here (m . R^T (x - T)), in A's
 // there ((R m) . (x - T)): the same number but for the pose's rounding, some 1e-16 of the scale.
-// The slack is 512 unit roundoffs of the scale (1024 on the spheres' and the disks' gaps, 2^-14
-// on the squared sine); squared comparisons move the threshold by the slack before squaring.
+// The slack is 512 unit roundoffs of the scale (1024 on the spheres' and the disks' gaps, 256 on
+// the squared sine); squared comparisons move the threshold by the slack before squaring.
 
 #include "narrow/node_test_avx2.h"
 
@@ -61,7 +61,8 @@ CALIBER_AVX2 inline V row(const float m[3][3][8], int k, const V x[3]) {
 /// The floats 4 block .. 4 block + 3 of four records, a record per lane: out[i] holds float
 /// 4 block + i of each.
 template <class Record>
-CALIBER_AVX2 inline void packed_block(const Record& r0, const Record& r1, const Record& r2, const Record& r3, int block, Q out[4]) {
+CALIBER_AVX2 inline void packed_block(const Record& r0, const Record& r1, const Record& r2, const Record& r3, int block,
+                                      Q out[4]) {
   out[0] = _mm_loadu_ps(reinterpret_cast<const float*>(&r0) + 4 * block);
   out[1] = _mm_loadu_ps(reinterpret_cast<const float*>(&r1) + 4 * block);
   out[2] = _mm_loadu_ps(reinterpret_cast<const float*>(&r2) + 4 * block);
@@ -78,23 +79,31 @@ struct Verdict {
     sure = either(sure, gt(value, hi));
     maybe = either(maybe, gt(value, lo));
   }
+  /// The same where `can` is set: elsewhere the double form cannot refuse by this comparison.
+  CALIBER_AVX2 void compare_where(V can, V value, V lo, V hi) {
+    sure = either(sure, gt(value, hi));
+    maybe = either(maybe, both(can, gt(value, lo)));
+  }
 };
 
 /// The disks' comparison on one side of the slab (gap: the disk's distance beyond it, scaled by
-/// the squared axis length): beyond when gap > 0 and gap^2 > rim2, the double form's test.
-CALIBER_AVX2 inline void compare_disk(Verdict& v, V gap, V slack, V rim_lo, V rim_hi) {
+/// the squared axis length): beyond when gap > 0 and gap^2 > rim2, the double form's test; only
+/// where `can` (the slab's node has an axis: without one, every term of the double form's gap is
+/// 0 but -slab_reach |m|^2, which never refuses).
+CALIBER_AVX2 inline void compare_disk(Verdict& v, V can, V gap, V slack, V rim_lo, V rim_hi) {
   const V zero = _mm256_setzero_ps();
   const V low = sub(gap, slack), high = add(gap, slack);
   v.sure = either(v.sure, both(gt(low, zero), gt(mul(low, low), rim_hi)));
-  v.maybe = either(v.maybe, both(gt(high, zero), gt(mul(high, high), rim_lo)));
+  v.maybe = either(v.maybe, both(can, both(gt(high, zero), gt(mul(high, high), rim_lo))));
 }
 
 /// The disks, from what float_bits gathered: at, each disk's center along the other's slab axis
 /// (lanes 0-3: A's axis dotted with B's center moved in; 4-7: B's axis with A's center moved into
 /// B's frame); along and nn per pair (A's axis dotted with B's moved into A's frame, and the
-/// latter's squared length); [slab lo | slab hi], [disk lo | disk hi], [radius | len2] per node.
-CALIBER_AVX2 __attribute__((always_inline)) inline void compare_disks(Verdict& v, const NodeLanes& l, V at, Q along4, Q nn, V bounds,
-                                                                      V disk, V shape) {
+/// latter's squared length); [slab lo | slab hi], [disk lo | disk hi], [radius | len2] per node;
+/// `can`: where the slab's node has an axis.
+CALIBER_AVX2 __attribute__((always_inline)) inline void compare_disks(Verdict& v, const NodeLanes& l, V can, V at, Q along4, Q nn,
+                                                                      V bounds, V disk, V shape) {
   const __m256i own_i = lanes(0, 0, 1, 1, 2, 3, 2, 3), axis_i = lanes(4, 4, 5, 5, 6, 7, 6, 7);
   const __m256i disk_i = lanes(2, 3, 2, 3, 0, 0, 1, 1), disk_hi_i = lanes(6, 7, 6, 7, 4, 4, 5, 5);
   // |m x n|^2 = |m|^2 |n|^2 - (m . n)^2 (m: A's axis, its len2 in the pair's lanes).
@@ -110,8 +119,8 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void compare_disks(Verdict& v
   const V rim_lo = mul(rim, sub(cross, cross_slack)), rim_hi = mul(rim, add(cross, cross_slack));
   const V slack = mul(_mm256_set1_ps(l.disk_slack), len8);
   const V lo = pick(bounds, own_i), hi = pick(bounds, axis_i);  // the other's slab
-  compare_disk(v, sub(low, mul(add(hi, slab), len8)), slack, rim_lo, rim_hi);
-  compare_disk(v, sub(mul(sub(lo, slab), len8), high), slack, rim_lo, rim_hi);
+  compare_disk(v, can, sub(low, mul(add(hi, slab), len8)), slack, rim_lo, rim_hi);
+  compare_disk(v, can, sub(mul(sub(lo, slab), len8), high), slack, rim_lo, rim_hi);
 }
 
 /// The spheres (four pair lanes): the distance of the centers against the summed radii and reach,
@@ -131,8 +140,8 @@ CALIBER_AVX2 inline void compare_spheres(const NodeLanes& l, Q dist2, Q radius, 
 /// of coordinate k at once (so that few values live across the loop): the boxes' axis k in eight
 /// lanes (A's in 0-3, B's in 4-7), the sums of the spheres', slabs' and disks' dot products.
 CALIBER_AVX2 __attribute__((always_inline)) inline void float_bits(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0,
-                                                                   std::uint32_t a1, std::uint32_t b0, std::uint32_t b1, int& pass,
-                                                                   int& unsure) {
+                                                                   std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
+                                                                   int& pass, int& unsure) {
   const BvhNode &na0 = f.nodes_a[a0], &na1 = f.nodes_a[a1], &nb0 = f.nodes_b[b0], &nb1 = f.nodes_b[b1];
   const BvhNodeFilter &fa0 = f.filters_a[a0], &fa1 = f.filters_a[a1], &fb0 = f.filters_b[b0], &fb1 = f.filters_b[b1];
   Q n0[4], n1[4], n2[4], f0[4], f1[4];
@@ -148,9 +157,9 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void float_bits(const NodeTes
     sizes[k] = pair(half[k], f0[k]);
   }
   const Q mid = dot3(f0, n0), len2 = dot3(f0, f0);
-  const V bounds = pair(f1[2], f1[3]);                                   // [slab lo | slab hi]
+  const V bounds = pair(f1[2], f1[3]);                                  // [slab lo | slab hi]
   const V disk = pair(_mm_sub_ps(f1[2], mid), _mm_sub_ps(f1[3], mid));  // [disk lo | disk hi]
-  const V shape = pair(n0[3], len2);                                     // [radius | len2]
+  const V shape = pair(n0[3], len2);                                    // [radius | len2]
   const __m256i from_i = lanes(6, 7, 6, 7, 2, 3, 2, 3), own_i = lanes(0, 0, 1, 1, 2, 3, 2, 3);
   const __m256i other_i = lanes(6, 7, 6, 7, 4, 4, 5, 5), axis_i = lanes(4, 4, 5, 5, 6, 7, 6, 7);
   const __m256i other_half_i = lanes(2, 3, 2, 3, 0, 0, 1, 1), center_i = lanes(2, 3, 2, 3, 0, 0, 1, 1);
@@ -184,9 +193,12 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void float_bits(const NodeTes
   compare_spheres(l, dist2, n0[3], sphere_sure, sphere_maybe);
   const V lo = pick(bounds, own_i), hi = pick(bounds, axis_i);
   const V slab_lo = _mm256_set1_ps(l.slab_lo), slab_hi = _mm256_set1_ps(l.slab_hi);
-  v.compare(sub(sub(slab_at, slab_reach), hi), slab_lo, slab_hi);
-  v.compare(sub(lo, add(slab_at, slab_reach)), slab_lo, slab_hi);
-  compare_disks(v, l, disk_at, along, nn, bounds, disk, shape);
+  // A slab's node without an axis (every triangle below degenerate) refuses nothing in the double
+  // form: its gaps are -hair times the other's half-extents, never above slab_reach (> 0).
+  const V can = gt(pick(shape, axis_i), _mm256_setzero_ps());
+  v.compare_where(can, sub(sub(slab_at, slab_reach), hi), slab_lo, slab_hi);
+  v.compare_where(can, sub(lo, add(slab_at, slab_reach)), slab_lo, slab_hi);
+  compare_disks(v, l, can, disk_at, along, nn, bounds, disk, shape);
   const int sure8 = _mm256_movemask_ps(v.sure), maybe8 = _mm256_movemask_ps(v.maybe);
   const int sure = (sure8 | (sure8 >> 4) | sphere_sure) & 0xF, maybe = (maybe8 | (maybe8 >> 4) | sphere_maybe) & 0xF;
   pass = ~maybe & 0xF;

@@ -124,7 +124,7 @@ class PairContext {
                                         const detail::NodeLanes* lanes = nullptr) const;
   /// What the four-lane forms read of this context, and its pose in their lanes (make_lanes).
   [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
-  [[nodiscard]] detail::NodeLanes node_lanes() const { return detail::make_lanes(mNodeFrame, mScale + mSlabReach); }
+  [[nodiscard]] detail::NodeLanes node_lanes() const;
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 

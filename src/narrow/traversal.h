@@ -70,7 +70,8 @@ template <bool kReversed = false>
     const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1, lanes) : ctx.node_tests_one_side(a0, a1, b0, b1, lanes);
     stats.node_tests += both ? 4 : 2;
     for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0;) {
-      const unsigned k = kReversed ? 31u - static_cast<unsigned>(__builtin_clz(bits)) : static_cast<unsigned>(__builtin_ctz(bits));
+      const unsigned k =
+          kReversed ? 31u - static_cast<unsigned>(__builtin_clz(bits)) : static_cast<unsigned>(__builtin_ctz(bits));
       bits ^= 1u << k;
       passed[count++] = NodePair{k / 2 != 0 ? a1 : a0, k % 2 != 0 ? b1 : b0};
     }
