@@ -191,8 +191,8 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_2x2_lanes(con
 /// From lanes (x0, x1, x2, x3): (x2, x3, x0, x1), the halves swapped.
 CALIBER_AVX2 inline __m256d swap_halves(__m256d p) { return _mm256_permute2f128_pd(p, p, 0x01); }
 
-/// node_within_2x2_lanes without the disks on a visit where one side descends (a0 = a1 or b0 = b1): its two
-/// pairs P0 = (a0, b0) and P1 = (a1, b1), bits 0 and 3. The nodes are moved as there; each test
+/// node_within_2x2_lanes's tests but the disks, on a visit where one side descends (a0 = a1 or
+/// b0 = b1): its two pairs P0 = (a0, b0) and P1 = (a1, b1), bits 0 and 3. The nodes are moved as there; each test
 /// that has a side of A's and one of B's (the boxes' axes, the slabs) then runs in one set of
 /// lanes for both sides, where the four-pair form runs two: lanes 0 and 1 hold P0's and P1's test
 /// on A's side, lanes 2 and 3 the same pairs' test on B's side, each lane the four-pair form's
@@ -243,10 +243,6 @@ CALIBER_AVX2 __attribute__((always_inline)) inline int node_within_one_side_lane
   return (pass & 1) | ((pass & 2) << 2);
 }
 
-CALIBER_AVX2 int node_within_2x2_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
-                                      std::uint32_t b0, std::uint32_t b1) {
-  return node_within_2x2_lanes(f, l, a0, a1, b0, b1);
-}
 CALIBER_AVX2 int node_within_one_side_avx2(const NodeTestFrame& f, const NodeLanes& l, std::uint32_t a0, std::uint32_t a1,
                                            std::uint32_t b0, std::uint32_t b1) {
   return node_within_one_side_lanes(f, l, a0, a1, b0, b1);
@@ -307,7 +303,7 @@ NodeWithin2x2 node_within_2x2_form(bool wide_registers, bool disks) {
     return disks ? &node_within_2x2_avx512vl : &node_within_one_side_avx512vl;
   }
   if (!__builtin_cpu_supports("avx2")) return nullptr;
-  return disks ? &node_within_2x2_avx2 : &node_within_one_side_avx2;
+  return disks ? &node_within_2x2_double : &node_within_one_side_avx2;
 }
 
 ConesFace2x2 cones_face_2x2_avx2_if_supported() {

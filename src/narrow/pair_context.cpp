@@ -63,13 +63,12 @@ bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& n
   if (total >= std::numbers::pi) return true;
   // B's axis in A's frame and its dot product with A's, each sum left to right (as the lanes of
   // detail::cones_face_2x2 make them).
-  double facing = 0.0;
+  double moved[3];
   for (int i = 0; i < 3; ++i) {
     const double* r = mNodeFrame.rot[i];
-    const double moved = (r[0] * nb.cone_axis[0] + r[1] * nb.cone_axis[1]) + r[2] * nb.cone_axis[2];
-    facing = i == 0 ? na.cone_axis[0] * moved : facing + na.cone_axis[i] * moved;
+    moved[i] = (r[0] * nb.cone_axis[0] + r[1] * nb.cone_axis[1]) + r[2] * nb.cone_axis[2];
   }
-  facing = -facing;
+  const double facing = -((na.cone_axis[0] * moved[0] + na.cone_axis[1] * moved[1]) + na.cone_axis[2] * moved[2]);
   // cos(alpha_a + alpha_b + theta) by the angle-sum formulas on the stored cosines and sines
   // (float-rounded: about 2.4e-7 of error at most, inside the 1e-6 margin).
   const double ca = na.cone_cos, sa = na.cone_sin, cb = nb.cone_cos, sb = nb.cone_sin;
