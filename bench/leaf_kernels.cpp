@@ -101,7 +101,7 @@ void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t c
       out.push_back(p);
       continue;
     }
-    NodePair children[4];
+    NodePair children[caliber::narrow::kMaxChildren];
     const int count = caliber::narrow::cd_children(ctx, n, children);
     for (int i = count - 1; i >= 0; --i) stack.emplace_back(children[i], n);
   }

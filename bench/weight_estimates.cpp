@@ -28,7 +28,7 @@ double below(const caliber::narrow::PairContext& ctx, caliber::narrow::NodePair 
   const caliber::ModelData& a = ctx.a();
   const caliber::ModelData& b = ctx.b();
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return 0.0;
-  caliber::narrow::NodePair kids[4];
+  caliber::narrow::NodePair kids[caliber::narrow::kMaxChildren];
   const int count = caliber::narrow::cd_children(ctx, n, kids);
   double tests = 0.0;
   for (int k = 0; k < count; ++k) {

@@ -18,6 +18,7 @@
 #include "bvh/lateral.h"
 #include "bvh/partition.h"
 #include "bvh/volume_origin.h"
+#include "bvh/wide_tree.h"
 #include "util/float_round.h"
 #include "parallel/executor.h"
 
@@ -365,6 +366,7 @@ std::shared_ptr<ModelData> build_on_this_thread(Mesh mesh, const BuildOptions& o
     Builder builder(model->origin == Vec3::Zero() ? mesh : moved, model->normals);
     builder.build(*model, options.oriented_boxes);
   }
+  bvh::build_wide_tree(*model);
   model->extent = bvh::largest_norm(mesh, Vec3::Zero());
   model->local_extent = bvh::largest_norm(mesh, model->origin);
   if (options.adjacency)

@@ -211,6 +211,30 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
   }
 }
 
+/// A node of the wide tree, read by the pair-collecting queries' node test (narrow/wide_test.h):
+/// a node of the BVH whose subtree is collapsed to at most kWideSlots slots, each slot a node
+/// below it (build_wide_tree: the slot of largest box surface that is not a leaf is replaced by its
+/// two children until the slots are full or all leaves; then each slot that is not a leaf gets a
+/// wide node of its own). A slot keeps its BVH node's id, so that the CD tree's nodes stay pairs
+/// of BVH nodes. Per slot, in lanes: its box as float bounds rounded outward from its BvhNode box
+/// (each bound the nearest float past the double center -+ half), its slab's axis and bounds as its
+/// BvhNodeFilter stores them. Slots past the last are empty: bounds +inf and -inf, no axis.
+struct alignas(32) WideNode {
+  static constexpr int kSlots = 8;
+  static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+  float lo[3][kSlots], hi[3][kSlots];      ///< box bounds along the object axes
+  float axis[3][kSlots];                   ///< slab axis (BvhNodeFilter::cone_axis)
+  float slab_lo[kSlots], slab_hi[kSlots];  ///< slab bounds
+  std::uint32_t node[kSlots];              ///< the slot's BVH node, kEmpty past the last
+  /// Number of slots (2 .. kSlots).
+  [[nodiscard]] int count() const {
+    int n = 2;
+    while (n < kSlots && node[n] != kEmpty) ++n;
+    return n;
+  }
+};
+static_assert(sizeof(WideNode) == 384);
+
 /// What a Model holds: the mesh with its BVH, normals and adjacency, laid out for the traversal.
 /// Made by build_model; never modified afterwards.
 struct ModelData : Model {
@@ -231,7 +255,7 @@ struct ModelData : Model {
   /// Position of each triangle in the leaf order. Every subtree is a run of it: the triangles below
   /// node i are those whose position lies in [first, first + nodes[i].count), where the root's
   /// first is 0 and a node's first child's is its own, its second child's its own plus the first
-  /// child's count (first_leaf_of).
+  /// child's count (first_leaf).
   std::vector<std::uint32_t> leaf_position;
 
   /// The group mask of node i (read only by queries with a group table).
@@ -242,10 +266,14 @@ struct ModelData : Model {
     const std::uint32_t p = leaf_position[triangle];
     return p >= first && p < first + nodes[node].count;
   }
-  /// Where the run of leaves of `node` starts, given that of `parent` (`first`): node is parent
-  /// itself, or one of its two children.
-  [[nodiscard]] std::uint32_t first_leaf_of(std::uint32_t node, std::uint32_t parent, std::uint32_t first) const {
-    return node == parent || node == nodes[parent].index ? first : first + nodes[nodes[parent].index].count;
+  /// The wide tree (WideNode), its root's first; and per BVH node, its wide node, or
+  /// WideNode::kEmpty for a leaf and for a node inside another's slots.
+  std::vector<WideNode> wide;
+  std::vector<std::uint32_t> wide_of;
+  /// Where the run of leaves of `node` starts: the place of its first leaf (its first children's).
+  [[nodiscard]] std::uint32_t first_leaf(std::uint32_t node) const {
+    while (!nodes[node].is_leaf()) node = nodes[node].index;
+    return leaf_position[nodes[node].index];
   }
   /// Unit face normal of each triangle in object space; zero for a degenerate triangle.
   std::vector<Eigen::Vector3d> normals;

@@ -54,7 +54,7 @@ std::string bvh_problem(const ModelData& m) {
   }
   if (m.nodes[0].count != triangles) return "the root does not hold every triangle";
   std::vector<std::uint8_t> reached(size, 0), placed(triangles, 0);
-  // Each node with where its run of leaves starts (ModelData::first_leaf_of).
+  // Each node with where its run of leaves starts (ModelData::first_leaf).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
   while (!stack.empty()) {
     const auto [i, first] = stack.back();

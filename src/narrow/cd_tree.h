@@ -3,6 +3,11 @@
 /// The CD tree of a pair of objects (the product of their BVHs): its nodes, which of them descend
 /// and into which children (the same for every method, schedule and pose), and the taboo lists
 /// with which the a posteriori method hands parts of it to sub-tasks.
+///
+/// Two shapes, by the query's kind. The pair-collecting kinds (interference, proximity, contact)
+/// walk the wide tree (WideNode): a node descends on one side, into the slots of that side's wide
+/// node (up to eight children). The distance query walks the binary BVH: a node descends on one
+/// or both sides (up to four children).
 
 #include <algorithm>
 #include <compare>
@@ -11,8 +16,12 @@
 
 #include "bvh/model_data.h"
 #include "narrow/pair_context.h"
+#include "narrow/wide_test.h"
 
 namespace caliber::narrow {
+
+/// The most children a CD-tree node has (the wide tree's slots).
+inline constexpr int kMaxChildren = WideNode::kSlots;
 
 /// A node of the CD tree: a node of A's BVH paired with a node of B's.
 struct NodePair {
@@ -51,7 +60,7 @@ inline bool on_taboo(TabooView taboo, NodePair child) {
   return true;
 }
 
-/// Which sides of CD-tree node n descend: both (up to 4 children) unless one is a leaf or its
+/// In the binary CD tree (the distance query's), which sides of node n descend: both (up to 4 children) unless one is a leaf or its
 /// sphere is more than `ratio` times the other's (PairContext::descend_alone_ratio), in which
 /// case only the larger one descends. Depends only on object-space radii and the query's kind, so
 /// the CD tree's shape does not depend on the poses. n must not be a pair of leaves.
@@ -60,11 +69,47 @@ inline void cd_descend(const BvhNode& a, const BvhNode& b, double ratio, bool& d
   descend_b = !b.is_leaf() && (a.is_leaf() || double(b.radius) * ratio >= double(a.radius));
 }
 
+/// Whether the queries of ctx walk the wide CD tree (the pair-collecting kinds) rather than the
+/// binary one (distance).
+inline bool wide_cd_tree(const PairContext& ctx) { return ctx.request().kind != QueryKind::distance; }
+
+/// In the wide CD tree, whether node (a, b), not a pair of leaves, descends on A's side: A's node
+/// is not a leaf, and B's is one or its sphere is no larger than A's. Depends only on object-space
+/// radii, so the CD tree's shape does not depend on the poses.
+inline bool wide_descends_a(const BvhNode& a, const BvhNode& b) { return !a.is_leaf() && (b.is_leaf() || a.radius >= b.radius); }
+
+/// A visit of the wide CD tree's node n (not a pair of leaves): the side that descends
+/// (wide_descends_a), its wide node and the node that stays; child k is slot k with that node.
+struct WideVisit {
+  const WideNode* node;
+  std::uint32_t stay;
+  bool a_descends;
+
+  [[nodiscard]] NodePair child(int k, NodePair n) const {
+    return a_descends ? NodePair{node->node[k], n.b} : NodePair{n.a, node->node[k]};
+  }
+};
+
+/// The wide visit of node n, whose BVH nodes are a (of A) and b (of B).
+inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
+  const bool down_a = wide_descends_a(a, b);
+  const ModelData& m = down_a ? ctx.a() : ctx.b();
+  return WideVisit{&m.wide[m.wide_of[down_a ? n.a : n.b]], down_a ? n.b : n.a, down_a};
+}
+
 /// The children of CD-tree node n of pair context ctx (not a pair of leaves), written to out;
-/// returns how many.
-inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
+/// returns how many. The wide tree's: the slots of the descending side's wide node, in order,
+/// each with the node that stays (WideVisit). The binary tree's: A's child i (or n.a) with B's
+/// child j (or n.b), i major.
+inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChildren]) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
+  if (wide_cd_tree(ctx)) {
+    const WideVisit v = wide_visit(ctx, n, a, b);
+    const int count = v.node->count();
+    for (int k = 0; k < count; ++k) out[k] = v.child(k, n);
+    return count;
+  }
   bool descend_a, descend_b;
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
   int count = 0;
@@ -76,12 +121,50 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[4]) {
   return count;
 }
 
-/// The node test that a visit of `parent` makes on `child` (one of its cd_children): with the
-/// disks where both sides descend (PairContext::node_test_2x2_lane), node_test where one does. For
-/// code that walks the CD tree its own way and must make the decisions narrow::visit makes (tests,
-/// benches).
+/// The lanes of the wide node test for ctx's pose (detail::make_wide_lanes, with the scale of
+/// PairContext::node_lanes): made once by a traversal.
+detail::WideLanes wide_lanes(const PairContext& ctx);
+
+/// The form of the wide node test this CPU runs (the AVX2 one where it has it, else the scalar
+/// one: the same decisions), chosen when the library loads.
+extern const detail::WideTest kWideTest;
+
+/// The node tests of the wide visit v of node n on its children: bit k set where child k
+/// (cd_children order) passes the wide test (detail::WideTest), then the groups and normal cones
+/// (PairContext::groups_and_cones_allow).
+inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes) {
+  const detail::WideTest test = kWideTest;
+  unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node);
+  if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
+  for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
+    const int k = __builtin_ctz(bits);
+    const NodePair child = v.child(k, n);
+    if (!ctx.groups_and_cones_allow(child.a, child.b)) pass &= ~(1u << k);
+  }
+  return pass;
+}
+
+/// How a CD-tree node is tested where no visit of its parent tests it (a traversal's root): not at
+/// all (tested and passed earlier), as a pair's root (PairContext::node_test), as a child of a
+/// binary visit where both sides descend (PairContext::node_test_2x2_lane), or as its wide
+/// parent's visit tests it, the parent having descended on A's side or on B's (wide_pass).
+enum class RootTest : std::uint8_t { done, as_root, with_disks, child_of_a, child_of_b };
+
+/// How the visit of `parent` tests `child` (one of its cd_children), as a RootTest; a node given
+/// as its own parent is tested as a root.
+inline RootTest child_root_test(const PairContext& ctx, NodePair parent, NodePair child) {
+  if (child == parent) return RootTest::as_root;
+  if (wide_cd_tree(ctx)) return child.a != parent.a ? RootTest::child_of_a : RootTest::child_of_b;
+  return child.a != parent.a && child.b != parent.b ? RootTest::with_disks : RootTest::as_root;
+}
+
+/// The node test of CD-tree node n made as `how` says (not RootTest::done).
+bool root_test(const PairContext& ctx, NodePair n, RootTest how);
+
+/// The node test that a visit of `parent` makes on `child` (one of its cd_children). For code that
+/// walks the CD tree its own way and must make the decisions narrow::visit makes (tests, benches).
 inline bool child_test(const PairContext& ctx, NodePair parent, NodePair child) {
-  return child.a != parent.a && child.b != parent.b ? ctx.node_test_2x2_lane(child.a, child.b) : ctx.node_test(child.a, child.b);
+  return root_test(ctx, child, child_root_test(ctx, parent, child));
 }
 
 }  // namespace caliber::narrow

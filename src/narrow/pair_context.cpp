@@ -148,14 +148,14 @@ int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, 
   // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
   for (int left = pass; left != 0; left &= left - 1) {
     const int k = __builtin_ctz(static_cast<unsigned>(left));
-    const BvhNodeFilter& fa = mA.filters[ia[k / 2]];
-    const BvhNodeFilter& fb = mB.filters[ib[k % 2]];
-    if ((mGroups != nullptr && !groups_can_touch(mA.group_mask(ia[k / 2]), mB.group_mask(ib[k % 2]))) ||
-        (mKind == QueryKind::contact && !cones_can_face(fa, fb))) {
-      pass &= ~(1 << k);
-    }
+    if (!groups_and_cones_allow(ia[k / 2], ib[k % 2])) pass &= ~(1 << k);
   }
   return pass;
+}
+
+bool PairContext::groups_and_cones_allow(std::uint32_t ia, std::uint32_t ib) const {
+  if (mGroups != nullptr && !groups_can_touch(mA.group_mask(ia), mB.group_mask(ib))) return false;
+  return mKind != QueryKind::contact || cones_can_face(mA.filters[ia], mB.filters[ib]);
 }
 
 void PairContext::prepare_disk_a(SideA& s) const {

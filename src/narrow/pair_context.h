@@ -28,15 +28,13 @@
 
 namespace caliber::narrow {
 
-/// A node whose sphere is more than this many times larger than its partner's descends alone (its
-/// partner waits): in the queries that collect pairs.
+/// In the binary CD tree, a node whose sphere is more than this many times larger than its
+/// partner's descends alone (its partner waits): the swept query's traversal.
 inline constexpr double kDescendAloneRatio = 2.0;
 /// The same in the distance query, whose visits where one side descends cost nearly as much as
 /// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance): 4
 /// was faster on the bunny at gap 1, as fast or a little faster on the armadillo and dragon, and
 /// faster on some cases, slower on others, on the turbine and blade and on the fandisk and rotor.
-/// (In the queries that collect pairs, 4 was about as fast as 2 on the scenes and the FCL cases,
-/// except the turbine and blade, slower, and the fandisk and rotor, faster: they keep 2.)
 inline constexpr double kDescendAloneRatioDistance = 4.0;
 
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
@@ -125,6 +123,10 @@ class PairContext {
   /// What the four-lane forms read of this context, and its pose in their lanes (make_lanes).
   [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
   [[nodiscard]] detail::NodeLanes node_lanes() const;
+  /// Whether groups or normal cones may refuse a pair (a table of groups, or the contact kind), and
+  /// whether they let node ia of A and node ib of B touch.
+  [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }
+  [[nodiscard]] bool groups_and_cones_allow(std::uint32_t ia, std::uint32_t ib) const;
   /// The node-node test on node ia of A and node ib of B (the same arithmetic as above).
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 
@@ -269,7 +271,6 @@ class PairContext {
 
   /// `pass` (bit 2i + j: ai and bj) less the pairs that groups or normal cones refuse (where some can).
   [[nodiscard]] int groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const;
-  [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }
   /// node_tests_2x2 (or, `one_side`, node_tests_one_side) with its form `within` (or none) where the
   /// lanes are not given or groups or cones may refuse.
   [[nodiscard]] int node_tests_otherwise(detail::NodeWithin2x2 within, bool one_side, std::uint32_t a0, std::uint32_t a1,

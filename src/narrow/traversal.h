@@ -14,88 +14,12 @@
 #include "narrow/cd_tree.h"
 #include "narrow/child_pairs.h"
 #include "narrow/pair_context.h"
+#include "narrow/visit.h"
 #include "narrow/visit_order.h"
 #include "util/assert.h"
 #include "util/gap_buckets.h"
 
 namespace caliber::narrow {
-
-/// How a traversal's root is tested: not at all (it was tested, and passed, earlier), as a pair's
-/// root (node_test), or as a child of a visit where both sides descend (node_test_2x2_lane: a root
-/// that its parent's visit would have tested with the disks, as narrow::child_test).
-enum class RootTest : std::uint8_t { done, as_root, with_disks };
-
-/// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root),
-/// as `how` says (not RootTest::done).
-inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, RootTest how = RootTest::as_root) {
-  ++stats.node_tests;
-  return how == RootTest::with_disks ? ctx.node_test_2x2_lane(n.a, n.b) : ctx.node_test(n.a, n.b);
-}
-
-/// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
-/// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
-/// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
-/// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
-/// that pass are written to `passed` in cd_children order and the visit returns how many (0..4).
-/// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
-/// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
-/// reading `out`. `lanes`: ctx.node_lanes(), made once by the traversal (null: by each test).
-/// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
-/// so, the first child on top).
-template <bool kReversed = false>
-[[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
-                                        NodePair passed[4], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
-                                        const detail::NodeLanes* lanes = nullptr) {
-  const BvhNode& a = ctx.a().nodes[n.a];
-  const BvhNode& b = ctx.b().nodes[n.b];
-  if (a.is_leaf() && b.is_leaf()) {
-    ++stats.leaf_tests;
-    if (buffer != nullptr) {
-      ctx.leaf_test(a.index, b.index, out, *buffer);
-    } else {
-      ctx.leaf_test(a.index, b.index, out);
-    }
-    return -1;
-  }
-  int count = 0;
-  bool descend_a, descend_b;
-  cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
-  const bool both = descend_a && descend_b;
-  if (taboo.taboo == nullptr) {
-    // No taboo list: the children tested and counted at once, taken by their bits in lane order:
-    // four where both sides descend (lane 2i + j: A's child i, B's child j), else the two of the
-    // side that descends against the other node (node_tests_one_side: lanes 0 and 3).
-    const std::uint32_t a0 = descend_a ? a.index : n.a, a1 = descend_a ? a.index + 1 : n.a;
-    const std::uint32_t b0 = descend_b ? b.index : n.b, b1 = descend_b ? b.index + 1 : n.b;
-    const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1, lanes) : ctx.node_tests_one_side(a0, a1, b0, b1, lanes);
-    stats.node_tests += both ? 4 : 2;
-    for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0;) {
-      const unsigned k =
-          kReversed ? 31u - static_cast<unsigned>(__builtin_clz(bits)) : static_cast<unsigned>(__builtin_ctz(bits));
-      bits ^= 1u << k;
-      passed[count++] = NodePair{k / 2 != 0 ? a1 : a0, k % 2 != 0 ? b1 : b0};
-    }
-    return count;
-  }
-  if (both) {
-    // With a taboo list: the four at once, taken in cd_children order (one on the list is marked
-    // reached, neither counted nor entered); where one side descends, pair by pair below.
-    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1, lanes);
-    for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
-      if ((pass >> k) & 1) passed[count++] = child;
-    });
-    if constexpr (kReversed) std::reverse(passed, passed + count);
-    return count;
-  }
-  for_each_child(
-      n, a, b, descend_a, descend_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); },
-      [&](std::uint32_t j) { return ctx.prepare_b(j); },
-      [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
-        if (ctx.node_test(sa, sb)) passed[count++] = child;
-      });
-  if constexpr (kReversed) std::reverse(passed, passed + count);
-  return count;
-}
 
 /// What the traversals of one object pair share, whatever threads they run on: how many triangle
 /// pairs they have kept, against QueryRequest::max_pairs (they stop once it is exceeded; which
@@ -138,18 +62,27 @@ struct TraversalScratch {
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                                  QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
                                  PairShared* limit = nullptr) {
-  // Each visit pops one node and pushes at most four, one level deeper: the stack never holds
-  // more than 3 * (height A + height B) + 1 nodes.
+  // Each visit pops one node and pushes at most eight, one level deeper in one of the trees: the
+  // stack never holds more than 7 * (height A + height B) + 1 nodes.
   std::vector<NodePair>& stack = scratch.stack;
-  const auto bound = static_cast<std::size_t>(3 * (ctx.a().height + ctx.b().height) + 4);
+  const auto bound = static_cast<std::size_t>(7 * (ctx.a().height + ctx.b().height) + 8);
   if (stack.size() < bound) stack.resize(bound);
   NodePair* const base = stack.data();
   NodePair* top = base;
   QueryStats counted;
   if (root_test == RootTest::done || test_root(ctx, root, counted, root_test)) *top++ = root;
-  NodePair passed[4];
-  detail::NodeLanes lanes;  // made only where the root passes: a pair refused at its root pays nothing
-  if (top != base) lanes = ctx.node_lanes();
+  NodePair passed[kMaxChildren];
+  // The lanes, made only where the root passes: a pair refused at its root pays nothing.
+  detail::WideLanes wide;
+  detail::NodeLanes binary;
+  VisitLanes lanes;
+  if (top != base && wide_cd_tree(ctx)) {
+    wide = wide_lanes(ctx);
+    lanes.wide = &wide;
+  } else if (top != base) {
+    binary = ctx.node_lanes();
+    lanes.binary = &binary;
+  }
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs wait in a buffer for the batch kernels, and the children that
   // pass are written straight onto the stack, the first one on top (the order of cd_children).
@@ -157,12 +90,12 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   LeafBuffer buffer;
   while (limit == nullptr && top != base) {
     const NodePair n = *--top;
-    const int count = visit<true>(ctx, n, out, counted, top, taboo, &buffer, &lanes);
+    const int count = visit<true>(ctx, n, out, counted, top, taboo, &buffer, lanes);
     top += count > 0 ? count : 0;
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
   while (limit != nullptr && top != base) {
-    const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, &lanes);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (count < 0) {
       if (out.size() != seen) {

@@ -16,35 +16,34 @@
 
 namespace caliber::narrow {
 
-/// Pushes the `count` children of a visit (passed, 0..4 of them) onto a depth-first stack at `top`
+/// Pushes the `count` children of a visit (passed, 0..8 of them) onto a depth-first stack at `top`
 /// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
 /// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
 /// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
 /// colliding poses: bench/results/amd-epyc-2c/batch/README.md), which pair it meets first being
 /// the traversal's choice (QueryRequest::max_pairs). A traversal that visits every node keeps
 /// cd_children order.
-inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[4], int count, NodePair* top) {
+inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[], int count, NodePair* top) {
   if (count < 2) {  // nothing to order
     if (count == 1) *top++ = passed[0];
     return top;
   }
-  // A visit's children share at most two nodes of B: each one's center is moved into A's frame
-  // once.
-  double apart[4], centers[2][3];
-  std::uint32_t moved[2];
+  // Each node of B among a visit's children has its center moved into A's frame once (a wide
+  // visit where B's side stays has one).
+  double apart[kMaxChildren], centers[kMaxChildren][3];
+  std::uint32_t moved[kMaxChildren];
   int known = 0;
   for (int k = 0; k < count; ++k) {
     int c = 0;
     while (c < known && moved[c] != passed[k].b) ++c;
     if (c == known) {
-      CALIBER_ASSERT(known < 2, "a visit's children share at most two nodes of B");
       ctx.sphere_center_in_a(passed[k].b, centers[c]);
       moved[known++] = passed[k].b;
     }
     apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b, centers[c]);
   }
   // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
-  // insertion sort of at most four.
+  // insertion sort of at most eight.
   for (int i = 1; i < count; ++i) {
     for (int j = i; j > 0 && apart[j] >= apart[j - 1]; --j) {
       std::swap(apart[j], apart[j - 1]);

@@ -43,14 +43,14 @@ struct StageItem {
 /// Every node of a level has passed its node test (made by its parent's visit, or the root's).
 struct StageOutcome {
   enum class Kind : std::uint8_t { leaf, split, root } kind = Kind::root;
-  bool reported = false;        ///< leaf: the leaf test kept the pair
-  bool keep = false;            ///< root: kept as a sub-task root (else it goes to the cart)
-  std::uint8_t children = 0;    ///< split: how many children passed their test
-  std::uint8_t tested = 0;      ///< split: how many children were tested
-  StageItem child[4];           ///< split: the children that passed, and their weights
-  narrow::NodePair all[4];      ///< split: every child tested (cd_children order)
-  QueryStats stats;             ///< the visit's node and leaf tests
-  narrow::Candidate candidate;  ///< leaf, reported: the pair
+  bool reported = false;                       ///< leaf: the leaf test kept the pair
+  bool keep = false;                           ///< root: kept as a sub-task root (else it goes to the cart)
+  std::uint8_t children = 0;                   ///< split: how many children passed their test
+  std::uint8_t tested = 0;                     ///< split: how many children were tested
+  StageItem child[narrow::kMaxChildren];       ///< split: the children that passed, and their weights
+  narrow::NodePair all[narrow::kMaxChildren];  ///< split: every child tested (cd_children order)
+  QueryStats stats;                            ///< the visit's node and leaf tests
+  narrow::Candidate candidate;                 ///< leaf, reported: the pair
 };
 
 /// What one chunk of a level produced: its tests, and how many of each output it adds (so that
@@ -90,7 +90,7 @@ void visit_level(const narrow::PairContext& ctx, const std::vector<StageItem>& l
         continue;
       }
       found.clear();
-      narrow::NodePair passed[4];
+      narrow::NodePair passed[narrow::kMaxChildren];
       const int count = narrow::visit(ctx, e.node, found, o.stats, passed);
       t.stats.node_tests += o.stats.node_tests;
       t.stats.leaf_tests += o.stats.leaf_tests;
@@ -246,26 +246,25 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 
 namespace {
 
-/// Fills summary[slot] for CD node n (its nodes' runs of leaves starting at `leaves`) with the
-/// reported pairs in [first, last) below it, then its children. The pairs are partitioned in place
-/// (each goes to the first child that holds both triangles, as a traversal would meet it), so the
-/// tree costs no allocation per node.
-void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, narrow::NodePair leaves, bool disks,
+/// Fills summary[slot] for CD node n (tested as `test` says) with the reported pairs in [first,
+/// last) below it, then its children. The pairs are partitioned in place (each goes to the first
+/// child that holds both triangles, as a traversal would meet it), so the tree costs no allocation
+/// per node.
+void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::NodePair n, narrow::RootTest test,
                   TrianglePair* first, TrianglePair* last, std::vector<SummaryNode>& summary) {
   const ModelData& a = ctx.a();
   const ModelData& b = ctx.b();
   summary[slot].node = n;
-  summary[slot].disks = disks;
+  summary[slot].test = test;
   summary[slot].contacts = static_cast<std::uint32_t>(last - first);
   if (a.nodes[n.a].is_leaf() && b.nodes[n.b].is_leaf()) return;
-  narrow::NodePair kids[4];
+  narrow::NodePair kids[narrow::kMaxChildren];
   const int count = narrow::cd_children(ctx, n, kids);
-  TrianglePair* bounds[5] = {first};
-  narrow::NodePair kid_leaves[4];
+  TrianglePair* bounds[narrow::kMaxChildren + 1] = {first};
   for (int k = 0; k < count; ++k) {
-    kid_leaves[k] = {a.first_leaf_of(kids[k].a, n.a, leaves.a), b.first_leaf_of(kids[k].b, n.b, leaves.b)};
+    const narrow::NodePair leaves{a.first_leaf(kids[k].a), b.first_leaf(kids[k].b)};
     bounds[k + 1] = std::partition(bounds[k], last, [&](const TrianglePair& p) {
-      return a.holds(kids[k].a, kid_leaves[k].a, p.tri_a) && b.holds(kids[k].b, kid_leaves[k].b, p.tri_b);
+      return a.holds(kids[k].a, leaves.a, p.tri_a) && b.holds(kids[k].b, leaves.b, p.tri_b);
     });
   }
   const auto at = static_cast<std::uint32_t>(summary.size());
@@ -275,9 +274,10 @@ void fill_summary(const narrow::PairContext& ctx, std::uint32_t slot, narrow::No
   summary[slot].children = children;
   summary.resize(summary.size() + children);
   std::uint32_t next = at;
-  const bool both = count == 4;  // both sides descend: the visit tests the children with the disks
   for (int k = 0; k < count; ++k) {
-    if (bounds[k + 1] != bounds[k]) fill_summary(ctx, next++, kids[k], kid_leaves[k], both, bounds[k], bounds[k + 1], summary);
+    if (bounds[k + 1] != bounds[k]) {
+      fill_summary(ctx, next++, kids[k], narrow::child_root_test(ctx, n, kids[k]), bounds[k], bounds[k + 1], summary);
+    }
   }
 }
 
@@ -297,7 +297,7 @@ std::vector<SummaryNode> build_summary(const narrow::PairContext& ctx, const std
   if (items.empty()) return summary;
   summary.reserve(2 * items.size() + 1);
   summary.resize(1);
-  fill_summary(ctx, 0, narrow::NodePair{0, 0}, narrow::NodePair{0, 0}, false, items.data(), items.data() + items.size(), summary);
+  fill_summary(ctx, 0, narrow::NodePair{0, 0}, narrow::RootTest::as_root, items.data(), items.data() + items.size(), summary);
   return summary;
 }
 
@@ -328,7 +328,7 @@ PosterioriSplit split_aposteriori(const std::vector<SummaryNode>& summary, std::
       continue;
     }
     Root r{pair, s.node, false, e.weight};
-    r.disks = s.disks;
+    r.test = s.test;
     (v == Verdict::cart ? out.cart : out.roots).push_back(r);
     out.taboo.push_back(s.node);
     out.rest -= e.weight;

@@ -28,12 +28,11 @@ struct Root {
   std::int32_t owner = -1;  ///< a posteriori: the taboo list this root is on (sub-tasks)
   std::int32_t slot = -1;   ///< a posteriori: its place on that list
   std::int32_t stage = -1;  ///< weight-driven stage: index of its record in SplitResult::stage
-  bool disks = false;       ///< untested, its CD parent descends on both sides: tested with the disks
+  /// Untested: how its parent's visit would test it (narrow::child_root_test), or as a root.
+  narrow::RootTest test = narrow::RootTest::as_root;
 
   /// How its traversal tests it (narrow::RootTest), as its parent's visit would.
-  [[nodiscard]] narrow::RootTest root_test() const {
-    return tested ? narrow::RootTest::done : disks ? narrow::RootTest::with_disks : narrow::RootTest::as_root;
-  }
+  [[nodiscard]] narrow::RootTest root_test() const { return tested ? narrow::RootTest::done : test; }
 };
 
 /// A run-time task's roots: up to three held in place (nearly every task has one to three, and a
@@ -96,11 +95,11 @@ std::vector<RunTask> merge_cart(std::vector<Root> cart, double omega);
 /// so that its subtree's node tests can be added up after the step (the node-history variant of
 /// hybrid reuses them).
 struct StageRecord {
-  narrow::NodePair node;      ///< the CD-tree node
-  std::uint8_t children = 0;  ///< expanded: how many children its visit tested
-  std::uint8_t passed = 0;    ///< expanded: bit k set when child k passed (and has a record)
-  narrow::NodePair child[4];  ///< expanded: the children tested
-  bool root = false;          ///< became a sub-task root or a cart item (tested)
+  narrow::NodePair node;                         ///< the CD-tree node
+  std::uint8_t children = 0;                     ///< expanded: how many children its visit tested
+  std::uint8_t passed = 0;                       ///< expanded: bit k set when child k passed (and has a record)
+  narrow::NodePair child[narrow::kMaxChildren];  ///< expanded: the children tested
+  bool root = false;                             ///< became a sub-task root or a cart item (tested)
 };
 
 /// Measured node tests of CD subtrees at the previous step, per CD node, sorted by node.
@@ -141,11 +140,11 @@ NodeCounts subtree_counts(const std::vector<StageRecord>& stage, const std::vect
 /// The a posteriori summary tree of one pair: the CD-tree nodes above the triangle pairs reported at
 /// the previous step, each weighted by how many of them lie below it. Children are contiguous.
 struct SummaryNode {
-  narrow::NodePair node;       ///< the CD-tree node
-  std::uint32_t contacts = 0;  ///< reported triangle pairs below it
-  std::uint32_t first = 0;     ///< index of its first child in the summary
-  std::uint32_t children = 0;  ///< how many children (only those with contacts below)
-  bool disks = false;          ///< its parent descends on both sides (its node test has the disks)
+  narrow::NodePair node;                              ///< the CD-tree node
+  std::uint32_t contacts = 0;                         ///< reported triangle pairs below it
+  std::uint32_t first = 0;                            ///< index of its first child in the summary
+  std::uint32_t children = 0;                         ///< how many children (only those with contacts below)
+  narrow::RootTest test = narrow::RootTest::as_root;  ///< how its parent's visit tests it (narrow::child_root_test)
 };
 
 /// Builds the summary tree of pair context ctx's CD tree from the previous step's reported triangle

@@ -25,7 +25,7 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
 /// pieces, which depend on what the others have found by then).
 void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested) {
   const narrow::PairContext& ctx = state.contexts[pair];
-  narrow::NodePair kids[4];
+  narrow::NodePair kids[narrow::kMaxChildren];
   int count = 0;
   {
     WorkerSlots& w = local_slots(state);

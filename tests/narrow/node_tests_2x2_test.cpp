@@ -150,15 +150,17 @@ TEST(NodeTests2x2, FarScalesUseTheDoubleForm) {
 }
 
 // narrow::visit takes a node's children that pass in cd_children order, each decided as child_test
-// decides it and counted once: with no taboo list (the lanes, one side or both descending) and
-// with one (pair by pair where one side descends), on models whose spheres differ in size, so
-// that many visits descend on one side, a leaf against an inner node among them.
+// decides it and counted once: with no taboo list and with one, in the wide CD tree (interference,
+// contact: either side descending, child_test making its slot's test alone) and in the binary one
+// (distance: the lanes, one side or both descending, and pair by pair where one side descends), on
+// models whose spheres differ in size, so that many visits descend on one side, a leaf against an
+// inner node among them.
 TEST(NodeTests2x2, VisitTakesThePassingChildrenInTreeOrder) {
   const auto a = build_model(make_torus(1.0, 0.35, 48, 24));
   const auto b = build_model(make_box(0.3, 0.2, 0.15, 3));
   std::mt19937_64 rng(20261201);
-  long one_side = 0, both = 0, taken = 0;
-  for (const QueryKind kind : {QueryKind::interference, QueryKind::contact}) {
+  long one_side = 0, both = 0, down_a = 0, down_b = 0, taken = 0;
+  for (const QueryKind kind : {QueryKind::interference, QueryKind::contact, QueryKind::distance}) {
     QueryRequest request;
     request.kind = kind;
     request.tolerance = kind == QueryKind::interference ? 0.0 : 0.05;
@@ -171,17 +173,21 @@ TEST(NodeTests2x2, VisitTakesThePassingChildrenInTreeOrder) {
       for (std::size_t w = 0; w < work.size() && w < 50000; ++w) {
         const NodePair n = work[w];
         if (ctx.a().nodes[n.a].is_leaf() && ctx.b().nodes[n.b].is_leaf()) continue;
-        NodePair kids[4], want[4];
+        NodePair kids[kMaxChildren], want[kMaxChildren];
         const int count = cd_children(ctx, n, kids);
         int wanted = 0;
         for (int k = 0; k < count; ++k) {
           if (child_test(ctx, n, kids[k])) want[wanted++] = kids[k];
         }
-        (count == 2 ? one_side : both) += 1;
+        if (kind == QueryKind::distance) {
+          (count == 2 ? one_side : both) += 1;
+        } else {
+          (kids[0].a != n.a ? down_a : down_b) += 1;
+        }
         for (const bool with_taboo : {false, true}) {
           std::vector<Candidate> out;
           QueryStats stats;
-          NodePair passed[4];
+          NodePair passed[kMaxChildren];
           const TabooView taboo = with_taboo ? TabooView{&elsewhere, reached} : TabooView{};
           const int got = visit(ctx, n, out, stats, passed, taboo);
           ASSERT_EQ(got, wanted) << "kind " << static_cast<int>(kind) << " pose " << p << " taboo " << with_taboo;
@@ -193,8 +199,10 @@ TEST(NodeTests2x2, VisitTakesThePassingChildrenInTreeOrder) {
       }
     }
   }
-  EXPECT_GT(one_side, 500) << "many visits descend on one side";
+  EXPECT_GT(one_side, 500) << "many binary visits descend on one side";
   EXPECT_GT(both, 1000);
+  EXPECT_GT(down_a, 500) << "wide visits descend on either side";
+  EXPECT_GT(down_b, 500);
   EXPECT_GT(taken, 2000);
 }
 

@@ -114,7 +114,7 @@ TEST(NodeSlab, GapsAroundTheToleranceGiveTheOracleAnswer) {
   EXPECT_GT(empty, 10);
 }
 
-TEST(NodeSlab, BothTiltedParallelPatchesApartAreCutByTheDisks) {
+TEST(NodeSlab, BothTiltedParallelPatchesApartAreCutHighInTheTree) {
   const auto a = build_model(patch(16, 0.0, kNormal));
   const auto b = build_model(patch(16, 0.37, kNormal));
   const Pose identity = Pose::from_values(0, 0, 0, 1, 0, 0, 0);
@@ -123,10 +123,11 @@ TEST(NodeSlab, BothTiltedParallelPatchesApartAreCutByTheDisks) {
   const QueryResult apart = query(*a, identity, *b, pose_at_gap(identity, Eigen::Quaterniond::Identity(), 0.01), interference);
   EXPECT_TRUE(apart.contacts.empty());
   // Both patches' boxes are thick, so the boxes and the slab-against-box tests let every pair down
-  // to the leaves (12.5k node tests and 2.9k leaf tests before the disks); a disk is as thin along
-  // the other's slab axis as its own slab.
+  // to the leaves (11.5k node tests and 2.9k leaf tests). The staying node's slab projected along
+  // the slot's slab (detail::WideTest: lambda times the slot's slab plus the rest of its box) is as
+  // thin along the other's slab axis as the slot's own slab: a few visits refuse every pair.
   EXPECT_EQ(apart.stats.leaf_tests, 0u);
-  EXPECT_LT(apart.stats.node_tests, 50u);
+  EXPECT_LT(apart.stats.node_tests, 100u);
 }
 
 /// Every vertex of the triangles below node `n` of `model` (leaves hold triangle ids).

@@ -22,13 +22,18 @@ namespace {
 
 const test::TorusSphere& shapes() { return test::torus_sphere(); }
 
+bool leaf_pair(const narrow::PairContext& ctx, narrow::NodePair n) {
+  return ctx.a().nodes[n.a].is_leaf() && ctx.b().nodes[n.b].is_leaf();
+}
+
 /// Every CD node of the first `levels` levels of the pair's tree, breadth first.
 std::vector<narrow::NodePair> top_of_tree(const narrow::PairContext& ctx, int levels) {
   std::vector<narrow::NodePair> all, level{{0, 0}};
   for (int depth = 0; depth < levels; ++depth) {
     std::vector<narrow::NodePair> next;
     for (const narrow::NodePair n : level) {
-      narrow::NodePair kids[4];
+      if (leaf_pair(ctx, n)) continue;
+      narrow::NodePair kids[narrow::kMaxChildren];
       next.insert(next.end(), kids, kids + narrow::cd_children(ctx, n, kids));
     }
     all.insert(all.end(), level.begin(), level.end());
@@ -44,8 +49,9 @@ TEST(VisitOrder, LimitedTraversalPopsTheNearestSpheresFirst) {
     const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
                                   QueryRequest{});
     for (const narrow::NodePair n : top_of_tree(ctx, 6)) {
+      if (leaf_pair(ctx, n)) continue;
       // The children pushed as a limited traversal pushes them, then popped.
-      narrow::NodePair kids[4], passed[4], stack[4];
+      narrow::NodePair kids[narrow::kMaxChildren], passed[narrow::kMaxChildren], stack[narrow::kMaxChildren];
       const int count = narrow::cd_children(ctx, n, kids);
       std::copy(kids, kids + count, passed);
       narrow::NodePair* const top = narrow::push_nearest_first(ctx, passed, count, stack);
@@ -78,7 +84,8 @@ TEST(VisitOrder, DistanceAtContactTakesTheMostOverlappingTouchingChildFirst) {
     const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
                                   request);
     for (const narrow::NodePair n : top_of_tree(ctx, 5)) {
-      narrow::NodePair kids[4];
+      if (leaf_pair(ctx, n)) continue;
+      narrow::NodePair kids[narrow::kMaxChildren];
       const int count = narrow::cd_children(ctx, n, kids);
       if (count < 2) continue;
       // Every pattern of children at gap 0 (the others at gaps 1, 2, ...), each child's prepared nodes its own.

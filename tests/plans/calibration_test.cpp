@@ -185,20 +185,25 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
     nodes_of_kind.emplace_back();
     for (const SummaryNode& s : kind_summary) {
       nodes_of_kind.back().push_back(s.node);
-      narrow::NodePair kids[4];
+      narrow::NodePair kids[narrow::kMaxChildren];
       const int count = s.children == 0 ? 0 : narrow::cd_children(kind_ctx, s.node, kids);
       for (std::uint32_t c = 0; c < s.children; ++c) {
-        EXPECT_NE(std::find(kids, kids + count, kind_summary[s.first + c].node), kids + count) << to_string(kind);
-        // A child of a visit where both sides descend is tested with the disks (narrow::child_test).
-        EXPECT_EQ(kind_summary[s.first + c].disks, count == 4) << to_string(kind);
-        both_and_one[count == 4] += 1;
+        const narrow::NodePair child = kind_summary[s.first + c].node;
+        EXPECT_NE(std::find(kids, kids + count, child), kids + count) << to_string(kind);
+        // Each child is tested as its parent's visit tests it: in the binary tree (distance), with
+        // the disks where both sides descend; in the wide tree, as a slot of the side that descends.
+        const narrow::RootTest want = kind == QueryKind::distance
+                                          ? (count == 4 ? narrow::RootTest::with_disks : narrow::RootTest::as_root)
+                                          : (child.a != s.node.a ? narrow::RootTest::child_of_a : narrow::RootTest::child_of_b);
+        EXPECT_EQ(kind_summary[s.first + c].test, want) << to_string(kind);
+        both_and_one[want == narrow::RootTest::with_disks || want == narrow::RootTest::child_of_a] += 1;
       }
     }
   }
   EXPECT_NE(nodes_of_kind[0], nodes_of_kind[1]);
   EXPECT_GT(both_and_one[0], 0);
   EXPECT_GT(both_and_one[1], 0);
-  EXPECT_FALSE(build_summary(ctx_for_root, reported)[0].disks) << "the root is tested as a root";
+  EXPECT_EQ(build_summary(ctx_for_root, reported)[0].test, narrow::RootTest::as_root) << "the root is tested as a root";
   const narrow::PairContext ctx(*a, Pose{}, *b, Pose{}, QueryRequest{});
   const auto summary = build_summary(ctx, reported);
   ASSERT_FALSE(summary.empty());
@@ -230,8 +235,8 @@ TEST(Calibration, SummaryTreeCountsTheContactsBelowEachNode) {
     for (const Root& r : *list) {
       const auto s = std::find_if(summary.begin(), summary.end(), [&](const SummaryNode& x) { return x.node == r.node; });
       ASSERT_NE(s, summary.end());
-      EXPECT_EQ(r.disks, s->disks);
-      EXPECT_EQ(r.root_test(), s->disks ? narrow::RootTest::with_disks : narrow::RootTest::as_root);
+      EXPECT_EQ(r.test, s->test);
+      EXPECT_EQ(r.root_test(), s->test);
     }
   }
 }
@@ -254,7 +259,7 @@ SplitResult priority_queue_stage(const narrow::PairContext& ctx, std::uint32_t p
   SplitResult out;
   std::priority_queue<Entry> queue;
   queue.push(Entry{root_weight, narrow::NodePair{0, 0}, narrow::NodePair{0, 0}});
-  narrow::NodePair kids[4];
+  narrow::NodePair kids[narrow::kMaxChildren];
   while (!queue.empty()) {
     const Entry e = queue.top();
     queue.pop();

@@ -1,0 +1,23 @@
+#pragma once
+/// \file
+/// The wide tree of a built BVH (WideNode): collapsed from its binary nodes, so that both describe
+/// the same volumes and a slot is a BVH node.
+
+#include <cstdint>
+
+#include "bvh/model_data.h"
+
+namespace caliber::bvh {
+
+/// Builds model.wide and model.wide_of from model.nodes and model.filters (the BVH already built).
+void build_wide_tree(ModelData& model);
+
+/// Writes BVH node `node` of `model` into slot k of `out` as build_wide_tree does: its box rounded
+/// outward, its slab.
+void fill_wide_slot(const ModelData& model, std::uint32_t node, int k, WideNode& out);
+
+/// A wide node whose one slot is BVH node `node` (the others empty): what a node's own test reads
+/// where no visit of its parent tested it (narrow::RootTest).
+[[nodiscard]] WideNode single_slot(const ModelData& model, std::uint32_t node);
+
+}  // namespace caliber::bvh

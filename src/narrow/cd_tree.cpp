@@ -1,0 +1,41 @@
+// The wide CD tree's node tests (cd_tree.h): a visit's children at once, and a node alone.
+
+#include "narrow/cd_tree.h"
+
+#include <cmath>
+
+#include "bvh/wide_tree.h"
+
+namespace caliber::narrow {
+
+const detail::WideTest kWideTest =
+    detail::wide_test_avx2_if_supported() != nullptr ? detail::wide_test_avx2_if_supported() : detail::wide_test_scalar;
+
+detail::WideLanes wide_lanes(const PairContext& ctx) {
+  // The scale of the float stage's slack: what its values are at most in magnitude, as
+  // PairContext::node_lanes takes it.
+  const detail::NodeTestFrame& f = ctx.node_test_frame();
+  const double* t = f.trans;
+  const double between = std::sqrt((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
+  return detail::make_wide_lanes(f, ctx.a().local_extent + ctx.b().local_extent + between + f.slab_reach);
+}
+
+bool root_test(const PairContext& ctx, NodePair n, RootTest how) {
+  switch (how) {
+    case RootTest::done:
+      return true;
+    case RootTest::as_root:
+      return ctx.node_test(n.a, n.b);
+    case RootTest::with_disks:
+      return ctx.node_test_2x2_lane(n.a, n.b);
+    case RootTest::child_of_a:
+    case RootTest::child_of_b:
+      break;
+  }
+  // As the wide parent's visit tests it: its own lane, the other lanes empty.
+  const bool down_a = how == RootTest::child_of_a;
+  const WideNode w = bvh::single_slot(down_a ? ctx.a() : ctx.b(), down_a ? n.a : n.b);
+  return (wide_pass(ctx, n, WideVisit{&w, down_a ? n.b : n.a, down_a}, wide_lanes(ctx)) & 1u) != 0;
+}
+
+}  // namespace caliber::narrow

@@ -1,0 +1,144 @@
+#pragma once
+/// \file
+/// The one node visit of every traversal (narrow::visit): a pair of leaves gets its leaf test, any
+/// other CD-tree node its children's node tests, in the wide CD tree (visit_wide) or the binary
+/// one (visit_binary; cd_tree.h).
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "caliber/query.h"
+#include "narrow/candidate.h"
+#include "narrow/cd_tree.h"
+#include "narrow/child_pairs.h"
+#include "narrow/leaf_buffer.h"
+#include "narrow/pair_context.h"
+
+namespace caliber::narrow {
+
+/// The lanes of a traversal's node tests, made once by it: those of the binary CD tree's
+/// (PairContext::node_lanes) or of the wide one's (wide_lanes); null: made by each visit.
+struct VisitLanes {
+  const detail::NodeLanes* binary = nullptr;
+  const detail::WideLanes* wide = nullptr;
+};
+
+/// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root),
+/// as `how` says (not RootTest::done).
+inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, RootTest how = RootTest::as_root) {
+  ++stats.node_tests;
+  return root_test(ctx, n, how);
+}
+
+/// The visit of a node of the wide CD tree (not a pair of leaves; narrow::visit): its children's
+/// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
+/// reversed), every child counted but those on the taboo list (skipped and marked reached).
+template <bool kReversed>
+[[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
+                                             QueryStats& stats, NodePair passed[], TabooView taboo,
+                                             const detail::WideLanes& lanes) {
+  const WideVisit v = wide_visit(ctx, n, a, b);
+  unsigned pass = wide_pass(ctx, n, v, lanes);
+  const int count = v.node->count();
+  if (taboo.taboo != nullptr) {
+    for (int k = 0; k < count; ++k) {
+      if (on_taboo(taboo, v.child(k, n))) {
+        pass &= ~(1u << k);
+      } else {
+        ++stats.node_tests;
+      }
+    }
+  } else {
+    stats.node_tests += static_cast<std::uint64_t>(count);
+  }
+  int passing = 0;
+  while (pass != 0) {
+    const unsigned k = kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
+    pass ^= 1u << k;
+    passed[passing++] = v.child(static_cast<int>(k), n);
+  }
+  return passing;
+}
+
+/// The visit of a node of the binary CD tree (not a pair of leaves; narrow::visit): its children's
+/// tests four or two at a time where no taboo list is given, else one pair at a time.
+template <bool kReversed>
+[[gnu::always_inline]] inline int visit_binary(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
+                                               QueryStats& stats, NodePair passed[], TabooView taboo,
+                                               const detail::NodeLanes* lanes) {
+  int count = 0;
+  bool descend_a, descend_b;
+  cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
+  const bool both = descend_a && descend_b;
+  if (taboo.taboo == nullptr) {
+    // No taboo list: the children tested and counted at once, taken by their bits in lane order:
+    // four where both sides descend (lane 2i + j: A's child i, B's child j), else the two of the
+    // side that descends against the other node (node_tests_one_side: lanes 0 and 3).
+    const std::uint32_t a0 = descend_a ? a.index : n.a, a1 = descend_a ? a.index + 1 : n.a;
+    const std::uint32_t b0 = descend_b ? b.index : n.b, b1 = descend_b ? b.index + 1 : n.b;
+    const int pass = both ? ctx.node_tests_2x2(a0, a1, b0, b1, lanes) : ctx.node_tests_one_side(a0, a1, b0, b1, lanes);
+    stats.node_tests += both ? 4 : 2;
+    for (unsigned bits = static_cast<unsigned>(pass) & 0xFu; bits != 0;) {
+      const unsigned k =
+          kReversed ? 31u - static_cast<unsigned>(__builtin_clz(bits)) : static_cast<unsigned>(__builtin_ctz(bits));
+      bits ^= 1u << k;
+      passed[count++] = NodePair{k / 2 != 0 ? a1 : a0, k % 2 != 0 ? b1 : b0};
+    }
+    return count;
+  }
+  if (both) {
+    // With a taboo list: the four at once, taken in cd_children order (one on the list is marked
+    // reached, neither counted nor entered); where one side descends, pair by pair below.
+    const int pass = ctx.node_tests_2x2(a.index, a.index + 1, b.index, b.index + 1, lanes);
+    for_each_child_2x2(a.index, b.index, stats, taboo, [&](std::uint32_t k, NodePair child) {
+      if ((pass >> k) & 1) passed[count++] = child;
+    });
+    if constexpr (kReversed) std::reverse(passed, passed + count);
+    return count;
+  }
+  for_each_child(
+      n, a, b, descend_a, descend_b, stats, taboo, [&](std::uint32_t i) { return ctx.prepare_a(i); },
+      [&](std::uint32_t j) { return ctx.prepare_b(j); },
+      [&](const PairContext::SideA& sa, const PairContext::SideB& sb, NodePair child) {
+        if (ctx.node_test(sa, sb)) passed[count++] = child;
+      });
+  if constexpr (kReversed) std::reverse(passed, passed + count);
+  return count;
+}
+
+/// The one node visit of every traversal (depth first, stealing, the weight-driven stage), at a
+/// CD-tree node n that passed its node test. A pair of leaves gets its leaf test (a kept pair is
+/// appended to `out`) and the visit returns -1. Any other node's children are tested, each counted
+/// in stats.node_tests, except those on the taboo list (skipped and marked reached); the children
+/// that pass are written to `passed` in cd_children order and the visit returns how many (0..8).
+/// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
+/// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
+/// reading `out`. `lanes`: the lanes of the node tests, made once by the traversal (null: made
+/// here): wide_lanes(ctx) in the wide CD tree (visit_wide), ctx.node_lanes() in the binary one.
+/// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
+/// so, the first child on top).
+template <bool kReversed = false>
+[[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
+                                        NodePair passed[kMaxChildren], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
+                                        VisitLanes lanes = {}) {
+  const BvhNode& a = ctx.a().nodes[n.a];
+  const BvhNode& b = ctx.b().nodes[n.b];
+  if (a.is_leaf() && b.is_leaf()) {
+    ++stats.leaf_tests;
+    if (buffer != nullptr) {
+      ctx.leaf_test(a.index, b.index, out, *buffer);
+    } else {
+      ctx.leaf_test(a.index, b.index, out);
+    }
+    return -1;
+  }
+  if (wide_cd_tree(ctx)) {
+    if (lanes.wide != nullptr) return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide);
+    const detail::WideLanes made = wide_lanes(ctx);
+    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, made);
+  }
+  return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
+}
+
+}  // namespace caliber::narrow

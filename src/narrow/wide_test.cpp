@@ -1,0 +1,159 @@
+// The wide node test's lanes and its scalar form (wide_test.h); the AVX2 form in
+// wide_test_avx2.cpp makes each lane's operations in this order, its multiply-adds fused as
+// std::fma fuses them here.
+//
+// Why the float stage's slack holds: every value it compares is a short sum of products of stored
+// floats (bounds, axes: exact), pose entries (|M| <= 1, rounded once to float) and coordinates of
+// at most the scale, each product and sum rounded once: a slot's center and half-extent from its
+// bounds within 1 unit roundoff of the scale, a projection on a staying axis within about 12, the
+// slabs' positions and reaches within about 20 (the staying slab's offset, computed in double,
+// within 1). The slack is 512 unit roundoffs of the scale (2^-15).
+
+#include "narrow/wide_test.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace caliber::narrow::detail {
+
+namespace {
+/// The float stage's slack, as a share of the scale.
+constexpr double kShare = 0x1p-15;
+/// Stage 1's growth before rounding to float: a share of the magnitude, and a least growth of a
+/// share of the scale (above float's smallest step, 2^-149, wherever that is above it).
+constexpr double kRoundShare = 0x1p-22, kFloorShare = 0x1p-32, kLeastFloor = 0x1p-149;
+/// The least cosine between two slab axes for the staying slab's projection to follow the slot's
+/// slab (lambda).
+constexpr float kParallel = 0.5f;
+
+void fill_side(double m[3][3], double abs_m[3][3], const double t[3], WideSide& s) {
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      s.col[j][i] = m[i][j];
+      s.abs_col[j][i] = abs_m[i][j];
+      for (int l = 0; l < 8; ++l) {
+        s.m[j][i][l] = static_cast<float>(m[j][i]);
+        s.abs_m[j][i][l] = std::abs(static_cast<float>(m[j][i]));
+      }
+    }
+    s.col[j][3] = s.abs_col[j][3] = 0.0;
+  }
+  for (int i = 0; i < 3; ++i) {
+    s.t[i] = t[i];
+    s.mt_t[i] = (m[0][i] * t[0] + m[1][i] * t[1]) + m[2][i] * t[2];
+  }
+  s.t[3] = s.mt_t[3] = 0.0;
+}
+
+}  // namespace
+
+WideLanes make_wide_lanes(const NodeTestFrame& f, double scale) {
+  WideLanes l;
+  double m[3][3], abs_m[3][3], t[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = f.rot[i][j];
+      abs_m[i][j] = f.abs_rot[i][j];
+    }
+  }
+  fill_side(m, abs_m, f.trans, l.side[0]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = f.rot[j][i];
+      abs_m[i][j] = f.abs_rot[j][i];
+    }
+    t[i] = -((f.rot[0][i] * f.trans[0] + f.rot[1][i] * f.trans[1]) + f.rot[2][i] * f.trans[2]);
+  }
+  fill_side(m, abs_m, t, l.side[1]);
+  l.reach = f.reach;
+  l.round_floor = std::max(kFloorShare * scale, kLeastFloor);
+  // The unit: 2^-k for the scale's exponent k, within float's range (else no float stage).
+  const int k = scale > 0.0 && std::isfinite(scale) ? std::ilogb(scale) : 0;
+  l.floats = scale > 0.0 && std::isfinite(scale) && k >= -120 && k <= 120;
+  l.unit = std::ldexp(1.0, -k);
+  l.unit_f = static_cast<float>(l.unit);
+  l.half_unit = static_cast<float>(0.5 * l.unit);
+  const double slack = kShare * scale * l.unit;
+  l.reach_f = static_cast<float>(f.reach * l.unit + slack);
+  l.slab_f = static_cast<float>(f.slab_reach * l.unit + slack);
+  return l;
+}
+
+namespace {
+
+/// Stage 1 on slot k: the slot's float box against the staying box's float bounds.
+bool boxes_overlap(const WideNode& w, int k, const float lo[3], const float hi[3]) {
+  bool pass = true;
+  for (int i = 0; i < 3; ++i) pass = pass && w.lo[i][k] <= hi[i] && w.hi[i][k] >= lo[i];
+  return pass;
+}
+
+/// Stage 2 on slot k (see wide_test.h), in units: the staying node as st.
+bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k, const StayingFloats& st) {
+  float cc[3], hh[3];
+  for (int i = 0; i < 3; ++i) {
+    cc[i] = (w.lo[i][k] + w.hi[i][k]) * l.half_unit;
+    hh[i] = (w.hi[i][k] - w.lo[i][k]) * l.half_unit;
+  }
+  bool pass = true;
+  for (int i = 0; i < 3; ++i) {  // the staying node's axes
+    const float p = std::fmaf(s.m[2][i][0], cc[2], std::fmaf(s.m[1][i][0], cc[1], std::fmaf(s.m[0][i][0], cc[0], 0.0f)));
+    const float r =
+        std::fmaf(s.abs_m[2][i][0], hh[2], std::fmaf(s.abs_m[1][i][0], hh[1], std::fmaf(s.abs_m[0][i][0], hh[0], st.ho[i])));
+    pass = pass && std::abs(p - st.co[i]) <= r;
+  }
+  const float ax[3] = {w.axis[0][k], w.axis[1][k], w.axis[2][k]};
+  const float slot_lo = w.slab_lo[k] * l.unit_f, slot_hi = w.slab_hi[k] * l.unit_f;
+  {  // the staying node's slab: lambda (the slot's slab) + the rest (its box) along the axis
+    const float dot = std::fmaf(ax[2], st.nf[2], std::fmaf(ax[1], st.nf[1], ax[0] * st.nf[0]));
+    const float lambda = std::abs(dot) >= kParallel ? dot : 0.0f;
+    float rest[3];
+    for (int i = 0; i < 3; ++i) rest[i] = std::fmaf(-lambda, ax[i], st.nf[i]);
+    const float at = std::fmaf(rest[2], cc[2], std::fmaf(rest[1], cc[1], std::fmaf(rest[0], cc[0], st.off)));
+    const float r = std::fmaf(std::abs(rest[2]), hh[2], std::fmaf(std::abs(rest[1]), hh[1], std::abs(rest[0]) * hh[0]));
+    const float e0 = lambda * slot_lo, e1 = lambda * slot_hi;
+    const float low = e0 < e1 ? e0 : e1, high = e0 > e1 ? e0 : e1;
+    pass = pass && (at - r) + low <= st.slab_hi && (at + r) + high >= st.slab_lo;
+  }
+  {  // the slot's slab against the staying box
+    const float at = std::fmaf(ax[2], st.cf[2], std::fmaf(ax[1], st.cf[1], ax[0] * st.cf[0]));
+    float on[3];
+    for (int j = 0; j < 3; ++j) on[j] = std::fmaf(ax[2], s.m[2][j][0], std::fmaf(ax[1], s.m[1][j][0], ax[0] * s.m[0][j][0]));
+    const float r = std::fmaf(std::abs(on[2]), st.sh[2], std::fmaf(std::abs(on[1]), st.sh[1], std::abs(on[0]) * st.sh[0]));
+    pass =
+        pass && at - r <= std::fmaf(w.slab_hi[k], l.unit_f, l.slab_f) && at + r >= std::fmaf(w.slab_lo[k], l.unit_f, -l.slab_f);
+  }
+  return pass;
+}
+
+}  // namespace
+
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w) {
+  const WideSide& s = l.side[a_descends ? 0 : 1];
+  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
+  const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
+  double c[3];
+  float lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    c[i] = std::fma(s.col[2][i], cd[2], std::fma(s.col[1][i], cd[1], std::fma(s.col[0][i], cd[0], s.t[i])));
+    const double e =
+        std::fma(s.abs_col[2][i], hd[2], std::fma(s.abs_col[1][i], hd[1], std::fma(s.abs_col[0][i], hd[0], l.reach)));
+    const double g = std::fma(std::abs(c[i]) + e, kRoundShare, e + l.round_floor);
+    lo[i] = static_cast<float>(c[i] - g);
+    hi[i] = static_cast<float>(c[i] + g);
+  }
+  unsigned pass = 0;
+  for (int k = 0; k < WideNode::kSlots; ++k) {
+    if (boxes_overlap(w, k, lo, hi)) pass |= 1u << k;
+  }
+  if (pass == 0 || !l.floats) return pass;
+  const StayingFloats st = staying_floats(l, s, sn, sf, c);
+  for (int k = 0; k < WideNode::kSlots; ++k) {
+    if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, st)) pass &= ~(1u << k);
+  }
+  return pass;
+}
+
+}  // namespace caliber::narrow::detail

@@ -1,0 +1,100 @@
+#pragma once
+/// \file
+/// The node test of the pair-collecting queries (interference, proximity, contact): a CD-tree node
+/// descends on one side, and its children, the pairs of the staying node with each slot of the
+/// descending side's wide node (WideNode), are tested at once, eight lanes of float.
+///
+/// 1. The boxes, exactly: the staying node's box moved into the other model's frame in double
+///    (center M c + t, half-extents |M| h + reach: PairContext's box test's quantities), grown by a
+///    share of its magnitude that covers the conversion, and rounded to float; each slot's float
+///    box (rounded outward) overlaps it or the pair is refused. No slack: every float lies outside
+///    the double box it stands for.
+/// 2. Then, in float, against each threshold plus a slack far above float's rounding (as the float
+///    four-pair test: 2^-15 of the scale): each slot's box along the staying node's own axes; each
+///    slot's slab against the staying box; the staying node's slab against each slot, projected
+///    along it as lambda (the slot's slab) + the rest (the slot's box), lambda the axes' cosine
+///    where the slabs are near parallel (|cos| >= 1/2; else 0: the slot's box alone), so that
+///    parallel patches a hair apart are refused high in the tree. Refused only where surely
+///    beyond.
+/// Every form (AVX2, scalar) makes each lane's operations in the same order: the same decisions.
+
+#include <cmath>
+#include <cstdint>
+
+#include "bvh/model_data.h"
+#include "narrow/node_test_avx2.h"
+
+namespace caliber::narrow::detail {
+
+/// The pose as a visit moves its staying node into the descending side's frame, x_D = M x_S + t:
+/// M = R, t = T where A descends (B stays); M = R^T, t = -R^T T where B descends.
+struct alignas(32) WideSide {
+  double col[3][4];      ///< column j of M (lanes x, y, z, 0)
+  double abs_col[3][4];  ///< column j of |M| grown by the hair (PairContext's abs_rot)
+  double t[4];           ///< t
+  double mt_t[4];        ///< M^T t
+  float m[3][3][8];      ///< m[j][i][*] = M(j, i) in float, in every lane
+  float abs_m[3][3][8];  ///< its magnitude
+};
+
+/// What the test reads besides the nodes: both directions, the reach, and the float stage's
+/// thresholds. The float stage computes in units of `unit`, the power of two nearest below the
+/// scale's inverse, so that its values are near 1 and scale with the models exactly (a pose and
+/// models scaled by a power of two get the same decisions). Made once per traversal
+/// (make_wide_lanes; 1,760 bytes: not kept in the pair context, which the engine holds for every
+/// pair).
+struct alignas(32) WideLanes {
+  WideSide side[2];    ///< [0]: A descends; [1]: B descends
+  double reach;        ///< the boxes' reach
+  double round_floor;  ///< stage 1's least growth before rounding to float
+  double unit;         ///< the float stage's unit
+  float unit_f;        ///< the same, in float
+  float half_unit;     ///< half of it
+  float reach_f;       ///< the reach plus the slack, in units
+  float slab_f;        ///< the slab reach plus the slack, in units
+  bool floats;         ///< the float stage runs
+};
+
+/// The staying node as the float stage reads it, in the descending frame and in units (the same
+/// operations in every form): its own center plus M^T t, its half-extents plus the reach, its slab
+/// axis moved (nf) and the slab's offset, its center moved (cf), its half-extents (sh), its slab
+/// bounds less and plus the slab reach.
+struct StayingFloats {
+  float co[3], ho[3], nf[3], off, cf[3], sh[3], slab_lo, slab_hi;
+};
+
+/// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
+inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const BvhNode& sn, const BvhNodeFilter& sf,
+                                    const double c[3]) {
+  StayingFloats out;
+  double nd[3];
+  for (int i = 0; i < 3; ++i) {
+    nd[i] = std::fma(s.col[2][i], sf.cone_axis[2], std::fma(s.col[1][i], sf.cone_axis[1], s.col[0][i] * sf.cone_axis[0]));
+    out.co[i] = static_cast<float>((static_cast<double>(sn.box_center[i]) + s.mt_t[i]) * l.unit);
+    out.sh[i] = static_cast<float>(sn.box_half[i] * l.unit);
+    out.ho[i] = out.sh[i] + l.reach_f;
+    out.nf[i] = static_cast<float>(nd[i]);
+    out.cf[i] = static_cast<float>(c[i] * l.unit);
+  }
+  out.off = static_cast<float>(-((nd[0] * s.t[0] + nd[1] * s.t[1]) + nd[2] * s.t[2]) * l.unit);
+  out.slab_lo = static_cast<float>(sf.slab_lo * l.unit) - l.slab_f;
+  out.slab_hi = static_cast<float>(sf.slab_hi * l.unit) + l.slab_f;
+  return out;
+}
+
+/// The lanes of frame f (its pose, reach and slab reach). `scale`: a bound on every coordinate,
+/// extent, reach and slab bound the test computes with, which sets the slack.
+WideLanes make_wide_lanes(const NodeTestFrame& f, double scale);
+
+/// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
+/// node `stay` stays) against the descending node's wide node w: bit k set where slot k passes
+/// (slots past the last never do).
+using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w);
+
+/// The scalar form.
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w);
+
+/// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
+WideTest wide_test_avx2_if_supported();
+
+}  // namespace caliber::narrow::detail

@@ -1,0 +1,129 @@
+// The wide node test in AVX2 (wide_test.h): the staying node moved in four double lanes, the
+// eight slots in eight float lanes; each lane makes wide_test_scalar's operations in its order
+// (the multiply-adds fused, as std::fma fuses them there).
+
+#include "narrow/wide_test.h"
+
+#include <cmath>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+namespace caliber::narrow::detail {
+namespace {
+
+#define CALIBER_AVX2 __attribute__((target("avx2,fma")))
+
+using V = __m256;
+using D = __m256d;
+
+CALIBER_AVX2 inline V add(V u, V v) { return _mm256_add_ps(u, v); }
+CALIBER_AVX2 inline V sub(V u, V v) { return _mm256_sub_ps(u, v); }
+CALIBER_AVX2 inline V mul(V u, V v) { return _mm256_mul_ps(u, v); }
+/// u v + w, rounded once.
+CALIBER_AVX2 inline V fma(V u, V v, V w) { return _mm256_fmadd_ps(u, v, w); }
+CALIBER_AVX2 inline V both(V u, V v) { return _mm256_and_ps(u, v); }
+CALIBER_AVX2 inline V at_most(V u, V v) { return _mm256_cmp_ps(u, v, _CMP_LE_OQ); }
+CALIBER_AVX2 inline V at_least(V u, V v) { return _mm256_cmp_ps(u, v, _CMP_GE_OQ); }
+CALIBER_AVX2 inline V magnitude(V u) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), u); }
+CALIBER_AVX2 inline V all(float x) { return _mm256_set1_ps(x); }
+CALIBER_AVX2 inline V load(const float* p) { return _mm256_load_ps(p); }
+CALIBER_AVX2 inline D addd(D u, D v) { return _mm256_add_pd(u, v); }
+CALIBER_AVX2 inline D muld(D u, D v) { return _mm256_mul_pd(u, v); }
+CALIBER_AVX2 inline D fmad(D u, D v, D w) { return _mm256_fmadd_pd(u, v, w); }
+/// Lanes (x, y, z, 0) of col2 x2 + (col1 x1 + (col0 x0 + w)), each step rounded once.
+CALIBER_AVX2 inline D times(const double col[3][4], const double x[3], D w) {
+  return fmad(_mm256_load_pd(col[2]), _mm256_set1_pd(x[2]),
+              fmad(_mm256_load_pd(col[1]), _mm256_set1_pd(x[1]), fmad(_mm256_load_pd(col[0]), _mm256_set1_pd(x[0]), w)));
+}
+/// m[2][i] x2 + (m[1][i] x1 + (m[0][i] x0 + w)), lane by lane, each step rounded once.
+CALIBER_AVX2 inline V project(const float m[3][3][8], int i, V x0, V x1, V x2, V w) {
+  return fma(load(m[2][i]), x2, fma(load(m[1][i]), x1, fma(load(m[0][i]), x0, w)));
+}
+
+/// Stage 2 (wide_test_scalar's floats_pass) on every lane, in units: the slots' bounds cl, ch;
+/// the staying node as st.
+CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w,
+                                                                 const V cl[3], const V ch[3], const StayingFloats& st) {
+  V cc[3], hh[3];
+  for (int i = 0; i < 3; ++i) {
+    cc[i] = mul(add(cl[i], ch[i]), all(l.half_unit));
+    hh[i] = mul(sub(ch[i], cl[i]), all(l.half_unit));
+  }
+  V pass = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int i = 0; i < 3; ++i) {  // the staying node's axes
+    const V p = project(s.m, i, cc[0], cc[1], cc[2], _mm256_setzero_ps());
+    const V r = project(s.abs_m, i, hh[0], hh[1], hh[2], all(st.ho[i]));
+    pass = both(pass, at_most(magnitude(sub(p, all(st.co[i]))), r));
+  }
+  const V ax[3] = {load(w.axis[0]), load(w.axis[1]), load(w.axis[2])};
+  const V unit = all(l.unit_f), slab_f = all(l.slab_f);
+  {  // the staying node's slab: lambda (the slot's slab) + the rest (its box) along the axis
+    const V nf[3] = {all(st.nf[0]), all(st.nf[1]), all(st.nf[2])};
+    const V dot = fma(ax[2], nf[2], fma(ax[1], nf[1], mul(ax[0], nf[0])));
+    const V lambda = both(dot, at_least(magnitude(dot), all(0.5f)));
+    V rest[3];
+    for (int i = 0; i < 3; ++i) rest[i] = _mm256_fnmadd_ps(lambda, ax[i], nf[i]);
+    const V at = fma(rest[2], cc[2], fma(rest[1], cc[1], fma(rest[0], cc[0], all(st.off))));
+    const V r = fma(magnitude(rest[2]), hh[2], fma(magnitude(rest[1]), hh[1], mul(magnitude(rest[0]), hh[0])));
+    const V e0 = mul(lambda, mul(load(w.slab_lo), unit)), e1 = mul(lambda, mul(load(w.slab_hi), unit));
+    const V low = _mm256_min_ps(e0, e1), high = _mm256_max_ps(e0, e1);
+    pass = both(pass, both(at_most(add(sub(at, r), low), all(st.slab_hi)), at_least(add(add(at, r), high), all(st.slab_lo))));
+  }
+  {  // the slot's slab against the staying box
+    const V at = fma(ax[2], all(st.cf[2]), fma(ax[1], all(st.cf[1]), mul(ax[0], all(st.cf[0]))));
+    V on[3];
+    for (int j = 0; j < 3; ++j) on[j] = fma(ax[2], load(s.m[2][j]), fma(ax[1], load(s.m[1][j]), mul(ax[0], load(s.m[0][j]))));
+    const V r = fma(magnitude(on[2]), all(st.sh[2]), fma(magnitude(on[1]), all(st.sh[1]), mul(magnitude(on[0]), all(st.sh[0]))));
+    pass = both(pass, both(at_most(sub(at, r), fma(load(w.slab_hi), unit, slab_f)),
+                           at_least(add(at, r), fma(load(w.slab_lo), unit, _mm256_sub_ps(_mm256_setzero_ps(), slab_f)))));
+  }
+  return pass;
+}
+
+CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
+                                     const WideNode& w) {
+  const WideSide& s = l.side[a_descends ? 0 : 1];
+  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
+  const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
+  // Stage 1: the staying box in the descending frame, in double lanes (x, y, z, 0).
+  const D c = times(s.col, cd, _mm256_load_pd(s.t));
+  const D e = times(s.abs_col, hd, _mm256_set1_pd(l.reach));
+  const D magnitude_c = _mm256_andnot_pd(_mm256_set1_pd(-0.0), c);
+  const D g = fmad(addd(magnitude_c, e), _mm256_set1_pd(0x1p-22), addd(e, _mm256_set1_pd(l.round_floor)));
+  alignas(16) float lo[4], hi[4];
+  _mm_store_ps(lo, _mm256_cvtpd_ps(_mm256_sub_pd(c, g)));
+  _mm_store_ps(hi, _mm256_cvtpd_ps(addd(c, g)));
+  V cl[3], ch[3];
+  V pass = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int i = 0; i < 3; ++i) {
+    cl[i] = load(w.lo[i]);
+    ch[i] = load(w.hi[i]);
+    pass = both(pass, both(at_most(cl[i], all(hi[i])), at_least(ch[i], all(lo[i]))));
+  }
+  const auto bits = static_cast<unsigned>(_mm256_movemask_ps(pass));
+  if (bits == 0 || !l.floats) return bits;
+  // Stage 2, on the lanes' slots.
+  alignas(32) double moved[4];
+  _mm256_store_pd(moved, c);
+  const StayingFloats st = staying_floats(l, s, sn, sf, moved);
+  return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, st)));
+}
+
+}  // namespace
+
+WideTest wide_test_avx2_if_supported() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? wide_test_avx2 : nullptr;
+}
+
+}  // namespace caliber::narrow::detail
+
+#else
+
+namespace caliber::narrow::detail {
+WideTest wide_test_avx2_if_supported() { return nullptr; }
+}  // namespace caliber::narrow::detail
+
+#endif
