@@ -229,7 +229,7 @@ struct alignas(32) WideNode {
   /// Number of slots (2 .. kSlots).
   [[nodiscard]] int count() const {
     int n = 2;
-    while (n < kSlots && node[n] != kEmpty) ++n;
+    for (int k = 2; k < kSlots; ++k) n += node[k] != kEmpty ? 1 : 0;  // the slots in use come first
     return n;
   }
 };
