@@ -226,10 +226,10 @@ struct alignas(32) WideNode {
   float axis[3][kSlots];                   ///< slab axis (BvhNodeFilter::cone_axis)
   float slab_lo[kSlots], slab_hi[kSlots];  ///< slab bounds
   std::uint32_t node[kSlots];              ///< the slot's BVH node, kEmpty past the last
-  /// Number of slots (2 .. kSlots).
+  /// Number of slots in use (they come first): 2 .. kSlots, 1 in bvh::single_slot's.
   [[nodiscard]] int count() const {
-    int n = 2;
-    for (int k = 2; k < kSlots; ++k) n += node[k] != kEmpty ? 1 : 0;  // the slots in use come first
+    int n = 0;
+    for (const std::uint32_t s : node) n += s != kEmpty ? 1 : 0;
     return n;
   }
 };

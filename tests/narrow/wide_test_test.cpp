@@ -1,0 +1,156 @@
+// The wide node test (narrow/wide_test.h): its scalar and AVX2 forms decide alike on the inputs
+// that stretch it (a mesh far from its own origin, slivers without a normal, a tolerance larger
+// than the meshes, tiny and huge scales), and it never refuses a slot below which some triangle
+// pair is kept by the leaf test.
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bvh/model_data.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "narrow/cd_tree.h"
+#include "narrow/pair_context.h"
+#include "support/random_poses.h"
+
+namespace caliber::narrow {
+namespace {
+
+/// m scaled by 2^e, then moved by offset.
+Mesh moved(Mesh m, int e, const Eigen::Vector3d& offset) {
+  for (Eigen::Vector3d& v : m.vertices) v = std::ldexp(1.0, e) * v + offset;
+  return m;
+}
+
+/// A sphere with `slivers` zero-area triangles more (a corner repeated: leaves without a slab).
+Mesh sphere_with_slivers(int slivers) {
+  Mesh m = make_sphere(0.6, 10, 14);
+  for (int i = 0; i < slivers; ++i) {
+    const auto t = m.triangles[static_cast<std::size_t>(i) * 5];
+    m.triangles.push_back({t[0], t[1], t[0]});
+  }
+  return m;
+}
+
+/// Calls visit(n, v) at each node of the wide CD tree that passes its test, breadth first, up to
+/// `most` visits (the children the scalar form passes).
+template <class Visit>
+void walk(const PairContext& ctx, const detail::WideLanes& lanes, std::size_t most, Visit&& visit) {
+  std::vector<NodePair> work{{0, 0}};
+  for (std::size_t w = 0; w < work.size() && w < most; ++w) {
+    const NodePair n = work[w];
+    const BvhNode& a = ctx.a().nodes[n.a];
+    const BvhNode& b = ctx.b().nodes[n.b];
+    if (a.is_leaf() && b.is_leaf()) continue;
+    const WideVisit v = wide_visit(ctx, n, a, b);
+    const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node);
+    visit(n, v, pass);
+    for (int k = 0; k < v.node->count(); ++k) {
+      if ((pass >> k & 1u) != 0) work.push_back(v.child(k, n));
+    }
+  }
+}
+
+TEST(WideTest, ScalarAndAvx2FormsDecideAlike) {
+  const detail::WideTest avx2 = detail::wide_test_avx2_if_supported();
+  if (avx2 == nullptr) GTEST_SKIP() << "no AVX2 and FMA on this CPU";
+  const Mesh torus = make_torus(1.0, 0.35, 40, 24);
+  const Eigen::Vector3d far(3e6, -2e6, 1e6);
+  struct Case {
+    Mesh a, b;
+    QueryKind kind;
+    double tolerance, spread;
+  };
+  const std::vector<Case> cases = {
+      {torus, make_box(0.4, 0.3, 0.2, 3), QueryKind::interference, 0.0, 0.6},
+      {moved(torus, 0, far), moved(torus, 0, far), QueryKind::interference, 0.0, 0.6},
+      {torus, sphere_with_slivers(60), QueryKind::contact, 0.05, 0.8},
+      {torus, make_sphere(0.3, 8, 10), QueryKind::proximity, 5.0, 0.8},
+      {moved(torus, -40, {0, 0, 0}), moved(torus, -40, {0, 0, 0}), QueryKind::interference, 0.0, std::ldexp(0.6, -40)},
+      {moved(torus, 40, {0, 0, 0}), moved(torus, 40, {0, 0, 0}), QueryKind::proximity, std::ldexp(0.01, 40), std::ldexp(0.6, 40)},
+  };
+  std::mt19937_64 rng(20261202);
+  long visits = 0, differing = 0, by_floats = 0;
+  for (const Case& c : cases) {
+    const auto a = build_model(c.a), b = build_model(c.b);
+    QueryRequest request;
+    request.kind = c.kind;
+    request.tolerance = c.tolerance;
+    for (int p = 0; p < 6; ++p) {
+      // B turned about the meshes' place (far from the origin in the second case) and moved a little.
+      Pose pose_b = test::random_pose(rng, c.spread);
+      const Eigen::Vector3d place = &c == &cases[1] ? far : Eigen::Vector3d::Zero();
+      pose_b.translation += place - pose_b.rotation * place;
+      const PairContext ctx(*a, Pose{}, *b, pose_b, request);
+      const detail::WideLanes lanes = wide_lanes(ctx);
+      ASSERT_TRUE(lanes.floats);
+      detail::WideLanes boxes_only = lanes;
+      boxes_only.floats = false;
+      walk(ctx, lanes, 20000, [&](NodePair, const WideVisit& v, unsigned pass) {
+        ++visits;
+        if (avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node) != pass) ++differing;
+        const unsigned boxes = detail::wide_test_scalar(ctx.node_test_frame(), boxes_only, v.a_descends, v.stay, *v.node);
+        EXPECT_EQ(pass & ~boxes, 0u) << "the float stage only refuses";
+        by_floats += __builtin_popcount(boxes & ~pass);
+      });
+    }
+  }
+  EXPECT_EQ(differing, 0) << "of " << visits << " visits";
+  EXPECT_GT(visits, 5000);
+  EXPECT_GT(by_floats, 1000) << "the float stage refuses slots the boxes let through";
+}
+
+/// The leaves (triangle ids) below BVH node i.
+std::vector<std::uint32_t> triangles_below(const ModelData& m, std::uint32_t i) {
+  std::vector<std::uint32_t> out, todo{i};
+  while (!todo.empty()) {
+    const BvhNode& n = m.nodes[todo.back()];
+    todo.pop_back();
+    if (n.is_leaf()) {
+      out.push_back(n.index);
+    } else {
+      todo.push_back(n.index);
+      todo.push_back(n.index + 1);
+    }
+  }
+  return out;
+}
+
+TEST(WideTest, NeverRefusesASlotAboveAKeptPair) {
+  const auto a = build_model(make_torus(1.0, 0.35, 16, 10));
+  const auto b = build_model(sphere_with_slivers(20));
+  std::mt19937_64 rng(7);
+  long checked = 0, refused = 0;
+  for (const QueryKind kind : {QueryKind::interference, QueryKind::proximity}) {
+    QueryRequest request;
+    request.kind = kind;
+    request.tolerance = kind == QueryKind::proximity ? 0.03 : 0.0;
+    for (int p = 0; p < 12; ++p) {
+      const PairContext ctx(*a, Pose{}, *b, test::random_pose(rng, 0.9), request);
+      walk(ctx, wide_lanes(ctx), 5000, [&](NodePair n, const WideVisit& v, unsigned pass) {
+        for (int k = 0; k < v.node->count(); ++k) {
+          if ((pass >> k & 1u) != 0) continue;
+          const NodePair child = v.child(k, n);
+          const std::vector<std::uint32_t> ta = triangles_below(ctx.a(), child.a), tb = triangles_below(ctx.b(), child.b);
+          if (ta.size() * tb.size() > 4000) continue;
+          ++refused;
+          std::vector<Candidate> out;
+          for (const std::uint32_t i : ta) {
+            for (const std::uint32_t j : tb) ctx.leaf_test(i, j, out);
+          }
+          checked += static_cast<long>(ta.size() * tb.size());
+          EXPECT_TRUE(out.empty()) << "a refused slot holds a kept pair: " << out.front().tri_a << ", " << out.front().tri_b;
+        }
+      });
+    }
+  }
+  EXPECT_GT(refused, 500);
+  EXPECT_GT(checked, 50000);
+}
+
+}  // namespace
+}  // namespace caliber::narrow
