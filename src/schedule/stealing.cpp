@@ -18,12 +18,41 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
   w.pieces.push_back(w.stats[pair].node_tests - before);
 }
 
+/// In the wide CD tree a visit passes about three of its up to eight children (2.6 to 3.1 on the
+/// bunny, turbine and elephant pairs), and enough pieces for stealing to balance are about this
+/// many per thread: the depth at which 3^depth reaches that (4 on 2 threads, 6 on 16). Deeper, the
+/// jobs cost more than they balance: on those pairs on 2 threads, depth 3 or 4 was fastest, 7 a
+/// third slower than sequential's half, 10 slower than sequential.
+constexpr long kWidePiecesPerThread = 32;
+
+int wide_depth(int threads) {
+  int depth = 0;
+  for (long pieces = 1; pieces < kWidePiecesPerThread * threads; pieces *= 3) ++depth;
+  return depth;
+}
+
+/// The lanes of a pair's node tests (narrow::VisitLanes), those of its CD tree's shape.
+struct PairLanes {
+  narrow::detail::WideLanes wide;
+  narrow::detail::NodeLanes binary;
+
+  narrow::VisitLanes of(const narrow::PairContext& ctx) {
+    if (narrow::wide_cd_tree(ctx)) {
+      wide = narrow::wide_lanes(ctx);
+      return narrow::VisitLanes{nullptr, &wide};
+    }
+    binary = ctx.node_lanes();
+    return narrow::VisitLanes{&binary, nullptr};
+  }
+};
+
 /// Above the cut-off depth, visits CD-tree node n of pair `pair` (it passed its test, made by its
 /// parent's visit or before the first call) and spawns one job per child that passes; from the
 /// cut-off down, one depth-first traversal (which tests n unless `tested`). The node tests made are
 /// exactly those of a single depth-first traversal of the tree (for a distance query, those of its
 /// pieces, which depend on what the others have found by then).
-void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested) {
+void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, int cutoff, bool tested,
+           const narrow::VisitLanes& lanes) {
   const narrow::PairContext& ctx = state.contexts[pair];
   narrow::NodePair kids[narrow::kMaxChildren];
   int count = 0;
@@ -42,15 +71,15 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
       return;
     }
     const std::uint64_t before = w.stats[pair].node_tests;
-    count = narrow::visit(ctx, n, w.candidates[pair], w.stats[pair], kids);
+    count = narrow::visit(ctx, n, w.candidates[pair], w.stats[pair], kids, {}, nullptr, lanes);
     w.split_node_tests += w.stats[pair].node_tests - before;
   }
   parallel::JobGroup group;
   for (int i = 1; i < count; ++i) {
     const narrow::NodePair kid = kids[i];
-    group.run([&state, pair, kid, depth, cutoff] { steal(state, pair, kid, depth + 1, cutoff, true); });
+    group.run([&state, pair, kid, depth, cutoff, &lanes] { steal(state, pair, kid, depth + 1, cutoff, true, lanes); });
   }
-  if (count > 0) steal(state, pair, kids[0], depth + 1, cutoff, true);
+  if (count > 0) steal(state, pair, kids[0], depth + 1, cutoff, true, lanes);
   group.wait();
 }
 
@@ -66,6 +95,7 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
   // the thread that traversed it, at once.
   // Cut for one thread there is nothing to balance: every pair runs whole (no depth to split to).
   if (threads <= 1) depth = 0;
+  if (n > 0 && narrow::wide_cd_tree(state.contexts[0])) depth = std::min(depth, wide_depth(threads));
   std::vector<std::uint32_t> heavy, light;
   if (depth > 0 && n > 1) {
     const std::vector<double> weight = plans::root_weights(state.contexts);
@@ -77,13 +107,16 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
     for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
   }
   parallel::JobGroup group;
-  for (const std::uint32_t i : heavy) {
-    group.run([&state, i, depth] {
+  // A split pair's node-test lanes, made once by the job that tests its root and read by every
+  // visit above the cut-off.
+  std::vector<PairLanes> lanes(heavy.size());
+  for (std::size_t k = 0; k < heavy.size(); ++k) {
+    group.run([&state, &lanes, k, i = heavy[k], depth] {
       // The root is tested above the cut-off: splitting work.
       WorkerSlots& w = local_slots(state);
       ++w.split_node_tests;
       if (!narrow::test_root(state.contexts[i], narrow::NodePair{0, 0}, w.stats[i])) return;
-      steal(state, i, narrow::NodePair{0, 0}, 0, depth, /*tested=*/true);
+      steal(state, i, narrow::NodePair{0, 0}, 0, depth, /*tested=*/true, lanes[k].of(state.contexts[i]));
     });
   }
   if (!light.empty()) {
