@@ -23,6 +23,8 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
+#include "narrow/lanes8_avx2.h"
+
 namespace caliber::narrow::detail {
 namespace {
 
@@ -31,13 +33,8 @@ namespace {
 using V = __m256;
 using Q = __m128;
 
-CALIBER_AVX2 inline V add(V u, V v) { return _mm256_add_ps(u, v); }
-CALIBER_AVX2 inline V sub(V u, V v) { return _mm256_sub_ps(u, v); }
-CALIBER_AVX2 inline V mul(V u, V v) { return _mm256_mul_ps(u, v); }
+using namespace lanes8;
 CALIBER_AVX2 inline V gt(V u, V v) { return _mm256_cmp_ps(u, v, _CMP_GT_OQ); }
-CALIBER_AVX2 inline V either(V u, V v) { return _mm256_or_ps(u, v); }
-CALIBER_AVX2 inline V both(V u, V v) { return _mm256_and_ps(u, v); }
-CALIBER_AVX2 inline V magnitude(V u) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), u); }
 CALIBER_AVX2 inline V dot3(const V u[3], const V v[3]) { return add(add(mul(u[0], v[0]), mul(u[1], v[1])), mul(u[2], v[2])); }
 CALIBER_AVX2 inline Q dot3(const Q u[3], const Q v[3]) {
   return _mm_add_ps(_mm_add_ps(_mm_mul_ps(u[0], v[0]), _mm_mul_ps(u[1], v[1])), _mm_mul_ps(u[2], v[2]));

@@ -9,6 +9,8 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
+#include "narrow/lanes8_avx2.h"
+
 namespace caliber::narrow::detail {
 namespace {
 
@@ -17,19 +19,14 @@ namespace {
 using V = __m256;
 using D = __m256d;
 
-CALIBER_AVX2 inline V add(V u, V v) { return _mm256_add_ps(u, v); }
-CALIBER_AVX2 inline V sub(V u, V v) { return _mm256_sub_ps(u, v); }
-CALIBER_AVX2 inline V mul(V u, V v) { return _mm256_mul_ps(u, v); }
+using namespace lanes8;
 /// u v + w, rounded once.
 CALIBER_AVX2 inline V fma(V u, V v, V w) { return _mm256_fmadd_ps(u, v, w); }
-CALIBER_AVX2 inline V both(V u, V v) { return _mm256_and_ps(u, v); }
 CALIBER_AVX2 inline V at_most(V u, V v) { return _mm256_cmp_ps(u, v, _CMP_LE_OQ); }
 CALIBER_AVX2 inline V at_least(V u, V v) { return _mm256_cmp_ps(u, v, _CMP_GE_OQ); }
-CALIBER_AVX2 inline V magnitude(V u) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), u); }
 CALIBER_AVX2 inline V all(float x) { return _mm256_set1_ps(x); }
 CALIBER_AVX2 inline V load(const float* p) { return _mm256_load_ps(p); }
 CALIBER_AVX2 inline D addd(D u, D v) { return _mm256_add_pd(u, v); }
-CALIBER_AVX2 inline D muld(D u, D v) { return _mm256_mul_pd(u, v); }
 CALIBER_AVX2 inline D fmad(D u, D v, D w) { return _mm256_fmadd_pd(u, v, w); }
 /// Lanes (x, y, z, 0) of col2 x2 + (col1 x1 + (col0 x0 + w)), each step rounded once.
 CALIBER_AVX2 inline D times(const double col[3][4], const double x[3], D w) {
