@@ -122,9 +122,11 @@ struct EngineOptions {
   /// thread, every method runs each pair whole. The cut for P threads run on one thread measures
   /// each of its pieces undisturbed (what predicted_step_ms replays); the contacts are the same.
   int plan_threads = 0;
-  /// Stealing: CD-tree depth from which a subtree is traversed serially by one job. Only pairs
-  /// whose a priori weight is at least 1 / (64 x plan threads) of the step's are split; the others run
-  /// whole, in a parallel loop over them.
+  /// Stealing: CD-tree depth from which a subtree is traversed serially by one job (the wide CD
+  /// tree of interference, proximity and contact queries: at most the depth that gives about 32
+  /// pieces a thread, 4 on 2 threads, 6 on 16). Only pairs whose a priori weight is at least
+  /// 1 / (64 x plan threads) of the step's are split; the others run whole, in a parallel loop
+  /// over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
   /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_beta.md): with 2 threads, beta = 2

@@ -17,6 +17,7 @@
 #include "bvh/model_data.h"
 #include "narrow/pair_context.h"
 #include "narrow/wide_test.h"
+#include "util/assert.h"
 
 namespace caliber::narrow {
 
@@ -92,6 +93,7 @@ struct WideVisit {
 
 /// The wide visit of node n, whose BVH nodes are a (of A) and b (of B).
 inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
+  CALIBER_ASSERT(!(a.is_leaf() && b.is_leaf()), "a pair of leaves has no children");
   const bool down_a = wide_descends_a(a, b);
   const ModelData& m = down_a ? ctx.a() : ctx.b();
   return WideVisit{&m.wide[m.wide_of[down_a ? n.a : n.b]], down_a ? n.b : n.a, down_a};
@@ -133,7 +135,8 @@ extern const detail::WideTest kWideTest;
 /// (cd_children order) passes the wide test (detail::WideTest), then the groups and normal cones
 /// (PairContext::groups_and_cones_allow).
 inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes) {
-  const detail::WideTest test = kWideTest;
+  // (Null before the library's constants are made: a query from another constant's constructor.)
+  const detail::WideTest test = kWideTest != nullptr ? kWideTest : detail::wide_test_scalar;
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {

@@ -4,10 +4,12 @@
 //
 // Why the float stage's slack holds: every value it compares is a short sum of products of stored
 // floats (bounds, axes: exact), pose entries (|M| <= 1, rounded once to float) and coordinates of
-// at most the scale, each product and sum rounded once: a slot's center and half-extent from its
-// bounds within 1 unit roundoff of the scale, a projection on a staying axis within about 12, the
-// slabs' positions and reaches within about 20 (the staying slab's offset, computed in double,
-// within 1). The slack is 512 unit roundoffs of the scale (2^-15).
+// at most a few times the scale (the λ test's sums reach about 5.5 scales: the offset between the
+// origins, the slot's center along the rest of the axis, λ times the slot's slab), each product
+// and sum rounded once: a slot's center and half-extent from its bounds within 1 unit roundoff of
+// the scale, a projection on a staying axis within about 12, the slabs' positions and reaches
+// within about 20 (the staying slab's offset, computed in double, within 1). The slack is 512 unit
+// roundoffs of the scale (2^-15).
 
 #include "narrow/wide_test.h"
 

@@ -38,9 +38,10 @@ struct alignas(32) WideSide {
 };
 
 /// What the test reads besides the nodes: both directions, the reach, and the float stage's
-/// thresholds. The float stage computes in units of `unit`, the power of two nearest below the
-/// scale's inverse, so that its values are near 1 and scale with the models exactly (a pose and
-/// models scaled by a power of two get the same decisions). Made once per traversal
+/// thresholds. The float stage computes in units of `unit`, 2^-k for the scale's exponent k (the
+/// scale is 1 to 2 units), so that its values are near 1 and scale with the models exactly: a pose
+/// and models scaled by a power of two get the same decisions, down to scales of about 2^-117,
+/// where floats' smallest steps (and the stage-1 floor, 2^-149) stop scaling. Made once per traversal
 /// (make_wide_lanes; 1,760 bytes: not kept in the pair context, which the engine holds for every
 /// pair).
 struct alignas(32) WideLanes {

@@ -102,6 +102,12 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   }
   const auto bits = static_cast<unsigned>(_mm256_movemask_ps(pass));
   if (bits == 0 || !l.floats) return bits;
+  // The lanes refused here (the empty slots' infinite bounds among them) as zero boxes: stage 2
+  // computes no infinity or NaN, so a host that traps invalid operations is not stopped.
+  for (int i = 0; i < 3; ++i) {
+    cl[i] = both(cl[i], pass);
+    ch[i] = both(ch[i], pass);
+  }
   // Stage 2, on the lanes' slots.
   alignas(32) double moved[4];
   _mm256_store_pd(moved, c);

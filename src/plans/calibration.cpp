@@ -27,7 +27,7 @@ double caliber_threshold(double total, double beta, int threads) {
 
 namespace {
 
-/// Nodes of one level of the stage handed to a thread at a time: a visit is up to four node tests,
+/// Nodes of one level of the stage handed to a thread at a time: a visit is up to eight node tests,
 /// so a chunk is a short piece of work, and a level of a hundred nodes spreads over a dozen
 /// threads. Fixed chunks (not the partitioner's), so that the load-balance simulation replays the
 /// very pieces that ran.

@@ -106,10 +106,10 @@ void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& reco
   } else {
     for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
   }
-  parallel::JobGroup group;
   // A split pair's node-test lanes, made once by the job that tests its root and read by every
-  // visit above the cut-off.
+  // visit above the cut-off (declared before the jobs' group, which waits for them on the way out).
   std::vector<PairLanes> lanes(heavy.size());
+  parallel::JobGroup group;
   for (std::size_t k = 0; k < heavy.size(); ++k) {
     group.run([&state, &lanes, k, i = heavy[k], depth] {
       // The root is tested above the cut-off: splitting work.
