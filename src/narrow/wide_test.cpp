@@ -72,7 +72,7 @@ WideLanes make_wide_lanes(const NodeTestFrame& f, double scale) {
   // The unit: 2^-k for the scale's exponent k, within float's range (else no float stage).
   const int k = scale > 0.0 && std::isfinite(scale) ? std::ilogb(scale) : 0;
   l.floats = scale > 0.0 && std::isfinite(scale) && k >= -120 && k <= 120;
-  l.unit = std::ldexp(1.0, -k);
+  l.unit = l.floats ? std::ldexp(1.0, -k) : 1.0;  // (unused without the float stage; in float's range)
   l.unit_f = static_cast<float>(l.unit);
   l.half_unit = static_cast<float>(0.5 * l.unit);
   const double slack = kShare * scale * l.unit;

@@ -154,3 +154,27 @@ TEST(WideTest, NeverRefusesASlotAboveAKeptPair) {
 
 }  // namespace
 }  // namespace caliber::narrow
+
+namespace caliber::narrow {
+namespace {
+
+// A mesh whose extent about its own volume origin is below float's range (1e-36 from the origin,
+// 1e-44 across: every coordinate accepted): the float stage is off, the boxes alone prune, and the
+// query is the brute force's.
+TEST(WideTest, AScaleBelowFloatsRangeLeavesTheBoxesAlone) {
+  Mesh grid = make_plate(1.0, 0.1, 4);
+  for (Eigen::Vector3d& v : grid.vertices) v = Eigen::Vector3d::Constant(1e-36) + 1e-44 * v;
+  const auto a = build_model(grid), b = build_model(grid);
+  QueryRequest request;
+  const Pose pose_b;  // the same place (a translation or a turn would move it by far more than it is large)
+  const PairContext ctx(*a, Pose{}, *b, pose_b, request);
+  const detail::WideLanes lanes = wide_lanes(ctx);
+  EXPECT_FALSE(lanes.floats);
+  EXPECT_TRUE(std::isfinite(lanes.unit_f)) << "no conversion out of float's range";
+  const QueryResult got = query(*a, Pose{}, *b, pose_b, request);
+  test::expect_identical(got, query_brute_force(*a, Pose{}, *b, pose_b, request), "below float's range");
+  EXPECT_FALSE(got.contacts.empty());
+}
+
+}  // namespace
+}  // namespace caliber::narrow
