@@ -2,23 +2,13 @@
 
 #include "narrow/cd_tree.h"
 
-#include <cmath>
-
 #include "bvh/wide_tree.h"
 
 namespace caliber::narrow {
 
-const detail::WideTest kWideTest =
-    detail::wide_test_avx2_if_supported() != nullptr ? detail::wide_test_avx2_if_supported() : detail::wide_test_scalar;
+const detail::WideTest kWideTest = detail::wide_test_avx2_if_supported();
 
-detail::WideLanes wide_lanes(const PairContext& ctx) {
-  // The scale of the float stage's slack: what its values are at most in magnitude, as
-  // PairContext::node_lanes takes it.
-  const detail::NodeTestFrame& f = ctx.node_test_frame();
-  const double* t = f.trans;
-  const double between = std::sqrt((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
-  return detail::make_wide_lanes(f, ctx.a().local_extent + ctx.b().local_extent + between + f.slab_reach);
-}
+detail::WideLanes wide_lanes(const PairContext& ctx) { return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale()); }
 
 bool root_test(const PairContext& ctx, NodePair n, RootTest how) {
   switch (how) {

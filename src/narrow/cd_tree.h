@@ -127,17 +127,18 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChil
 /// PairContext::node_lanes): made once by a traversal.
 detail::WideLanes wide_lanes(const PairContext& ctx);
 
-/// The form of the wide node test this CPU runs (the AVX2 one where it has it, else the scalar
-/// one: the same decisions), chosen when the library loads.
+/// The AVX2 form of the wide node test where this CPU has it, else null (wide_pass then runs the
+/// scalar form: the same decisions), chosen when the library loads.
 extern const detail::WideTest kWideTest;
 
 /// The node tests of the wide visit v of node n on its children: bit k set where child k
-/// (cd_children order) passes the wide test (detail::WideTest), then the groups and normal cones
-/// (PairContext::groups_and_cones_allow).
-inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes) {
-  // (Null before the library's constants are made: a query from another constant's constructor.)
+/// (cd_children order) passes the wide test (detail::WideTest; its staying node read from or kept
+/// in `cache`, if given), then the groups and normal cones (PairContext::groups_and_cones_allow).
+inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes,
+                          detail::StayingCache* cache = nullptr) {
+  // (Null also before the library's constants are made: a query from another constant's constructor.)
   const detail::WideTest test = kWideTest != nullptr ? kWideTest : detail::wide_test_scalar;
-  unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node);
+  unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);

@@ -173,13 +173,14 @@ QueryResult interference_result(const std::vector<Candidate>& candidates, Object
     std::sort(keys.begin(), keys.end());
   }
   CALIBER_ASSERT(std::adjacent_find(keys.begin(), keys.end()) == keys.end(), "each triangle pair is a candidate once");
-  result.contacts.resize(keys.size());
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    Contact& contact = result.contacts[i];
+  // Each contact made where it is written (a resize would clear them all in a pass of its own).
+  result.contacts.reserve(keys.size());
+  for (const std::uint64_t key : keys) {
+    Contact& contact = result.contacts.emplace_back();
     contact.object_a = objects.a;
     contact.object_b = objects.b;
-    contact.tri_a = static_cast<std::uint32_t>(keys[i] >> 32);
-    contact.tri_b = static_cast<std::uint32_t>(keys[i]);
+    contact.tri_a = static_cast<std::uint32_t>(key >> 32);
+    contact.tri_b = static_cast<std::uint32_t>(key);
     contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
   }
   return result;

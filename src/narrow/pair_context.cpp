@@ -85,13 +85,13 @@ bool PairContext::node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
   return node_test_2x2_lane(a, b);
 }
 
-detail::NodeLanes PairContext::node_lanes() const {
-  // The scale of the float pre-decision's slack: what its values are at most in magnitude, the
-  // extents about the volume origins, the distance between those and the slab reach (not mScale's
-  // share of the absolute scale: the lanes compute from the local values alone).
+double PairContext::lanes_scale() const {
+  // What the float stages' values are at most in magnitude: the extents about the volume origins,
+  // the distance between those and the slab reach (not mScale's share of the absolute scale: the
+  // lanes compute from the local values alone).
   const double* t = mNodeFrame.trans;
   const double between = std::sqrt((t[0] * t[0] + t[1] * t[1]) + t[2] * t[2]);
-  return detail::make_lanes(mNodeFrame, mA.local_extent + mB.local_extent + between + mSlabReach);
+  return mA.local_extent + mB.local_extent + between + mSlabReach;
 }
 
 namespace {

@@ -31,10 +31,9 @@ namespace caliber::narrow {
 /// In the binary CD tree, a node whose sphere is more than this many times larger than its
 /// partner's descends alone (its partner waits): the swept query's traversal.
 inline constexpr double kDescendAloneRatio = 2.0;
-/// The same in the distance query, whose visits where one side descends cost nearly as much as
-/// those where both do (four lanes of bounds for two children). Against 2 (bench_fcl_distance): 4
-/// was faster on the bunny at gap 1, as fast or a little faster on the armadillo and dragon, and
-/// faster on some cases, slower on others, on the turbine and blade and on the fandisk and rotor.
+/// The distance query's: its one-sided visits cost nearly as much as two-sided ones (four lanes of
+/// bounds for two children); against 2 (bench_fcl_distance), 4 was faster on the bunny at gap 1, as
+/// fast or faster on the armadillo and dragon, mixed on turbine × blade and fandisk × rotor.
 inline constexpr double kDescendAloneRatioDistance = 4.0;
 
 /// The per-pair state of a query: immutable while traversals run, so several threads may traverse
@@ -100,9 +99,8 @@ class PairContext {
   }
 
   /// The node test of a visit where both sides descend: node_test, and neither node's disk beyond
-  /// the other's slab (disks_beyond_slabs; both nodes prepared with their disks). Visits where one
-  /// side descends use node_test alone: on the turbine and blade, whose visits mostly descend on one side,
-  /// the disks refused no pair and cost a noticeable part of the query.
+  /// the other's slab (disks_beyond_slabs; both nodes prepared with their disks). One-sided visits
+  /// use node_test alone: on turbine × blade the disks refused none of them and cost noticeably.
   [[nodiscard]] bool node_test_2x2_lane(const SideA& a, const SideB& b) const {
     return node_test(a, b) && !narrow::disks_beyond_slabs(a, b, mSlabReach);
   }
@@ -120,9 +118,11 @@ class PairContext {
   /// stays given twice; node_tests_2x2's lanes without disks (1 and 2 cleared), else pair by pair.
   [[nodiscard]] int node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1,
                                         const detail::NodeLanes* lanes = nullptr) const;
-  /// What the four-lane forms read of this context, and its pose in their lanes (make_lanes).
+  /// What the four-lane forms read of this context, its pose in their lanes (make_lanes), and the
+  /// scale of their float stage's slack (the wide test's too: narrow::wide_lanes).
   [[nodiscard]] const detail::NodeTestFrame& node_test_frame() const { return mNodeFrame; }
-  [[nodiscard]] detail::NodeLanes node_lanes() const;
+  [[nodiscard]] detail::NodeLanes node_lanes() const { return detail::make_lanes(mNodeFrame, lanes_scale()); }
+  [[nodiscard]] double lanes_scale() const;
   /// Whether groups or normal cones may refuse a pair (a table of groups, or the contact kind), and
   /// whether they let node ia of A and node ib of B touch.
   [[nodiscard]] bool refuses_by_groups_or_cones() const { return mGroups != nullptr || mKind == QueryKind::contact; }

@@ -18,10 +18,13 @@
 namespace caliber::narrow {
 
 /// The lanes of a traversal's node tests, made once by it: those of the binary CD tree's
-/// (PairContext::node_lanes) or of the wide one's (wide_lanes); null: made by each visit.
+/// (PairContext::node_lanes) or of the wide one's (wide_lanes); null: made by each visit. In the
+/// wide tree, `staying`: the staying nodes its visits moved (detail::StayingCache), renewed by the
+/// traversal, which alone uses it, on one thread (null: each visit moves its own).
 struct VisitLanes {
   const detail::NodeLanes* binary = nullptr;
   const detail::WideLanes* wide = nullptr;
+  detail::StayingCache* staying = nullptr;
 };
 
 /// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root),
@@ -37,9 +40,9 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
 template <bool kReversed>
 [[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
-                                             const detail::WideLanes& lanes) {
+                                             const detail::WideLanes& lanes, detail::StayingCache* staying) {
   const WideVisit v = wide_visit(ctx, n, a, b);
-  unsigned pass = wide_pass(ctx, n, v, lanes);
+  unsigned pass = wide_pass(ctx, n, v, lanes, staying);
   const int count = v.node->count();
   if (taboo.taboo != nullptr) {
     for (int k = 0; k < count; ++k) {
@@ -59,6 +62,14 @@ template <bool kReversed>
     passed[passing++] = v.child(static_cast<int>(k), n);
   }
   return passing;
+}
+
+/// visit_wide for a visit without the traversal's lanes: made here.
+template <bool kReversed>
+[[gnu::noinline]] int visit_wide_alone(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b, QueryStats& stats,
+                                       NodePair passed[], TabooView taboo) {
+  const detail::WideLanes made = wide_lanes(ctx);
+  return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, made, nullptr);
 }
 
 /// The visit of a node of the binary CD tree (not a pair of leaves; narrow::visit): its children's
@@ -134,9 +145,8 @@ template <bool kReversed = false>
     return -1;
   }
   if (wide_cd_tree(ctx)) {
-    if (lanes.wide != nullptr) return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide);
-    const detail::WideLanes made = wide_lanes(ctx);
-    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, made);
+    if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
+    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying);
   }
   return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
 }

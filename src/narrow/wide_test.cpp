@@ -130,30 +130,42 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
 
 }  // namespace
 
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w) {
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
+                          StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
-  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
-  const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
-  const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
-  double c[3];
-  float lo[3], hi[3];
-  for (int i = 0; i < 3; ++i) {
-    c[i] = std::fma(s.col[2][i], cd[2], std::fma(s.col[1][i], cd[1], std::fma(s.col[0][i], cd[0], s.t[i])));
-    const double e =
-        std::fma(s.abs_col[2][i], hd[2], std::fma(s.abs_col[1][i], hd[1], std::fma(s.abs_col[0][i], hd[0], l.reach)));
-    const double g = std::fma(std::abs(c[i]) + e, kRoundShare, e + l.round_floor);
-    lo[i] = static_cast<float>(c[i] - g);
-    hi[i] = static_cast<float>(c[i] + g);
+  bool held = false;
+  StayingCache::Entry spare;
+  StayingCache::Entry& kept = cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+  if (!held) {
+    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+    const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
+    const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
+    double c[3];
+    float lo[3], hi[3];
+    for (int i = 0; i < 3; ++i) {
+      c[i] = std::fma(s.col[2][i], cd[2], std::fma(s.col[1][i], cd[1], std::fma(s.col[0][i], cd[0], s.t[i])));
+      const double e =
+          std::fma(s.abs_col[2][i], hd[2], std::fma(s.abs_col[1][i], hd[1], std::fma(s.abs_col[0][i], hd[0], l.reach)));
+      const double g = std::fma(std::abs(c[i]) + e, kRoundShare, e + l.round_floor);
+      lo[i] = static_cast<float>(c[i] - g);
+      hi[i] = static_cast<float>(c[i] + g);
+    }
+    StayingCache::fill(kept, c, lo, hi);
+    if (cache != nullptr) cache->mark(stay, a_descends);
   }
   unsigned pass = 0;
   for (int k = 0; k < WideNode::kSlots; ++k) {
-    if (boxes_overlap(w, k, lo, hi)) pass |= 1u << k;
+    if (boxes_overlap(w, k, kept.lo, kept.hi)) pass |= 1u << k;
   }
   if (pass == 0 || !l.floats) return pass;
-  const StayingFloats st = staying_floats(l, s, sn, sf, c);
+  if (!kept.has_floats) {
+    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+    const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+    kept.floats = staying_floats(l, s, sn, sf, kept.moved);
+    kept.has_floats = true;
+  }
   for (int k = 0; k < WideNode::kSlots; ++k) {
-    if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, st)) pass &= ~(1u << k);
+    if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, kept.floats)) pass &= ~(1u << k);
   }
   return pass;
 }

@@ -17,8 +17,10 @@
 ///    parallel patches a hair apart are refused high in the tree. Refused only where surely
 ///    beyond.
 /// Every form (AVX2, scalar) makes each lane's operations in the same order: the same decisions.
+/// What they compute of the staying node is kept for the visits after (StayingCache).
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "bvh/model_data.h"
@@ -64,6 +66,64 @@ struct StayingFloats {
   float co[3], ho[3], nf[3], off, cf[3], sh[3], slab_lo, slab_hi;
 };
 
+/// The staying nodes of a traversal's visits as the test moved them, kept for the visits after
+/// them: a staying node stays for the visits below it while the other side descends, and those
+/// visits read it here rather than move it again (the same values: the same operations on the
+/// same node). A table of kEntries, each node at one place (by its index and side), a newer node
+/// taking an older one's place. The test fills it. One thread's traversals use it one after the
+/// other (TraversalScratch::staying), each from renew on: one pair context and its lanes.
+struct StayingCache {
+  static constexpr int kEntries = 64;
+  /// One staying node moved.
+  struct Entry {
+    alignas(16) float lo[4];  ///< stage 1's box, its low corner (lanes x, y, z; the fourth unused)
+    alignas(16) float hi[4];  ///< its high corner
+    double moved[3];          ///< its box center in the descending frame
+    bool has_floats;          ///< `floats` made (stage 2 ran on it)
+    StayingFloats floats;     ///< what stage 2 reads of it
+  };
+  /// Past this many traversals, the keys are cleared and the count starts again.
+  static constexpr std::uint64_t kGenerations = std::uint64_t{1} << 29;
+  std::uint64_t key[kEntries] = {};  ///< generation << 34 | (2 stay + (A descends)); 0: empty
+  Entry entry[kEntries];
+  std::uint64_t generation = 1;  ///< the traversal's (renew): the keys of earlier ones do not match
+
+  /// Starts a traversal (of any pair, pose and lanes): nothing kept before is found again.
+  void renew() {
+    if (++generation == kGenerations) {
+      for (std::uint64_t& k : key) k = 0;
+      generation = 1;
+    }
+  }
+  /// The place of node `stay` moved for the side `a_descends` says; `held`: whether it holds that
+  /// node (else the caller fills it: fill, then mark).
+  Entry& find(std::uint32_t stay, bool a_descends, bool& held) {
+    const std::uint64_t k = key_of(stay, a_descends);
+    held = key[place(k)] == k;
+    return entry[place(k)];
+  }
+  /// Marks node `stay`'s place (filled) as holding it.
+  void mark(std::uint32_t stay, bool a_descends) {
+    const std::uint64_t k = key_of(stay, a_descends);
+    key[place(k)] = k;
+  }
+  /// Never 0 (generation >= 1); 2 stay + 1 < 2^34.
+  [[nodiscard]] std::uint64_t key_of(std::uint32_t stay, bool a_descends) const {
+    return generation << 34 | (2u * std::uint64_t{stay} + (a_descends ? 1u : 0u));
+  }
+  static std::size_t place(std::uint64_t k) { return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> 58); }
+  /// Fills entry e with a node moved: its center `c`, its box lo, hi (its floats not yet made).
+  static void fill(Entry& e, const double c[3], const float lo[3], const float hi[3]) {
+    e.has_floats = false;
+    for (int i = 0; i < 3; ++i) {
+      e.moved[i] = c[i];
+      e.lo[i] = lo[i];
+      e.hi[i] = hi[i];
+    }
+    e.lo[3] = e.hi[3] = 0.0f;
+  }
+};
+
 /// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
 inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const BvhNode& sn, const BvhNodeFilter& sf,
                                     const double c[3]) {
@@ -89,11 +149,14 @@ WideLanes make_wide_lanes(const NodeTestFrame& f, double scale);
 
 /// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
 /// node `stay` stays) against the descending node's wide node w: bit k set where slot k passes
-/// (slots past the last never do).
-using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w);
+/// (slots past the last never do). The staying node is read from `cache` where it holds it, else
+/// moved and kept there (null: moved for this test alone).
+using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
+                              StayingCache* cache);
 
 /// The scalar form.
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w);
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
+                          StayingCache* cache);
 
 /// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
 WideTest wide_test_avx2_if_supported();

@@ -79,26 +79,34 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
 }
 
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                     const WideNode& w) {
+                                     const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
-  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
-  const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
-  const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
-  // Stage 1: the staying box in the descending frame, in double lanes (x, y, z, 0).
-  const D c = times(s.col, cd, _mm256_load_pd(s.t));
-  const D e = times(s.abs_col, hd, _mm256_set1_pd(l.reach));
-  const D magnitude_c = _mm256_andnot_pd(_mm256_set1_pd(-0.0), c);
-  const D g = fmad(addd(magnitude_c, e), _mm256_set1_pd(0x1p-22), addd(e, _mm256_set1_pd(l.round_floor)));
-  alignas(16) float lo[4], hi[4];
-  _mm_store_ps(lo, _mm256_cvtpd_ps(_mm256_sub_pd(c, g)));
-  _mm_store_ps(hi, _mm256_cvtpd_ps(addd(c, g)));
+  bool held = false;
+  StayingCache::Entry spare;
+  StayingCache::Entry& kept = cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+  if (!held) {
+    // Stage 1's box: the staying box in the descending frame, in double lanes (x, y, z, 0).
+    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+    const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
+    const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
+    const D c = times(s.col, cd, _mm256_load_pd(s.t));
+    const D e = times(s.abs_col, hd, _mm256_set1_pd(l.reach));
+    const D magnitude_c = _mm256_andnot_pd(_mm256_set1_pd(-0.0), c);
+    const D g = fmad(addd(magnitude_c, e), _mm256_set1_pd(0x1p-22), addd(e, _mm256_set1_pd(l.round_floor)));
+    alignas(32) double moved[4];
+    _mm256_store_pd(moved, c);
+    alignas(16) float lo[4], hi[4];
+    _mm_store_ps(lo, _mm256_cvtpd_ps(_mm256_sub_pd(c, g)));
+    _mm_store_ps(hi, _mm256_cvtpd_ps(addd(c, g)));
+    StayingCache::fill(kept, moved, lo, hi);
+    if (cache != nullptr) cache->mark(stay, a_descends);
+  }
   V cl[3], ch[3];
   V pass = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   for (int i = 0; i < 3; ++i) {
     cl[i] = load(w.lo[i]);
     ch[i] = load(w.hi[i]);
-    pass = both(pass, both(at_most(cl[i], all(hi[i])), at_least(ch[i], all(lo[i]))));
+    pass = both(pass, both(at_most(cl[i], all(kept.hi[i])), at_least(ch[i], all(kept.lo[i]))));
   }
   const auto bits = static_cast<unsigned>(_mm256_movemask_ps(pass));
   if (bits == 0 || !l.floats) return bits;
@@ -109,10 +117,13 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
     ch[i] = both(ch[i], pass);
   }
   // Stage 2, on the lanes' slots.
-  alignas(32) double moved[4];
-  _mm256_store_pd(moved, c);
-  const StayingFloats st = staying_floats(l, s, sn, sf, moved);
-  return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, st)));
+  if (!kept.has_floats) {
+    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+    const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+    kept.floats = staying_floats(l, s, sn, sf, kept.moved);
+    kept.has_floats = true;
+  }
+  return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // than the meshes, tiny and huge scales), and it never refuses a slot below which some triangle
 // pair is kept by the leaf test.
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -15,6 +16,8 @@
 #include "caliber/query.h"
 #include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
+#include "narrow/traversal.h"
+#include "narrow/visit.h"
 #include "support/random_poses.h"
 
 namespace caliber::narrow {
@@ -47,7 +50,7 @@ void walk(const PairContext& ctx, const detail::WideLanes& lanes, std::size_t mo
     const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) continue;
     const WideVisit v = wide_visit(ctx, n, a, b);
-    const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node);
+    const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr);
     visit(n, v, pass);
     for (int k = 0; k < v.node->count(); ++k) {
       if ((pass >> k & 1u) != 0) work.push_back(v.child(k, n));
@@ -92,8 +95,9 @@ TEST(WideTest, ScalarAndAvx2FormsDecideAlike) {
       boxes_only.floats = false;
       walk(ctx, lanes, 20000, [&](NodePair, const WideVisit& v, unsigned pass) {
         ++visits;
-        if (avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node) != pass) ++differing;
-        const unsigned boxes = detail::wide_test_scalar(ctx.node_test_frame(), boxes_only, v.a_descends, v.stay, *v.node);
+        if (avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr) != pass) ++differing;
+        const unsigned boxes =
+            detail::wide_test_scalar(ctx.node_test_frame(), boxes_only, v.a_descends, v.stay, *v.node, nullptr);
         EXPECT_EQ(pass & ~boxes, 0u) << "the float stage only refuses";
         by_floats += __builtin_popcount(boxes & ~pass);
       });
@@ -102,6 +106,100 @@ TEST(WideTest, ScalarAndAvx2FormsDecideAlike) {
   EXPECT_EQ(differing, 0) << "of " << visits << " visits";
   EXPECT_GT(visits, 5000);
   EXPECT_GT(by_floats, 1000) << "the float stage refuses slots the boxes let through";
+}
+
+TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
+  // Depth first, as the traversal walks: each form keeps its staying nodes from visit to visit
+  // (self-pairs, where a node of A and one of B share an index, and a pair of different meshes;
+  // near the origin, far from it, and with the float stage off).
+  const detail::WideTest avx2 = detail::wide_test_avx2_if_supported();
+  const Eigen::Vector3d far(3e6, -2e6, 1e6);
+  const auto torus = build_model(make_torus(1.0, 0.35, 40, 24));
+  const auto sphere = build_model(sphere_with_slivers(30));
+  const auto far_torus = build_model(moved(make_torus(1.0, 0.35, 40, 24), 0, far));
+  std::mt19937_64 rng(12);
+  long differing = 0;
+  for (int c = 0; c < 6; ++c) {
+    const bool far_case = c >= 4;
+    const Model& a = far_case ? *far_torus : *torus;
+    const Model& b = far_case ? *far_torus : c % 2 == 0 ? *torus : *sphere;
+    QueryRequest request;
+    request.kind = c % 2 == 0 ? QueryKind::interference : QueryKind::proximity;
+    request.tolerance = c % 2 == 0 ? 0.0 : 0.02;
+    Pose pose_b = test::random_pose(rng, 0.5);
+    if (far_case) pose_b.translation += far - pose_b.rotation * far;
+    const PairContext ctx(a, Pose{}, b, pose_b, request);
+    detail::WideLanes lanes = wide_lanes(ctx);
+    lanes.floats = c != 2;  // one case with the float stage off
+    detail::StayingCache scalar_cache, avx2_cache;
+    long visits = 0, kept[2] = {0, 0}, floats_kept = 0;
+    std::vector<NodePair> stack{{0, 0}};
+    while (!stack.empty() && visits < 20000) {
+      const NodePair n = stack.back();
+      stack.pop_back();
+      const BvhNode& na = ctx.a().nodes[n.a];
+      const BvhNode& nb = ctx.b().nodes[n.b];
+      if (na.is_leaf() && nb.is_leaf()) continue;
+      const WideVisit v = wide_visit(ctx, n, na, nb);
+      ++visits;
+      bool held = false;
+      const detail::StayingCache::Entry& e = scalar_cache.find(v.stay, v.a_descends, held);
+      kept[v.a_descends ? 0 : 1] += held ? 1 : 0;
+      floats_kept += held && e.has_floats ? 1 : 0;
+      const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr);
+      if (detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, &scalar_cache) != pass) {
+        ++differing;
+      }
+      if (avx2 != nullptr && avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, &avx2_cache) != pass) {
+        ++differing;
+      }
+      for (int k = v.node->count() - 1; k >= 0; --k) {
+        if ((pass >> k & 1u) != 0) stack.push_back(v.child(k, n));
+      }
+    }
+    EXPECT_GT(visits, 200) << "case " << c;
+    EXPECT_GT(kept[0], visits / 10) << "case " << c << ": visits descending on A find B's node kept";
+    EXPECT_GT(kept[1], visits / 10) << "case " << c << ": visits descending on B find A's node kept";
+    if (lanes.floats) EXPECT_GT(floats_kept, visits / 10) << "case " << c << ": the float stage's values are kept too";
+  }
+  EXPECT_EQ(differing, 0);
+}
+
+TEST(WideTest, TraversalsWithAndWithoutKeptNodesFindTheSamePairs) {
+  // The depth-first traversal (which keeps its staying nodes) against visits that each move their
+  // own (narrow::visit without the traversal's lanes), node tests and leaf tests counted alike.
+  const auto a = build_model(make_torus(1.0, 0.35, 30, 18));
+  const auto b = build_model(sphere_with_slivers(20));
+  std::mt19937_64 rng(5);
+  TraversalScratch scratch;  // one for every pose: each traversal forgets the last one's nodes
+  for (int p = 0; p < 6; ++p) {
+    QueryRequest request;
+    request.kind = p % 2 == 0 ? QueryKind::interference : QueryKind::proximity;
+    request.tolerance = p % 2 == 0 ? 0.0 : 0.02;
+    const PairContext ctx(*a, Pose{}, *b, test::random_pose(rng, 0.7), request);
+    std::vector<Candidate> kept_out, alone_out;
+    QueryStats kept_stats, alone_stats;
+    traverse_depth_first(ctx, NodePair{0, 0}, scratch, kept_out, kept_stats);
+    std::vector<NodePair> stack;
+    if (test_root(ctx, NodePair{0, 0}, alone_stats)) stack.push_back(NodePair{0, 0});
+    while (!stack.empty()) {
+      const NodePair n = stack.back();
+      stack.pop_back();
+      NodePair passed[kMaxChildren];
+      const int count = visit(ctx, n, alone_out, alone_stats, passed);
+      for (int k = count - 1; k >= 0; --k) stack.push_back(passed[k]);
+    }
+    const auto ids = [](std::vector<Candidate> c) {
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+      for (const Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
+      std::sort(out.begin(), out.end());
+      return out;
+    };
+    EXPECT_EQ(ids(kept_out), ids(alone_out)) << "pose " << p;
+    EXPECT_EQ(kept_stats.node_tests, alone_stats.node_tests);
+    EXPECT_EQ(kept_stats.leaf_tests, alone_stats.leaf_tests);
+    EXPECT_GT(kept_stats.leaf_tests, 0u) << "pose " << p << ": the meshes meet";
+  }
 }
 
 /// The leaves (triangle ids) below BVH node i.
