@@ -133,13 +133,12 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
 unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
                           StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
-  bool held = false;
+  bool held;
   StayingCache::Entry spare;
-  StayingCache::Entry& kept = cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+  StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
   if (!held) {
-    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-    const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
-    const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
+    const StayingBox box = staying_box(f, a_descends, stay);
+    const double *cd = box.c, *hd = box.h;
     double c[3];
     float lo[3], hi[3];
     for (int i = 0; i < 3; ++i) {
@@ -158,12 +157,7 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
     if (boxes_overlap(w, k, kept.lo, kept.hi)) pass |= 1u << k;
   }
   if (pass == 0 || !l.floats) return pass;
-  if (!kept.has_floats) {
-    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-    const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
-    kept.floats = staying_floats(l, s, sn, sf, kept.moved);
-    kept.has_floats = true;
-  }
+  make_staying_floats(f, l, a_descends, stay, kept);
   for (int k = 0; k < WideNode::kSlots; ++k) {
     if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, kept.floats)) pass &= ~(1u << k);
   }

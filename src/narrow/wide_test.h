@@ -143,6 +143,33 @@ inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const
   return out;
 }
 
+/// The box of node `stay` of the side that stays (B's where A descends), in double: center, half-extents.
+struct StayingBox {
+  double c[3], h[3];
+};
+inline StayingBox staying_box(const NodeTestFrame& f, bool a_descends, std::uint32_t stay) {
+  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+  return StayingBox{{sn.box_center[0], sn.box_center[1], sn.box_center[2]}, {sn.box_half[0], sn.box_half[1], sn.box_half[2]}};
+}
+
+/// A test's entry for node `stay`: its place in `cache` (`held`: whether it holds the node, else
+/// the test fills it and marks it), or `spare` without a cache.
+inline StayingCache::Entry& staying_entry(StayingCache* cache, StayingCache::Entry& spare, std::uint32_t stay, bool a_descends,
+                                          bool& held) {
+  held = false;
+  return cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+}
+
+/// Makes entry `kept`'s float values (stage 2's) for node `stay`, unless made already.
+inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
+                                StayingCache::Entry& kept) {
+  if (kept.has_floats) return;
+  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, sf, kept.moved);
+  kept.has_floats = true;
+}
+
 /// The lanes of frame f (its pose, reach and slab reach). `scale`: a bound on every coordinate,
 /// extent, reach and slab bound the test computes with, which sets the slack.
 WideLanes make_wide_lanes(const NodeTestFrame& f, double scale);

@@ -81,16 +81,14 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                      const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
-  bool held = false;
+  bool held;
   StayingCache::Entry spare;
-  StayingCache::Entry& kept = cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+  StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
   if (!held) {
     // Stage 1's box: the staying box in the descending frame, in double lanes (x, y, z, 0).
-    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-    const double cd[3] = {sn.box_center[0], sn.box_center[1], sn.box_center[2]};
-    const double hd[3] = {sn.box_half[0], sn.box_half[1], sn.box_half[2]};
-    const D c = times(s.col, cd, _mm256_load_pd(s.t));
-    const D e = times(s.abs_col, hd, _mm256_set1_pd(l.reach));
+    const StayingBox box = staying_box(f, a_descends, stay);
+    const D c = times(s.col, box.c, _mm256_load_pd(s.t));
+    const D e = times(s.abs_col, box.h, _mm256_set1_pd(l.reach));
     const D magnitude_c = _mm256_andnot_pd(_mm256_set1_pd(-0.0), c);
     const D g = fmad(addd(magnitude_c, e), _mm256_set1_pd(0x1p-22), addd(e, _mm256_set1_pd(l.round_floor)));
     alignas(32) double moved[4];
@@ -117,12 +115,7 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
     ch[i] = both(ch[i], pass);
   }
   // Stage 2, on the lanes' slots.
-  if (!kept.has_floats) {
-    const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
-    const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
-    kept.floats = staying_floats(l, s, sn, sf, kept.moved);
-    kept.has_floats = true;
-  }
+  make_staying_floats(f, l, a_descends, stay, kept);
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 
