@@ -49,7 +49,9 @@ struct TraversalScratch {
   util::GapBuckets<Reached> waiting;        ///< distance traversal: the nodes waiting, by gap
   PreparedTree<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
   PreparedTree<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
-  detail::StayingCache staying;             ///< wide traversals: the staying nodes moved (renewed by each)
+  /// Wide traversals: the staying nodes moved, renewed by each (made by the first; 9.7 KB, kept
+  /// off the thread's own storage).
+  std::unique_ptr<detail::StayingCache> staying;
 
   /// Bytes held that grow with the largest traversal so far (not the buckets' fixed tables).
   [[nodiscard]] std::size_t footprint() const {
@@ -80,8 +82,9 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   if (top != base && wide_cd_tree(ctx)) {
     wide = wide_lanes(ctx);
     lanes.wide = &wide;
-    scratch.staying.renew();
-    lanes.staying = &scratch.staying;
+    if (scratch.staying == nullptr) scratch.staying = std::make_unique<detail::StayingCache>();
+    scratch.staying->renew();
+    lanes.staying = scratch.staying.get();
   } else if (top != base) {
     binary = ctx.node_lanes();
     lanes.binary = &binary;

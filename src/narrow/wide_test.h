@@ -17,7 +17,8 @@
 ///    parallel patches a hair apart are refused high in the tree. Refused only where surely
 ///    beyond.
 /// Every form (AVX2, scalar) makes each lane's operations in the same order: the same decisions.
-/// What they compute of the staying node is kept for the visits after (StayingCache).
+/// What they compute of the staying node is kept for the visits after, when given a cache
+/// (StayingCache).
 
 #include <cmath>
 #include <cstddef>
@@ -82,7 +83,7 @@ struct StayingCache {
     bool has_floats;          ///< `floats` made (stage 2 ran on it)
     StayingFloats floats;     ///< what stage 2 reads of it
   };
-  /// Past this many traversals, the keys are cleared and the count starts again.
+  /// When the generation reaches this, the keys are cleared and it starts again at 1.
   static constexpr std::uint64_t kGenerations = std::uint64_t{1} << 29;
   std::uint64_t key[kEntries] = {};  ///< generation << 34 | (2 stay + (A descends)); 0: empty
   Entry entry[kEntries];
@@ -107,7 +108,7 @@ struct StayingCache {
     const std::uint64_t k = key_of(stay, a_descends);
     key[place(k)] = k;
   }
-  /// Never 0 (generation >= 1); 2 stay + 1 < 2^34.
+  /// Never 0 (generation >= 1); 2 stay + 1 < 2^33, below the generation's bits.
   [[nodiscard]] std::uint64_t key_of(std::uint32_t stay, bool a_descends) const {
     return generation << 34 | (2u * std::uint64_t{stay} + (a_descends ? 1u : 0u));
   }

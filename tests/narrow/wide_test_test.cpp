@@ -165,6 +165,30 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
   EXPECT_EQ(differing, 0);
 }
 
+TEST(WideTest, ARenewedCacheHoldsNothingKeptBefore) {
+  detail::StayingCache cache;
+  bool held = true;
+  cache.find(7, true, held);
+  EXPECT_FALSE(held) << "a new cache holds nothing";
+  cache.mark(7, true);
+  cache.find(7, true, held);
+  EXPECT_TRUE(held);
+  cache.find(7, false, held);
+  EXPECT_FALSE(held) << "the other side's node of the same id";
+  cache.renew();
+  cache.find(7, true, held);
+  EXPECT_FALSE(held) << "a renewed cache forgets";
+  // At the last generation: renew clears the keys and starts again at 1.
+  cache.generation = detail::StayingCache::kGenerations - 1;
+  cache.mark(9, false);
+  cache.renew();
+  EXPECT_EQ(cache.generation, 1u);
+  for (const std::uint64_t k : cache.key) EXPECT_EQ(k, 0u);
+  cache.find(9, false, held);
+  EXPECT_FALSE(held);
+  EXPECT_NE(cache.key_of(0, false), 0u) << "no key is an empty place's";
+}
+
 TEST(WideTest, TraversalsWithAndWithoutKeptNodesFindTheSamePairs) {
   // The depth-first traversal (which keeps its staying nodes) against visits that each move their
   // own (narrow::visit without the traversal's lanes), node tests and leaf tests counted alike.
