@@ -50,9 +50,9 @@ struct BvhNode {
 static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
 
 /// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
-/// tests have passed; the cone only by contact queries): 32 bytes, two to a cache line. Kept apart
-/// from BvhNode so that the first two tests touch 48 bytes.
-struct BvhNodeFilter {
+/// tests have passed; the cone only by contact queries): 32 bytes aligned to 32, two to a cache
+/// line and never across two. Kept apart from BvhNode so that the first two tests touch 48 bytes.
+struct alignas(32) BvhNodeFilter {
   /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
   float cone_axis[3];
   /// Normal-cone half-angle in radians, rounded up; negative when every triangle below is
@@ -223,7 +223,8 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
 /// of BVH nodes. Per slot, in lanes: its box as float bounds rounded outward from its BvhNode box
 /// (each bound the nearest float past the double center -+ half), its slab's axis and bounds as its
 /// BvhNodeFilter stores them. Slots past the last are empty: bounds +inf and -inf, no axis.
-struct alignas(32) WideNode {
+/// Aligned to a cache line: a node is six lines, never seven.
+struct alignas(64) WideNode {
   static constexpr int kSlots = 8;
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
   float lo[3][kSlots], hi[3][kSlots];      ///< box bounds along the object axes

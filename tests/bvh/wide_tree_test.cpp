@@ -4,6 +4,7 @@
 // filled.
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -74,6 +75,20 @@ TEST(WideTree, SlotsSplitTheirNodesLeavesInOrder) {
     const auto model = build_model(mesh);
     EXPECT_EQ(wide_problem(data(*model)), "") << mesh.source;
     EXPECT_FALSE(data(*model).wide.empty());
+  }
+}
+
+// A wide node starts a cache line and a node's filter lies in one: a visit reads six lines of the
+// one and one of the other, not seven and two.
+TEST(WideTree, NodesLieOnCacheLines) {
+  for (const Mesh& mesh : {make_torus(1.0, 0.35, 48, 24), make_sphere(0.5, 9, 11)}) {
+    const auto model = build_model(mesh);
+    const ModelData& m = data(*model);
+    ASSERT_FALSE(m.wide.empty());
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(m.wide.data()) % 64, 0u);
+    EXPECT_EQ(sizeof(WideNode) % 64, 0u);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(m.filters.data()) % 32, 0u);
+    EXPECT_EQ(64 % sizeof(BvhNodeFilter), 0u);
   }
 }
 
