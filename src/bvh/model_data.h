@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -220,17 +221,28 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
 /// below it (build_wide_tree: the slot of largest box surface that is not a leaf is replaced by its
 /// two children until the slots are full or all leaves; then each slot that is not a leaf gets a
 /// wide node of its own). A slot keeps its BVH node's id, so that the CD tree's nodes stay pairs
-/// of BVH nodes. Per slot, in lanes: its box as float bounds rounded outward from its BvhNode box
-/// (each bound the nearest float past the double center -+ half), its slab's axis and bounds as its
-/// BvhNodeFilter stores them. Slots past the last are empty: bounds +inf and -inf, no axis.
-/// Aligned to a cache line: a node is six lines, never seven.
+/// of BVH nodes. Per slot, in lanes: its box as 16-bit bounds on the node's grid (low, high), its
+/// slab's axis and bounds as its BvhNodeFilter stores them. The grid: a power of two `step` and an
+/// `origin` on it, both floats, so that every bound origin + q step is a float, the same however
+/// computed; each bound is the grid's nearest outside the float bound nearest outside its BvhNode
+/// box's double bound (bvh::build_wide_tree). Slots past the last are empty: node kEmpty, low
+/// above high. 320 bytes, aligned to a cache line: five lines.
 struct alignas(64) WideNode {
   static constexpr int kSlots = 8;
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
-  float lo[3][kSlots], hi[3][kSlots];      ///< box bounds along the object axes
-  float axis[3][kSlots];                   ///< slab axis (BvhNodeFilter::cone_axis)
-  float slab_lo[kSlots], slab_hi[kSlots];  ///< slab bounds
-  std::uint32_t node[kSlots];              ///< the slot's BVH node, kEmpty past the last
+  /// The most steps a bound lies from the origin.
+  static constexpr int kSteps = 32767;
+  // (The float and id arrays at multiples of 32 bytes, the 16-bit ones of 16: the test's aligned
+  // loads.)
+  std::int16_t lo[3][kSlots], hi[3][kSlots];  ///< box bounds along the object axes, in steps
+  float axis[3][kSlots];                      ///< slab axis (BvhNodeFilter::cone_axis)
+  float slab_lo[kSlots], slab_hi[kSlots];     ///< slab bounds
+  std::uint32_t node[kSlots];                 ///< the slot's BVH node, kEmpty past the last
+  float origin[3];                            ///< the grid's origin (a multiple of step)
+  float step;                                 ///< the grid's step, a power of two
+  /// Slot k's low and high bounds along axis i (exact: origin + q step is a float).
+  [[nodiscard]] float low(int i, int k) const { return static_cast<float>(lo[i][k]) * step + origin[i]; }
+  [[nodiscard]] float high(int i, int k) const { return static_cast<float>(hi[i][k]) * step + origin[i]; }
   /// Number of slots in use (they come first): 2 .. kSlots, 1 in bvh::single_slot's.
   [[nodiscard]] int count() const {
 #if defined(__SSE2__)
@@ -248,7 +260,10 @@ struct alignas(64) WideNode {
 #endif
   }
 };
-static_assert(sizeof(WideNode) == 384);
+static_assert(sizeof(WideNode) == 320);
+static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 == 0 && offsetof(WideNode, axis) % 32 == 0 &&
+              offsetof(WideNode, slab_lo) % 32 == 0 && offsetof(WideNode, slab_hi) % 32 == 0 &&
+              offsetof(WideNode, node) % 32 == 0);
 
 /// What a Model holds: the mesh with its BVH, normals and adjacency, laid out for the traversal.
 /// Made by build_model; never modified afterwards.

@@ -2,9 +2,12 @@
 
 #include "bvh/wide_tree.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "util/assert.h"
 
 namespace caliber::bvh {
 namespace {
@@ -29,12 +32,78 @@ double half_surface(const BvhNode& n) {
 
 void clear_slot(int k, WideNode& out) {
   for (int i = 0; i < 3; ++i) {
-    out.lo[i][k] = std::numeric_limits<float>::infinity();
-    out.hi[i][k] = -std::numeric_limits<float>::infinity();
+    out.lo[i][k] = WideNode::kSteps;
+    out.hi[i][k] = -WideNode::kSteps;
     out.axis[i][k] = 0.0f;
   }
   out.slab_lo[k] = out.slab_hi[k] = 0.0f;
   out.node[k] = WideNode::kEmpty;
+}
+
+/// A node's float box: along each axis, the nearest floats outside its double bounds.
+struct FloatBox {
+  float lo[3], hi[3];
+};
+FloatBox float_box(const BvhNode& n) {
+  FloatBox out;
+  for (int i = 0; i < 3; ++i) {
+    const double center = n.box_center[i], half = n.box_half[i];
+    out.lo[i] = float_below(center - half);
+    out.hi[i] = float_above(center + half);
+  }
+  return out;
+}
+
+/// The grid of a wide node whose slots' float boxes are boxes[0 .. n): the least power of two
+/// step with the boxes within 32000 steps of the origin (the multiple of the step nearest their
+/// center), at least 2^-23 of their largest magnitude, so that the origin and every bound within
+/// kSteps of it are floats (below 2^24 steps from zero), and at least 2^-126, so that every bound
+/// is 0 or a normal float (a process that flushes subnormals reads it as stored).
+void set_grid(const FloatBox* boxes, int n, WideNode& out) {
+  double lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    lo[i] = std::numeric_limits<double>::infinity();
+    hi[i] = -lo[i];
+    for (int k = 0; k < n; ++k) {
+      lo[i] = std::min(lo[i], static_cast<double>(boxes[k].lo[i]));
+      hi[i] = std::max(hi[i], static_cast<double>(boxes[k].hi[i]));
+    }
+  }
+  double reach = 0.0, far = 0.0, center[3];
+  for (int i = 0; i < 3; ++i) {
+    center[i] = 0.5 * lo[i] + 0.5 * hi[i];
+    reach = std::max(reach, 0.5 * hi[i] - 0.5 * lo[i]);
+    far = std::max(far, std::max(std::abs(lo[i]), std::abs(hi[i])));
+  }
+  const double least = std::max({reach / 32000.0, far * 0x1p-23, 0x1p-126});
+  double step = std::ldexp(1.0, std::ilogb(least));
+  if (step < least) step *= 2.0;
+  out.step = static_cast<float>(step);
+  for (int i = 0; i < 3; ++i) out.origin[i] = static_cast<float>(std::nearbyint(center[i] / step) * step);
+}
+
+/// Writes BVH node `node`, whose float box is `box`, into slot k of `out` (its grid set).
+void fill_slot(const ModelData& model, std::uint32_t node, const FloatBox& box, int k, WideNode& out) {
+  const BvhNodeFilter& f = model.filters[node];
+  const double step = out.step, per_step = 1.0 / step;  // (powers of two: exact)
+  for (int i = 0; i < 3; ++i) {
+    // The grid's nearest bounds outside the float box: from the quotients (truncated; within a
+    // step or two of them), then set exactly (origin + q step is exact in double).
+    const double origin = out.origin[i], lo = box.lo[i], hi = box.hi[i];
+    auto q_lo = static_cast<int>((lo - origin) * per_step);
+    auto q_hi = static_cast<int>((hi - origin) * per_step);
+    while (origin + q_lo * step > lo) --q_lo;
+    while (origin + (q_lo + 1) * step <= lo) ++q_lo;
+    while (origin + q_hi * step < hi) ++q_hi;
+    while (origin + (q_hi - 1) * step >= hi) --q_hi;
+    CALIBER_ASSERT(q_lo >= -WideNode::kSteps && q_hi <= WideNode::kSteps, "a slot's box lies within its node's grid");
+    out.lo[i][k] = static_cast<std::int16_t>(q_lo);
+    out.hi[i][k] = static_cast<std::int16_t>(q_hi);
+    out.axis[i][k] = f.cone_axis[i];
+  }
+  out.slab_lo[k] = f.slab_lo;
+  out.slab_hi[k] = f.slab_hi;
+  out.node[k] = node;
 }
 
 /// The slots of internal node `root`: its two children, then, while there is room, one slot
@@ -72,24 +141,38 @@ int collapse(const ModelData& m, std::uint32_t root, std::uint32_t slots[WideNod
 
 }  // namespace
 
-void fill_wide_slot(const ModelData& model, std::uint32_t node, int k, WideNode& out) {
-  const BvhNode& n = model.nodes[node];
-  const BvhNodeFilter& f = model.filters[node];
-  for (int i = 0; i < 3; ++i) {
-    const double center = n.box_center[i], half = n.box_half[i];
-    out.lo[i][k] = float_below(center - half);
-    out.hi[i][k] = float_above(center + half);
-    out.axis[i][k] = f.cone_axis[i];
-  }
-  out.slab_lo[k] = f.slab_lo;
-  out.slab_hi[k] = f.slab_hi;
-  out.node[k] = node;
-}
-
 WideNode single_slot(const ModelData& model, std::uint32_t node) {
+  // The wide node that holds `node` as a slot, from the root down: at each, the slot whose run of
+  // leaves holds node's first leaf is node, or holds node below it.
+  const std::uint32_t place = model.first_leaf(node), count = model.nodes[node].count;
+  std::uint32_t holder = 0, first = 0;  // the BVH node whose wide node is searched, its first leaf's place
+  while (node != holder && model.wide_of[holder] != WideNode::kEmpty) {
+    const WideNode& w = model.wide[model.wide_of[holder]];
+    int k = 0;
+    while (place >= first + model.nodes[w.node[k]].count) first += model.nodes[w.node[k++]].count;
+    if (w.node[k] == node) {
+      WideNode out = w;
+      for (int j = 0; j < WideNode::kSlots; ++j) clear_slot(j, out);
+      for (int i = 0; i < 3; ++i) {
+        out.lo[i][0] = w.lo[i][k];
+        out.hi[i][0] = w.hi[i][k];
+        out.axis[i][0] = w.axis[i][k];
+      }
+      out.slab_lo[0] = w.slab_lo[k];
+      out.slab_hi[0] = w.slab_hi[k];
+      out.node[0] = node;
+      return out;
+    }
+    if (model.nodes[w.node[k]].count <= count) break;  // node lies between w's root and its slots
+    holder = w.node[k];
+  }
+  // Not a slot (the root, or a node inside a wide node's slots): on a grid of its own.
+  CALIBER_ASSERT(false, "a node of the wide CD tree is a slot of a wide node");
   WideNode out;
+  const FloatBox box = float_box(model.nodes[node]);
+  set_grid(&box, 1, out);
   for (int k = 0; k < WideNode::kSlots; ++k) clear_slot(k, out);
-  fill_wide_slot(model, node, 0, out);
+  fill_slot(model, node, box, 0, out);
   return out;
 }
 
@@ -107,9 +190,12 @@ void build_wide_tree(ModelData& model) {
     const int n = collapse(model, root, slots);
     model.wide_of[root] = static_cast<std::uint32_t>(model.wide.size());
     WideNode& w = model.wide.emplace_back();
+    FloatBox boxes[WideNode::kSlots];
+    for (int k = 0; k < n; ++k) boxes[k] = float_box(model.nodes[slots[k]]);
+    set_grid(boxes, n, w);
     for (int k = 0; k < WideNode::kSlots; ++k) {
       if (k < n) {
-        fill_wide_slot(model, slots[k], k, w);
+        fill_slot(model, slots[k], boxes[k], k, w);
       } else {
         clear_slot(k, w);
       }

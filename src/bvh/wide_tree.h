@@ -12,12 +12,10 @@ namespace caliber::bvh {
 /// Builds model.wide and model.wide_of from model.nodes and model.filters (the BVH already built).
 void build_wide_tree(ModelData& model);
 
-/// Writes BVH node `node` of `model` into slot k of `out` as build_wide_tree does: its box rounded
-/// outward, its slab.
-void fill_wide_slot(const ModelData& model, std::uint32_t node, int k, WideNode& out);
-
-/// A wide node whose one slot is BVH node `node` (the others empty): what a node's own test reads
-/// where no visit of its parent tested it (narrow::RootTest).
+/// A wide node whose one slot is BVH node `node` as the wide node that holds it as a slot has it
+/// (its grid, its bounds; the others empty): what a node's own test reads where no visit of its
+/// parent tested it (narrow::RootTest). `node` is a slot of some wide node (a node of the wide CD
+/// tree, not the root).
 [[nodiscard]] WideNode single_slot(const ModelData& model, std::uint32_t node);
 
 }  // namespace caliber::bvh

@@ -86,7 +86,7 @@ namespace {
 /// Stage 1 on slot k: the slot's float box against the staying box's float bounds.
 bool boxes_overlap(const WideNode& w, int k, const float lo[3], const float hi[3]) {
   bool pass = true;
-  for (int i = 0; i < 3; ++i) pass = pass && w.lo[i][k] <= hi[i] && w.hi[i][k] >= lo[i];
+  for (int i = 0; i < 3; ++i) pass = pass && w.low(i, k) <= hi[i] && w.high(i, k) >= lo[i];
   return pass;
 }
 
@@ -94,8 +94,8 @@ bool boxes_overlap(const WideNode& w, int k, const float lo[3], const float hi[3
 bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k, const StayingFloats& st) {
   float cc[3], hh[3];
   for (int i = 0; i < 3; ++i) {
-    cc[i] = (w.lo[i][k] + w.hi[i][k]) * l.half_unit;
-    hh[i] = (w.hi[i][k] - w.lo[i][k]) * l.half_unit;
+    cc[i] = (w.low(i, k) + w.high(i, k)) * l.half_unit;
+    hh[i] = (w.high(i, k) - w.low(i, k)) * l.half_unit;
   }
   bool pass = true;
   for (int i = 0; i < 3; ++i) {  // the staying node's axes
@@ -153,7 +153,8 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
     if (cache != nullptr) cache->mark(stay, a_descends);
   }
   unsigned pass = 0;
-  for (int k = 0; k < WideNode::kSlots; ++k) {
+  const int count = w.count();
+  for (int k = 0; k < count; ++k) {
     if (boxes_overlap(w, k, kept.lo, kept.hi)) pass |= 1u << k;
   }
   if (pass == 0 || !l.floats) return pass;

@@ -6,9 +6,9 @@
 ///
 /// 1. The boxes, exactly: the staying node's box moved into the other model's frame in double
 ///    (center M c + t, half-extents |M| h + reach: PairContext's box test's quantities), grown by a
-///    share of its magnitude that covers the conversion, and rounded to float; each slot's float
-///    box (rounded outward) overlaps it or the pair is refused. No slack: every float lies outside
-///    the double box it stands for.
+///    share of its magnitude that covers the conversion, and rounded to float; each slot's box
+///    (its grid bounds, floats computed exactly: WideNode) overlaps it or the pair is refused, as
+///    are the empty slots. No slack: every float lies outside the double box it stands for.
 /// 2. Then, in float, against each threshold plus a slack far above float's rounding (as the float
 ///    four-pair test: 2^-15 of the scale): each slot's box along the staying node's own axes; each
 ///    slot's slab against the staying box; the staying node's slab against each slot, projected

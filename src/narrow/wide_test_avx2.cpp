@@ -33,6 +33,10 @@ CALIBER_AVX2 inline D times(const double col[3][4], const double x[3], D w) {
   return fmad(_mm256_load_pd(col[2]), _mm256_set1_pd(x[2]),
               fmad(_mm256_load_pd(col[1]), _mm256_set1_pd(x[1]), fmad(_mm256_load_pd(col[0]), _mm256_set1_pd(x[0]), w)));
 }
+/// Eight 16-bit grid steps (16-byte aligned), as floats.
+CALIBER_AVX2 inline V steps(const std::int16_t* q) {
+  return _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(q))));
+}
 /// m[2][i] x2 + (m[1][i] x1 + (m[0][i] x0 + w)), lane by lane, each step rounded once.
 CALIBER_AVX2 inline V project(const float m[3][3][8], int i, V x0, V x1, V x2, V w) {
   return fma(load(m[2][i]), x2, fma(load(m[1][i]), x1, fma(load(m[0][i]), x0, w)));
@@ -99,17 +103,20 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
     StayingCache::fill(kept, moved, lo, hi);
     if (cache != nullptr) cache->mark(stay, a_descends);
   }
+  // The slots' bounds from the grid (exact: origin + q step is a float), the empty slots refused.
   V cl[3], ch[3];
-  V pass = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  const V step = all(w.step);
+  const __m256i ids = _mm256_load_si256(reinterpret_cast<const __m256i*>(w.node));
+  V pass = _mm256_castsi256_ps(_mm256_xor_si256(_mm256_cmpeq_epi32(ids, _mm256_set1_epi32(-1)), _mm256_set1_epi32(-1)));
   for (int i = 0; i < 3; ++i) {
-    cl[i] = load(w.lo[i]);
-    ch[i] = load(w.hi[i]);
+    cl[i] = fma(steps(w.lo[i]), step, all(w.origin[i]));
+    ch[i] = fma(steps(w.hi[i]), step, all(w.origin[i]));
     pass = both(pass, both(at_most(cl[i], all(kept.hi[i])), at_least(ch[i], all(kept.lo[i]))));
   }
   const auto bits = static_cast<unsigned>(_mm256_movemask_ps(pass));
   if (bits == 0 || !l.floats) return bits;
-  // The lanes refused here (the empty slots' infinite bounds among them) as zero boxes: stage 2
-  // computes no infinity or NaN, so a host that traps invalid operations is not stopped.
+  // The lanes refused here (the empty slots among them) as zero boxes: stage 2 computes with
+  // the slots that passed only.
   for (int i = 0; i < 3; ++i) {
     cl[i] = both(cl[i], pass);
     ch[i] = both(ch[i], pass);

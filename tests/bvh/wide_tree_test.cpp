@@ -1,8 +1,9 @@
 // The wide tree (bvh/wide_tree.h): every wide node's slots are BVH nodes below it whose runs of
 // leaves split its own, in order; every leaf and every wide node is one slot (the root's is the
-// root); each slot's float box is the tightest float box around its BVH box; the nodes are well
-// filled.
+// root); each slot's box is the tightest on its node's grid around the tightest float box around
+// its BVH box, its bounds floats; the nodes are well filled.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -28,11 +29,17 @@ std::string wide_problem(const ModelData& m) {
     if (w == WideNode::kEmpty) continue;
     const WideNode& node = m.wide[w];
     const int count = node.count();
+    int exponent = 0;
+    if (std::frexp(node.step, &exponent) != 0.5f) return "the grid's step is not a power of two";
+    for (int a = 0; a < 3; ++a) {
+      if (std::fmod(double(node.origin[a]), double(node.step)) != 0.0) return "the grid's origin is not on it";
+    }
+    double box_lo[3] = {INFINITY, INFINITY, INFINITY}, box_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     // The slots' runs of leaves follow one another and cover the node's.
     std::uint32_t next = m.first_leaf(i);
     for (int k = 0; k < WideNode::kSlots; ++k) {
       if (k >= count) {
-        if (node.node[k] != WideNode::kEmpty || node.lo[0][k] <= node.hi[0][k]) return "a slot past the last is not empty";
+        if (node.node[k] != WideNode::kEmpty || node.low(0, k) <= node.high(0, k)) return "a slot past the last is not empty";
         continue;
       }
       const std::uint32_t s = node.node[k];
@@ -43,15 +50,30 @@ std::string wide_problem(const ModelData& m) {
       const BvhNode& b = m.nodes[s];
       for (int a = 0; a < 3; ++a) {
         const double lo = double(b.box_center[a]) - b.box_half[a], hi = double(b.box_center[a]) + b.box_half[a];
-        if (!(node.lo[a][k] <= lo && node.hi[a][k] >= hi)) return "a slot's box does not hold its node's";
-        if (std::nextafter(node.lo[a][k], INFINITY) <= lo || std::nextafter(node.hi[a][k], -INFINITY) >= hi) {
-          return "a slot's box is not the tightest float box";
-        }
+        // The bounds as the test reads them, exact (origin + q step in double equals it in float).
+        const double low = node.origin[a] + double(node.lo[a][k]) * node.step;
+        const double high = node.origin[a] + double(node.hi[a][k]) * node.step;
+        if (low != node.low(a, k) || high != node.high(a, k)) return "a slot's bound is not a float";
+        if (!(low <= lo && high >= hi)) return "a slot's box does not hold its node's";
+        // The grid's tightest outside the tightest float box.
+        const float below = float(lo) > lo ? std::nextafter(float(lo), -INFINITY) : float(lo);
+        const float above = float(hi) < hi ? std::nextafter(float(hi), INFINITY) : float(hi);
+        if (low + node.step <= below || high - node.step >= above) return "a slot's box is not the grid's tightest";
+        box_lo[a] = std::min(box_lo[a], double(below));
+        box_hi[a] = std::max(box_hi[a], double(above));
         if (node.axis[a][k] != m.filters[s].cone_axis[a]) return "a slot's slab axis is not its node's";
       }
       if (node.slab_lo[k] != m.filters[s].slab_lo || node.slab_hi[k] != m.filters[s].slab_hi) return "a slot's slab";
     }
     if (next != m.first_leaf(i) + m.nodes[i].count) return "the slots do not cover their node's leaves";
+    // The least step the grid's rules allow (wide_tree.cpp's set_grid).
+    double reach = 0.0, far = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      reach = std::max(reach, 0.5 * (box_hi[a] - box_lo[a]));
+      far = std::max({far, std::abs(box_lo[a]), std::abs(box_hi[a])});
+    }
+    const double least = std::max({reach / 32000.0, far * 0x1p-23, 0x1p-126});
+    if (!(node.step >= least && node.step < 2.0 * least)) return "the grid's step is not the least its rules allow";
   }
   // Every leaf is one slot; a node between a wide node and its slots is neither root nor slot.
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
@@ -70,16 +92,20 @@ TEST(WideTree, SlotsSplitTheirNodesLeavesInOrder) {
     const auto t = slivers.triangles[i * 3];
     slivers.triangles.push_back({t[0], t[1], t[0]});
   }
+  // A box so small that the grids' least step (2^-126) sets the steps of its upper nodes.
+  Mesh tiny = make_box(1.0, 0.5, 0.25, 4);
+  for (Eigen::Vector3d& v : tiny.vertices) v *= std::ldexp(1.0, -112);
   for (const Mesh& mesh : {make_torus(1.0, 0.35, 48, 24), make_sphere(0.5, 9, 11), make_box(1.0, 0.5, 0.25, 4),
-                           make_plate(2.0, 0.01, 16), far, slivers}) {
+                           make_plate(2.0, 0.01, 16), far, slivers, tiny}) {
     const auto model = build_model(mesh);
     EXPECT_EQ(wide_problem(data(*model)), "") << mesh.source;
     EXPECT_FALSE(data(*model).wide.empty());
   }
+  EXPECT_EQ(data(*build_model(tiny)).wide[0].step, 0x1p-126f) << "the least step sets the root's grid";
 }
 
-// A wide node starts a cache line and a node's filter lies in one: a visit reads six lines of the
-// one and one of the other, not seven and two.
+// A wide node starts a cache line and a node's filter lies in one: a visit reads five lines of the
+// one and one of the other, not six and two.
 TEST(WideTree, NodesLieOnCacheLines) {
   for (const Mesh& mesh : {make_torus(1.0, 0.35, 48, 24), make_sphere(0.5, 9, 11)}) {
     const auto model = build_model(mesh);
@@ -114,22 +140,33 @@ TEST(WideTree, NodesAreWellFilled) {
   }
 }
 
+// Every slot, at every depth, alone as the wide node that holds it has it: its grid and bounds.
 TEST(WideTree, OneSlotAsItsParentHasIt) {
-  const auto model = build_model(make_torus(1.0, 0.35, 20, 12));
-  const ModelData& m = data(*model);
-  const WideNode& root = m.wide[0];
-  for (int k = 0; k < root.count(); ++k) {
-    const WideNode one = bvh::single_slot(m, root.node[k]);
-    EXPECT_EQ(one.count(), 1);
-    EXPECT_EQ(one.node[0], root.node[k]);
-    for (int a = 0; a < 3; ++a) {
-      EXPECT_EQ(one.lo[a][0], root.lo[a][k]);
-      EXPECT_EQ(one.hi[a][0], root.hi[a][k]);
-      EXPECT_EQ(one.axis[a][0], root.axis[a][k]);
-      for (int j = 1; j < WideNode::kSlots; ++j) EXPECT_GT(one.lo[a][j], one.hi[a][j]) << "the other slots are empty";
+  Mesh far = make_torus(1.0, 0.35, 20, 12);
+  for (Eigen::Vector3d& v : far.vertices) v += Eigen::Vector3d(3e6, -2e6, 1e6);
+  for (const Mesh& mesh : {make_torus(1.0, 0.35, 20, 12), far}) {
+    const auto model = build_model(mesh);
+    const ModelData& m = data(*model);
+    std::size_t checked = 0;
+    for (const WideNode& w : m.wide) {
+      for (int k = 0; k < w.count(); ++k) {
+        const WideNode one = bvh::single_slot(m, w.node[k]);
+        ++checked;
+        EXPECT_EQ(one.count(), 1);
+        EXPECT_EQ(one.node[0], w.node[k]);
+        EXPECT_EQ(one.step, w.step);
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_EQ(one.origin[a], w.origin[a]);
+          EXPECT_EQ(one.low(a, 0), w.low(a, k));
+          EXPECT_EQ(one.high(a, 0), w.high(a, k));
+          EXPECT_EQ(one.axis[a][0], w.axis[a][k]);
+          for (int j = 1; j < WideNode::kSlots; ++j) EXPECT_GT(one.low(a, j), one.high(a, j)) << "the other slots are empty";
+        }
+        EXPECT_EQ(one.slab_lo[0], w.slab_lo[k]);
+        EXPECT_EQ(one.slab_hi[0], w.slab_hi[k]);
+      }
     }
-    EXPECT_EQ(one.slab_lo[0], root.slab_lo[k]);
-    EXPECT_EQ(one.slab_hi[0], root.slab_hi[k]);
+    EXPECT_EQ(checked, m.mesh.triangles.size() + m.wide.size() - 1) << "every slot of every wide node";
   }
 }
 
