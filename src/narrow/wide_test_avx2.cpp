@@ -115,13 +115,8 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   }
   const auto bits = static_cast<unsigned>(_mm256_movemask_ps(pass));
   if (bits == 0 || !l.floats) return bits;
-  // The lanes refused here (the empty slots among them) as zero boxes: stage 2 computes with
-  // the slots that passed only.
-  for (int i = 0; i < 3; ++i) {
-    cl[i] = both(cl[i], pass);
-    ch[i] = both(ch[i], pass);
-  }
-  // Stage 2, on the lanes' slots.
+  // Stage 2 on every lane (each bound is finite, the empty slots' too); only the lanes stage 1
+  // passed are kept.
   make_staying_floats(f, l, a_descends, stay, kept);
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
