@@ -265,6 +265,28 @@ static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 ==
               offsetof(WideNode, slab_lo) % 32 == 0 && offsetof(WideNode, slab_hi) % 32 == 0 &&
               offsetof(WideNode, node) % 32 == 0);
 
+/// What a visit of the wide CD tree reads of a BVH node (narrow/visit.h): its box and sphere radius
+/// (its BvhNode's, the same floats) and where the visit goes from it (`link`): its wide node, or
+/// its triangle for a leaf. 32 bytes aligned to 32, two to a cache line and never across two, so
+/// that a visit reads one line of each side (a BvhNode spans two in half the cases).
+struct alignas(32) VisitNode {
+  /// `link`'s bit of a leaf.
+  static constexpr std::uint32_t kLeaf = 0x80000000u;
+  /// `link` of an internal node that is no wide node's root (it lies inside another's slots).
+  static constexpr std::uint32_t kNoWide = 0x7FFFFFFFu;
+  float box_center[3];
+  float box_half[3];
+  float radius;
+  /// kLeaf | the triangle id for a leaf; else the index of its wide node in ModelData::wide, or
+  /// kNoWide.
+  std::uint32_t link;
+
+  [[nodiscard]] bool is_leaf() const { return (link & kLeaf) != 0; }
+  [[nodiscard]] std::uint32_t triangle() const { return link & ~kLeaf; }
+  [[nodiscard]] bool has_wide() const { return link < kNoWide; }
+};
+static_assert(sizeof(VisitNode) == 32);
+
 /// What a Model holds: the mesh with its BVH, normals and adjacency, laid out for the traversal.
 /// Made by build_model; never modified afterwards.
 struct ModelData : Model {
@@ -296,10 +318,10 @@ struct ModelData : Model {
     const std::uint32_t p = leaf_position[triangle];
     return p >= first && p < first + nodes[node].count;
   }
-  /// The wide tree (WideNode), its root's first; and per BVH node, its wide node, or
-  /// WideNode::kEmpty for a leaf and for a node inside another's slots.
+  /// The wide tree (WideNode), its root's first; and per BVH node, what a visit reads of it
+  /// (VisitNode: its box, radius and wide node or triangle).
   std::vector<WideNode> wide;
-  std::vector<std::uint32_t> wide_of;
+  std::vector<VisitNode> visit_nodes;
   /// Where the run of leaves of `node` starts: the place of its first leaf (its first children's).
   [[nodiscard]] std::uint32_t first_leaf(std::uint32_t node) const {
     while (!nodes[node].is_leaf()) node = nodes[node].index;

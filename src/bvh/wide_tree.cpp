@@ -146,8 +146,8 @@ WideNode single_slot(const ModelData& model, std::uint32_t node) {
   // leaves holds node's first leaf is node, or holds node below it.
   const std::uint32_t place = model.first_leaf(node), count = model.nodes[node].count;
   std::uint32_t holder = 0, first = 0;  // the BVH node whose wide node is searched, its first leaf's place
-  while (node != holder && model.wide_of[holder] != WideNode::kEmpty) {
-    const WideNode& w = model.wide[model.wide_of[holder]];
+  while (node != holder && model.visit_nodes[holder].has_wide()) {
+    const WideNode& w = model.wide[model.visit_nodes[holder].link];
     int k = 0;
     while (place >= first + model.nodes[w.node[k]].count) first += model.nodes[w.node[k++]].count;
     if (w.node[k] == node) {
@@ -178,7 +178,17 @@ WideNode single_slot(const ModelData& model, std::uint32_t node) {
 
 void build_wide_tree(ModelData& model) {
   model.wide.clear();
-  model.wide_of.assign(model.nodes.size(), WideNode::kEmpty);
+  model.visit_nodes.resize(model.nodes.size());
+  for (std::size_t i = 0; i < model.nodes.size(); ++i) {
+    const BvhNode& n = model.nodes[i];
+    VisitNode& v = model.visit_nodes[i];
+    for (int k = 0; k < 3; ++k) {
+      v.box_center[k] = n.box_center[k];
+      v.box_half[k] = n.box_half[k];
+    }
+    v.radius = n.radius;
+    v.link = n.is_leaf() ? VisitNode::kLeaf | n.index : VisitNode::kNoWide;
+  }
   if (model.nodes.empty() || model.nodes[0].is_leaf()) return;
   // Depth first, an explicit stack (a BVH may be deep): each wide node is made when its BVH node
   // is popped, so a node's slots come after it.
@@ -188,7 +198,7 @@ void build_wide_tree(ModelData& model) {
     stack.pop_back();
     std::uint32_t slots[WideNode::kSlots];
     const int n = collapse(model, root, slots);
-    model.wide_of[root] = static_cast<std::uint32_t>(model.wide.size());
+    model.visit_nodes[root].link = static_cast<std::uint32_t>(model.wide.size());
     WideNode& w = model.wide.emplace_back();
     FloatBox boxes[WideNode::kSlots];
     for (int k = 0; k < n; ++k) boxes[k] = float_box(model.nodes[slots[k]]);

@@ -77,26 +77,31 @@ inline bool wide_cd_tree(const PairContext& ctx) { return ctx.request().kind != 
 /// In the wide CD tree, whether node (a, b), not a pair of leaves, descends on A's side: A's node
 /// is not a leaf, and B's is one or its sphere is no larger than A's. Depends only on object-space
 /// radii, so the CD tree's shape does not depend on the poses.
-inline bool wide_descends_a(const BvhNode& a, const BvhNode& b) { return !a.is_leaf() && (b.is_leaf() || a.radius >= b.radius); }
+inline bool wide_descends_a(const VisitNode& a, const VisitNode& b) {
+  return !a.is_leaf() && (b.is_leaf() || a.radius >= b.radius);
+}
 
 /// A visit of the wide CD tree's node n (not a pair of leaves): the side that descends
-/// (wide_descends_a), its wide node and the node that stays; child k is slot k with that node.
+/// (wide_descends_a), its wide node and the node that stays (its id and VisitNode); child k is
+/// slot k with that node.
 struct WideVisit {
   const WideNode* node;
   std::uint32_t stay;
   bool a_descends;
+  const VisitNode* staying;
 
   [[nodiscard]] NodePair child(int k, NodePair n) const {
     return a_descends ? NodePair{node->node[k], n.b} : NodePair{n.a, node->node[k]};
   }
 };
 
-/// The wide visit of node n, whose BVH nodes are a (of A) and b (of B).
-inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
+/// The wide visit of node n, whose visit nodes are a (of A) and b (of B).
+inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b) {
   CALIBER_ASSERT(!(a.is_leaf() && b.is_leaf()), "a pair of leaves has no children");
   const bool down_a = wide_descends_a(a, b);
-  const ModelData& m = down_a ? ctx.a() : ctx.b();
-  return WideVisit{&m.wide[m.wide_of[down_a ? n.a : n.b]], down_a ? n.b : n.a, down_a};
+  const std::uint32_t link = down_a ? a.link : b.link;
+  CALIBER_ASSERT(link < VisitNode::kNoWide, "a node of the wide CD tree that descends has a wide node");
+  return WideVisit{&(down_a ? ctx.a() : ctx.b()).wide[link], down_a ? n.b : n.a, down_a, down_a ? &b : &a};
 }
 
 /// The children of CD-tree node n of pair context ctx (not a pair of leaves), written to out;
@@ -104,14 +109,14 @@ inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a
 /// each with the node that stays (WideVisit). The binary tree's: A's child i (or n.a) with B's
 /// child j (or n.b), i major.
 inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChildren]) {
-  const BvhNode& a = ctx.a().nodes[n.a];
-  const BvhNode& b = ctx.b().nodes[n.b];
   if (wide_cd_tree(ctx)) {
-    const WideVisit v = wide_visit(ctx, n, a, b);
+    const WideVisit v = wide_visit(ctx, n, ctx.a().visit_nodes[n.a], ctx.b().visit_nodes[n.b]);
     const int count = v.node->count();
     for (int k = 0; k < count; ++k) out[k] = v.child(k, n);
     return count;
   }
+  const BvhNode& a = ctx.a().nodes[n.a];
+  const BvhNode& b = ctx.b().nodes[n.b];
   bool descend_a, descend_b;
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
   int count = 0;
@@ -138,7 +143,7 @@ inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v
                           detail::StayingCache* cache = nullptr) {
   // (Null also before the library's constants are made: a query from another constant's constructor.)
   const detail::WideTest test = kWideTest != nullptr ? kWideTest : detail::wide_test_scalar;
-  unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, cache);
+  unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);

@@ -38,7 +38,7 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
 /// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
 /// reversed), every child counted but those on the taboo list (skipped and marked reached).
 template <bool kReversed>
-[[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
+[[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
                                              const detail::WideLanes& lanes, detail::StayingCache* staying) {
   const WideVisit v = wide_visit(ctx, n, a, b);
@@ -66,8 +66,8 @@ template <bool kReversed>
 
 /// visit_wide for a visit without the traversal's lanes: made here.
 template <bool kReversed>
-[[gnu::noinline]] int visit_wide_alone(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b, QueryStats& stats,
-                                       NodePair passed[], TabooView taboo) {
+[[gnu::noinline]] int visit_wide_alone(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b,
+                                       QueryStats& stats, NodePair passed[], TabooView taboo) {
   const detail::WideLanes made = wide_lanes(ctx);
   return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, made, nullptr);
 }
@@ -133,21 +133,27 @@ template <bool kReversed = false>
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
                                         NodePair passed[kMaxChildren], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
                                         VisitLanes lanes = {}) {
-  const BvhNode& a = ctx.a().nodes[n.a];
-  const BvhNode& b = ctx.b().nodes[n.b];
-  if (a.is_leaf() && b.is_leaf()) {
+  const auto leaf_pair = [&](std::uint32_t ta, std::uint32_t tb) {
     ++stats.leaf_tests;
     if (buffer != nullptr) {
-      ctx.leaf_test(a.index, b.index, out, *buffer);
+      ctx.leaf_test(ta, tb, out, *buffer);
     } else {
-      ctx.leaf_test(a.index, b.index, out);
+      ctx.leaf_test(ta, tb, out);
     }
     return -1;
-  }
+  };
   if (wide_cd_tree(ctx)) {
+    // One line of each side (VisitNode): the leaves' triangles, the radii, the wide node, the
+    // staying box.
+    const VisitNode& a = ctx.a().visit_nodes[n.a];
+    const VisitNode& b = ctx.b().visit_nodes[n.b];
+    if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
     return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying);
   }
+  const BvhNode& a = ctx.a().nodes[n.a];
+  const BvhNode& b = ctx.b().nodes[n.b];
+  if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.index, b.index);
   return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
 }
 

@@ -130,14 +130,14 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
 
 }  // namespace
 
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
-                          StayingCache* cache) {
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const VisitNode& sn,
+                          const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
   bool held;
   StayingCache::Entry spare;
   StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
   if (!held) {
-    const StayingBox box = staying_box(f, a_descends, stay);
+    const StayingBox box = staying_box(sn);
     const double *cd = box.c, *hd = box.h;
     double c[3];
     float lo[3], hi[3];
@@ -158,7 +158,7 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
     if (boxes_overlap(w, k, kept.lo, kept.hi)) pass |= 1u << k;
   }
   if (pass == 0 || !l.floats) return pass;
-  make_staying_floats(f, l, a_descends, stay, kept);
+  make_staying_floats(f, l, a_descends, stay, sn, kept);
   for (int k = 0; k < WideNode::kSlots; ++k) {
     if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, kept.floats)) pass &= ~(1u << k);
   }

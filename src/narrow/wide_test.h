@@ -126,7 +126,7 @@ struct StayingCache {
 };
 
 /// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
-inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const BvhNode& sn, const BvhNodeFilter& sf,
+inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const VisitNode& sn, const BvhNodeFilter& sf,
                                     const double c[3]) {
   StayingFloats out;
   double nd[3];
@@ -144,12 +144,11 @@ inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const
   return out;
 }
 
-/// The box of node `stay` of the side that stays (B's where A descends), in double: center, half-extents.
+/// The box of the node that stays, sn, in double: center, half-extents.
 struct StayingBox {
   double c[3], h[3];
 };
-inline StayingBox staying_box(const NodeTestFrame& f, bool a_descends, std::uint32_t stay) {
-  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
+inline StayingBox staying_box(const VisitNode& sn) {
   return StayingBox{{sn.box_center[0], sn.box_center[1], sn.box_center[2]}, {sn.box_half[0], sn.box_half[1], sn.box_half[2]}};
 }
 
@@ -161,11 +160,10 @@ inline StayingCache::Entry& staying_entry(StayingCache* cache, StayingCache::Ent
   return cache != nullptr ? cache->find(stay, a_descends, held) : spare;
 }
 
-/// Makes entry `kept`'s float values (stage 2's) for node `stay`, unless made already.
+/// Makes entry `kept`'s float values (stage 2's) for node `stay` (sn), unless made already.
 inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                StayingCache::Entry& kept) {
+                                const VisitNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
-  const BvhNode& sn = a_descends ? f.nodes_b[stay] : f.nodes_a[stay];
   const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
   kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, sf, kept.moved);
   kept.has_floats = true;
@@ -176,15 +174,15 @@ inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool
 WideLanes make_wide_lanes(const NodeTestFrame& f, double scale);
 
 /// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
-/// node `stay` stays) against the descending node's wide node w: bit k set where slot k passes
-/// (slots past the last never do). The staying node is read from `cache` where it holds it, else
-/// moved and kept there (null: moved for this test alone).
-using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
-                              StayingCache* cache);
+/// node `stay` stays; sn: its VisitNode) against the descending node's wide node w: bit k set where
+/// slot k passes (slots past the last never do). The staying node is read from `cache` where it
+/// holds it, else moved and kept there (null: moved for this test alone).
+using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
+                              const VisitNode& sn, const WideNode& w, StayingCache* cache);
 
 /// The scalar form.
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const WideNode& w,
-                          StayingCache* cache);
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const VisitNode& sn,
+                          const WideNode& w, StayingCache* cache);
 
 /// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
 WideTest wide_test_avx2_if_supported();

@@ -83,14 +83,14 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
 }
 
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                     const WideNode& w, StayingCache* cache) {
+                                     const VisitNode& sn, const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
   bool held;
   StayingCache::Entry spare;
   StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
   if (!held) {
     // Stage 1's box: the staying box in the descending frame, in double lanes (x, y, z, 0).
-    const StayingBox box = staying_box(f, a_descends, stay);
+    const StayingBox box = staying_box(sn);
     const D c = times(s.col, box.c, _mm256_load_pd(s.t));
     const D e = times(s.abs_col, box.h, _mm256_set1_pd(l.reach));
     const D magnitude_c = _mm256_andnot_pd(_mm256_set1_pd(-0.0), c);
@@ -117,7 +117,7 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   if (bits == 0 || !l.floats) return bits;
   // Stage 2 on every lane (each bound is finite, the empty slots' too); only the lanes stage 1
   // passed are kept.
-  make_staying_floats(f, l, a_descends, stay, kept);
+  make_staying_floats(f, l, a_descends, stay, sn, kept);
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 

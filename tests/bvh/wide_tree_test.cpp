@@ -20,13 +20,21 @@ namespace {
 
 /// The first broken property of m's wide tree, in words (empty when none).
 std::string wide_problem(const ModelData& m) {
-  if (m.wide_of.size() != m.nodes.size()) return "wide_of is not one a node";
+  if (m.visit_nodes.size() != m.nodes.size()) return "visit_nodes is not one a node";
   std::vector<int> seen(m.nodes.size(), 0);
   seen[0] = 1;
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
-    const std::uint32_t w = m.wide_of[i];
-    if (m.nodes[i].is_leaf() && w != WideNode::kEmpty) return "a leaf has a wide node";
-    if (w == WideNode::kEmpty) continue;
+    // A visit reads the node's own box and radius, and its triangle or wide node.
+    const BvhNode& n = m.nodes[i];
+    const VisitNode& v = m.visit_nodes[i];
+    for (int a = 0; a < 3; ++a) {
+      if (v.box_center[a] != n.box_center[a] || v.box_half[a] != n.box_half[a]) return "a visit node's box is not its node's";
+    }
+    if (v.radius != n.radius) return "a visit node's radius is not its node's";
+    if (v.is_leaf() != n.is_leaf() || (n.is_leaf() && v.triangle() != n.index)) return "a visit node's leaf or triangle";
+    if (n.is_leaf() || !v.has_wide()) continue;
+    const std::uint32_t w = v.link;
+    if (w >= m.wide.size()) return "a visit node's wide node is out of range";
     const WideNode& node = m.wide[w];
     const int count = node.count();
     int exponent = 0;
@@ -46,7 +54,7 @@ std::string wide_problem(const ModelData& m) {
       if (s >= m.nodes.size() || seen[s]++ != 0) return "slot " + std::to_string(s) + " is bad or seen twice";
       if (m.first_leaf(s) != next) return "the slots' runs of leaves do not follow one another";
       next += m.nodes[s].count;
-      if (m.nodes[s].is_leaf() != (m.wide_of[s] == WideNode::kEmpty)) return "an inner slot without a wide node";
+      if (!m.nodes[s].is_leaf() && !m.visit_nodes[s].has_wide()) return "an inner slot without a wide node";
       const BvhNode& b = m.nodes[s];
       for (int a = 0; a < 3; ++a) {
         const double lo = double(b.box_center[a]) - b.box_half[a], hi = double(b.box_center[a]) + b.box_half[a];
@@ -78,8 +86,7 @@ std::string wide_problem(const ModelData& m) {
   // Every leaf is one slot; a node between a wide node and its slots is neither root nor slot.
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
     if (m.nodes[i].is_leaf() && seen[i] != 1) return "leaf " + std::to_string(i) + " is not one slot";
-    if (m.wide_of[i] != WideNode::kEmpty && seen[i] != 1)
-      return "wide node " + std::to_string(i) + " is not the root or one slot";
+    if (m.visit_nodes[i].has_wide() && seen[i] != 1) return "wide node " + std::to_string(i) + " is not the root or one slot";
   }
   return {};
 }
@@ -124,7 +131,9 @@ TEST(WideTree, ARootLeafHasNoWideNode) {
   one.triangles = {{0, 1, 2}};
   const auto model = build_model(one);
   EXPECT_TRUE(data(*model).wide.empty());
-  EXPECT_EQ(data(*model).wide_of, std::vector<std::uint32_t>{WideNode::kEmpty});
+  ASSERT_EQ(data(*model).visit_nodes.size(), 1u);
+  EXPECT_TRUE(data(*model).visit_nodes[0].is_leaf());
+  EXPECT_EQ(data(*model).visit_nodes[0].triangle(), 0u);
 }
 
 // Subtrees that fit are opened to their leaves: the nodes hold more than half their slots on

@@ -46,11 +46,12 @@ void walk(const PairContext& ctx, const detail::WideLanes& lanes, std::size_t mo
   std::vector<NodePair> work{{0, 0}};
   for (std::size_t w = 0; w < work.size() && w < most; ++w) {
     const NodePair n = work[w];
-    const BvhNode& a = ctx.a().nodes[n.a];
-    const BvhNode& b = ctx.b().nodes[n.b];
+    const VisitNode& a = ctx.a().visit_nodes[n.a];
+    const VisitNode& b = ctx.b().visit_nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) continue;
     const WideVisit v = wide_visit(ctx, n, a, b);
-    const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr);
+    const unsigned pass =
+        detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, nullptr);
     visit(n, v, pass);
     for (int k = 0; k < v.node->count(); ++k) {
       if ((pass >> k & 1u) != 0) work.push_back(v.child(k, n));
@@ -95,9 +96,9 @@ TEST(WideTest, ScalarAndAvx2FormsDecideAlike) {
       boxes_only.floats = false;
       walk(ctx, lanes, 20000, [&](NodePair, const WideVisit& v, unsigned pass) {
         ++visits;
-        if (avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr) != pass) ++differing;
+        if (avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, nullptr) != pass) ++differing;
         const unsigned boxes =
-            detail::wide_test_scalar(ctx.node_test_frame(), boxes_only, v.a_descends, v.stay, *v.node, nullptr);
+            detail::wide_test_scalar(ctx.node_test_frame(), boxes_only, v.a_descends, v.stay, *v.staying, *v.node, nullptr);
         EXPECT_EQ(pass & ~boxes, 0u) << "the float stage only refuses";
         by_floats += __builtin_popcount(boxes & ~pass);
       });
@@ -137,8 +138,8 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
     while (!stack.empty() && visits < 20000) {
       const NodePair n = stack.back();
       stack.pop_back();
-      const BvhNode& na = ctx.a().nodes[n.a];
-      const BvhNode& nb = ctx.b().nodes[n.b];
+      const VisitNode& na = ctx.a().visit_nodes[n.a];
+      const VisitNode& nb = ctx.b().visit_nodes[n.b];
       if (na.is_leaf() && nb.is_leaf()) continue;
       const WideVisit v = wide_visit(ctx, n, na, nb);
       ++visits;
@@ -146,11 +147,13 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
       const detail::StayingCache::Entry& e = scalar_cache.find(v.stay, v.a_descends, held);
       kept[v.a_descends ? 0 : 1] += held ? 1 : 0;
       floats_kept += held && e.has_floats ? 1 : 0;
-      const unsigned pass = detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, nullptr);
-      if (detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, &scalar_cache) != pass) {
+      const unsigned pass =
+          detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, nullptr);
+      if (detail::wide_test_scalar(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, &scalar_cache) !=
+          pass) {
         ++differing;
       }
-      if (avx2 != nullptr && avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.node, &avx2_cache) != pass) {
+      if (avx2 != nullptr && avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, &avx2_cache) != pass) {
         ++differing;
       }
       for (int k = v.node->count() - 1; k >= 0; --k) {
