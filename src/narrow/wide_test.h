@@ -77,11 +77,11 @@ struct StayingCache {
   static constexpr int kEntries = 64;
   /// One staying node moved.
   struct Entry {
-    alignas(16) float lo[4];  ///< stage 1's box, its low corner (lanes x, y, z; the fourth unused)
-    alignas(16) float hi[4];  ///< its high corner
-    double moved[3];          ///< its box center in the descending frame
-    bool has_floats;          ///< `floats` made (stage 2 ran on it)
-    StayingFloats floats;     ///< what stage 2 reads of it
+    alignas(16) float lo[4];      ///< stage 1's box, its low corner (lanes x, y, z; the fourth unused)
+    alignas(16) float hi[4];      ///< its high corner
+    alignas(32) double moved[4];  ///< its box center in the descending frame (lanes x, y, z; the fourth 0)
+    bool has_floats;              ///< `floats` made (stage 2 ran on it)
+    StayingFloats floats;         ///< what stage 2 reads of it
   };
   /// When the generation reaches this, the keys are cleared and it starts again at 1.
   static constexpr std::uint64_t kGenerations = std::uint64_t{1} << 29;
@@ -122,6 +122,7 @@ struct StayingCache {
       e.hi[i] = hi[i];
     }
     e.lo[3] = e.hi[3] = 0.0f;
+    e.moved[3] = 0.0;
   }
 };
 

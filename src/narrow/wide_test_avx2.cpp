@@ -82,6 +82,34 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
   return pass;
 }
 
+/// make_staying_floats (staying_floats) in double lanes (x, y, z, 0), each lane making its
+/// operations in its order; the offset and slab bounds as it computes them.
+CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const WideLanes& l, const WideSide& s, bool a_descends,
+                                                  std::uint32_t stay, const VisitNode& sn, StayingCache::Entry& kept) {
+  if (kept.has_floats) return;
+  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  const D unit = _mm256_set1_pd(l.unit);
+  const D nd = fmad(_mm256_load_pd(s.col[2]), _mm256_set1_pd(sf.cone_axis[2]),
+                    fmad(_mm256_load_pd(s.col[1]), _mm256_set1_pd(sf.cone_axis[1]),
+                         _mm256_mul_pd(_mm256_load_pd(s.col[0]), _mm256_set1_pd(sf.cone_axis[0]))));
+  // (Four floats from box_center and box_half: the fourth lane, box_half[0] and the radius, unused.)
+  const D center = _mm256_cvtps_pd(_mm_loadu_ps(sn.box_center)), half = _mm256_cvtps_pd(_mm_loadu_ps(sn.box_half));
+  const __m128 sh = _mm256_cvtpd_ps(_mm256_mul_pd(half, unit));
+  StayingFloats& out = kept.floats;
+  // Each four-lane store's fourth lane is overwritten by the next.
+  _mm_storeu_ps(out.co, _mm256_cvtpd_ps(_mm256_mul_pd(addd(center, _mm256_load_pd(s.mt_t)), unit)));
+  _mm_storeu_ps(out.ho, _mm_add_ps(sh, _mm_set1_ps(l.reach_f)));
+  _mm_storeu_ps(out.nf, _mm256_cvtpd_ps(nd));
+  alignas(32) double n[4];
+  _mm256_store_pd(n, nd);
+  out.off = static_cast<float>(-((n[0] * s.t[0] + n[1] * s.t[1]) + n[2] * s.t[2]) * l.unit);
+  _mm_storeu_ps(out.cf, _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_load_pd(kept.moved), unit)));
+  _mm_storeu_ps(out.sh, sh);
+  out.slab_lo = static_cast<float>(sf.slab_lo * l.unit) - l.slab_f;
+  out.slab_hi = static_cast<float>(sf.slab_hi * l.unit) + l.slab_f;
+  kept.has_floats = true;
+}
+
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                      const VisitNode& sn, const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
@@ -117,7 +145,7 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   if (bits == 0 || !l.floats) return bits;
   // Stage 2 on every lane (each bound is finite, the empty slots' too); only the lanes stage 1
   // passed are kept.
-  make_staying_floats(f, l, a_descends, stay, sn, kept);
+  make_staying_floats_avx2(f, l, s, a_descends, stay, sn, kept);
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 

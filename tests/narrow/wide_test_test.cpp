@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -119,7 +120,7 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
   const auto sphere = build_model(sphere_with_slivers(30));
   const auto far_torus = build_model(moved(make_torus(1.0, 0.35, 40, 24), 0, far));
   std::mt19937_64 rng(12);
-  long differing = 0;
+  long differing = 0, differing_kept = 0, compared_floats = 0;
   for (int c = 0; c < 6; ++c) {
     const bool far_case = c >= 4;
     const Model& a = far_case ? *far_torus : *torus;
@@ -156,6 +157,18 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
       if (avx2 != nullptr && avx2(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, &avx2_cache) != pass) {
         ++differing;
       }
+      if (avx2 != nullptr) {
+        // Both forms kept the same values of the node, bit for bit (the float stage's where made).
+        bool in_scalar = false, in_avx2 = false;
+        const detail::StayingCache::Entry& s = scalar_cache.find(v.stay, v.a_descends, in_scalar);
+        const detail::StayingCache::Entry& x = avx2_cache.find(v.stay, v.a_descends, in_avx2);
+        const bool same_box = std::memcmp(s.lo, x.lo, sizeof s.lo) == 0 && std::memcmp(s.hi, x.hi, sizeof s.hi) == 0 &&
+                              std::memcmp(s.moved, x.moved, sizeof s.moved) == 0;
+        const bool same_floats =
+            s.has_floats == x.has_floats && (!s.has_floats || std::memcmp(&s.floats, &x.floats, sizeof s.floats) == 0);
+        if (!in_scalar || !in_avx2 || !same_box || !same_floats) ++differing_kept;
+        compared_floats += s.has_floats ? 1 : 0;
+      }
       for (int k = v.node->count() - 1; k >= 0; --k) {
         if ((pass >> k & 1u) != 0) stack.push_back(v.child(k, n));
       }
@@ -166,6 +179,8 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
     if (lanes.floats) EXPECT_GT(floats_kept, visits / 10) << "case " << c << ": the float stage's values are kept too";
   }
   EXPECT_EQ(differing, 0);
+  EXPECT_EQ(differing_kept, 0);
+  if (avx2 != nullptr) EXPECT_GT(compared_floats, 1000);
 }
 
 TEST(WideTest, ARenewedCacheHoldsNothingKeptBefore) {
