@@ -272,7 +272,8 @@ static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 ==
 struct alignas(32) VisitNode {
   /// `link`'s bit of a leaf.
   static constexpr std::uint32_t kLeaf = 0x80000000u;
-  /// `link` of an internal node that is no wide node's root (it lies inside another's slots).
+  /// `link` of an internal node that is no wide node's root (collapsed away: it lies between a wide
+  /// node and that node's slots).
   static constexpr std::uint32_t kNoWide = 0x7FFFFFFFu;
   float box_center[3];
   float box_half[3];

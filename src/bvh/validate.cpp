@@ -75,6 +75,17 @@ std::string bvh_problem(const ModelData& m) {
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
   }
+  // What a wide visit reads of each node: its own box, radius and leaf (where the wide tree is built).
+  if (!m.visit_nodes.empty()) {
+    if (m.visit_nodes.size() != size) return "the visit nodes are not one a node";
+    for (std::size_t i = 0; i < size; ++i) {
+      const BvhNode& n = m.nodes[i];
+      const VisitNode& v = m.visit_nodes[i];
+      bool same = v.radius == n.radius && v.is_leaf() == n.is_leaf() && (!n.is_leaf() || v.triangle() == n.index);
+      for (int k = 0; k < 3; ++k) same = same && v.box_center[k] == n.box_center[k] && v.box_half[k] == n.box_half[k];
+      if (!same) return "node " + std::to_string(i) + ": its visit node is not a copy of it";
+    }
+  }
   return {};
 }
 

@@ -143,6 +143,7 @@ inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v
                           detail::StayingCache* cache = nullptr) {
   // (Null also before the library's constants are made: a query from another constant's constructor.)
   const detail::WideTest test = kWideTest != nullptr ? kWideTest : detail::wide_test_scalar;
+  CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).visit_nodes[v.stay], "the staying node is node stay");
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {

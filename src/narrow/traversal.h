@@ -49,7 +49,7 @@ struct TraversalScratch {
   util::GapBuckets<Reached> waiting;        ///< distance traversal: the nodes waiting, by gap
   PreparedTree<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
   PreparedTree<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
-  /// Wide traversals: the staying nodes moved, renewed by each (made by the first; 9.7 KB, kept
+  /// Wide traversals: the staying nodes moved, renewed by each (made by the first; 10.5 KB, kept
   /// off the thread's own storage).
   std::unique_ptr<detail::StayingCache> staying;
 

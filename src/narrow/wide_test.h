@@ -45,7 +45,7 @@ struct alignas(32) WideSide {
 /// scale is 1 to 2 units), so that its values are near 1 and scale with the models exactly: a pose
 /// and models scaled by a power of two get the same decisions, down to scales of about 2^-117,
 /// where floats' smallest steps (and the stage-1 floor, 2^-149) stop scaling. Made once per traversal
-/// (make_wide_lanes; 1,760 bytes: not kept in the pair context, which the engine holds for every
+/// (make_wide_lanes; 1,728 bytes: not kept in the pair context, which the engine holds for every
 /// pair).
 struct alignas(32) WideLanes {
   WideSide side[2];    ///< [0]: A descends; [1]: B descends

@@ -132,8 +132,15 @@ TEST(WideTree, ARootLeafHasNoWideNode) {
   const auto model = build_model(one);
   EXPECT_TRUE(data(*model).wide.empty());
   ASSERT_EQ(data(*model).visit_nodes.size(), 1u);
-  EXPECT_TRUE(data(*model).visit_nodes[0].is_leaf());
-  EXPECT_EQ(data(*model).visit_nodes[0].triangle(), 0u);
+  const VisitNode& v = data(*model).visit_nodes[0];
+  const BvhNode& n = data(*model).nodes[0];
+  EXPECT_TRUE(v.is_leaf());
+  EXPECT_EQ(v.triangle(), 0u);
+  EXPECT_EQ(v.radius, n.radius);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(v.box_center[k], n.box_center[k]);
+    EXPECT_EQ(v.box_half[k], n.box_half[k]);
+  }
 }
 
 // Subtrees that fit are opened to their leaves: the nodes hold more than half their slots on
