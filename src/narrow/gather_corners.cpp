@@ -1,5 +1,5 @@
 // PairContext::gather_corners: a leaf batch's corners read straight into its lanes, B's moved into
-// A's frame there.
+// A's frame there; the portable form, and the choice of form.
 
 #include "narrow/pair_context.h"
 
@@ -15,38 +15,32 @@
 namespace caliber::narrow {
 
 void PairContext::gather_corners(BufferedPairs& waiting) const {
-  const int n = waiting.batch.size;
-  if (n == 0) return;  // no ids to read (the lanes past n repeat lane 0's)
-  // The triangles' corner ids, then their corners, asked of memory for every pair before any is
-  // read: the misses overlap rather than follow one another.
-  for (int l = 0; l < n; ++l) {
-    __builtin_prefetch(&mA.mesh.triangles[waiting.ta[l]]);
-    __builtin_prefetch(&mB.mesh.triangles[waiting.tb[l]]);
-  }
-  for (int l = 0; l < n; ++l) {
-    for (int k = 0; k < 3; ++k) {
-      __builtin_prefetch(&mA.mesh.vertices[mA.mesh.triangles[waiting.ta[l]][k]]);
-      __builtin_prefetch(&mB.mesh.vertices[mB.mesh.triangles[waiting.tb[l]][k]]);
-    }
-  }
-  // The corners straight into the batch's lanes (the lanes past n as lane 0, as TriangleBatch::pad
-  // fills them), then B's moved into A's frame in all eight lanes, two at a time with SSE2, with
-  // b_vertex's formula (geometry::RigidMove): the same operations, so the same bits as corners().
+  static const detail::GatherCorners form = [] {
+    const detail::GatherCorners avx2 = detail::gather_corners_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : detail::gather_corners_portable;
+  }();
+  form(mA, mB, b_move(), waiting);
+}
+
+namespace detail {
+
+void gather_corners_portable(const ModelData& a, const ModelData& b, const geometry::RigidMove& move, BufferedPairs& waiting) {
+  if (waiting.batch.size == 0) return;  // no ids to read (the lanes past the pairs repeat lane 0's)
+  CornerPointers at;
+  corners_prefetched(a, b, waiting, at);
+  // The corners straight into the batch's lanes, then B's moved into A's frame in all eight lanes,
+  // two at a time with SSE2, with b_vertex's formula (geometry::RigidMove): the same operations,
+  // so the same bits as corners().
   geometry::TriangleBatch& batch = waiting.batch;
   constexpr int kLanes = geometry::TriangleBatch::kLanes;
   for (int l = 0; l < kLanes; ++l) {
-    const auto& tri_a = mA.mesh.triangles[waiting.ta[l < n ? l : 0]];
-    const auto& tri_b = mB.mesh.triangles[waiting.tb[l < n ? l : 0]];
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& va = mA.mesh.vertices[tri_a[k]];
-      const Eigen::Vector3d& vb = mB.mesh.vertices[tri_b[k]];
       for (int c = 0; c < 3; ++c) {
-        batch.a[k][c][l] = va[c];
-        batch.b[k][c][l] = vb[c];
+        batch.a[k][c][l] = at.a[k][l][c];
+        batch.b[k][c][l] = at.b[k][l][c];
       }
     }
   }
-  const geometry::RigidMove move(mRot, mTrans);
   for (int k = 0; k < 3; ++k) {
 #if defined(__SSE2__)
     for (int l = 0; l < kLanes; l += 2) {
@@ -66,4 +60,5 @@ void PairContext::gather_corners(BufferedPairs& waiting) const {
   }
 }
 
+}  // namespace detail
 }  // namespace caliber::narrow

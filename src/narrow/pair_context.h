@@ -244,17 +244,17 @@ class PairContext {
   /// leaf_test, so a pair has the same distance whichever of the two computed it.
   bool leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const;
 
-  [[nodiscard]] const ModelData& a() const { return mA; }  ///< Model A.
-  [[nodiscard]] const ModelData& b() const { return mB; }  ///< Model B.
-  /// The query.
-  [[nodiscard]] const QueryRequest& request() const { return mRequest; }
-  /// Pose of A (to bring results to world coordinates).
-  [[nodiscard]] const Pose& pose_a() const { return mPoseA; }
+  [[nodiscard]] const ModelData& a() const { return mA; }                 ///< Model A.
+  [[nodiscard]] const ModelData& b() const { return mB; }                 ///< Model B.
+  [[nodiscard]] const QueryRequest& request() const { return mRequest; }  ///< The query.
+  [[nodiscard]] const Pose& pose_a() const { return mPoseA; }             ///< Pose of A (for world coordinates).
   /// Rotation taking B's object frame to A's.
   [[nodiscard]] const Eigen::Matrix3d& rotation_b_to_a() const { return mRot; }
-  /// Vertex k of triangle tb of B, in A's frame (the one formula every test uses: geometry::RigidMove).
+  /// The move of B's vertices into A's frame (the one formula every test uses: geometry::RigidMove).
+  [[nodiscard]] geometry::RigidMove b_move() const { return {mRot, mTrans}; }
+  /// Vertex k of triangle tb of B, in A's frame (b_move).
   [[nodiscard]] Eigen::Vector3d b_vertex(std::uint32_t tb, int k) const {
-    return geometry::RigidMove(mRot, mTrans)(mB.mesh.vertices[mB.mesh.triangles[tb][k]]);
+    return b_move()(mB.mesh.vertices[mB.mesh.triangles[tb][k]]);
   }
   /// Reads the corners of the pairs waiting in `waiting` (their ids, batch.size of them) into its
   /// batch, B's moved into A's frame with b_vertex's arithmetic: the same bits as corners().

@@ -20,7 +20,8 @@ namespace {
 
 bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
 
-TEST(GatherCorners, SameBitsAsCorners) {
+/// Checks `gather` (null: PairContext::gather_corners, the form the CPU gets) on 64 random poses.
+void expect_same_bits_as_corners(detail::GatherCorners gather) {
   const auto a = build_model(make_torus(1.0, 0.35, 24, 16));
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 6));
   std::mt19937_64 rng(20261202);
@@ -39,13 +40,19 @@ TEST(GatherCorners, SameBitsAsCorners) {
       waiting.ta[l] = pick_a(rng);
       waiting.tb[l] = pick_b(rng);
     }
-    ctx.gather_corners(waiting);
-    for (int l = 0; l < waiting.batch.size; ++l) {
+    if (gather == nullptr) {
+      ctx.gather_corners(waiting);
+    } else {
+      gather(ctx.a(), ctx.b(), ctx.b_move(), waiting);
+    }
+    // Every lane, those past the pairs too (they repeat lane 0's).
+    for (int l = 0; l < geometry::TriangleBatch::kLanes; ++l) {
+      const int from = l < waiting.batch.size ? l : 0;
       Eigen::Vector3d ga[3], gb[3];
       waiting.batch.get(l, ga, gb);
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d ca = ctx.a().mesh.vertices[ctx.a().mesh.triangles[waiting.ta[l]][k]];
-        const Eigen::Vector3d cb = ctx.b_vertex(waiting.tb[l], k);
+        const Eigen::Vector3d ca = ctx.a().mesh.vertices[ctx.a().mesh.triangles[waiting.ta[from]][k]];
+        const Eigen::Vector3d cb = ctx.b_vertex(waiting.tb[from], k);
         for (int c = 0; c < 3; ++c) {
           ASSERT_TRUE(same_bits(ca[c], ga[k][c])) << "pose " << p << ", lane " << l << ": A's corner " << k;
           ASSERT_TRUE(same_bits(cb[c], gb[k][c])) << "pose " << p << ", lane " << l << ": B's corner " << k;
@@ -54,7 +61,17 @@ TEST(GatherCorners, SameBitsAsCorners) {
       }
     }
   }
-  EXPECT_GT(compared, 64 * 9);
+  EXPECT_EQ(compared, 64 * 8 * 9);
+}
+
+TEST(GatherCorners, SameBitsAsCorners) { expect_same_bits_as_corners(nullptr); }
+
+TEST(GatherCorners, PortableFormSameBitsAsCorners) { expect_same_bits_as_corners(detail::gather_corners_portable); }
+
+TEST(GatherCorners, Avx2FormSameBitsAsCorners) {
+  const detail::GatherCorners avx2 = detail::gather_corners_avx2_if_supported();
+  if (avx2 == nullptr) GTEST_SKIP() << "no AVX2 on this CPU";
+  expect_same_bits_as_corners(avx2);
 }
 
 TEST(GatherCorners, AnEmptyBatchReadsNothing) {
@@ -65,6 +82,10 @@ TEST(GatherCorners, AnEmptyBatchReadsNothing) {
   for (int l = 0; l < geometry::TriangleBatch::kLanes; ++l) waiting.ta[l] = waiting.tb[l] = 0xFFFFFFF0u;
   waiting.batch.size = 0;
   ctx.gather_corners(waiting);
+  detail::gather_corners_portable(ctx.a(), ctx.b(), ctx.b_move(), waiting);
+  if (const detail::GatherCorners avx2 = detail::gather_corners_avx2_if_supported()) {
+    avx2(ctx.a(), ctx.b(), ctx.b_move(), waiting);
+  }
   EXPECT_EQ(waiting.batch.size, 0);
 }
 
