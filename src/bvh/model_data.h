@@ -265,23 +265,36 @@ static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 ==
               offsetof(WideNode, slab_lo) % 32 == 0 && offsetof(WideNode, slab_hi) % 32 == 0 &&
               offsetof(WideNode, node) % 32 == 0);
 
-/// What a visit of the wide CD tree reads of a BVH node (narrow/visit.h): its box and sphere radius
-/// (its BvhNode's, the same floats) and where the visit goes from it (`link`): its wide node, or
-/// its triangle for a leaf. 32 bytes aligned to 32, two to a cache line and never across two, so
-/// that a visit reads one line of each side (a BvhNode spans two in half the cases).
+/// What a visit of the wide CD tree reads of a BVH node (narrow/visit.h): its box (its BvhNode's,
+/// the same floats), where its slab lies (`slot`: its place in the wide node that holds it, which
+/// stores its slab as its BvhNodeFilter does, and which the visit that reached it read last) and
+/// where the visit goes from it (`link`): its wide node, or its triangle for a leaf. 32 bytes
+/// aligned to 32, two to a cache line and never across two, so that a visit reads one line of
+/// each side (a BvhNode spans two in half the cases).
 struct alignas(32) VisitNode {
   /// `link`'s bit of a leaf.
   static constexpr std::uint32_t kLeaf = 0x80000000u;
   /// `link` of an internal node that is no wide node's root (collapsed away: it lies between a wide
   /// node and that node's slots).
   static constexpr std::uint32_t kNoWide = 0x7FFFFFFFu;
+  /// `slot` of a node that is no slot (the root, the nodes collapsed away), or whose wide node's
+  /// index is 2^29 or more: its slab is read from its BvhNodeFilter.
+  static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
+  /// The wide nodes whose slots `slot` can name.
+  static constexpr std::uint32_t kSlotWideNodes = std::uint32_t{1} << 29;
   float box_center[3];
   float box_half[3];
-  float radius;
+  /// The wide node that holds it as a slot, its index in ModelData::wide times WideNode::kSlots
+  /// plus the slot; or kNoSlot.
+  std::uint32_t slot;
   /// kLeaf | the triangle id for a leaf; else the index of its wide node in ModelData::wide, or
   /// kNoWide.
   std::uint32_t link;
 
+  /// The size the wide CD tree compares to choose the side that descends: the sum of its box's
+  /// half-extents, in float (the same operations wherever asked; scaling a model by a power of
+  /// two scales it exactly, down to float's smallest normal numbers).
+  [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
   [[nodiscard]] bool is_leaf() const { return (link & kLeaf) != 0; }
   [[nodiscard]] std::uint32_t triangle() const { return link & ~kLeaf; }
   [[nodiscard]] bool has_wide() const { return link < kNoWide; }

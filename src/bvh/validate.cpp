@@ -41,6 +41,17 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   return {};
 }
 
+/// Whether slot `slot` (VisitNode::slot) of m's wide tree holds node i, with i's slab.
+bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
+  if (slot / WideNode::kSlots >= m.wide.size()) return false;
+  const WideNode& w = m.wide[slot / WideNode::kSlots];
+  const std::uint32_t k = slot % WideNode::kSlots;
+  const BvhNodeFilter& f = m.filters[i];
+  bool same = w.node[k] == i && w.slab_lo[k] == f.slab_lo && w.slab_hi[k] == f.slab_hi;
+  for (int a = 0; a < 3; ++a) same = same && w.axis[a][k] == f.cone_axis[a];
+  return same;
+}
+
 }  // namespace
 
 std::string bvh_problem(const ModelData& m) {
@@ -75,15 +86,18 @@ std::string bvh_problem(const ModelData& m) {
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
   }
-  // What a wide visit reads of each node: its own box, radius and leaf (where the wide tree is built).
+  // What a wide visit reads of each node: its own box and leaf, and its slot (where the wide tree
+  // is built): the slot holds it, and stores its slab as its filter does.
   if (!m.visit_nodes.empty()) {
     if (m.visit_nodes.size() != size) return "the visit nodes are not one a node";
     for (std::size_t i = 0; i < size; ++i) {
       const BvhNode& n = m.nodes[i];
       const VisitNode& v = m.visit_nodes[i];
-      bool same = v.radius == n.radius && v.is_leaf() == n.is_leaf() && (!n.is_leaf() || v.triangle() == n.index);
+      bool same = v.is_leaf() == n.is_leaf() && (!n.is_leaf() || v.triangle() == n.index);
       for (int k = 0; k < 3; ++k) same = same && v.box_center[k] == n.box_center[k] && v.box_half[k] == n.box_half[k];
       if (!same) return "node " + std::to_string(i) + ": its visit node is not a copy of it";
+      if (v.slot != VisitNode::kNoSlot && !slot_holds(m, v.slot, i))
+        return "node " + std::to_string(i) + ": its slot does not hold it";
     }
   }
   return {};

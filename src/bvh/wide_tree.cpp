@@ -139,30 +139,37 @@ int collapse(const ModelData& m, std::uint32_t root, std::uint32_t slots[WideNod
   return n;
 }
 
+/// Wide node w with slot k alone.
+WideNode with_slot_alone(const WideNode& w, int k) {
+  WideNode out = w;
+  for (int j = 0; j < WideNode::kSlots; ++j) clear_slot(j, out);
+  for (int i = 0; i < 3; ++i) {
+    out.lo[i][0] = w.lo[i][k];
+    out.hi[i][0] = w.hi[i][k];
+    out.axis[i][0] = w.axis[i][k];
+  }
+  out.slab_lo[0] = w.slab_lo[k];
+  out.slab_hi[0] = w.slab_hi[k];
+  out.node[0] = w.node[k];
+  return out;
+}
+
 }  // namespace
 
 WideNode single_slot(const ModelData& model, std::uint32_t node) {
-  // The wide node that holds `node` as a slot, from the root down: at each, the slot whose run of
-  // leaves holds node's first leaf is node, or holds node below it.
+  if (const std::uint32_t slot = model.visit_nodes[node].slot; slot != VisitNode::kNoSlot) {
+    return with_slot_alone(model.wide[slot / WideNode::kSlots], static_cast<int>(slot % WideNode::kSlots));
+  }
+  // (A slot whose wide node is too far on for VisitNode::slot.) The wide node that holds `node` as
+  // a slot, from the root down: at each, the slot whose run of leaves holds node's first leaf is
+  // node, or holds node below it.
   const std::uint32_t place = model.first_leaf(node), count = model.nodes[node].count;
   std::uint32_t holder = 0, first = 0;  // the BVH node whose wide node is searched, its first leaf's place
   while (node != holder && model.visit_nodes[holder].has_wide()) {
     const WideNode& w = model.wide[model.visit_nodes[holder].link];
     int k = 0;
     while (place >= first + model.nodes[w.node[k]].count) first += model.nodes[w.node[k++]].count;
-    if (w.node[k] == node) {
-      WideNode out = w;
-      for (int j = 0; j < WideNode::kSlots; ++j) clear_slot(j, out);
-      for (int i = 0; i < 3; ++i) {
-        out.lo[i][0] = w.lo[i][k];
-        out.hi[i][0] = w.hi[i][k];
-        out.axis[i][0] = w.axis[i][k];
-      }
-      out.slab_lo[0] = w.slab_lo[k];
-      out.slab_hi[0] = w.slab_hi[k];
-      out.node[0] = node;
-      return out;
-    }
+    if (w.node[k] == node) return with_slot_alone(w, k);
     if (model.nodes[w.node[k]].count <= count) break;  // node lies between w's root and its slots
     holder = w.node[k];
   }
@@ -186,7 +193,7 @@ void build_wide_tree(ModelData& model) {
       v.box_center[k] = n.box_center[k];
       v.box_half[k] = n.box_half[k];
     }
-    v.radius = n.radius;
+    v.slot = VisitNode::kNoSlot;
     v.link = n.is_leaf() ? VisitNode::kLeaf | n.index : VisitNode::kNoWide;
   }
   if (model.nodes.empty() || model.nodes[0].is_leaf()) return;
@@ -198,7 +205,8 @@ void build_wide_tree(ModelData& model) {
     stack.pop_back();
     std::uint32_t slots[WideNode::kSlots];
     const int n = collapse(model, root, slots);
-    model.visit_nodes[root].link = static_cast<std::uint32_t>(model.wide.size());
+    const auto index = static_cast<std::uint32_t>(model.wide.size());
+    model.visit_nodes[root].link = index;
     WideNode& w = model.wide.emplace_back();
     FloatBox boxes[WideNode::kSlots];
     for (int k = 0; k < n; ++k) boxes[k] = float_box(model.nodes[slots[k]]);
@@ -206,6 +214,8 @@ void build_wide_tree(ModelData& model) {
     for (int k = 0; k < WideNode::kSlots; ++k) {
       if (k < n) {
         fill_slot(model, slots[k], boxes[k], k, w);
+        if (index < VisitNode::kSlotWideNodes)
+          model.visit_nodes[slots[k]].slot = index * WideNode::kSlots + static_cast<std::uint32_t>(k);
       } else {
         clear_slot(k, w);
       }

@@ -8,7 +8,9 @@ namespace caliber::narrow {
 
 const detail::WideTest kWideTest = detail::wide_test_avx2_if_supported();
 
-detail::WideLanes wide_lanes(const PairContext& ctx) { return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale()); }
+detail::WideLanes wide_lanes(const PairContext& ctx) {
+  return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale(), ctx.a(), ctx.b());
+}
 
 bool root_test(const PairContext& ctx, NodePair n, RootTest how) {
   switch (how) {

@@ -75,10 +75,10 @@ inline void cd_descend(const BvhNode& a, const BvhNode& b, double ratio, bool& d
 inline bool wide_cd_tree(const PairContext& ctx) { return ctx.request().kind != QueryKind::distance; }
 
 /// In the wide CD tree, whether node (a, b), not a pair of leaves, descends on A's side: A's node
-/// is not a leaf, and B's is one or its sphere is no larger than A's. Depends only on object-space
-/// radii, so the CD tree's shape does not depend on the poses.
+/// is not a leaf, and B's is one or its box is no larger than A's (VisitNode::size). Depends only
+/// on object-space boxes, so the CD tree's shape does not depend on the poses.
 inline bool wide_descends_a(const VisitNode& a, const VisitNode& b) {
-  return !a.is_leaf() && (b.is_leaf() || a.radius >= b.radius);
+  return !a.is_leaf() && (b.is_leaf() || a.size() >= b.size());
 }
 
 /// A visit of the wide CD tree's node n (not a pair of leaves): the side that descends

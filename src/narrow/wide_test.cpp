@@ -49,8 +49,10 @@ void fill_side(double m[3][3], double abs_m[3][3], const double t[3], WideSide& 
 
 }  // namespace
 
-WideLanes make_wide_lanes(const NodeTestFrame& f, double scale) {
+WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b) {
   WideLanes l;
+  l.staying_wide[0] = b.wide.data();
+  l.staying_wide[1] = a.wide.data();
   double m[3][3], abs_m[3][3], t[3];
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {

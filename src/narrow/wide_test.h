@@ -57,6 +57,8 @@ struct alignas(32) WideLanes {
   float reach_f;       ///< the reach plus the slack, in units
   float slab_f;        ///< the slab reach plus the slack, in units
   bool floats;         ///< the float stage runs
+  /// The wide nodes of the side that stays: [0] B's (A descends), [1] A's (StayingSlab).
+  const WideNode* staying_wide[2];
 };
 
 /// The staying node as the float stage reads it, in the descending frame and in units (the same
@@ -126,13 +128,30 @@ struct StayingCache {
   }
 };
 
+/// A staying node's slab: its axis and bounds, as its BvhNodeFilter stores them.
+struct StayingSlab {
+  float axis[3], lo, hi;
+};
+/// The slab of node `stay` (sn), of B where A descends: read in the wide node that holds it
+/// (VisitNode::slot; the visit that reached it read that node), else in its filter.
+inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
+                                const VisitNode& sn) {
+  if (sn.slot != VisitNode::kNoSlot) {
+    const WideNode& w = l.staying_wide[a_descends ? 0 : 1][sn.slot / WideNode::kSlots];
+    const std::uint32_t k = sn.slot % WideNode::kSlots;
+    return {{w.axis[0][k], w.axis[1][k], w.axis[2][k]}, w.slab_lo[k], w.slab_hi[k]};
+  }
+  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  return {{sf.cone_axis[0], sf.cone_axis[1], sf.cone_axis[2]}, sf.slab_lo, sf.slab_hi};
+}
+
 /// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
-inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const VisitNode& sn, const BvhNodeFilter& sf,
+inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const VisitNode& sn, const StayingSlab& sf,
                                     const double c[3]) {
   StayingFloats out;
   double nd[3];
   for (int i = 0; i < 3; ++i) {
-    nd[i] = std::fma(s.col[2][i], sf.cone_axis[2], std::fma(s.col[1][i], sf.cone_axis[1], s.col[0][i] * sf.cone_axis[0]));
+    nd[i] = std::fma(s.col[2][i], sf.axis[2], std::fma(s.col[1][i], sf.axis[1], s.col[0][i] * sf.axis[0]));
     out.co[i] = static_cast<float>((static_cast<double>(sn.box_center[i]) + s.mt_t[i]) * l.unit);
     out.sh[i] = static_cast<float>(sn.box_half[i] * l.unit);
     out.ho[i] = out.sh[i] + l.reach_f;
@@ -140,8 +159,8 @@ inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const
     out.cf[i] = static_cast<float>(c[i] * l.unit);
   }
   out.off = static_cast<float>(-((nd[0] * s.t[0] + nd[1] * s.t[1]) + nd[2] * s.t[2]) * l.unit);
-  out.slab_lo = static_cast<float>(sf.slab_lo * l.unit) - l.slab_f;
-  out.slab_hi = static_cast<float>(sf.slab_hi * l.unit) + l.slab_f;
+  out.slab_lo = static_cast<float>(sf.lo * l.unit) - l.slab_f;
+  out.slab_hi = static_cast<float>(sf.hi * l.unit) + l.slab_f;
   return out;
 }
 
@@ -165,14 +184,13 @@ inline StayingCache::Entry& staying_entry(StayingCache* cache, StayingCache::Ent
 inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                 const VisitNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
-  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
-  kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, sf, kept.moved);
+  kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, staying_slab(f, l, a_descends, stay, sn), kept.moved);
   kept.has_floats = true;
 }
 
-/// The lanes of frame f (its pose, reach and slab reach). `scale`: a bound on every coordinate,
-/// extent, reach and slab bound the test computes with, which sets the slack.
-WideLanes make_wide_lanes(const NodeTestFrame& f, double scale);
+/// The lanes of frame f (its pose, reach and slab reach) between models a and b. `scale`: a bound
+/// on every coordinate, extent, reach and slab bound the test computes with, which sets the slack.
+WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b);
 
 /// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
 /// node `stay` stays; sn: its VisitNode) against the descending node's wide node w: bit k set where

@@ -87,11 +87,11 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
 CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const WideLanes& l, const WideSide& s, bool a_descends,
                                                   std::uint32_t stay, const VisitNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
-  const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
+  const StayingSlab sf = staying_slab(f, l, a_descends, stay, sn);
   const D unit = _mm256_set1_pd(l.unit);
-  const D nd = fmad(_mm256_load_pd(s.col[2]), _mm256_set1_pd(sf.cone_axis[2]),
-                    fmad(_mm256_load_pd(s.col[1]), _mm256_set1_pd(sf.cone_axis[1]),
-                         _mm256_mul_pd(_mm256_load_pd(s.col[0]), _mm256_set1_pd(sf.cone_axis[0]))));
+  const D nd = fmad(_mm256_load_pd(s.col[2]), _mm256_set1_pd(sf.axis[2]),
+                    fmad(_mm256_load_pd(s.col[1]), _mm256_set1_pd(sf.axis[1]),
+                         _mm256_mul_pd(_mm256_load_pd(s.col[0]), _mm256_set1_pd(sf.axis[0]))));
   // (Four floats from box_center and box_half: the fourth lane, box_half[0] and the radius, unused.)
   const D center = _mm256_cvtps_pd(_mm_loadu_ps(sn.box_center)), half = _mm256_cvtps_pd(_mm_loadu_ps(sn.box_half));
   const __m128 sh = _mm256_cvtpd_ps(_mm256_mul_pd(half, unit));
@@ -105,8 +105,8 @@ CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const 
   out.off = static_cast<float>(-((n[0] * s.t[0] + n[1] * s.t[1]) + n[2] * s.t[2]) * l.unit);
   _mm_storeu_ps(out.cf, _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_load_pd(kept.moved), unit)));
   _mm_storeu_ps(out.sh, sh);
-  out.slab_lo = static_cast<float>(sf.slab_lo * l.unit) - l.slab_f;
-  out.slab_hi = static_cast<float>(sf.slab_hi * l.unit) + l.slab_f;
+  out.slab_lo = static_cast<float>(sf.lo * l.unit) - l.slab_f;
+  out.slab_hi = static_cast<float>(sf.hi * l.unit) + l.slab_f;
   kept.has_floats = true;
 }
 

@@ -24,13 +24,12 @@ std::string wide_problem(const ModelData& m) {
   std::vector<int> seen(m.nodes.size(), 0);
   seen[0] = 1;
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
-    // A visit reads the node's own box and radius, and its triangle or wide node.
+    // A visit reads the node's own box, its triangle or wide node, and its slot.
     const BvhNode& n = m.nodes[i];
     const VisitNode& v = m.visit_nodes[i];
     for (int a = 0; a < 3; ++a) {
       if (v.box_center[a] != n.box_center[a] || v.box_half[a] != n.box_half[a]) return "a visit node's box is not its node's";
     }
-    if (v.radius != n.radius) return "a visit node's radius is not its node's";
     if (v.is_leaf() != n.is_leaf() || (n.is_leaf() && v.triangle() != n.index)) return "a visit node's leaf or triangle";
     if (n.is_leaf() || !v.has_wide()) continue;
     const std::uint32_t w = v.link;
@@ -55,6 +54,8 @@ std::string wide_problem(const ModelData& m) {
       if (m.first_leaf(s) != next) return "the slots' runs of leaves do not follow one another";
       next += m.nodes[s].count;
       if (!m.nodes[s].is_leaf() && !m.visit_nodes[s].has_wide()) return "an inner slot without a wide node";
+      if (m.visit_nodes[s].slot != w * WideNode::kSlots + static_cast<std::uint32_t>(k))
+        return "a slot's visit node does not name it";
       const BvhNode& b = m.nodes[s];
       for (int a = 0; a < 3; ++a) {
         const double lo = double(b.box_center[a]) - b.box_half[a], hi = double(b.box_center[a]) + b.box_half[a];
@@ -87,6 +88,8 @@ std::string wide_problem(const ModelData& m) {
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
     if (m.nodes[i].is_leaf() && seen[i] != 1) return "leaf " + std::to_string(i) + " is not one slot";
     if (m.visit_nodes[i].has_wide() && seen[i] != 1) return "wide node " + std::to_string(i) + " is not the root or one slot";
+    if ((seen[i] == 0 || i == 0) && m.visit_nodes[i].slot != VisitNode::kNoSlot)
+      return "node " + std::to_string(i) + " is no slot but names one";
   }
   return {};
 }
@@ -136,7 +139,7 @@ TEST(WideTree, ARootLeafHasNoWideNode) {
   const BvhNode& n = data(*model).nodes[0];
   EXPECT_TRUE(v.is_leaf());
   EXPECT_EQ(v.triangle(), 0u);
-  EXPECT_EQ(v.radius, n.radius);
+  EXPECT_EQ(v.slot, VisitNode::kNoSlot);
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(v.box_center[k], n.box_center[k]);
     EXPECT_EQ(v.box_half[k], n.box_half[k]);
