@@ -278,10 +278,10 @@ struct alignas(32) VisitNode {
   /// node and that node's slots).
   static constexpr std::uint32_t kNoWide = 0x7FFFFFFFu;
   /// `slot` of a node that is no slot (the root, the nodes collapsed away), or whose wide node's
-  /// index is 2^29 or more: its slab is read from its BvhNodeFilter.
+  /// index is kSlotWideNodes or more: its slab is read from its BvhNodeFilter.
   static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
-  /// The wide nodes whose slots `slot` can name.
-  static constexpr std::uint32_t kSlotWideNodes = std::uint32_t{1} << 29;
+  /// The wide nodes whose slots `slot` can name (the last slot of the next would be kNoSlot).
+  static constexpr std::uint32_t kSlotWideNodes = (std::uint32_t{1} << 29) - 1;
   float box_center[3];
   float box_half[3];
   /// The wide node that holds it as a slot, its index in ModelData::wide times WideNode::kSlots
@@ -291,9 +291,9 @@ struct alignas(32) VisitNode {
   /// kNoWide.
   std::uint32_t link;
 
-  /// The size the wide CD tree compares to choose the side that descends: the sum of its box's
-  /// half-extents, in float (the same operations wherever asked; scaling a model by a power of
-  /// two scales it exactly, down to float's smallest normal numbers).
+  /// What the wide CD tree compares to choose the side that descends: the sum of its box's
+  /// half-extents in float (a model scaled by a power of two scales it exactly, where its boxes'
+  /// half-extents are normal floats).
   [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
   [[nodiscard]] bool is_leaf() const { return (link & kLeaf) != 0; }
   [[nodiscard]] std::uint32_t triangle() const { return link & ~kLeaf; }
@@ -333,7 +333,7 @@ struct ModelData : Model {
     return p >= first && p < first + nodes[node].count;
   }
   /// The wide tree (WideNode), its root's first; and per BVH node, what a visit reads of it
-  /// (VisitNode: its box, radius and wide node or triangle).
+  /// (VisitNode: its box, its slot and its wide node or triangle).
   std::vector<WideNode> wide;
   std::vector<VisitNode> visit_nodes;
   /// Where the run of leaves of `node` starts: the place of its first leaf (its first children's).

@@ -2,6 +2,7 @@
 
 #include "bvh/validate.h"
 
+#include <bit>
 #include <utility>
 #include <vector>
 
@@ -41,14 +42,15 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   return {};
 }
 
-/// Whether slot `slot` (VisitNode::slot) of m's wide tree holds node i, with i's slab.
+/// Whether slot `slot` (VisitNode::slot) of m's wide tree holds node i, with i's slab bit for bit.
 bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
   if (slot / WideNode::kSlots >= m.wide.size()) return false;
   const WideNode& w = m.wide[slot / WideNode::kSlots];
   const std::uint32_t k = slot % WideNode::kSlots;
   const BvhNodeFilter& f = m.filters[i];
-  bool same = w.node[k] == i && w.slab_lo[k] == f.slab_lo && w.slab_hi[k] == f.slab_hi;
-  for (int a = 0; a < 3; ++a) same = same && w.axis[a][k] == f.cone_axis[a];
+  const auto bits = [](float x) { return std::bit_cast<std::uint32_t>(x); };
+  bool same = w.node[k] == i && bits(w.slab_lo[k]) == bits(f.slab_lo) && bits(w.slab_hi[k]) == bits(f.slab_hi);
+  for (int a = 0; a < 3; ++a) same = same && bits(w.axis[a][k]) == bits(f.cone_axis[a]);
   return same;
 }
 

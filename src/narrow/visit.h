@@ -143,8 +143,8 @@ template <bool kReversed = false>
     return -1;
   };
   if (wide_cd_tree(ctx)) {
-    // One line of each side (VisitNode): the leaves' triangles, the radii, the wide node, the
-    // staying box.
+    // One line of each side (VisitNode): the leaves' triangles, the sizes, the wide node, the
+    // staying box and slot.
     const VisitNode& a = ctx.a().visit_nodes[n.a];
     const VisitNode& b = ctx.b().visit_nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
