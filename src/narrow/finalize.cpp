@@ -3,11 +3,11 @@
 #include "narrow/finalize.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <functional>
 
 #include "caliber/error.h"
+#include "narrow/local_minima.h"
 #include "parallel/executor.h"
 #include "util/assert.h"
 
@@ -16,102 +16,6 @@ namespace narrow {
 namespace {
 
 bool by_ids(const Candidate& x, const Candidate& y) { return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b; }
-
-/// Where each candidate of a list sits, by its triangle pair: an open-addressing hash table (linear
-/// probing, at most half full), so a neighbour lookup costs one or two probes whatever the list's
-/// length. Filled in parallel (each slot claimed by compare-and-swap; which slot a candidate gets
-/// may vary, what a lookup finds does not), then only read.
-class PairIndex {
- public:
-  PairIndex(const std::vector<Candidate>& candidates, std::size_t grain) : mCandidates(candidates) {
-    std::size_t capacity = 16;
-    while (capacity < 2 * candidates.size()) capacity *= 2;
-    mMask = capacity - 1;
-    mSlots.assign(capacity, kEmpty);
-    parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t i = lo; i != hi; ++i) {
-        for (std::size_t h = slot(key(candidates[i].tri_a, candidates[i].tri_b));; h = (h + 1) & mMask) {
-          std::uint32_t expected = kEmpty;
-          if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
-                                                                                std::memory_order_relaxed)) {
-            break;
-          }
-        }
-      }
-    });
-  }
-
-  /// The candidate (ta, tb), or nullptr.
-  [[nodiscard]] const Candidate* find(std::uint32_t ta, std::uint32_t tb) const {
-    for (std::size_t h = slot(key(ta, tb));; h = (h + 1) & mMask) {
-      const std::uint32_t i = mSlots[h];
-      if (i == kEmpty) return nullptr;
-      const Candidate& c = mCandidates[i];
-      if (c.tri_a == ta && c.tri_b == tb) return &c;
-    }
-  }
-
- private:
-  static constexpr std::uint32_t kEmpty = 0xffffffffu;
-  static std::uint64_t key(std::uint32_t ta, std::uint32_t tb) { return (std::uint64_t{ta} << 32) | tb; }
-  /// Fibonacci hashing: the high bits of the key times 2^64 / phi, folded to the table's size.
-  [[nodiscard]] std::size_t slot(std::uint64_t k) const {
-    return static_cast<std::size_t>((k * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
-  }
-
-  const std::vector<Candidate>& mCandidates;
-  /// Candidate positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
-  std::vector<std::uint32_t> mSlots;
-  std::size_t mMask = 0;
-};
-
-/// How many candidates on each side of a candidate local_minima looks at before its lookups.
-constexpr std::size_t kNearby = 8;
-
-/// Quasi-LMD reduction: keep a candidate unless a candidate that shares one of its triangles and
-/// whose other triangle is vertex-adjacent to its own is closer (ties: lower ids win). Linear in
-/// the candidates (times the adjacency's degree): the candidates next to it in the list first, then
-/// each neighbour by one hash lookup. Each verdict
-/// depends only on the set of candidates, not on their order, so they need no sorting first; the
-/// kept ones are returned in the input's order.
-std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
-  const PairIndex index(candidates, grain);
-  const ModelData& ma = ctx.a();
-  const ModelData& mb = ctx.b();
-  std::vector<char> keep(candidates.size(), 0);
-  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) {
-      const Candidate& c = candidates[i];
-      // The traversals list nearby pairs next to one another, so a closer neighbour is often among
-      // the few candidates around c in the list (in cache): looked for there first. A neighbour
-      // found there is one the lookups below would find, so the verdict is the same.
-      bool dominated = false;
-      const std::size_t first = i >= kNearby ? i - kNearby : 0, last = std::min(candidates.size(), i + kNearby + 1);
-      for (std::size_t j = first; j != last && !dominated; ++j) {
-        const Candidate& o = candidates[j];
-        dominated = closer(o, c) && ((o.tri_b == c.tri_b && ma.are_neighbours(o.tri_a, c.tri_a)) ||
-                                     (o.tri_a == c.tri_a && mb.are_neighbours(o.tri_b, c.tri_b)));
-      }
-      if (dominated) continue;  // keep[i] stays 0
-      ma.for_each_neighbour(c.tri_a, [&](std::uint32_t u) {
-        if (dominated) return;
-        const Candidate* other = index.find(u, c.tri_b);
-        dominated = other != nullptr && closer(*other, c);
-      });
-      mb.for_each_neighbour(c.tri_b, [&](std::uint32_t u) {
-        if (dominated) return;
-        const Candidate* other = index.find(c.tri_a, u);
-        dominated = other != nullptr && closer(*other, c);
-      });
-      keep[i] = dominated ? 0 : 1;
-    }
-  });
-  std::vector<Candidate> kept;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (keep[i]) kept.push_back(candidates[i]);
-  }
-  return kept;
-}
 
 /// Contact::depth of an intersecting pair (A's frame): the largest depth of B's vertices behind
 /// the plane through A's closest point with the contact normal.

@@ -1,0 +1,159 @@
+// The contact reduction: each candidate against the candidates next to it in the list, then
+// against its neighbours' pairs through a table of the candidates' keys and distances.
+
+#include "narrow/local_minima.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+
+#include "parallel/executor.h"
+
+namespace caliber::narrow {
+namespace {
+
+/// A candidate as the reduction reads it, 16 of its 64 bytes: its triangle pair as one key (A's id
+/// in the high half, so that keys order as `closer` orders the ids) and its distance.
+struct Entry {
+  std::uint64_t key;
+  double distance;
+};
+
+std::uint64_t key_of(std::uint32_t ta, std::uint32_t tb) { return (std::uint64_t{ta} << 32) | tb; }
+std::uint32_t tri_a(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
+std::uint32_t tri_b(std::uint64_t key) { return static_cast<std::uint32_t>(key); }
+
+/// `closer` on entries: the same order.
+bool closer(const Entry& x, const Entry& y) { return x.distance != y.distance ? x.distance < y.distance : x.key < y.key; }
+
+/// Where each entry sits, by its key: open addressing with linear probing, at most half full, four
+/// bytes a slot (the table of a pair's 70,000 candidates fits in 1 MiB, so that filling it stays
+/// in cache). Filled in parallel (a slot claimed by compare-and-swap; which slot an entry gets may
+/// vary, what a lookup finds does not), then only read.
+class EntryTable {
+ public:
+  EntryTable(const std::vector<Entry>& entries, std::size_t grain) : mEntries(entries) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * entries.size()) capacity *= 2;
+    mMask = capacity - 1;
+    mSlots.assign(capacity, kEmpty);
+    parallel::parallel_for(0, entries.size(), grain, [&](std::size_t lo, std::size_t hi) {
+      for (std::size_t i = lo; i != hi; ++i) {
+        for (std::size_t h = slot(entries[i].key);; h = (h + 1) & mMask) {
+          std::uint32_t expected = kEmpty;
+          if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
+                                                                                std::memory_order_relaxed)) {
+            break;
+          }
+        }
+      }
+    });
+  }
+
+  void prefetch(std::uint64_t key) const { __builtin_prefetch(&mSlots[slot(key)]); }
+
+  /// The entry of `key`, or nullptr.
+  [[nodiscard]] const Entry* find(std::uint64_t key) const {
+    for (std::size_t h = slot(key);; h = (h + 1) & mMask) {
+      const std::uint32_t i = mSlots[h];
+      if (i == kEmpty) return nullptr;
+      if (mEntries[i].key == key) return &mEntries[i];
+    }
+  }
+
+ private:
+  /// Entry positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  /// Fibonacci hashing: the high bits of the key times 2^64 / phi, folded to the table's size.
+  [[nodiscard]] std::size_t slot(std::uint64_t key) const {
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
+  }
+
+  const std::vector<Entry>& mEntries;
+  std::vector<std::uint32_t> mSlots;
+  std::size_t mMask = 0;
+};
+
+/// How many candidates on each side of a candidate the reduction looks at before its lookups.
+constexpr std::size_t kNearby = 8;
+
+/// The reduction's reading of a pair's candidates.
+struct Reduction {
+  const ModelData& a;
+  const ModelData& b;
+  const std::vector<Entry>& entries;
+  const EntryTable& table;
+
+  /// Whether o is closer than c, shares one of its triangles and has the other vertex-adjacent.
+  [[nodiscard]] bool dominates(const Entry& o, const Entry& c) const {
+    return closer(o, c) && ((tri_b(o.key) == tri_b(c.key) && a.are_neighbours(tri_a(o.key), tri_a(c.key))) ||
+                            (tri_a(o.key) == tri_a(c.key) && b.are_neighbours(tri_b(o.key), tri_b(c.key))));
+  }
+
+  /// Whether a candidate among the kNearby on each side of entry i in the list (nearest first)
+  /// dominates it. The traversals list nearby pairs together, so one often does, and it is one
+  /// the lookups would find: the same verdict, without them.
+  [[nodiscard]] bool dominated_nearby(std::size_t i) const {
+    const Entry& c = entries[i];
+    for (std::size_t d = 1; d <= kNearby; ++d) {
+      if (d <= i && dominates(entries[i - d], c)) return true;
+      if (i + d < entries.size() && dominates(entries[i + d], c)) return true;
+    }
+    return false;
+  }
+
+  /// Whether one of the pairs keys[0 .. count) is a candidate closer than c (their slots prefetched).
+  [[nodiscard]] bool any_closer(const std::uint64_t* keys, int count, const Entry& c) const {
+    return std::any_of(keys, keys + count, [&](std::uint64_t key) {
+      const Entry* o = table.find(key);
+      return o != nullptr && closer(*o, c);
+    });
+  }
+
+  /// Whether a candidate dominates entry i: its pairs with a neighbour of either triangle looked
+  /// up kLookups at a time, each batch's slots prefetched before the first lookup.
+  [[nodiscard]] bool dominated(std::size_t i) const {
+    if (dominated_nearby(i)) return true;
+    const Entry& c = entries[i];
+    const std::uint32_t ta = tri_a(c.key), tb = tri_b(c.key);
+    constexpr int kLookups = 32;
+    std::uint64_t keys[kLookups];
+    int count = 0;
+    bool found = false;
+    const auto add = [&](std::uint64_t key) {
+      if (found) return;
+      table.prefetch(key);
+      keys[count++] = key;
+      if (count == kLookups) {
+        found = any_closer(keys, count, c);
+        count = 0;
+      }
+    };
+    a.for_each_neighbour(ta, [&](std::uint32_t u) { add(key_of(u, tb)); });
+    b.for_each_neighbour(tb, [&](std::uint32_t u) { add(key_of(ta, u)); });
+    return found || any_closer(keys, count, c);
+  }
+};
+
+}  // namespace
+
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
+  std::vector<Entry> entries(candidates.size());
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i)
+      entries[i] = {key_of(candidates[i].tri_a, candidates[i].tri_b), candidates[i].distance};
+  });
+  const EntryTable table(entries, grain);
+  const Reduction reduction{ctx.a(), ctx.b(), entries, table};
+  std::vector<char> keep(candidates.size(), 0);
+  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) keep[i] = reduction.dominated(i) ? 0 : 1;
+  });
+  std::vector<Candidate> kept;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (keep[i]) kept.push_back(candidates[i]);
+  }
+  return kept;
+}
+
+}  // namespace caliber::narrow

@@ -1,0 +1,21 @@
+#pragma once
+/// \file
+/// The contact query's reduction of a pair's candidates to their local minima.
+
+#include <cstddef>
+#include <vector>
+
+#include "narrow/candidate.h"
+#include "narrow/pair_context.h"
+
+namespace caliber::narrow {
+
+/// Quasi-LMD reduction: keeps a candidate unless a candidate that shares one of its triangles and
+/// whose other triangle is vertex-adjacent to its own (ModelData::are_neighbours) is closer
+/// (`closer`: ties to the lower ids). Each verdict depends only on the set of candidates, not on
+/// their order, so they need no sorting first; the kept ones are returned in the input's order.
+/// Linear in the candidates times the adjacency's degree; in chunks of `grain` on the current
+/// executor (a grain as large as the input keeps it on this thread). Both models need adjacency.
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain);
+
+}  // namespace caliber::narrow
