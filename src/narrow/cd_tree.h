@@ -146,8 +146,15 @@ inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v
   CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).visit_nodes[v.stay], "the staying node is node stay");
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
+  // A pair of leaves skips them: its leaf test tests the triangles' groups and normals exactly
+  // (PairContext::groups_allow, normals_allow), refusing all that the nodes' groups and cones would
+  // (two thirds of the cone tests of a contact query, each reading two nodes' filters). Whether a
+  // slot is a leaf is read in its visit node, which the visit of that pair reads next.
+  const std::vector<VisitNode>& descending = (v.a_descends ? ctx.a() : ctx.b()).visit_nodes;
+  const bool staying_leaf = v.staying->is_leaf();
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
+    if (staying_leaf && descending[v.node->node[k]].is_leaf()) continue;
     const NodePair child = v.child(k, n);
     if (!ctx.groups_and_cones_allow(child.a, child.b)) pass &= ~(1u << k);
   }
