@@ -290,8 +290,9 @@ void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& ou
 
 unsigned triangles_apart_batch(TriangleBatch& batch, double reach) {
   static const detail::ApartBatchTest chosen = [] {
-    const detail::ApartBatchTest avx512 = detail::triangles_apart_batch_avx512_if_supported();
-    return avx512 != nullptr ? avx512 : &detail::triangles_apart_batch_by_pair;
+    if (const detail::ApartBatchTest avx512 = detail::triangles_apart_batch_avx512_if_supported()) return avx512;
+    const detail::ApartBatchTest avx2 = detail::triangles_apart_batch_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : &detail::triangles_apart_batch_by_pair;
   }();
   if (batch.size == 0) return 0;
   batch.pad();

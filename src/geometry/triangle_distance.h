@@ -115,6 +115,8 @@ using ApartBatchTest = unsigned (*)(const TriangleBatch& batch, double reach);
 unsigned triangles_apart_batch_by_pair(const TriangleBatch& batch, double reach);
 /// Its AVX-512 form, or nullptr where this build or this CPU has none.
 ApartBatchTest triangles_apart_batch_avx512_if_supported();
+/// Its AVX2 form (four lanes at a time), or nullptr where this build or this CPU has none.
+ApartBatchTest triangles_apart_batch_avx2_if_supported();
 using ApartTest = bool (*)(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 bool triangles_apart_portable(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 /// The AVX2 forms, or nullptr where this build or this CPU has none.

@@ -281,6 +281,7 @@ TEST(TriangleDistance, BatchApartSameVerdictsAsThePortableTest) {
   if (const detail::ApartBatchTest avx512 = detail::triangles_apart_batch_avx512_if_supported()) {
     forms.emplace_back("avx512", avx512);
   }
+  if (const detail::ApartBatchTest avx2 = detail::triangles_apart_batch_avx2_if_supported()) forms.emplace_back("avx2", avx2);
   const double factors[] = {0.0, 0.5, 0.9, 1.0 - 1e-9, 1.0, 1.0 + 1e-9, 2.0};
   int failures = 0, iter = 0, batches = 0, apart = 0;
   while (iter < 100000) {
