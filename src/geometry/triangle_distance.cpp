@@ -280,8 +280,9 @@ void TriangleBatch::pad() {
 
 void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out) {
   static const detail::BatchKernel chosen = [] {
-    const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported();
-    return avx512 != nullptr ? avx512 : &detail::closest_points_triangles_batch_by_pair;
+    if (const detail::BatchKernel avx512 = detail::closest_points_triangles_batch_avx512_if_supported()) return avx512;
+    const detail::BatchKernel avx2 = detail::closest_points_triangles_batch_avx2_if_supported();
+    return avx2 != nullptr ? avx2 : &detail::closest_points_triangles_batch_by_pair;
   }();
   if (batch.size == 0) return;
   batch.pad();

@@ -110,6 +110,8 @@ using BatchKernel = void (*)(const TriangleBatch& batch, ClosestPointsBatch& out
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPointsBatch& out);
 /// The AVX-512 batch kernel, or nullptr where this build or this CPU has none.
 BatchKernel closest_points_triangles_batch_avx512_if_supported();
+/// The AVX2 batch kernel (four lanes at a time), or nullptr where this build or this CPU has none.
+BatchKernel closest_points_triangles_batch_avx2_if_supported();
 using ApartBatchTest = unsigned (*)(const TriangleBatch& batch, double reach);
 /// triangles_apart_batch pair by pair, through triangles_apart.
 unsigned triangles_apart_batch_by_pair(const TriangleBatch& batch, double reach);
