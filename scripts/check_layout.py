@@ -85,7 +85,7 @@ def main():
     breaches = []
     for folder in ("src", "apps", "python", "bench", "examples"):
         for path in sorted((root / folder).rglob("*")):
-            if path.suffix not in (".cpp", ".h"):
+            if path.suffix not in (".cpp", ".h", ".inc"):
                 continue
             count = len(path.read_text().splitlines())
             if count > MAX_FILE:

@@ -5,7 +5,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/setup.sh"
 # The C++ follows .clang-format (clang-format -i FILE fixes a file).
-(cd "$root" && git ls-files 'include/*.h' 'src/*.cpp' 'src/*.h' 'apps/*.cpp' 'apps/*.h' 'bench/*.cpp' 'bench/*.h' \
+(cd "$root" && git ls-files 'include/*.h' 'src/*.cpp' 'src/*.h' 'src/*.inc' 'apps/*.cpp' 'apps/*.h' 'bench/*.cpp' 'bench/*.h' \
   'tests/*.cpp' 'tests/*.h' 'python/*.cpp' 'python/*.h' 'examples/*.cpp' | xargs clang-format --dry-run -Werror) ||
   { echo "test: the files above do not follow .clang-format (clang-format -i FILE)" >&2; exit 1; }
 echo "test: the C++ follows .clang-format"

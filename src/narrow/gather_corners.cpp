@@ -3,7 +3,6 @@
 
 #include "narrow/pair_context.h"
 
-#include <Eigen/Core>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
