@@ -76,8 +76,9 @@ struct Sample {
 std::string g_scenes = CALIBER_BENCH_SCENES;
 std::map<std::string, Sample> g_samples;
 
-/// Every leaf pair of the CD tree whose node test passes (what traverse_depth_first hands to the
-/// leaf test), in the traversal's order.
+/// Every leaf pair of the CD tree whose node test passes and whose normals face each other (what
+/// traverse_depth_first hands to the leaf test, less what its normal test refuses before any
+/// kernel), in the traversal's order.
 void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t context, std::vector<TrianglePair>& out) {
   using caliber::narrow::NodePair;
   // Each node with its parent (the root's its own: tested by node_test).
@@ -89,6 +90,7 @@ void collect_leaf_pairs(const caliber::narrow::PairContext& ctx, std::uint32_t c
     const caliber::BvhNode& a = ctx.a().nodes[n.a];
     const caliber::BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) {
+      if (!ctx.normals_allow(a.index, b.index)) continue;
       TrianglePair p;
       const auto& tri = ctx.a().mesh.triangles[a.index];
       for (int k = 0; k < 3; ++k) {

@@ -1,9 +1,9 @@
 #pragma once
 /// \file
 /// Three-vectors in four AVX2 lanes for the triangle kernel (triangle_distance_avx2.cpp: a lane
-/// per feature pair) and the batched intersection test (triangle_intersect_avx2.cpp: a lane per
-/// triangle pair), each operation the IEEE operation the portable code does (no FMA), so that every
-/// lane computes its bits. Included only by code built for x86-64 with GNU C++; every
+/// per feature pair) and the batched tests (triangle_intersect_avx2.cpp, triangle_apart_avx2.cpp,
+/// triangle_distance_batch_avx2.cpp: a lane per triangle pair), each operation the IEEE operation
+/// the portable code does (no FMA), so that every lane computes its bits. Included only by code built for x86-64 with GNU C++; every
 /// function is compiled for AVX2 alone, chosen at run time.
 
 #if defined(__x86_64__) && defined(__GNUC__)

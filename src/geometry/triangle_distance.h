@@ -71,8 +71,9 @@ struct ClosestPointsBatch {
 };
 
 /// closest_points_triangles of every pair of `batch`: out.get(i) is exactly (the same bits) what
-/// closest_points_triangles returns for pair i. Where the CPU has AVX-512, one pair per lane (the
-/// kernel's feature pairs in its order, each lane's the same IEEE operations), else pair by pair.
+/// closest_points_triangles returns for pair i. One pair per lane (the kernel's feature pairs in its
+/// order, each lane's the same IEEE operations): eight AVX-512 lanes, or four AVX2 lanes twice where
+/// the CPU has no AVX-512; else pair by pair.
 /// Pads the batch (TriangleBatch::pad) first.
 void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out);
 
@@ -89,8 +90,8 @@ bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Ve
 bool triangles_apart(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 
 /// triangles_apart of every pair of `batch` (reach >= 0): bit i set where pair i is apart. Eight
-/// AVX-512 lanes where the CPU has them, else pair by pair; the same verdicts either way. Pads the
-/// batch (TriangleBatch::pad) first.
+/// AVX-512 lanes where the CPU has them, four AVX2 lanes twice where it has AVX2 alone, else pair
+/// by pair; the same verdicts every way. Pads the batch (TriangleBatch::pad) first.
 unsigned triangles_apart_batch(TriangleBatch& batch, double reach);
 
 /// The plane test alone: true when every corner of q is on one side of the plane of triangle p,

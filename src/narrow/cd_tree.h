@@ -138,7 +138,8 @@ extern const detail::WideTest kWideTest;
 
 /// The node tests of the wide visit v of node n on its children: bit k set where child k
 /// (cd_children order) passes the wide test (detail::WideTest; its staying node read from or kept
-/// in `cache`, if given), then the groups and normal cones (PairContext::groups_and_cones_allow).
+/// in `cache`, if given), then the groups and normal cones (PairContext::groups_and_cones_allow)
+/// of each that is not a pair of leaves.
 inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes,
                           detail::StayingCache* cache = nullptr) {
   // (Null also before the library's constants are made: a query from another constant's constructor.)

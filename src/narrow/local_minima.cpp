@@ -34,7 +34,11 @@ class EntryTable {
  public:
   EntryTable(const std::vector<Entry>& entries, std::size_t grain) : mEntries(entries) {
     std::size_t capacity = 16;
-    while (capacity < 2 * entries.size()) capacity *= 2;
+    mShift = 60;
+    while (capacity < 2 * entries.size()) {
+      capacity *= 2;
+      --mShift;
+    }
     mMask = capacity - 1;
     mSlots.assign(capacity, kEmpty);
     parallel::parallel_for(0, entries.size(), grain, [&](std::size_t lo, std::size_t hi) {
@@ -64,14 +68,16 @@ class EntryTable {
  private:
   /// Entry positions; kEmpty marks a free slot (2^32 - 1 candidates of 64 bytes cannot be in memory).
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
-  /// Fibonacci hashing: the high bits of the key times 2^64 / phi, folded to the table's size.
+  /// Fibonacci hashing: the top log2(capacity) bits of the key times 2^64 / phi, which every bit
+  /// of both ids moves (the low bits would not see A's id beyond its residue modulo the capacity).
   [[nodiscard]] std::size_t slot(std::uint64_t key) const {
-    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 32) & mMask;
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> mShift);
   }
 
   const std::vector<Entry>& mEntries;
   std::vector<std::uint32_t> mSlots;
   std::size_t mMask = 0;
+  int mShift = 60;  ///< 64 - log2(capacity)
 };
 
 /// How many candidates on each side of a candidate the reduction looks at before its lookups.

@@ -259,6 +259,8 @@ class PairContext {
   /// Reads the corners of the pairs waiting in `waiting` (their ids, batch.size of them) into its
   /// batch, B's moved into A's frame with b_vertex's arithmetic: the same bits as corners().
   void gather_corners(BufferedPairs& waiting) const;
+  /// The contact kind's normal test on a leaf pair (true for other kinds): a leaf test's first step.
+  [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
 
  private:
   /// Relative safety margin on every bound: rounding in the transformed centers and vertices is a
@@ -311,8 +313,6 @@ class PairContext {
   void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   /// The buffered interference tests (gather_corners, triangles_intersect_batch): the pairs that meet to `out`.
   void intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const;
-  /// The contact kind's normal test on a leaf pair (true for the other kinds).
-  [[nodiscard]] bool normals_allow(std::uint32_t ta, std::uint32_t tb) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;
   static double square(double x) { return x * x; }
   /// The box of a prepared node of A (SideA or NearA).
