@@ -3,7 +3,6 @@
 
 #include "narrow/pair_context.h"
 
-
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
