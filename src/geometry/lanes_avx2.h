@@ -2,14 +2,17 @@
 /// \file
 /// Three-vectors in four AVX2 lanes for the triangle kernel (triangle_distance_avx2.cpp: a lane
 /// per feature pair) and the batched tests (triangle_intersect_avx2.cpp, triangle_apart_avx2.cpp,
-/// triangle_distance_batch_avx2.cpp: a lane per triangle pair), each operation the IEEE operation
-/// the portable code does (no FMA), so that every lane computes its bits. Included only by code built for x86-64 with GNU C++; every
+/// triangle_distance_batch_avx2.cpp: a lane per triangle pair, the last two through
+/// lanes_avx2_masked.h), each operation the IEEE operation the portable code does (no FMA), so
+/// that every lane computes its bits. Included only by code built for x86-64 with GNU C++; every
 /// function is compiled for AVX2 alone, chosen at run time.
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
 #include <Eigen/Core>
+
+#include "geometry/triangle_distance.h"
 
 namespace caliber::geometry::lanes4 {
 
@@ -106,6 +109,37 @@ CALIBER_AVX2 inline Triangle4 load(const Vec3 t[3]) {
   r.len2 = dot(r.e, r.e);
   return r;
 }
+
+/// Eigen's cross product, coordinate by coordinate.
+CALIBER_AVX2 inline Pack3 cross(const Pack3& u, const Pack3& v) {
+  return {_mm256_sub_pd(_mm256_mul_pd(u.y, v.z), _mm256_mul_pd(u.z, v.y)),
+          _mm256_sub_pd(_mm256_mul_pd(u.z, v.x), _mm256_mul_pd(u.x, v.z)),
+          _mm256_sub_pd(_mm256_mul_pd(u.x, v.y), _mm256_mul_pd(u.y, v.x))};
+}
+
+/// Lanes 4 half to 4 half + 3 of a corner of a batch's triangles ([coordinate][pair]).
+CALIBER_AVX2 inline Pack3 load_half(const double (&c)[3][TriangleBatch::kLanes], int half) {
+  return {_mm256_load_pd(c[0] + 4 * half), _mm256_load_pd(c[1] + 4 * half), _mm256_load_pd(c[2] + 4 * half)};
+}
+
+/// Half `half` of a batch's triangles of one side (TriangleBatch::a or b; lanes 4 half to 4 half +
+/// 3) with what both batch kernels read, lanes8::Triangle8's values by the same operations: the
+/// edges (corner i to corner i + 1), ac (corner 0 to 2), the normal ab x ac (ab is edge 0) and
+/// the squared lengths of ab, ac and the normal.
+struct BatchHalf {
+  Pack3 v[3], e[3], ac, normal;
+  __m256d ab2, ac2, normal2;
+
+  CALIBER_AVX2 BatchHalf(const double (&c)[3][3][TriangleBatch::kLanes], int half) {
+    for (int k = 0; k < 3; ++k) v[k] = load_half(c[k], half);
+    for (int i = 0; i < 3; ++i) e[i] = v[(i + 1) % 3] - v[i];
+    ac = v[2] - v[0];
+    normal = cross(e[0], ac);
+    ab2 = dot(e[0], e[0]);
+    ac2 = dot(ac, ac);
+    normal2 = dot(normal, normal);
+  }
+};
 
 #undef CALIBER_AVX2
 

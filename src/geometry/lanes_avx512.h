@@ -59,6 +59,26 @@ CALIBER_AVX512 inline P3 pick(M mask, const P3& u, const P3& v) {
 /// maxsd does there, so NaN falls to 0.
 CALIBER_AVX512 inline D clamp01(D t) { return _mm512_min_pd(_mm512_max_pd(t, _mm512_setzero_pd()), all_lanes(1.0)); }
 
+CALIBER_AVX512 inline D root(D u) { return _mm512_sqrt_pd(u); }
+CALIBER_AVX512 inline D magnitude(D u) {
+  return _mm512_castsi512_pd(_mm512_andnot_si512(_mm512_set1_epi64(INT64_MIN), _mm512_castpd_si512(u)));
+}
+CALIBER_AVX512 inline D min_lanes(D u, D v) { return _mm512_min_pd(u, v); }
+CALIBER_AVX512 inline D max_lanes(D u, D v) { return _mm512_max_pd(u, v); }
+CALIBER_AVX512 inline M eq(D u, D v) { return _mm512_cmp_pd_mask(u, v, _CMP_EQ_OQ); }
+CALIBER_AVX512 inline M every_lane() { return 0xFF; }
+CALIBER_AVX512 inline M no_lane() { return 0; }
+CALIBER_AVX512 inline bool none(M m) { return m == 0; }
+CALIBER_AVX512 inline bool all_set(M m) { return m == 0xFF; }
+CALIBER_AVX512 inline M not_lanes(M m) { return static_cast<M>(~m); }
+/// u where the mask is set, else 0.
+CALIBER_AVX512 inline D keep(M m, D u) { return _mm512_maskz_mov_pd(m, u); }
+/// base + step where the mask is set, else base.
+CALIBER_AVX512 inline P3 add_where(M m, const P3& base, const P3& step) {
+  return {_mm512_mask_add_pd(base.x, m, base.x, step.x), _mm512_mask_add_pd(base.y, m, base.y, step.y),
+          _mm512_mask_add_pd(base.z, m, base.z, step.z)};
+}
+
 CALIBER_AVX512 inline P3 load(const double (&c)[3][TriangleBatch::kLanes]) {
   return {_mm512_load_pd(c[0]), _mm512_load_pd(c[1]), _mm512_load_pd(c[2])};
 }

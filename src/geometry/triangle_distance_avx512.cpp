@@ -17,17 +17,6 @@ using namespace lanes8;
 #define CALIBER_LANES CALIBER_AVX512
 
 using Tri = Triangle8;
-CALIBER_AVX512 inline D root(D u) { return _mm512_sqrt_pd(u); }
-CALIBER_AVX512 inline M eq(D u, D v) { return _mm512_cmp_pd_mask(u, v, _CMP_EQ_OQ); }
-CALIBER_AVX512 inline M every_lane() { return 0xFF; }
-CALIBER_AVX512 inline bool none(M m) { return m == 0; }
-CALIBER_AVX512 inline bool all_set(M m) { return m == 0xFF; }
-CALIBER_AVX512 inline M not_lanes(M m) { return static_cast<M>(~m); }
-CALIBER_AVX512 inline D keep(M m, D u) { return _mm512_maskz_mov_pd(m, u); }
-CALIBER_AVX512 inline P3 add_where(M m, const P3& base, const P3& step) {
-  return {_mm512_mask_add_pd(base.x, m, base.x, step.x), _mm512_mask_add_pd(base.y, m, base.y, step.y),
-          _mm512_mask_add_pd(base.z, m, base.z, step.z)};
-}
 
 #include "geometry/triangle_batch_kernel.inc"
 

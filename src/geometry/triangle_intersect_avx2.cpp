@@ -32,15 +32,6 @@ CALIBER_AVX2 inline D none() { return _mm256_setzero_pd(); }
 /// The lanes where u and v agree (both set or both clear).
 CALIBER_AVX2 inline D agree(D u, D v) { return _mm256_xor_pd(_mm256_xor_pd(u, v), _mm256_castsi256_pd(_mm256_set1_epi64x(-1))); }
 CALIBER_AVX2 inline D magnitude(D u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
-/// Eigen's cross product, coordinate by coordinate.
-CALIBER_AVX2 inline Pack3 cross(const Pack3& u, const Pack3& v) {
-  return {sub(mul(u.y, v.z), mul(u.z, v.y)), sub(mul(u.z, v.x), mul(u.x, v.z)), sub(mul(u.x, v.y), mul(u.y, v.x))};
-}
-/// Lanes 4 half .. 4 half + 3 of corner c of a batch's triangles.
-CALIBER_AVX2 inline Pack3 load(const double (&c)[3][TriangleBatch::kLanes], int half) {
-  return {_mm256_load_pd(c[0] + 4 * half), _mm256_load_pd(c[1] + 4 * half), _mm256_load_pd(c[2] + 4 * half)};
-}
-
 /// The plane of triangle p against q's corners: `pos` and `neg` the lanes where the sign of
 /// corner i is trusted positive or negative.
 struct PlaneSigns {
@@ -126,8 +117,8 @@ CALIBER_AVX2 inline void planes_cross_meet(const Pack3 a[3], const Pack3 b[3], c
 /// Four lanes of the batch (4 half .. 4 half + 3): the lanes whose verdict the filters decided
 /// (`decided`) and, of those, the ones that meet, as four bits each.
 CALIBER_AVX2 inline void intersect_half(const TriangleBatch& batch, int half, unsigned& decided, unsigned& meets) {
-  const Pack3 a[3] = {load(batch.a[0], half), load(batch.a[1], half), load(batch.a[2], half)};
-  const Pack3 b[3] = {load(batch.b[0], half), load(batch.b[1], half), load(batch.b[2], half)};
+  const Pack3 a[3] = {load_half(batch.a[0], half), load_half(batch.a[1], half), load_half(batch.a[2], half)};
+  const Pack3 b[3] = {load_half(batch.b[0], half), load_half(batch.b[1], half), load_half(batch.b[2], half)};
   const PlaneSigns sa = plane_signs(b, a);  // A's corners against B's plane
   const PlaneSigns sb = plane_signs(a, b);  // B's corners against A's plane
   // One plane with the other triangle strictly on one side: apart.
