@@ -123,7 +123,7 @@ CALIBER_AVX2 inline Pack3 load_half(const double (&c)[3][TriangleBatch::kLanes],
 }
 
 /// Half `half` of a batch's triangles of one side (TriangleBatch::a or b; lanes 4 half to 4 half +
-/// 3) with what both batch kernels read, lanes8::Triangle8's values by the same operations: the
+/// 3) with what the refusal batch reads, lanes8::Triangle8's values by the same operations: the
 /// edges (corner i to corner i + 1), ac (corner 0 to 2), the normal ab x ac (ab is edge 0) and
 /// the squared lengths of ab, ac and the normal.
 struct BatchHalf {
