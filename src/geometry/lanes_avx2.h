@@ -34,6 +34,12 @@ CALIBER_AVX2 inline Pack3 operator+(const Pack3& u, const Pack3& v) {
 CALIBER_AVX2 inline Pack3 operator-(const Pack3& u, const Pack3& v) {
   return {_mm256_sub_pd(u.x, v.x), _mm256_sub_pd(u.y, v.y), _mm256_sub_pd(u.z, v.z)};
 }
+CALIBER_AVX2 inline Pack3 broadcast(const Vec3& v) {
+  return {_mm256_set1_pd(v.x()), _mm256_set1_pd(v.y()), _mm256_set1_pd(v.z())};
+}
+/// Absolute values.
+CALIBER_AVX2 inline __m256d magnitude(__m256d u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
+CALIBER_AVX2 inline Pack3 magnitude(const Pack3& u) { return {magnitude(u.x), magnitude(u.y), magnitude(u.z)}; }
 /// s * v, as Eigen's scalar times vector: s * v[k] for each coordinate.
 CALIBER_AVX2 inline Pack3 operator*(__m256d s, const Pack3& v) {
   return {_mm256_mul_pd(s, v.x), _mm256_mul_pd(s, v.y), _mm256_mul_pd(s, v.z)};
@@ -140,6 +146,19 @@ struct BatchHalf {
     normal2 = dot(normal, normal);
   }
 };
+
+/// kernel::slab_clear's test of the corners w (relative to p or q) against v, |v| being m.
+CALIBER_AVX2 inline __m256d slab_side(const Pack3& w, const Pack3& v, const Pack3& m) {
+  return ge(dot(w, v), _mm256_mul_pd(dot(magnitude(w), m), _mm256_set1_pd(-0x1p-49)));
+}
+
+/// kernel::slab_clear (triangle_kernel.h) with A's corners in the lanes of ca and B's in cb (each
+/// lane a corner: Triangle4's fourth repeats its first): the same expressions in the same order.
+CALIBER_AVX2 inline bool slab_clear_x4(const Pack3& ca, const Pack3& cb, const Vec3& p, const Vec3& q) {
+  const Pack3 bp = broadcast(p), bq = broadcast(q);
+  const Pack3 v = bq - bp, m = magnitude(v);
+  return _mm256_movemask_pd(_mm256_and_pd(slab_side(bp - ca, v, m), slab_side(cb - bq, v, m))) == 0xF;
+}
 
 #undef CALIBER_AVX2
 

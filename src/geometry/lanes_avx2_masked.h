@@ -16,6 +16,7 @@ namespace caliber::geometry::lanes4::masked {
 
 using lanes4::cross;
 using lanes4::dot;
+using lanes4::magnitude;
 using lanes4::negate;
 using lanes4::Pack3;
 using lanes4::pick;
@@ -49,7 +50,6 @@ CALIBER_AVX2 inline D all_lanes(double v) { return _mm256_set1_pd(v); }
 /// u where the mask is set, else 0 (_mm512_maskz_mov_pd).
 CALIBER_AVX2 inline D keep(M m, D u) { return _mm256_and_pd(m.m, u); }
 CALIBER_AVX2 inline D root(D u) { return _mm256_sqrt_pd(u); }
-CALIBER_AVX2 inline D magnitude(D u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
 CALIBER_AVX2 inline D min_lanes(D u, D v) { return _mm256_min_pd(u, v); }
 CALIBER_AVX2 inline D max_lanes(D u, D v) { return _mm256_max_pd(u, v); }
 CALIBER_AVX2 inline M no_lane() { return _mm256_setzero_pd(); }

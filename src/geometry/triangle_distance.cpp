@@ -185,6 +185,7 @@ ClosestPoints nearest_of_frames(const Vec3 a[3], const Vec3 b[3], const kernel::
       nearest.consider(c1, c2);
     }
   }
+  if (slab_clear(a, b, nearest.best.on_a, nearest.best.on_b)) return nearest.best;
   for (int i = 0; i < 3; ++i) {
     nearest.consider(a[i], closest_point_on_frame(a[i], fb));
     nearest.consider(closest_point_on_frame(b[i], fa), b[i]);

@@ -29,7 +29,8 @@ namespace {
 #define CALIBER_AVX2 __attribute__((target("avx2")))
 
 using namespace lanes4;
-using lanes4::pick;  // beside pick on Frame4 below, which would hide it
+using lanes4::broadcast;  // beside broadcast and pick on Frame4 below, which would hide them
+using lanes4::pick;
 
 /// Four feature pairs' points and squared distances, lane by lane, for Nearest.
 struct FeaturePairs4 {
@@ -157,10 +158,6 @@ CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
   return pick(all(t.solid, in_a), t.a, y);
 }
 
-CALIBER_AVX2 inline Pack3 broadcast(const Vec3& v) {
-  return {_mm256_set1_pd(v.x()), _mm256_set1_pd(v.y()), _mm256_set1_pd(v.z())};
-}
-
 /// One triangle's frame in all four lanes.
 CALIBER_AVX2 Frame4 broadcast(const TriangleFrame& f) {
   return {broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2]),
@@ -232,9 +229,8 @@ CALIBER_AVX2 void add_crossings(const Pack3& p, const Pack3& e, __m256d sp, __m2
 /// uv = sqrt(|ab|^2 |ac|^2): the scalar's expressions in its order, so the same verdict.
 CALIBER_AVX2 inline bool beyond_plane_x4(const Pack3& w, __m256d s, double len, double uv, double reach) {
   if (!(len > 0.0)) return false;
-  const __m256d sign = _mm256_set1_pd(-0.0);
-  const __m256d one_norm =
-      _mm256_add_pd(_mm256_add_pd(_mm256_andnot_pd(sign, w.x), _mm256_andnot_pd(sign, w.y)), _mm256_andnot_pd(sign, w.z));
+  const Pack3 m = magnitude(w);
+  const __m256d one_norm = _mm256_add_pd(_mm256_add_pd(m.x, m.y), m.z);
   const __m256d need = _mm256_add_pd(_mm256_set1_pd(kernel::plane_need(reach, len)),
                                      _mm256_mul_pd(_mm256_set1_pd(kernel::plane_slack(uv)), one_norm));
   const int above = _mm256_movemask_pd(gt(s, need)) & 0x7, below = _mm256_movemask_pd(lt(s, negate(need))) & 0x7;
@@ -244,9 +240,7 @@ CALIBER_AVX2 inline bool beyond_plane_x4(const Pack3& w, __m256d s, double len, 
 /// kernel::axis_apart on four axes at once (edge e of A and f of B in each lane): bit l set where
 /// lane l's axis puts the pair apart. The portable form's expressions in its order.
 CALIBER_AVX2 inline int axes_apart_x4(const Pack3& e, const Pack3& f, const kernel::EdgeAxesPair& pair, double reach) {
-  const Pack3 n{_mm256_sub_pd(_mm256_mul_pd(e.y, f.z), _mm256_mul_pd(e.z, f.y)),
-                _mm256_sub_pd(_mm256_mul_pd(e.z, f.x), _mm256_mul_pd(e.x, f.z)),
-                _mm256_sub_pd(_mm256_mul_pd(e.x, f.y), _mm256_mul_pd(e.y, f.x))};
+  const Pack3 n = cross(e, f);
   const __m256d pa1 = dot(n, broadcast(pair.ab)), pa2 = dot(n, broadcast(pair.ac));
   const __m256d pb0 = dot(n, broadcast(pair.wb[0])), pb1 = dot(n, broadcast(pair.wb[1])), pb2 = dot(n, broadcast(pair.wb[2]));
   const __m256d zero = _mm256_setzero_pd();
@@ -282,8 +276,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
   // The third batch replaced a portable scalar call, which took longer than both batches together
   // (the kernel's measurements: bench/results/intel-xeon-2c/kernels/README.md).
-  // Every feature pair is computed first and offered in order at the end, so that the batches do not
-  // wait on one another.
+  // All three batches are computed before any is offered, so that they do not wait on one another.
   FeaturePairs4 edges[3];
   closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
                           gather<0, 1, 2, 0>(tb.v), gather<0, 1, 2, 0>(tb.e), gather<0, 1, 2, 0>(tb.len2), edges[0]);
@@ -291,6 +284,10 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
                           gather<1, 2, 0, 1>(tb.v), gather<1, 2, 0, 1>(tb.e), gather<1, 2, 0, 1>(tb.len2), edges[1]);
   closest_points_edges_x4(gather<2, 2, 2, 2>(ta.v), gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(ta.len2),
                           gather<2, 2, 2, 2>(tb.v), gather<2, 2, 2, 2>(tb.e), gather<2, 2, 2, 2>(tb.len2), edges[2]);
+  take(edges[0], 0xF, nearest);
+  take(edges[1], 0xF, nearest);
+  take(edges[2], 0x1, nearest);
+  if (slab_clear_x4(ta.v, tb.v, nearest.best.on_a, nearest.best.on_b)) return nearest.best;
 
   // Vertex-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
@@ -310,9 +307,6 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   FeaturePairs4 projected[Projections::kMost / 4];
   project(points, fa, fb, projected);
 
-  take(edges[0], 0xF, nearest);
-  take(edges[1], 0xF, nearest);
-  take(edges[2], 0x1, nearest);
   for (int first = 0; first < points.count; first += 4) {
     take(projected[first / 4], points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
   }
@@ -371,19 +365,17 @@ __attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const
   return pair_apart(Pair4(a, b), b, reach);
 }
 
-ApartTest triangles_apart_avx2_if_supported() {
+/// `form` where the CPU has AVX2, else nullptr.
+template <class Form>
+Form where_avx2(Form form) {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? &triangles_apart_avx2 : nullptr;
+  return __builtin_cpu_supports("avx2") ? form : nullptr;
 }
 
-TriangleKernel closest_points_triangles_avx2_if_supported() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? &closest_points_triangles_avx2 : nullptr;
-}
-
+ApartTest triangles_apart_avx2_if_supported() { return where_avx2<ApartTest>(&triangles_apart_avx2); }
+TriangleKernel closest_points_triangles_avx2_if_supported() { return where_avx2<TriangleKernel>(&closest_points_triangles_avx2); }
 WithinKernel closest_points_triangles_within_avx2_if_supported() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? &closest_points_triangles_within_avx2 : nullptr;
+  return where_avx2<WithinKernel>(&closest_points_triangles_within_avx2);
 }
 
 }  // namespace detail

@@ -31,7 +31,6 @@ CALIBER_AVX2 inline D but_not(D u, D v) { return _mm256_andnot_pd(v, u); }
 CALIBER_AVX2 inline D none() { return _mm256_setzero_pd(); }
 /// The lanes where u and v agree (both set or both clear).
 CALIBER_AVX2 inline D agree(D u, D v) { return _mm256_xor_pd(_mm256_xor_pd(u, v), _mm256_castsi256_pd(_mm256_set1_epi64x(-1))); }
-CALIBER_AVX2 inline D magnitude(D u) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), u); }
 /// The plane of triangle p against q's corners: `pos` and `neg` the lanes where the sign of
 /// corner i is trusted positive or negative.
 struct PlaneSigns {

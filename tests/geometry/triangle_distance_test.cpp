@@ -1,8 +1,10 @@
 #include "geometry/triangle_distance.h"
 #include "geometry/triangle_distance_reference.h"
 
+#include <algorithm>
 #include <cstring>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -146,28 +148,51 @@ int random_pair(std::mt19937_64& rng, int iter, Vec3 (&a)[3], Vec3 (&b)[3], doub
   return k;
 }
 
-/// The kernel against its 2a20389 form, bit for bit, on triangle pairs of every kind the leaf test
-/// meets (random_pair).
-TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
+bool same_result(const ClosestPoints& x, const ClosestPoints& y) {
+  return same_bits(x.on_a, y.on_a) && same_bits(x.on_b, y.on_b) && std::memcmp(&x.distance, &y.distance, sizeof(double)) == 0;
+}
+
+/// Where the kernel's early stop (kernel::slab_clear) keeps an edge pair that the 2a20389 kernel,
+/// going on, replaced by a pair nearer by rounding: that edge pair is `got`. Its distance is then
+/// no less than the old kernel's (a minimum over more pairs, this one among them) and above it by
+/// no more than the stop's allowance (about 2^-46 of the triangles' extent; 2^-44 of their largest
+/// coordinate here, which also covers the rounding of points far from the origin).
+bool within_stop_allowance(const ClosestPoints& got, const ClosestPoints& old, const Vec3 a[3], const Vec3 b[3], double& worst) {
+  double largest = 0.0;
+  for (int i = 0; i < 3; ++i) largest = std::max({largest, a[i].cwiseAbs().maxCoeff(), b[i].cwiseAbs().maxCoeff()});
+  worst = std::max(worst, (got.distance - old.distance) / largest);
+  return got.distance >= old.distance && got.distance - old.distance <= 0x1p-44 * largest;
+}
+
+/// Every form of the kernel against the portable one, bit for bit, on triangle pairs of every kind
+/// the leaf test meets (random_pair); the portable one against its 2a20389 form: the same bits, or
+/// the edge pair its early stop proved nearest, at the old distance within the stop's allowance.
+TEST(TriangleDistance, EveryFormSameBitsAndTheReferenceDistance) {
   std::mt19937_64 rng(20261123);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const auto random_point = [&] { return Vec3(u(rng), u(rng), u(rng)); };
-  int differing = 0;
-  // Every form this build and this CPU have: the one the library calls, the portable one, AVX2.
-  std::vector<std::pair<const char*, detail::TriangleKernel>> kernels{{"dispatched", &closest_points_triangles},
-                                                                      {"portable", &detail::closest_points_triangles_portable}};
+  int differing = 0, moved = 0;
+  double worst = 0.0;
+  // Every other form this build and this CPU have: the one the library calls, AVX2.
+  std::vector<std::pair<const char*, detail::TriangleKernel>> kernels{{"dispatched", &closest_points_triangles}};
   if (const detail::TriangleKernel avx2 = detail::closest_points_triangles_avx2_if_supported())
     kernels.emplace_back("avx2", avx2);
-  for (int iter = 0; iter < 200000; ++iter) {
+  const int pairs = 200000;
+  for (int iter = 0; iter < pairs; ++iter) {
     Vec3 a[3], b[3];
     double scale = 1.0;
     const int k = random_pair(rng, iter, a, b, scale);
-    const ClosestPoints want = reference::closest_points_triangles(a, b);
+    const ClosestPoints want = detail::closest_points_triangles_portable(a, b);
+    if (const ClosestPoints old = reference::closest_points_triangles(a, b); !same_result(want, old)) {
+      ++moved;
+      if (!within_stop_allowance(want, old, a, b, worst) && ++differing <= 5) {
+        ADD_FAILURE() << "portable against 2a20389, iteration " << iter << " kind " << k << ": " << want.distance << " vs "
+                      << old.distance;
+      }
+    }
     for (const auto& [form, kernel] : kernels) {
       const ClosestPoints got = kernel(a, b);
-      const bool same = same_bits(got.on_a, want.on_a) && same_bits(got.on_b, want.on_b) &&
-                        std::memcmp(&got.distance, &want.distance, sizeof(double)) == 0;
-      if (!same && ++differing <= 5) {
+      if (!same_result(got, want) && ++differing <= 5) {
         ADD_FAILURE() << form << ", iteration " << iter << " kind " << k << ": " << got.distance << " vs " << want.distance;
       }
     }
@@ -180,12 +205,16 @@ TEST(TriangleDistance, SameBitsAsTheReferenceKernel) {
     }
   }
   EXPECT_EQ(differing, 0);
+  // The stop breaks some ties the other way, by rounding; most pairs keep the old bits.
+  EXPECT_LT(moved, pairs / 20);
+  RecordProperty("moved", moved);
+  RecordProperty("worst_in_2^-52_of_the_largest_coordinate", std::to_string(worst / 0x1p-52));
 }
 
-/// The batch kernel, every form, against the 2a20389 kernel bit for bit: the same pairs as
-/// SameBitsAsTheReferenceKernel, in batches of every size from 1 to 8 (a lane of a partial batch
+/// The batch kernel, every form, against the portable kernel bit for bit: the same pairs as
+/// EveryFormSameBitsAndTheReferenceDistance, in batches of every size from 1 to 8 (a lane of a partial batch
 /// must not depend on the padding), each pair's kind in different lanes from batch to batch.
-TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
+TEST(TriangleDistance, BatchSameBitsAsThePortableKernel) {
   std::mt19937_64 rng(20261123);
   std::vector<std::pair<const char*, detail::BatchKernel>> kernels{{"dispatched", nullptr},
                                                                    {"by pair", &detail::closest_points_triangles_batch_by_pair}};
@@ -204,7 +233,7 @@ TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
       Vec3 a[3], b[3];
       double scale = 1.0;
       kinds[l] = random_pair(rng, iter, a, b, scale);
-      want[l] = reference::closest_points_triangles(a, b);
+      want[l] = detail::closest_points_triangles_portable(a, b);
       batch.add(a, b);
     }
     for (const auto& [form, kernel] : kernels) {
@@ -219,9 +248,7 @@ TEST(TriangleDistance, BatchSameBitsAsTheReferenceKernel) {
       }
       for (int l = 0; l < size; ++l) {
         const ClosestPoints got = lanes.get(l);
-        const bool same = same_bits(got.on_a, want[l].on_a) && same_bits(got.on_b, want[l].on_b) &&
-                          std::memcmp(&got.distance, &want[l].distance, sizeof(double)) == 0;
-        if (!same && ++differing <= 5) {
+        if (!same_result(got, want[l]) && ++differing <= 5) {
           ADD_FAILURE() << form << ", batch " << batches << " lane " << l << " kind " << kinds[l] << ": " << got.distance
                         << " vs " << want[l].distance;
         }
@@ -248,15 +275,14 @@ TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
     Vec3 a[3], b[3];
     double scale = 1.0;
     const int k = random_pair(rng, iter, a, b, scale);
-    const ClosestPoints want = reference::closest_points_triangles(a, b);
-    const double reach = want.distance * factors[iter % 7];
+    const ClosestPoints want = detail::closest_points_triangles_portable(a, b);
+    const double distance = reference::closest_points_triangles(a, b).distance;  // the nearest of all feature pairs
+    const double reach = distance * factors[iter % 7];
     int first_verdict = -1;
     for (const auto& [form, within] : kernels) {
       ClosestPoints got{};
       const bool computed = within(a, b, reach, got);
-      const bool ok = computed ? same_bits(got.on_a, want.on_a) && same_bits(got.on_b, want.on_b) &&
-                                     std::memcmp(&got.distance, &want.distance, sizeof(double)) == 0
-                               : want.distance > reach;
+      const bool ok = computed ? same_result(got, want) : distance > reach;
       const bool agrees = first_verdict < 0 || first_verdict == int(computed);
       if ((!ok || !agrees) && ++failures <= 5) {
         ADD_FAILURE() << form << ", iteration " << iter << " kind " << k << ": computed " << computed << ", distance "
