@@ -173,50 +173,54 @@ namespace detail {
 
 namespace {
 
-ClosestPoints nearest_of_frames(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa,
-                                const kernel::TriangleFrame& fb) {
-  using namespace kernel;
-  const EdgeVectors e(a, b);
-  Nearest nearest(a[0], b[0]);
+/// The kernel's edge pairs, taken into `nearest` (which starts at the corners 0): true where the
+/// early stop (slab_clear) settles the pair there.
+bool edge_pairs(const Vec3 a[3], const Vec3 b[3], kernel::Nearest& nearest) {
+  const kernel::EdgeVectors e(a, b);
   Vec3 c1, c2;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      closest_points_edges(a[i], e.a[i], e.la[i], b[j], e.b[j], e.lb[j], c1, c2);
+      kernel::closest_points_edges(a[i], e.a[i], e.la[i], b[j], e.b[j], e.lb[j], c1, c2);
       nearest.consider(c1, c2);
     }
   }
-  if (slab_clear(a, b, nearest.best.on_a, nearest.best.on_b)) return nearest.best;
+  return kernel::slab_clear(a, b, nearest.best.on_a, nearest.best.on_b);
+}
+
+/// The kernel's other feature pairs, taken into `nearest` after the edge pairs.
+void face_pairs(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa, const kernel::TriangleFrame& fb,
+                kernel::Nearest& nearest) {
+  using kernel::closest_point_on_frame;
   for (int i = 0; i < 3; ++i) {
     nearest.consider(a[i], closest_point_on_frame(a[i], fb));
     nearest.consider(closest_point_on_frame(b[i], fa), b[i]);
   }
-  consider_crossings(a, b, fa, fb, nearest);
-  return nearest.best;
+  kernel::consider_crossings(a, b, fa, fb, nearest);
 }
 
 }  // namespace
 
 ClosestPoints closest_points_triangles_portable(const Vec3 a[3], const Vec3 b[3]) {
-  const kernel::TriangleFrame fa(a), fb(b);
-  return nearest_of_frames(a, b, fa, fb);
+  kernel::Nearest nearest(a[0], b[0]);
+  if (!edge_pairs(a, b, nearest)) face_pairs(a, b, kernel::TriangleFrame(a), kernel::TriangleFrame(b), nearest);
+  return nearest.best;
 }
-
-namespace {
-bool frames_apart(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa, const kernel::TriangleFrame& fb,
-                  double reach) {
-  return kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(fa, b, reach);
-}
-}  // namespace
 
 bool closest_points_triangles_within_portable(const Vec3 a[3], const Vec3 b[3], double reach, ClosestPoints& out) {
   const kernel::TriangleFrame fa(a), fb(b);
-  if (frames_apart(a, b, fa, fb, reach)) return false;
-  out = nearest_of_frames(a, b, fa, fb);
+  if (kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach)) return false;
+  kernel::Nearest nearest(a[0], b[0]);
+  if (!edge_pairs(a, b, nearest)) {
+    if (kernel::edges_apart(fa, b, reach)) return false;
+    face_pairs(a, b, fa, fb, nearest);
+  }
+  out = nearest.best;
   return true;
 }
 
 bool triangles_apart_portable(const Vec3 a[3], const Vec3 b[3], double reach) {
-  return frames_apart(a, b, kernel::TriangleFrame(a), kernel::TriangleFrame(b), reach);
+  const kernel::TriangleFrame fa(a), fb(b);
+  return kernel::beyond_plane(fa, b, reach) || kernel::beyond_plane(fb, a, reach) || kernel::edges_apart(fa, b, reach);
 }
 
 void closest_points_triangles_batch_by_pair(const TriangleBatch& batch, ClosestPointsBatch& out) {

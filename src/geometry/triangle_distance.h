@@ -85,15 +85,18 @@ struct ClosestPointsBatch {
 void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& out);
 
 /// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
-/// untouched) when a direction certifiably puts the triangles farther apart than `reach` (a plane
-/// of one triangle with the whole other triangle beyond it, or the cross product of an edge of
-/// each with the corners' projections apart: edge_axes.h), else true with `out` exactly what
-/// closest_points_triangles returns. The plane test shares the kernel's normals and signed
-/// distances; it may also return true for pairs farther apart than `reach`.
+/// untouched) when a direction certifiably puts the triangles farther apart than `reach`, else true
+/// with `out` exactly what closest_points_triangles returns. The directions: a plane of one
+/// triangle with the whole other triangle beyond it (tested first, sharing the kernel's normals
+/// and signed distances), then, unless the kernel's edge pairs settle the pair (its early stop:
+/// then true, whatever the distance), the cross product of an edge of each with the corners'
+/// projections apart (edge_axes.h). It may return true for pairs farther apart than `reach`.
 bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);
 
-/// closest_points_triangles_within's refusal alone: true exactly where it returns false (the
-/// triangles certifiably farther apart than `reach`), without computing the closest points.
+/// closest_points_triangles_within's refusal alone, without computing the closest points: true
+/// where the triangles are certifiably farther apart than `reach` along one of its directions.
+/// There closest_points_triangles_within returns false, or a pair its early stop settled, whose
+/// distance then exceeds `reach` (less rounding).
 bool triangles_apart(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach);
 
 /// triangles_apart of every pair of `batch` (reach >= 0): bit i set where pair i is apart. Eight

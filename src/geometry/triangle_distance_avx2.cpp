@@ -266,16 +266,11 @@ CALIBER_AVX2 inline bool edges_apart_x4(const TriangleFrame& fa, const Vec3 b[3]
   return (axes_apart_x4(gather<2, 2, 2, 2>(ta.e), gather<2, 2, 2, 2>(tb.e), pair, reach) & 1) != 0;
 }
 
-/// The kernel's feature pairs once the frames, the corners' lanes and their signed distances along
-/// the other's normal (sa: A's corners against B's plane, sb: B's against A's) are known.
-CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(const Vec3 a[3], const Vec3 b[3], const Triangle4& ta,
-                                                                            const Triangle4& tb, const TriangleFrame& fa,
-                                                                            const TriangleFrame& fb, __m256d sa, __m256d sb) {
-  Nearest nearest(a[0], b[0]);
+/// The kernel's edge pairs, taken into `nearest` (which starts at the corners 0): true where the
+/// early stop (kernel::slab_clear) settles the pair there.
+CALIBER_AVX2 __attribute__((always_inline)) inline bool edge_pairs(const Triangle4& ta, const Triangle4& tb, Nearest& nearest) {
   // Edge pairs (i, j) in the portable order: (0,0) (0,1) (0,2) (1,0) in the first four lanes,
   // (1,1) (1,2) (2,0) (2,1) in the next four, (2,2) alone in a third (every lane; lane 0 offered).
-  // The third batch replaced a portable scalar call, which took longer than both batches together
-  // (the kernel's measurements: bench/results/intel-xeon-2c/kernels/README.md).
   // All three batches are computed before any is offered, so that they do not wait on one another.
   FeaturePairs4 edges[3];
   closest_points_edges_x4(gather<0, 0, 0, 1>(ta.v), gather<0, 0, 0, 1>(ta.e), gather<0, 0, 0, 1>(ta.len2),
@@ -287,8 +282,15 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   take(edges[0], 0xF, nearest);
   take(edges[1], 0xF, nearest);
   take(edges[2], 0x1, nearest);
-  if (slab_clear_x4(ta.v, tb.v, nearest.best.on_a, nearest.best.on_b)) return nearest.best;
+  return slab_clear_x4(ta.v, tb.v, nearest.best.on_a, nearest.best.on_b);
+}
 
+/// The kernel's other feature pairs, taken into `nearest` after the edge pairs, once the frames,
+/// the corners' lanes and their signed distances along the other's normal (sa: A's corners against
+/// B's plane, sb: B's against A's) are known.
+CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangle4& ta, const Triangle4& tb,
+                                                                   const TriangleFrame& fa, const TriangleFrame& fb, __m256d sa,
+                                                                   __m256d sb, Nearest& nearest) {
   // Vertex-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
   Projections points;
@@ -310,7 +312,6 @@ CALIBER_AVX2 __attribute__((always_inline)) inline ClosestPoints nearest_of(cons
   for (int first = 0; first < points.count; first += 4) {
     take(projected[first / 4], points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
   }
-  return nearest.best;
 }
 
 /// A triangle pair's lanes, frames and signed distances: what the plane test and the feature
@@ -341,31 +342,38 @@ namespace detail {
 
 __attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
   const Pair4 p(a, b);
-  return nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
+  Nearest nearest(a[0], b[0]);
+  if (!edge_pairs(p.ta, p.tb, nearest)) face_pairs(p.ta, p.tb, p.fa, p.fb, p.sa, p.sb, nearest);
+  return nearest.best;
 }
 
-/// The refusal of closest_points_triangles_within_avx2 on the pair's lanes. Both planes' lengths
-/// and uv in one square root of four lanes (correctly rounded, as std::sqrt).
-__attribute__((target("avx2"), always_inline)) inline bool pair_apart(const Pair4& p, const Vec3 b[3], double reach) {
+/// The plane tests of the refusal on the pair's lanes. Both planes' lengths and uv in one square
+/// root of four lanes (correctly rounded, as std::sqrt).
+__attribute__((target("avx2"), always_inline)) inline bool planes_apart(const Pair4& p, double reach) {
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
-  return beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach) ||
-         edges_apart_x4(p.fa, b, p.ta, p.tb, reach);
+  return beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach);
 }
 
+/// closest_points_triangles_within_portable's steps in its order, on the pair's lanes.
 __attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
                                                                           ClosestPoints& out) {
   const Pair4 p(a, b);
-  if (pair_apart(p, b, reach)) return false;
-  out = nearest_of(a, b, p.ta, p.tb, p.fa, p.fb, p.sa, p.sb);
+  if (planes_apart(p, reach)) return false;
+  Nearest nearest(a[0], b[0]);
+  if (!edge_pairs(p.ta, p.tb, nearest)) {
+    if (edges_apart_x4(p.fa, b, p.ta, p.tb, reach)) return false;
+    face_pairs(p.ta, p.tb, p.fa, p.fb, p.sa, p.sb, nearest);
+  }
+  out = nearest.best;
   return true;
 }
 
 __attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const Vec3 b[3], double reach) {
-  return pair_apart(Pair4(a, b), b, reach);
+  const Pair4 p(a, b);
+  return planes_apart(p, reach) || edges_apart_x4(p.fa, b, p.ta, p.tb, reach);
 }
 
-/// `form` where the CPU has AVX2, else nullptr.
 template <class Form>
 Form where_avx2(Form form) {
   __builtin_cpu_init();

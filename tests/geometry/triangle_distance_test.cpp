@@ -260,7 +260,8 @@ TEST(TriangleDistance, BatchSameBitsAsThePortableKernel) {
 
 /// closest_points_triangles_within, every form: where it computes, exactly the kernel's result;
 /// where it refuses, the pair is farther apart than the reach (the reference kernel's distance,
-/// strictly); the forms refuse the same pairs. Reaches on both sides of each pair's distance, the
+/// strictly); the forms refuse the same pairs; where triangles_apart says apart, it refuses or
+/// computes a pair beyond the reach. Reaches on both sides of each pair's distance, the
 /// nearest a relative 1e-9 away.
 TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
   std::mt19937_64 rng(20261125);
@@ -282,7 +283,9 @@ TEST(TriangleDistance, WithinRefusesOnlyPairsBeyondTheReach) {
     for (const auto& [form, within] : kernels) {
       ClosestPoints got{};
       const bool computed = within(a, b, reach, got);
-      const bool ok = computed ? same_result(got, want) : distance > reach;
+      // Where the refusal alone says apart, the kernel refuses or settles the pair beyond the reach.
+      const bool apart_agrees = !triangles_apart(a, b, reach) || !computed || got.distance >= reach;
+      const bool ok = (computed ? same_result(got, want) : distance > reach) && apart_agrees;
       const bool agrees = first_verdict < 0 || first_verdict == int(computed);
       if ((!ok || !agrees) && ++failures <= 5) {
         ADD_FAILURE() << form << ", iteration " << iter << " kind " << k << ": computed " << computed << ", distance "
@@ -354,16 +357,21 @@ TEST(TriangleDistance, EdgeAxesSeparateSkewEdges) {
   const Vec3 b[3] = {{0, -1, 0.5}, {0, 1, 0.5}, {0, 0, 1.5}};
   EXPECT_FALSE(beyond_plane(a, b, 0.0));
   EXPECT_FALSE(beyond_plane(b, a, 0.0));
-  ClosestPoints out{};
-  EXPECT_FALSE(closest_points_triangles_within(a, b, 0.49, out));
-  EXPECT_FALSE(detail::closest_points_triangles_within_portable(a, b, 0.49, out));
-  EXPECT_TRUE(closest_points_triangles_within(a, b, 0.5, out));  // not beyond 0.5: no certificate
-  EXPECT_NEAR(out.distance, 0.5, 1e-15);
+  EXPECT_TRUE(triangles_apart(a, b, 0.49));
+  EXPECT_TRUE(detail::triangles_apart_portable(a, b, 0.49));
+  EXPECT_FALSE(triangles_apart(a, b, 0.5));  // not beyond 0.5: no certificate
+  // The within kernel's edge pairs settle this pair before its edge axes are tested: the pair at
+  // 0.5, which the caller compares with its reach.
+  for (const double reach : {0.49, 0.5}) {
+    ClosestPoints out{};
+    EXPECT_TRUE(closest_points_triangles_within(a, b, reach, out));
+    EXPECT_NEAR(out.distance, 0.5, 1e-15);
+  }
   // Far from the origin the projections are taken from A's first corner: the same verdicts.
   Vec3 fa[3], fb[3];
   for (int i = 0; i < 3; ++i) fa[i] = a[i] + Vec3(1e6, -2e6, 3e6), fb[i] = b[i] + Vec3(1e6, -2e6, 3e6);
-  EXPECT_FALSE(closest_points_triangles_within(fa, fb, 0.49, out));
-  EXPECT_TRUE(closest_points_triangles_within(fa, fb, 0.5, out));
+  EXPECT_TRUE(triangles_apart(fa, fb, 0.49));
+  EXPECT_FALSE(triangles_apart(fa, fb, 0.5));
 }
 
 TEST(TriangleDistance, BeyondPlaneOfParallelFaces) {
