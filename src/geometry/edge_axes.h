@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// The edge-axis test of the triangle kernel's reach (closest_points_triangles_within): along the
+/// The edge-axis test of the triangle kernel's reach (triangles_apart, and
+/// closest_points_triangles_within for a pair its edge pairs do not settle): along the
 /// cross product of an edge of A and an edge of B, the corners' projections can prove the
 /// triangles farther apart than the reach, where neither triangle's plane does (edges passing
 /// each other at a distance). The portable form is here; the AVX2 kernel computes the same

@@ -149,7 +149,9 @@ struct BatchHalf {
 
 /// kernel::slab_clear's test of the corners w (relative to p or q) against v, |v| being m.
 CALIBER_AVX2 inline __m256d slab_side(const Pack3& w, const Pack3& v, const Pack3& m) {
-  return ge(dot(w, v), _mm256_mul_pd(dot(magnitude(w), m), _mm256_set1_pd(-0x1p-49)));
+  const __m256d bound = dot(magnitude(w), m);
+  return _mm256_and_pd(ge(dot(w, v), _mm256_mul_pd(bound, _mm256_set1_pd(-0x1p-49))),
+                       le(bound, _mm256_set1_pd(0x1.fffffffffffffp+1023)));
 }
 
 /// kernel::slab_clear (triangle_kernel.h) with A's corners in the lanes of ca and B's in cb (each

@@ -23,7 +23,7 @@ using kernel::Vec3;
 // C++), and clamp01 is max then min with the operands in the order of the scalar maxsd/minsd of clamp01
 // (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The feature pairs are then taken by the same Nearest
 // in the portable order, so the same pair wins. Eigen computes a 3-vector's dot product as (x0*y0 + x1*y1) + x2*y2; so does
-// dot() (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths with the 2a20389 kernel bit for bit).
+// dot() (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths bit for bit).
 namespace {
 
 #define CALIBER_AVX2 __attribute__((target("avx2")))

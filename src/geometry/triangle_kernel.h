@@ -100,8 +100,9 @@ struct Nearest {
 /// (|w| . |v|: the dot product of the absolute values). The planes through p and q across v then
 /// have A on one side and B on the other, but for 2^-49 |w| . |v| -- several times the rounding
 /// error of the float dot product -- so no point of A is nearer to B than |v| less about 2^-46 of
-/// the corners' distances to p and q: the pair is the nearest up to rounding. False on NaN. The
-/// vector forms compute the same expressions in the same order.
+/// the corners' distances to p and q: the pair is the nearest up to rounding. False where a bound
+/// is not finite (an infinite corner, or products past the largest double) or a value is NaN.
+/// The vector forms compute the same expressions in the same order.
 inline bool slab_clear(const Vec3 a[3], const Vec3 b[3], const Vec3& p, const Vec3& q) {
   const Vec3 v = q - p;
   const Vec3 m(std::abs(v.x()), std::abs(v.y()), std::abs(v.z()));
@@ -109,7 +110,7 @@ inline bool slab_clear(const Vec3 a[3], const Vec3 b[3], const Vec3& p, const Ve
   for (int i = 0; i < 3; ++i) {
     for (const Vec3& w : {Vec3(p - a[i]), Vec3(b[i] - q)}) {
       const double bound = (std::abs(w.x()) * m.x() + std::abs(w.y()) * m.y()) + std::abs(w.z()) * m.z();
-      clear &= w.dot(v) >= bound * -0x1p-49;
+      clear &= (w.dot(v) >= bound * -0x1p-49) & (bound <= 0x1.fffffffffffffp+1023);
     }
   }
   return clear;
