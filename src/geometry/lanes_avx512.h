@@ -63,6 +63,7 @@ CALIBER_AVX512 inline D root(D u) { return _mm512_sqrt_pd(u); }
 CALIBER_AVX512 inline D magnitude(D u) {
   return _mm512_castsi512_pd(_mm512_andnot_si512(_mm512_set1_epi64(INT64_MIN), _mm512_castpd_si512(u)));
 }
+CALIBER_AVX512 inline P3 magnitude(const P3& u) { return {magnitude(u.x), magnitude(u.y), magnitude(u.z)}; }
 CALIBER_AVX512 inline D min_lanes(D u, D v) { return _mm512_min_pd(u, v); }
 CALIBER_AVX512 inline D max_lanes(D u, D v) { return _mm512_max_pd(u, v); }
 CALIBER_AVX512 inline M eq(D u, D v) { return _mm512_cmp_pd_mask(u, v, _CMP_EQ_OQ); }
