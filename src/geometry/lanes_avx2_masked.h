@@ -25,7 +25,10 @@ using D = __m256d;
 using P3 = Pack3;
 
 /// A mask, all ones or all zeros per lane, with the AVX-512 form's operators on its masks (GCC
-/// has no bitwise operators on double vectors).
+/// has no bitwise operators on double vectors). A function that returns an M is inlined
+/// (always_inline beyond the one-instruction ones here), and one that takes it takes a reference:
+/// GCC 12.2 compiled an out-of-line function returning an M with a vzeroupper before its ret,
+/// which cleared lanes 2 and 3 of the result it had just put in ymm0.
 struct M {
   __m256d m;
   M() = default;
