@@ -2,6 +2,7 @@
 // vertices, non-manifold edges, only degenerate triangles. Documented behaviour: all are accepted,
 // and queries on them are exact (identical to the brute-force oracle).
 
+#include <algorithm>
 #include <numbers>
 #include <random>
 
@@ -92,6 +93,40 @@ TEST(OddMeshes, OnlyDegenerateTrianglesAreExact) {
   const auto degenerate = build_model(m);
   const auto box = build_model(make_box(0.4, 0.4, 0.4, 2));
   EXPECT_GT(compare_with_oracle(*degenerate, *box, 300, 0.4, 11, "degenerate-box"), 0);
+}
+
+/// A degenerate triangle has no normal, so a contact query never reports it, whatever its angle
+/// (below 90 degrees the normal test refuses it through the dot product alone, from 90 on by a test
+/// of its own). A box with a degenerate triangle of its own vertices on its top face, against a box
+/// just above: the proximity query reports the degenerate triangle, the contact query at every
+/// angle does not, still reports the faces, and equals the brute force (which tests every pair,
+/// where the traversal's cone test may already have pruned the degenerate triangle's leaf).
+TEST(OddMeshes, DegenerateTrianglesMakeNoContactAtAnyAngle) {
+  Mesh top = make_box(0.5, 0.5, 0.5, 2);
+  const auto first = static_cast<std::uint32_t>(top.vertices.size());
+  top.vertices.emplace_back(-0.2, 0.1, 0.5);
+  top.vertices.emplace_back(0.0, 0.1, 0.5);
+  top.vertices.emplace_back(0.2, 0.1, 0.5);
+  top.triangles.push_back({first, first + 1, first + 2});
+  const auto degenerate = static_cast<std::uint32_t>(top.triangles.size() - 1);
+  const auto a = build_model(top);
+  const auto b = build_model(make_box(0.5, 0.5, 0.5, 2));
+  const Pose pa, pb = Pose::from_values(0.05, 0.02, 1.01, 1, 0, 0, 0);
+  QueryRequest request;
+  request.tolerance = 0.02;
+  request.kind = QueryKind::proximity;
+  const auto has_degenerate = [&](const QueryResult& r) {
+    return std::any_of(r.contacts.begin(), r.contacts.end(), [&](const Contact& c) { return c.tri_a == degenerate; });
+  };
+  ASSERT_TRUE(has_degenerate(query(*a, pa, *b, pb, request)));
+  request.kind = QueryKind::contact;
+  for (const double angle : {0.0, 30.0, 89.0, 90.0, 91.0, 120.0, 180.0}) {
+    request.angle_deg = angle;
+    const QueryResult r = query(*a, pa, *b, pb, request);
+    EXPECT_FALSE(has_degenerate(r)) << angle << " degrees";
+    EXPECT_FALSE(r.contacts.empty()) << angle << " degrees";
+    test::expect_identical(r, query_brute_force(*a, pa, *b, pb, request), "angle " + std::to_string(angle));
+  }
 }
 
 }  // namespace
