@@ -25,10 +25,10 @@ using D = __m256d;
 using P3 = Pack3;
 
 /// A mask, all ones or all zeros per lane, with the AVX-512 form's operators on its masks (GCC
-/// has no bitwise operators on double vectors). A function that returns an M is inlined
-/// (always_inline beyond the one-instruction ones here), and one that takes it takes a reference:
-/// GCC 12.2 compiled an out-of-line function returning an M with a vzeroupper before its ret,
-/// which cleared lanes 2 and 3 of the result it had just put in ymm0.
+/// has no bitwise operators on double vectors). A function that returns an M or takes one by value
+/// is inlined (always_inline beyond the one-instruction helpers here); the others take a
+/// reference: GCC 12.2 compiled an out-of-line function returning an M with a vzeroupper before
+/// its ret, which cleared lanes 2 and 3 of the result it had just put in ymm0.
 struct M {
   __m256d m;
   M() = default;
@@ -62,7 +62,9 @@ CALIBER_AVX2 inline bool none(M m) { return bits(m) == 0; }
 CALIBER_AVX2 inline bool all_set(M m) { return bits(m) == 0xF; }
 CALIBER_AVX2 inline M not_lanes(M m) { return ~m; }
 CALIBER_AVX2 inline D clamp01(D t) { return lanes4::clamp01x4(t); }
-CALIBER_AVX2 inline P3 add_where(M m, const P3& base, const P3& step) { return pick(m, base + step, base); }
+CALIBER_AVX2 __attribute__((always_inline)) inline P3 add_where(M m, const P3& base, const P3& step) {
+  return pick(m, base + step, base);
+}
 
 /// lanes8::Triangle8 for half `half` of a batch's triangles of one side: the same values. (Not
 /// built on BatchHalf: that form, with ab2, ac2 and normal2 as members beside len2, took 1.8 %

@@ -276,8 +276,9 @@ bool PairContext::normals_allow(std::uint32_t ta, std::uint32_t tb) const {
   if (mKind != QueryKind::contact) return true;
   const Eigen::Vector3d& na = mA.normals[ta];
   const Eigen::Vector3d& nb = mB.normals[tb];
-  // A degenerate triangle has no normal (a zero vector, adjacency.cpp) and is refused. Below 90
-  // degrees, the product's zero exceeds -cos(theta) and refuses it without a test of its own.
+  // A degenerate triangle has no normal (a zero vector, adjacency.cpp) and is refused. Up to 90
+  // degrees (cos(theta) > 0; 6e-17 at 90), the product's zero exceeds -cos(theta) and refuses it
+  // without a test of its own.
   if (!(mCosTheta > 0.0) && (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0)) return false;
   return !(na.dot(mRot * nb) > -mCosTheta);
 }

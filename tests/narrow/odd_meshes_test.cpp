@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -96,11 +97,10 @@ TEST(OddMeshes, OnlyDegenerateTrianglesAreExact) {
 }
 
 /// A degenerate triangle has no normal, so a contact query never reports it, whatever its angle
-/// (below 90 degrees the normal test refuses it through the dot product alone, from 90 on by a test
-/// of its own). A box with a degenerate triangle of its own vertices on its top face, against a box
-/// just above: the proximity query reports the degenerate triangle, the contact query at every
-/// angle does not, still reports the faces, and equals the brute force (which tests every pair,
-/// where the traversal's cone test may already have pruned the degenerate triangle's leaf).
+/// (up to 90 degrees the normal test refuses it through the dot product alone, above by a test of
+/// its own). A box with a degenerate triangle of its own vertices on its top face, against a box
+/// just above, as A and as B: the proximity query reports the degenerate triangle; the contact
+/// query at every angle, and its brute force, do not, still report the faces, and agree.
 TEST(OddMeshes, DegenerateTrianglesMakeNoContactAtAnyAngle) {
   Mesh top = make_box(0.5, 0.5, 0.5, 2);
   const auto first = static_cast<std::uint32_t>(top.vertices.size());
@@ -111,21 +111,31 @@ TEST(OddMeshes, DegenerateTrianglesMakeNoContactAtAnyAngle) {
   const auto degenerate = static_cast<std::uint32_t>(top.triangles.size() - 1);
   const auto a = build_model(top);
   const auto b = build_model(make_box(0.5, 0.5, 0.5, 2));
-  const Pose pa, pb = Pose::from_values(0.05, 0.02, 1.01, 1, 0, 0, 0);
-  QueryRequest request;
-  request.tolerance = 0.02;
-  request.kind = QueryKind::proximity;
-  const auto has_degenerate = [&](const QueryResult& r) {
-    return std::any_of(r.contacts.begin(), r.contacts.end(), [&](const Contact& c) { return c.tri_a == degenerate; });
-  };
-  ASSERT_TRUE(has_degenerate(query(*a, pa, *b, pb, request)));
-  request.kind = QueryKind::contact;
-  for (const double angle : {0.0, 30.0, 89.0, 90.0, 91.0, 120.0, 180.0}) {
-    request.angle_deg = angle;
-    const QueryResult r = query(*a, pa, *b, pb, request);
-    EXPECT_FALSE(has_degenerate(r)) << angle << " degrees";
-    EXPECT_FALSE(r.contacts.empty()) << angle << " degrees";
-    test::expect_identical(r, query_brute_force(*a, pa, *b, pb, request), "angle " + std::to_string(angle));
+  const Pose low, high = Pose::from_values(0.05, 0.02, 1.01, 1, 0, 0, 0);
+  for (const bool degenerate_is_a : {true, false}) {
+    const Model& first_model = degenerate_is_a ? *a : *b;
+    const Model& second_model = degenerate_is_a ? *b : *a;
+    const Pose& first_pose = degenerate_is_a ? low : high;
+    const Pose& second_pose = degenerate_is_a ? high : low;
+    const auto has_degenerate = [&](const QueryResult& r) {
+      return std::any_of(r.contacts.begin(), r.contacts.end(),
+                         [&](const Contact& c) { return (degenerate_is_a ? c.tri_a : c.tri_b) == degenerate; });
+    };
+    QueryRequest request;
+    request.tolerance = 0.02;
+    request.kind = QueryKind::proximity;
+    ASSERT_TRUE(has_degenerate(query(first_model, first_pose, second_model, second_pose, request)));
+    request.kind = QueryKind::contact;
+    for (const double angle : {0.0, 30.0, 89.0, 90.0, 91.0, 120.0, 180.0}) {
+      request.angle_deg = angle;
+      const std::string name = std::string(degenerate_is_a ? "A" : "B") + " degenerate, " + std::to_string(angle) + " degrees";
+      const QueryResult r = query(first_model, first_pose, second_model, second_pose, request);
+      const QueryResult brute = query_brute_force(first_model, first_pose, second_model, second_pose, request);
+      EXPECT_FALSE(has_degenerate(r)) << name;
+      EXPECT_FALSE(has_degenerate(brute)) << name;
+      EXPECT_FALSE(r.contacts.empty()) << name;
+      test::expect_identical(r, brute, name);
+    }
   }
 }
 
