@@ -354,25 +354,25 @@ struct ModelData : Model {
   std::vector<std::uint64_t> vertex_offsets;
   /// See vertex_offsets.
   std::vector<std::uint32_t> vertex_triangles;
-  /// Whether the vertex adjacency was built.
-  [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }
+  [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }  ///< Whether the vertex adjacency was built.
   /// The welded vertices of triangle t's three corners.
   [[nodiscard]] const std::uint32_t* welded_corners(std::uint32_t t) const {
     return corner_vertex.empty() ? mesh.triangles[t].data() : &corner_vertex[std::size_t{t} * 3];
   }
-  /// Calls f(u) for every triangle u that shares a vertex position with triangle t (u != t; a
-  /// triangle sharing two or three positions with t comes two or three times).
+  /// Calls f(u) for the triangles u that share a vertex position with triangle t (u != t; a triangle
+  /// sharing two or three positions with t comes two or three times) until f returns true: whether it did.
   template <class F>
-  void for_each_neighbour(std::uint32_t t, F&& f) const {
+  bool any_neighbour(std::uint32_t t, F&& f) const {
     const std::uint32_t* corners = welded_corners(t);
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t w = corners[k];
       for (std::uint64_t i = vertex_offsets[w]; i < vertex_offsets[w + 1]; ++i) {
-        if (vertex_triangles[i] != t) f(vertex_triangles[i]);
+        if (vertex_triangles[i] != t && f(vertex_triangles[i])) return true;
       }
     }
+    return false;
   }
-  /// Whether u is among the triangles for_each_neighbour(t, ...) gives: distinct from t, sharing
+  /// Whether u is among the triangles any_neighbour(t, ...) gives: distinct from t, sharing
   /// a vertex position with it.
   [[nodiscard]] bool are_neighbours(std::uint32_t t, std::uint32_t u) const {
     if (t == u) return false;

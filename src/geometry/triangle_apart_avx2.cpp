@@ -31,7 +31,7 @@ CALIBER_AVX2 unsigned apart_avx2(const TriangleBatch& batch, double reach) {
   for (int half = 0; half < 2 && 4 * half < batch.size; ++half) {
     const ApartTri ta(batch.a, half), tb(batch.b, half);
     M m = beyond_plane(ta, tb, r) | beyond_plane(tb, ta, r);
-    if (!all_set(m)) m = m | edges_apart(ta, tb, r);
+    if (!all_set(m)) m = edges_apart(ta, tb, r, m);
     apart |= static_cast<unsigned>(bits(m)) << (4 * half);
   }
   return apart & ((1u << batch.size) - 1u);

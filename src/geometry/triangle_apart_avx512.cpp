@@ -26,7 +26,7 @@ CALIBER_AVX512 unsigned apart_avx512(const TriangleBatch& batch, double reach) {
   const Triangle8 ta(batch.a), tb(batch.b);
   const D r = all_lanes(reach);
   M apart = beyond_plane(ta, tb, r) | beyond_plane(tb, ta, r);
-  if (!all_set(apart)) apart |= edges_apart(ta, tb, r);
+  if (!all_set(apart)) apart = edges_apart(ta, tb, r, apart);
   return static_cast<unsigned>(apart) & ((1u << batch.size) - 1u);
 }
 

@@ -254,17 +254,6 @@ void TriangleBatch::add(const Vec3 pa[3], const Vec3 pb[3]) {
   ++size;
 }
 
-void TriangleBatch::add(const TriangleBatch& from, int lane) {
-  CALIBER_ASSERT(size < kLanes && lane >= 0 && lane < from.size, "a triangle batch takes at most kLanes pairs");
-  for (int k = 0; k < 3; ++k) {
-    for (int c = 0; c < 3; ++c) {
-      a[k][c][size] = from.a[k][c][lane];
-      b[k][c][size] = from.b[k][c][lane];
-    }
-  }
-  ++size;
-}
-
 void TriangleBatch::get(int lane, Vec3 pa[3], Vec3 pb[3]) const {
   for (int k = 0; k < 3; ++k) {
     pa[k] = Vec3(a[k][0][lane], a[k][1][lane], a[k][2][lane]);

@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "util/assert.h"
+
 namespace caliber::geometry {
 
 /// Closest point to x on the closed segment pq (pq may be a point).
@@ -50,8 +52,17 @@ struct TriangleBatch {
   [[nodiscard]] bool full() const { return size == kLanes; }
   /// Appends a pair (the batch must not be full).
   void add(const Eigen::Vector3d pa[3], const Eigen::Vector3d pb[3]);
-  /// Appends pair `lane` of `from`.
-  void add(const TriangleBatch& from, int lane);
+  /// Appends pair `lane` of `from` (inline: a leaf buffer moves most pairs it refuses none of).
+  void add(const TriangleBatch& from, int lane) {
+    CALIBER_ASSERT(size < kLanes && lane >= 0 && lane < from.size, "a triangle batch takes at most kLanes pairs");
+    for (int k = 0; k < 3; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        a[k][c][size] = from.a[k][c][lane];
+        b[k][c][size] = from.b[k][c][lane];
+      }
+    }
+    ++size;
+  }
   /// Copies pair 0 into the lanes past `size`, so that a kernel reads only defined values.
   void pad();
   /// The corners of pair `lane`.

@@ -117,27 +117,24 @@ struct Reduction {
   }
 
   /// Whether a candidate dominates entry i: its pairs with a neighbour of either triangle looked
-  /// up kLookups at a time, each batch's slots prefetched before the first lookup.
+  /// up kLookups at a time, each batch's slots prefetched before the first lookup; the walk over
+  /// the neighbours stops at the first batch that finds one.
   [[nodiscard]] bool dominated(std::size_t i) const {
     if (dominated_nearby(i)) return true;
     const Entry& c = entries[i];
     const std::uint32_t ta = tri_a(c.key), tb = tri_b(c.key);
-    constexpr int kLookups = 32;
+    constexpr int kLookups = 4;
     std::uint64_t keys[kLookups];
     int count = 0;
-    bool found = false;
     const auto add = [&](std::uint64_t key) {
-      if (found) return;
       table.prefetch(key);
       keys[count++] = key;
-      if (count == kLookups) {
-        found = any_closer(keys, count, c);
-        count = 0;
-      }
+      if (count < kLookups) return false;
+      count = 0;
+      return any_closer(keys, kLookups, c);
     };
-    a.for_each_neighbour(ta, [&](std::uint32_t u) { add(key_of(u, tb)); });
-    b.for_each_neighbour(tb, [&](std::uint32_t u) { add(key_of(ta, u)); });
-    return found || any_closer(keys, count, c);
+    return a.any_neighbour(ta, [&](std::uint32_t u) { return add(key_of(u, tb)); }) ||
+           b.any_neighbour(tb, [&](std::uint32_t u) { return add(key_of(ta, u)); }) || any_closer(keys, count, c);
   }
 };
 

@@ -272,20 +272,26 @@ bool PairContext::leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, 
   return finish_leaf(ta, tb, a, b, closest, bound, keep);
 }
 
-bool PairContext::normals_allow(std::uint32_t ta, std::uint32_t tb) const {
-  if (mKind != QueryKind::contact) return true;
-  const Eigen::Vector3d& na = mA.normals[ta];
-  const Eigen::Vector3d& nb = mB.normals[tb];
+namespace {
+/// PairContext::normals_allow's test on the two normals (na in A's frame, nb in B's), inlined into
+/// the leaf tests.
+[[gnu::always_inline]] inline bool normals_face(const Eigen::Vector3d& na, const Eigen::Vector3d& nb, const Eigen::Matrix3d& rot,
+                                                double cos_theta) {
   // A degenerate triangle has no normal (a zero vector, adjacency.cpp) and is refused. Up to 90
   // degrees (cos(theta) > 0; 6e-17 at 90), the product's zero exceeds -cos(theta) and refuses it
   // without a test of its own.
-  if (!(mCosTheta > 0.0) && (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0)) return false;
-  return !(na.dot(mRot * nb) > -mCosTheta);
+  if (!(cos_theta > 0.0) && (na.squaredNorm() == 0.0 || nb.squaredNorm() == 0.0)) return false;
+  return !(na.dot(rot * nb) > -cos_theta);
+}
+}  // namespace
+
+bool PairContext::normals_allow(std::uint32_t ta, std::uint32_t tb) const {
+  return mKind != QueryKind::contact || normals_face(mA.normals[ta], mB.normals[tb], mRot, mCosTheta);
 }
 
 bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const {
   if (mKind != QueryKind::interference) {
-    if (!normals_allow(ta, tb)) return false;
+    if (mKind == QueryKind::contact && !normals_face(mA.normals[ta], mB.normals[tb], mRot, mCosTheta)) return false;
     // Proximity, contact and distance keep the pairs within the tolerance (mReach is its reach).
     return leaf_within(ta, tb, mRequest.tolerance, mReach, [&](Candidate&& c) { out.push_back(std::move(c)); });
   }
@@ -314,7 +320,8 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   }
   // leaf_within's steps up to the refusal, which waits for the batch; the corners are read when it
   // is full, as above.
-  if (!normals_allow(ta, tb) || (mGroups != nullptr && !groups_allow(ta, tb))) return;
+  if (mKind == QueryKind::contact && !normals_face(mA.normals[ta], mB.normals[tb], mRot, mCosTheta)) return;
+  if (mGroups != nullptr && !groups_allow(ta, tb)) return;
   BufferedPairs& waiting = buffer.refusal;
   waiting.ta[waiting.batch.size] = ta;
   waiting.tb[waiting.batch.size] = tb;

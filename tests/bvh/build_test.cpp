@@ -232,7 +232,10 @@ TEST(BuildModel, SingleTriangleAndOnlyDegenerate) {
 /// The triangles sharing a vertex position with t, sorted and distinct.
 std::vector<std::uint32_t> neighbours(const Model& model, std::uint32_t t) {
   std::vector<std::uint32_t> out;
-  data(model).for_each_neighbour(t, [&](std::uint32_t u) { out.push_back(u); });
+  EXPECT_FALSE(data(model).any_neighbour(t, [&](std::uint32_t u) {
+    out.push_back(u);
+    return false;
+  }));
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -248,6 +251,11 @@ TEST(BuildModel, AdjacencyWeldsRepeatedVertices) {
   const auto neighbors = [&](std::uint32_t t) { return neighbours(*model, t); };
   EXPECT_EQ(neighbors(0), std::vector<std::uint32_t>{1});
   EXPECT_EQ(neighbors(1), std::vector<std::uint32_t>{0});
+  // The walk stops at the first neighbour the function accepts (triangle 1 comes twice: two shared
+  // positions).
+  int calls = 0;
+  EXPECT_TRUE(data(*model).any_neighbour(0, [&](std::uint32_t u) { return ++calls, u == 1; }));
+  EXPECT_EQ(calls, 1);
   EXPECT_TRUE(neighbors(2).empty());
   EXPECT_EQ(data(*model).corner_vertex.size(), 9u) << "repeated positions: the welded corners are kept";
   EXPECT_TRUE(data(*model).are_neighbours(0, 1));
