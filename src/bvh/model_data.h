@@ -13,10 +13,6 @@
 
 #include <Eigen/Core>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 
@@ -226,7 +222,8 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
 /// `origin` on it, both floats, so that every bound origin + q step is a float, the same however
 /// computed; each bound is the grid's nearest outside the float bound nearest outside its BvhNode
 /// box's double bound (bvh::build_wide_tree). Slots past the last are empty: node kEmpty, low
-/// above high. 320 bytes, aligned to a cache line: five lines.
+/// above high; `slots` counts those in use (every visit reads it). 320 bytes, aligned to a cache
+/// line: five lines.
 struct alignas(64) WideNode {
   static constexpr int kSlots = 8;
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
@@ -240,25 +237,12 @@ struct alignas(64) WideNode {
   std::uint32_t node[kSlots];                 ///< the slot's BVH node, kEmpty past the last
   float origin[3];                            ///< the grid's origin (a multiple of step)
   float step;                                 ///< the grid's step, a power of two
+  std::uint8_t slots = 0;                     ///< slots in use (they come first): count()
   /// Slot k's low and high bounds along axis i (exact: origin + q step is a float).
   [[nodiscard]] float low(int i, int k) const { return static_cast<float>(lo[i][k]) * step + origin[i]; }
   [[nodiscard]] float high(int i, int k) const { return static_cast<float>(hi[i][k]) * step + origin[i]; }
   /// Number of slots in use (they come first): 2 .. kSlots, 1 in bvh::single_slot's.
-  [[nodiscard]] int count() const {
-#if defined(__SSE2__)
-    // The first empty slot, from the eight ids compared at once (every visit asks).
-    const __m128i empty = _mm_set1_epi32(-1);
-    const __m128i low = _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(node)), empty);
-    const __m128i high = _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(node + 4)), empty);
-    const auto mask =
-        static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(low)) | _mm_movemask_ps(_mm_castsi128_ps(high)) << 4);
-    return __builtin_ctz(mask | 1u << kSlots);
-#else
-    int n = 0;
-    while (n < kSlots && node[n] != kEmpty) ++n;
-    return n;
-#endif
-  }
+  [[nodiscard]] int count() const { return slots; }
 };
 static_assert(sizeof(WideNode) == 320);
 static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 == 0 && offsetof(WideNode, axis) % 32 == 0 &&

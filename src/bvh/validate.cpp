@@ -102,6 +102,13 @@ std::string bvh_problem(const ModelData& m) {
         return "node " + std::to_string(i) + ": its slot does not hold it";
     }
   }
+  // Each wide node's count: its slots in use come first, the rest are empty.
+  for (std::size_t w = 0; w < m.wide.size(); ++w) {
+    const int used = m.wide[w].count();
+    bool counted = used >= 1 && used <= WideNode::kSlots;
+    for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (m.wide[w].node[k] != WideNode::kEmpty) == (k < used);
+    if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
+  }
   return {};
 }
 

@@ -38,6 +38,7 @@ void clear_slot(int k, WideNode& out) {
   }
   out.slab_lo[k] = out.slab_hi[k] = 0.0f;
   out.node[k] = WideNode::kEmpty;
+  out.slots = static_cast<std::uint8_t>(std::min<int>(out.slots, k));
 }
 
 /// A node's float box: along each axis, the nearest floats outside its double bounds.
@@ -104,6 +105,7 @@ void fill_slot(const ModelData& model, std::uint32_t node, const FloatBox& box, 
   out.slab_lo[k] = f.slab_lo;
   out.slab_hi[k] = f.slab_hi;
   out.node[k] = node;
+  out.slots = static_cast<std::uint8_t>(std::max<int>(out.slots, k + 1));
 }
 
 /// The slots of internal node `root`: its two children, then, while there is room, one slot
@@ -151,6 +153,7 @@ WideNode with_slot_alone(const WideNode& w, int k) {
   out.slab_lo[0] = w.slab_lo[k];
   out.slab_hi[0] = w.slab_hi[k];
   out.node[0] = w.node[k];
+  out.slots = 1;
   return out;
 }
 
@@ -175,7 +178,7 @@ WideNode single_slot(const ModelData& model, std::uint32_t node) {
   }
   // Not a slot (the root, or a node inside a wide node's slots): on a grid of its own.
   CALIBER_ASSERT(false, "a node of the wide CD tree is a slot of a wide node");
-  WideNode out;
+  WideNode out{};
   const FloatBox box = float_box(model.nodes[node]);
   set_grid(&box, 1, out);
   for (int k = 0; k < WideNode::kSlots; ++k) clear_slot(k, out);

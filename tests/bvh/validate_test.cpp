@@ -34,6 +34,7 @@ TEST(BvhProblem, EachBreakIsFound) {
     const std::vector<std::uint32_t> leaf_position = m.leaf_position;
     const std::vector<std::uint64_t> group_masks = m.group_masks;
     const std::vector<std::uint8_t> groups = m.mesh.groups;
+    const std::vector<WideNode> wide = m.wide;
     change();
     const std::string problem = bvh::bvh_problem(m);
     m.nodes = nodes;
@@ -41,6 +42,7 @@ TEST(BvhProblem, EachBreakIsFound) {
     m.leaf_position = leaf_position;
     m.group_masks = group_masks;
     m.mesh.groups = groups;
+    m.wide = wide;
     return problem;
   };
   std::uint32_t leaf = 0, inner = 1;  // the first leaf, and the first inner node below the root
@@ -77,6 +79,9 @@ TEST(BvhProblem, EachBreakIsFound) {
   std::uint32_t other = leaf + 1;
   while (!m.nodes[other].is_leaf()) ++other;
   EXPECT_NE(broken([&] { m.nodes[other].index = m.nodes[leaf].index; }), "") << "a triangle in two leaves";
+  ASSERT_FALSE(m.wide.empty());
+  EXPECT_NE(broken([&] { m.wide[0].slots -= 1; }), "") << "a wide node counting one slot fewer than it uses";
+  EXPECT_NE(broken([&] { m.wide.back().slots = WideNode::kSlots + 1; }), "") << "a count past the slots";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
 
