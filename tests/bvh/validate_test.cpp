@@ -80,8 +80,18 @@ TEST(BvhProblem, EachBreakIsFound) {
   while (!m.nodes[other].is_leaf()) ++other;
   EXPECT_NE(broken([&] { m.nodes[other].index = m.nodes[leaf].index; }), "") << "a triangle in two leaves";
   ASSERT_FALSE(m.wide.empty());
+  std::size_t partial = 0;  // a wide node with an empty slot
+  while (partial < m.wide.size() && m.wide[partial].count() == WideNode::kSlots) ++partial;
+  ASSERT_LT(partial, m.wide.size());
   EXPECT_NE(broken([&] { m.wide[0].slots -= 1; }), "") << "a wide node counting one slot fewer than it uses";
-  EXPECT_NE(broken([&] { m.wide.back().slots = WideNode::kSlots + 1; }), "") << "a count past the slots";
+  EXPECT_NE(broken([&] { m.wide[partial].slots += 1; }), "") << "a wide node counting an empty slot";
+  EXPECT_NE(broken([&] { m.wide[0].slots = 0; }), "") << "a wide node of no slot";
+  EXPECT_NE(broken([&] {
+              m.wide[0].slots = WideNode::kSlots + 1;
+              for (std::uint32_t& node : m.wide[0].node) node = node == WideNode::kEmpty ? 0 : node;
+            }),
+            "")
+      << "a count past the slots";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
 
