@@ -3,10 +3,12 @@
 #include "narrow/cd_tree.h"
 
 #include "bvh/wide_tree.h"
+#include "narrow/visit.h"
 
 namespace caliber::narrow {
 
 const detail::WideTest kWideTest = detail::wide_test_avx2_if_supported();
+const WideLoop kWideLoop = kWideTest != nullptr ? detail::wide_loop_avx2_if_supported() : nullptr;
 
 detail::WideLanes wide_lanes(const PairContext& ctx) {
   return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale(), ctx.a(), ctx.b());

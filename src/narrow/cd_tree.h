@@ -136,14 +136,24 @@ detail::WideLanes wide_lanes(const PairContext& ctx);
 /// scalar form: the same decisions), chosen when the library loads.
 extern const detail::WideTest kWideTest;
 
+/// The wide node test as the library chose it when it loaded (kWideTest, else the scalar form),
+/// called through a pointer: what a visit runs unless its caller names the form (Test below).
+struct ChosenWideTest {
+  unsigned operator()(const detail::NodeTestFrame& f, const detail::WideLanes& l, bool a_descends, std::uint32_t stay,
+                      const VisitNode& sn, const WideNode& w, detail::StayingCache* cache) const {
+    // (Null also before the library's constants are made: a query from another constant's constructor.)
+    return (kWideTest != nullptr ? kWideTest : detail::wide_test_scalar)(f, l, a_descends, stay, sn, w, cache);
+  }
+};
+
 /// The node tests of the wide visit v of node n on its children: bit k set where child k
-/// (cd_children order) passes the wide test (detail::WideTest; its staying node read from or kept
-/// in `cache`, if given), then the groups and normal cones (PairContext::groups_and_cones_allow)
-/// of each that is not a pair of leaves.
-inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v, const detail::WideLanes& lanes,
-                          detail::StayingCache* cache = nullptr) {
-  // (Null also before the library's constants are made: a query from another constant's constructor.)
-  const detail::WideTest test = kWideTest != nullptr ? kWideTest : detail::wide_test_scalar;
+/// (cd_children order) passes the wide test (`test`, a form of detail::WideTest; its staying node
+/// read from or kept in `cache`, if given), then the groups and normal cones
+/// (PairContext::groups_and_cones_allow) of each that is not a pair of leaves.
+template <class Test = ChosenWideTest>
+[[gnu::always_inline]] inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v,
+                                                 const detail::WideLanes& lanes, detail::StayingCache* cache = nullptr,
+                                                 Test test = {}) {
   CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).visit_nodes[v.stay], "the staying node is node stay");
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;

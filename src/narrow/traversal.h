@@ -94,6 +94,10 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   // pass are written straight onto the stack, the first one on top (the order of cd_children).
   // With one, each leaf test's pair is counted as it is kept.
   LeafBuffer buffer;
+  if (limit == nullptr && lanes.wide != nullptr && kWideLoop != nullptr) {
+    kWideLoop(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+    top = base;
+  }
   while (limit == nullptr && top != base) {
     const NodePair n = *--top;
     const int count = visit<true>(ctx, n, out, counted, top, taboo, &buffer, lanes);

@@ -37,12 +37,12 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
 /// The visit of a node of the wide CD tree (not a pair of leaves; narrow::visit): its children's
 /// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
 /// reversed), every child counted but those on the taboo list (skipped and marked reached).
-template <bool kReversed>
+template <bool kReversed, class Test = ChosenWideTest>
 [[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
-                                             const detail::WideLanes& lanes, detail::StayingCache* staying) {
+                                             const detail::WideLanes& lanes, detail::StayingCache* staying, Test test = {}) {
   const WideVisit v = wide_visit(ctx, n, a, b);
-  unsigned pass = wide_pass(ctx, n, v, lanes, staying);
+  unsigned pass = wide_pass(ctx, n, v, lanes, staying, test);
   const int count = v.node->count();
   if (taboo.taboo != nullptr) {
     for (int k = 0; k < count; ++k) {
@@ -128,11 +128,12 @@ template <bool kReversed>
 /// reading `out`. `lanes`: the lanes of the node tests, made once by the traversal (null: made
 /// here): wide_lanes(ctx) in the wide CD tree (visit_wide), ctx.node_lanes() in the binary one.
 /// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
-/// so, the first child on top).
-template <bool kReversed = false>
+/// so, the first child on top). Test: the form of the wide node test (ChosenWideTest: the one the
+/// library chose; a loop built for AVX2 names its own, inlined: the same decisions).
+template <bool kReversed = false, class Test = ChosenWideTest>
 [[gnu::always_inline]] inline int visit(const PairContext& ctx, NodePair n, std::vector<Candidate>& out, QueryStats& stats,
                                         NodePair passed[kMaxChildren], TabooView taboo = {}, LeafBuffer* buffer = nullptr,
-                                        VisitLanes lanes = {}) {
+                                        VisitLanes lanes = {}, Test test = {}) {
   const auto leaf_pair = [&](std::uint32_t ta, std::uint32_t tb) {
     ++stats.leaf_tests;
     if (buffer != nullptr) {
@@ -149,12 +150,25 @@ template <bool kReversed = false>
     const VisitNode& b = ctx.b().visit_nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
-    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying);
+    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);
   }
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.index, b.index);
   return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
 }
+
+/// A depth-first traversal's loop without a limit on the wide CD tree, from the stack [base, top)
+/// until it is empty: each node popped is visited (visit<true>, the leaf pairs waiting in
+/// `buffer`), the children that pass pushed (at most `bound` nodes on the stack), as
+/// traverse_depth_first's own loop does. The form built for AVX2 with its wide test inlined
+/// (wide_test_avx2.cpp; the same visits and decisions), or null where the CPU has no AVX2.
+using WideLoop = void (*)(const PairContext& ctx, NodePair* base, NodePair* top, std::size_t bound, std::vector<Candidate>& out,
+                          QueryStats& stats, TabooView taboo, LeafBuffer& buffer, VisitLanes lanes);
+namespace detail {
+WideLoop wide_loop_avx2_if_supported();
+}  // namespace detail
+/// The AVX2 loop where this CPU has it (with kWideTest), else null, chosen when the library loads.
+extern const WideLoop kWideLoop;
 
 }  // namespace caliber::narrow

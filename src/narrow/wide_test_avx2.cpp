@@ -4,6 +4,8 @@
 
 #include "narrow/wide_test.h"
 
+#include "narrow/visit.h"
+
 #include <cmath>
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -151,10 +153,36 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 
+/// wide_test_avx2, inlined where a visit calls it.
+struct InlinedTest {
+  CALIBER_AVX2 unsigned operator()(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
+                                   const VisitNode& sn, const WideNode& w, StayingCache* cache) const {
+    return wide_test_avx2(f, l, a_descends, stay, sn, w, cache);
+  }
+};
+
+/// WideLoop built for AVX2: traverse_depth_first's loop, each visit's wide test inlined (no call
+/// through a pointer, its per-traversal values kept in registers across visits: flatten).
+CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx, NodePair* const base, NodePair* top,
+                                                          std::size_t bound, std::vector<Candidate>& out, QueryStats& stats,
+                                                          TabooView taboo, LeafBuffer& buffer, VisitLanes lanes) {
+  while (top != base) {
+    const NodePair n = *--top;
+    const int count = visit<true>(ctx, n, out, stats, top, taboo, &buffer, lanes, InlinedTest{});
+    top += count > 0 ? count : 0;
+    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
+  }
+  static_cast<void>(bound);  // (read by the assertion alone)
+}
+
 }  // namespace
 
 WideTest wide_test_avx2_if_supported() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? wide_test_avx2 : nullptr;
+}
+
+WideLoop wide_loop_avx2_if_supported() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? wide_loop_avx2 : nullptr;
 }
 
 }  // namespace caliber::narrow::detail
@@ -163,6 +191,7 @@ WideTest wide_test_avx2_if_supported() {
 
 namespace caliber::narrow::detail {
 WideTest wide_test_avx2_if_supported() { return nullptr; }
+WideLoop wide_loop_avx2_if_supported() { return nullptr; }
 }  // namespace caliber::narrow::detail
 
 #endif
