@@ -244,49 +244,54 @@ TEST(WideTest, TraversalsWithAndWithoutKeptNodesFindTheSamePairs) {
   }
 }
 
-TEST(WideTest, TheAvx2LoopVisitsAsThePortableOne) {
-  // The traversal's loop built for AVX2 (its wide test inlined) against the same loop calling the
-  // test the library chose: the same candidates in the same order, the same counts.
-  const WideLoop avx2 = detail::wide_loop_avx2_if_supported();
-  if (avx2 == nullptr) GTEST_SKIP() << "no AVX2 on this CPU";
+/// The scalar form of the wide test, named as a visit's Test.
+struct ScalarWideTest {
+  unsigned operator()(const detail::NodeTestFrame& f, const detail::WideLanes& l, bool a_descends, std::uint32_t stay,
+                      const VisitNode& sn, const WideNode& w, detail::StayingCache* cache) const {
+    return detail::wide_test_scalar(f, l, a_descends, stay, sn, w, cache);
+  }
+};
+
+TEST(WideTest, TheAvx2LoopVisitsAsTheScalarOne) {
+  // The traversal's loop built for AVX2 (its wide test inlined), as traverse_depth_first runs it,
+  // against the same loop visiting with the scalar test: the same candidates in the same order,
+  // the same counts.
+  if (kWideLoop == nullptr) GTEST_SKIP() << "no AVX2 and FMA on this CPU";
   const auto a = build_model(make_torus(1.0, 0.35, 30, 18));
   const auto b = build_model(sphere_with_slivers(20));
   std::mt19937_64 rng(9);
+  TraversalScratch scratch;
   for (int p = 0; p < 6; ++p) {
     QueryRequest request;
     request.kind = p % 3 == 0 ? QueryKind::interference : p % 3 == 1 ? QueryKind::proximity : QueryKind::contact;
     request.tolerance = p % 3 == 0 ? 0.0 : 0.02;
     const PairContext ctx(*a, Pose{}, *b, test::random_pose(rng, 0.7), request);
+    std::vector<Candidate> loop_out;
+    QueryStats loop_stats, scalar_stats;
+    traverse_depth_first(ctx, NodePair{0, 0}, scratch, loop_out, loop_stats);
     const detail::WideLanes lanes = wide_lanes(ctx);
-    const auto run = [&](bool inlined, QueryStats& stats) {
-      detail::StayingCache staying;
-      const std::size_t bound = 7 * static_cast<std::size_t>(ctx.a().height + ctx.b().height) + 8;
-      std::vector<NodePair> stack(bound);
-      std::vector<Candidate> out;
-      LeafBuffer buffer;
-      NodePair* top = stack.data();
-      if (test_root(ctx, NodePair{0, 0}, stats)) *top++ = NodePair{0, 0};
-      const VisitLanes with{nullptr, &lanes, &staying};
-      if (inlined) {
-        avx2(ctx, stack.data(), top, bound, out, stats, {}, buffer, with);
-      } else {
-        while (top != stack.data()) {
-          const NodePair n = *--top;
-          const int count = visit<true>(ctx, n, out, stats, top, {}, &buffer, with);
-          top += count > 0 ? count : 0;
-        }
-      }
-      ctx.flush_leaves(buffer, out);
-      std::vector<std::pair<std::uint32_t, std::uint32_t>> ids;
-      for (const Candidate& c : out) ids.emplace_back(c.tri_a, c.tri_b);
-      return ids;
+    detail::StayingCache staying;
+    std::vector<NodePair> stack(7 * static_cast<std::size_t>(ctx.a().height + ctx.b().height) + 8);
+    std::vector<Candidate> scalar_out;
+    LeafBuffer buffer;
+    NodePair* top = stack.data();
+    if (test_root(ctx, NodePair{0, 0}, scalar_stats)) *top++ = NodePair{0, 0};
+    while (top != stack.data()) {
+      const NodePair n = *--top;
+      const int count = visit<true>(ctx, n, scalar_out, scalar_stats, top, {}, &buffer, VisitLanes{nullptr, &lanes, &staying},
+                                    ScalarWideTest{});
+      top += count > 0 ? count : 0;
+    }
+    ctx.flush_leaves(buffer, scalar_out);
+    const auto ids = [](const std::vector<Candidate>& c) {
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+      for (const Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
+      return out;
     };
-    QueryStats inlined_stats, portable_stats;
-    const auto inlined = run(true, inlined_stats);
-    EXPECT_EQ(inlined, run(false, portable_stats)) << "pose " << p;
-    EXPECT_EQ(inlined_stats.node_tests, portable_stats.node_tests);
-    EXPECT_EQ(inlined_stats.leaf_tests, portable_stats.leaf_tests);
-    EXPECT_GT(inlined_stats.leaf_tests, 0u) << "pose " << p << ": the meshes meet";
+    EXPECT_EQ(ids(loop_out), ids(scalar_out)) << "pose " << p;
+    EXPECT_EQ(loop_stats.node_tests, scalar_stats.node_tests);
+    EXPECT_EQ(loop_stats.leaf_tests, scalar_stats.leaf_tests);
+    EXPECT_GT(loop_stats.leaf_tests, 0u) << "pose " << p << ": the meshes meet";
   }
 }
 
