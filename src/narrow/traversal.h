@@ -94,15 +94,13 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   // pass are written straight onto the stack, the first one on top (the order of cd_children).
   // With one, each leaf test's pair is counted as it is kept.
   LeafBuffer buffer;
-  if (limit == nullptr && lanes.wide != nullptr && kWideLoop != nullptr) {
-    kWideLoop(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+  if (limit == nullptr) {
+    if (lanes.wide != nullptr && kWideLoop != nullptr) {
+      kWideLoop(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+    } else {
+      visit_until_empty(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+    }
     top = base;
-  }
-  while (limit == nullptr && top != base) {
-    const NodePair n = *--top;
-    const int count = visit<true>(ctx, n, out, counted, top, taboo, &buffer, lanes);
-    top += count > 0 ? count : 0;
-    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
   while (limit != nullptr && top != base) {
     const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);

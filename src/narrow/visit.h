@@ -158,10 +158,23 @@ template <bool kReversed = false, class Test = ChosenWideTest>
   return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
 }
 
-/// A depth-first traversal's loop without a limit on the wide CD tree, from the stack [base, top)
-/// until it is empty: each node popped is visited (visit<true>, the leaf pairs waiting in
-/// `buffer`), the children that pass pushed (at most `bound` nodes on the stack), as
-/// traverse_depth_first's own loop does. The form built for AVX2 with its wide test inlined
+/// A depth-first traversal's loop without a limit, from the stack [base, top) until it is empty:
+/// each node popped is visited (visit<true>, the leaf pairs waiting in `buffer`), the children
+/// that pass pushed (at most `bound` nodes on the stack). Test: the wide test's form, as visit's.
+template <class Test = ChosenWideTest>
+[[gnu::always_inline]] inline void visit_until_empty(const PairContext& ctx, NodePair* const base, NodePair* top,
+                                                     std::size_t bound, std::vector<Candidate>& out, QueryStats& stats,
+                                                     TabooView taboo, LeafBuffer& buffer, VisitLanes lanes, Test test = {}) {
+  while (top != base) {
+    const NodePair n = *--top;
+    const int count = visit<true>(ctx, n, out, stats, top, taboo, &buffer, lanes, test);
+    top += count > 0 ? count : 0;
+    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
+  }
+  static_cast<void>(bound);  // (read by the assertion alone)
+}
+
+/// visit_until_empty on the wide CD tree, built for AVX2 with its wide test inlined
 /// (wide_test_avx2.cpp; the same visits and decisions), or null where the CPU has no AVX2.
 using WideLoop = void (*)(const PairContext& ctx, NodePair* base, NodePair* top, std::size_t bound, std::vector<Candidate>& out,
                           QueryStats& stats, TabooView taboo, LeafBuffer& buffer, VisitLanes lanes);

@@ -161,18 +161,12 @@ struct InlinedTest {
   }
 };
 
-/// WideLoop built for AVX2: traverse_depth_first's loop, each visit's wide test inlined (no call
-/// through a pointer, its per-traversal values kept in registers across visits: flatten).
+/// WideLoop built for AVX2: visit_until_empty with each visit's wide test inlined (no call through
+/// a pointer, its per-traversal values kept in registers across visits: flatten).
 CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx, NodePair* const base, NodePair* top,
                                                           std::size_t bound, std::vector<Candidate>& out, QueryStats& stats,
                                                           TabooView taboo, LeafBuffer& buffer, VisitLanes lanes) {
-  while (top != base) {
-    const NodePair n = *--top;
-    const int count = visit<true>(ctx, n, out, stats, top, taboo, &buffer, lanes, InlinedTest{});
-    top += count > 0 ? count : 0;
-    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
-  }
-  static_cast<void>(bound);  // (read by the assertion alone)
+  visit_until_empty(ctx, base, top, bound, out, stats, taboo, buffer, lanes, InlinedTest{});
 }
 
 }  // namespace

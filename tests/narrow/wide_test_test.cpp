@@ -276,12 +276,8 @@ TEST(WideTest, TheAvx2LoopVisitsAsTheScalarOne) {
     LeafBuffer buffer;
     NodePair* top = stack.data();
     if (test_root(ctx, NodePair{0, 0}, scalar_stats)) *top++ = NodePair{0, 0};
-    while (top != stack.data()) {
-      const NodePair n = *--top;
-      const int count = visit<true>(ctx, n, scalar_out, scalar_stats, top, {}, &buffer, VisitLanes{nullptr, &lanes, &staying},
-                                    ScalarWideTest{});
-      top += count > 0 ? count : 0;
-    }
+    visit_until_empty(ctx, stack.data(), top, stack.size(), scalar_out, scalar_stats, {}, buffer,
+                      VisitLanes{nullptr, &lanes, &staying}, ScalarWideTest{});
     ctx.flush_leaves(buffer, scalar_out);
     const auto ids = [](const std::vector<Candidate>& c) {
       std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
