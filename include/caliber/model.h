@@ -62,8 +62,7 @@ class CALIBER_EXPORT Model {
   [[nodiscard]] bool has_oriented_boxes() const;
   /// Bytes the model holds: its mesh (vertices, triangles, groups), normals, BVH (what the
   /// traversals read, the leaf order, oriented boxes when kept; the wide tree the pair-collecting
-  /// queries walk and what their visits read of each node, about 135 bytes a triangle, built for
-  /// every model) and adjacency.
+  /// queries walk, about 70 bytes a triangle, built for every model) and adjacency.
   [[nodiscard]] std::size_t memory_bytes() const;
 
  protected:

@@ -21,9 +21,8 @@ std::size_t Model::memory_bytes() const {
   const ModelData& m = data(*this);
   const auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
   return bytes(m.mesh.vertices) + bytes(m.mesh.triangles) + bytes(m.mesh.groups) + bytes(m.normals) + bytes(m.nodes) +
-         bytes(m.wide) + bytes(m.visit_nodes) + bytes(m.filters) + bytes(m.laterals) + bytes(m.group_masks) +
-         bytes(m.oriented_boxes) + bytes(m.leaf_position) + bytes(m.corner_vertex) + bytes(m.vertex_offsets) +
-         bytes(m.vertex_triangles);
+         bytes(m.wide) + bytes(m.filters) + bytes(m.laterals) + bytes(m.group_masks) + bytes(m.oriented_boxes) +
+         bytes(m.leaf_position) + bytes(m.corner_vertex) + bytes(m.vertex_offsets) + bytes(m.vertex_triangles);
 }
 
 NodeBox node_box(const Model& model, std::uint32_t node) {

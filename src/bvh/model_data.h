@@ -18,16 +18,28 @@
 
 namespace caliber {
 
-/// One node of the BVH, as the node-node test reads it: 48 bytes. Two bounding volumes per node:
-/// the paper's sphere, tested first, and the node's axis-aligned box in the mesh's own frame, which
-/// sharpens what the sphere lets through (thin and elongated parts, where spheres are loose). All
-/// boxes of one mesh share that frame, so the rotation between two meshes' boxes is one matrix per
-/// query and the box test is a separating-axis test on six face axes.
+/// One node of the BVH, as the node tests and the visits read it: 64 bytes aligned to 64, one cache
+/// line. Two bounding volumes per node: the paper's sphere, tested first by the binary CD tree's
+/// node test, and the node's axis-aligned box in the mesh's own frame, which sharpens what the
+/// sphere lets through (thin and elongated parts, where spheres are loose). All boxes of one mesh
+/// share that frame, so the rotation between two meshes' boxes is one matrix per query and the box
+/// test is a separating-axis test on six face axes. Then what a visit of the wide CD tree reads
+/// (narrow/visit.h): where the node's slab lies (`slot`: its place in the wide node that holds it,
+/// which stores its slab as its BvhNodeFilter does, and which the visit that reached it read last)
+/// and its wide node (`link`).
 ///
 /// Values are stored as floats, rounded outward at build time (the radius and half-extents cover
 /// the rounding of the centers), so every vertex below lies inside both volumes exactly as stored.
 /// The children of an internal node are adjacent: `index` and `index + 1`.
-struct BvhNode {
+struct alignas(64) BvhNode {
+  /// `link` of a leaf, or of an internal node that is no wide node's root (collapsed away: it lies
+  /// between a wide node and that node's slots).
+  static constexpr std::uint32_t kNoWide = 0xFFFFFFFFu;
+  /// `slot` of a node that is no slot (the root, the nodes collapsed away), or whose wide node's
+  /// index is kSlotWideNodes or more: its slab is read from its BvhNodeFilter.
+  static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
+  /// The wide nodes whose slots `slot` can name (the last slot of the next would be kNoSlot).
+  static constexpr std::uint32_t kSlotWideNodes = (std::uint32_t{1} << 29) - 1;
   /// Bounding-sphere center (object space).
   float center[3];
   /// Bounding-sphere radius.
@@ -40,15 +52,28 @@ struct BvhNode {
   std::uint32_t index;
   /// Number of triangles below (the paper's P); 1 for a leaf.
   std::uint32_t count;
+  /// The wide node that holds it as a slot, its index in ModelData::wide times WideNode::kSlots
+  /// plus the slot; or kNoSlot (bvh::build_wide_tree sets it).
+  std::uint32_t slot = kNoSlot;
+  /// The index of its wide node in ModelData::wide, or kNoWide (bvh::build_wide_tree sets it).
+  std::uint32_t link = kNoWide;
 
   /// True for a leaf (one triangle).
   [[nodiscard]] bool is_leaf() const { return count == 1; }
+  /// A leaf's triangle.
+  [[nodiscard]] std::uint32_t triangle() const { return index; }
+  /// Whether it is a wide node's root (`link` names it).
+  [[nodiscard]] bool has_wide() const { return link != kNoWide; }
+  /// What the wide CD tree compares to choose the side that descends: the sum of its box's
+  /// half-extents in float (a model scaled by a power of two scales it exactly, where its boxes'
+  /// half-extents are normal floats).
+  [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
 };
-static_assert(sizeof(BvhNode) == 48, "BvhNode is meant to stay compact");
+static_assert(sizeof(BvhNode) == 64, "BvhNode is meant to stay one cache line");
 
 /// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
 /// tests have passed; the cone only by contact queries): 32 bytes aligned to 32, two to a cache
-/// line and never across two. Kept apart from BvhNode so that the first two tests touch 48 bytes.
+/// line and never across two. Kept apart from BvhNode, whose line the first two tests read.
 struct alignas(32) BvhNodeFilter {
   /// Normal-cone axis (unit up to float rounding; the half-angle is measured from this axis).
   float cone_axis[3];
@@ -249,42 +274,6 @@ static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 ==
               offsetof(WideNode, slab_lo) % 32 == 0 && offsetof(WideNode, slab_hi) % 32 == 0 &&
               offsetof(WideNode, node) % 32 == 0);
 
-/// What a visit of the wide CD tree reads of a BVH node (narrow/visit.h): its box (its BvhNode's,
-/// the same floats), where its slab lies (`slot`: its place in the wide node that holds it, which
-/// stores its slab as its BvhNodeFilter does, and which the visit that reached it read last) and
-/// where the visit goes from it (`link`): its wide node, or its triangle for a leaf. 32 bytes
-/// aligned to 32, two to a cache line and never across two, so that a visit reads one line of
-/// each side (a BvhNode spans two in half the cases).
-struct alignas(32) VisitNode {
-  /// `link`'s bit of a leaf.
-  static constexpr std::uint32_t kLeaf = 0x80000000u;
-  /// `link` of an internal node that is no wide node's root (collapsed away: it lies between a wide
-  /// node and that node's slots).
-  static constexpr std::uint32_t kNoWide = 0x7FFFFFFFu;
-  /// `slot` of a node that is no slot (the root, the nodes collapsed away), or whose wide node's
-  /// index is kSlotWideNodes or more: its slab is read from its BvhNodeFilter.
-  static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
-  /// The wide nodes whose slots `slot` can name (the last slot of the next would be kNoSlot).
-  static constexpr std::uint32_t kSlotWideNodes = (std::uint32_t{1} << 29) - 1;
-  float box_center[3];
-  float box_half[3];
-  /// The wide node that holds it as a slot, its index in ModelData::wide times WideNode::kSlots
-  /// plus the slot; or kNoSlot.
-  std::uint32_t slot;
-  /// kLeaf | the triangle id for a leaf; else the index of its wide node in ModelData::wide, or
-  /// kNoWide.
-  std::uint32_t link;
-
-  /// What the wide CD tree compares to choose the side that descends: the sum of its box's
-  /// half-extents in float (a model scaled by a power of two scales it exactly, where its boxes'
-  /// half-extents are normal floats).
-  [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
-  [[nodiscard]] bool is_leaf() const { return (link & kLeaf) != 0; }
-  [[nodiscard]] std::uint32_t triangle() const { return link & ~kLeaf; }
-  [[nodiscard]] bool has_wide() const { return link < kNoWide; }
-};
-static_assert(sizeof(VisitNode) == 32);
-
 /// What a Model holds: the mesh with its BVH, normals and adjacency, laid out for the traversal.
 /// Made by build_model; never modified afterwards.
 struct ModelData : Model {
@@ -316,10 +305,8 @@ struct ModelData : Model {
     const std::uint32_t p = leaf_position[triangle];
     return p >= first && p < first + nodes[node].count;
   }
-  /// The wide tree (WideNode), its root's first; and per BVH node, what a visit reads of it
-  /// (VisitNode: its box, its slot and its wide node or triangle).
+  /// The wide tree (WideNode), its root's first (BvhNode::link and BvhNode::slot name its nodes).
   std::vector<WideNode> wide;
-  std::vector<VisitNode> visit_nodes;
   /// Where the run of leaves of `node` starts: the place of its first leaf (its first children's).
   [[nodiscard]] std::uint32_t first_leaf(std::uint32_t node) const {
     while (!nodes[node].is_leaf()) node = nodes[node].index;

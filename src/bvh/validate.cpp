@@ -42,7 +42,7 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   return {};
 }
 
-/// Whether slot `slot` (VisitNode::slot) of m's wide tree holds node i, with i's slab bit for bit.
+/// Whether slot `slot` (BvhNode::slot) of m's wide tree holds node i, with i's slab bit for bit.
 bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
   if (slot / WideNode::kSlots >= m.wide.size()) return false;
   const WideNode& w = m.wide[slot / WideNode::kSlots];
@@ -88,19 +88,13 @@ std::string bvh_problem(const ModelData& m) {
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
   }
-  // What a wide visit reads of each node: its own box and leaf, and its slot (where the wide tree
-  // is built): the slot holds it, and stores its slab as its filter does.
-  if (!m.visit_nodes.empty()) {
-    if (m.visit_nodes.size() != size) return "the visit nodes are not one a node";
-    for (std::size_t i = 0; i < size; ++i) {
-      const BvhNode& n = m.nodes[i];
-      const VisitNode& v = m.visit_nodes[i];
-      bool same = v.is_leaf() == n.is_leaf() && (!n.is_leaf() || v.triangle() == n.index);
-      for (int k = 0; k < 3; ++k) same = same && v.box_center[k] == n.box_center[k] && v.box_half[k] == n.box_half[k];
-      if (!same) return "node " + std::to_string(i) + ": its visit node is not a copy of it";
-      if (v.slot != VisitNode::kNoSlot && !slot_holds(m, v.slot, i))
-        return "node " + std::to_string(i) + ": its slot does not hold it";
-    }
+  // What a wide visit reads of each node (where the wide tree is built): its wide node, a wide
+  // node for none of the leaves; its slot, which holds it and stores its slab as its filter does.
+  for (std::size_t i = 0; i < size; ++i) {
+    const BvhNode& n = m.nodes[i];
+    if (n.has_wide() && (n.is_leaf() || n.link >= m.wide.size())) return "node " + std::to_string(i) + ": a bad wide node";
+    if (n.slot != BvhNode::kNoSlot && !slot_holds(m, n.slot, i))
+      return "node " + std::to_string(i) + ": its slot does not hold it";
   }
   // Each wide node's count: its slots in use come first, the rest are empty.
   for (std::size_t w = 0; w < m.wide.size(); ++w) {

@@ -160,16 +160,16 @@ WideNode with_slot_alone(const WideNode& w, int k) {
 }  // namespace
 
 WideNode single_slot(const ModelData& model, std::uint32_t node) {
-  if (const std::uint32_t slot = model.visit_nodes[node].slot; slot != VisitNode::kNoSlot) {
+  if (const std::uint32_t slot = model.nodes[node].slot; slot != BvhNode::kNoSlot) {
     return with_slot_alone(model.wide[slot / WideNode::kSlots], static_cast<int>(slot % WideNode::kSlots));
   }
-  // (A slot whose wide node is too far on for VisitNode::slot.) The wide node that holds `node` as
+  // (A slot whose wide node is too far on for BvhNode::slot.) The wide node that holds `node` as
   // a slot, from the root down: at each, the slot whose run of leaves holds node's first leaf is
   // node, or holds node below it.
   const std::uint32_t place = model.first_leaf(node), count = model.nodes[node].count;
   std::uint32_t holder = 0, first = 0;  // the BVH node whose wide node is searched, its first leaf's place
-  while (node != holder && model.visit_nodes[holder].has_wide()) {
-    const WideNode& w = model.wide[model.visit_nodes[holder].link];
+  while (node != holder && model.nodes[holder].has_wide()) {
+    const WideNode& w = model.wide[model.nodes[holder].link];
     int k = 0;
     while (place >= first + model.nodes[w.node[k]].count) first += model.nodes[w.node[k++]].count;
     if (w.node[k] == node) return with_slot_alone(w, k);
@@ -188,16 +188,9 @@ WideNode single_slot(const ModelData& model, std::uint32_t node) {
 
 void build_wide_tree(ModelData& model) {
   model.wide.clear();
-  model.visit_nodes.resize(model.nodes.size());
-  for (std::size_t i = 0; i < model.nodes.size(); ++i) {
-    const BvhNode& n = model.nodes[i];
-    VisitNode& v = model.visit_nodes[i];
-    for (int k = 0; k < 3; ++k) {
-      v.box_center[k] = n.box_center[k];
-      v.box_half[k] = n.box_half[k];
-    }
-    v.slot = VisitNode::kNoSlot;
-    v.link = n.is_leaf() ? VisitNode::kLeaf | n.index : VisitNode::kNoWide;
+  for (BvhNode& n : model.nodes) {
+    n.slot = BvhNode::kNoSlot;
+    n.link = BvhNode::kNoWide;
   }
   if (model.nodes.empty() || model.nodes[0].is_leaf()) return;
   // Depth first, an explicit stack (a BVH may be deep): each wide node is made when its BVH node
@@ -209,7 +202,7 @@ void build_wide_tree(ModelData& model) {
     std::uint32_t slots[WideNode::kSlots];
     const int n = collapse(model, root, slots);
     const auto index = static_cast<std::uint32_t>(model.wide.size());
-    model.visit_nodes[root].link = index;
+    model.nodes[root].link = index;
     WideNode& w = model.wide.emplace_back();
     FloatBox boxes[WideNode::kSlots];
     for (int k = 0; k < n; ++k) boxes[k] = float_box(model.nodes[slots[k]]);
@@ -217,8 +210,8 @@ void build_wide_tree(ModelData& model) {
     for (int k = 0; k < WideNode::kSlots; ++k) {
       if (k < n) {
         fill_slot(model, slots[k], boxes[k], k, w);
-        if (index < VisitNode::kSlotWideNodes)
-          model.visit_nodes[slots[k]].slot = index * WideNode::kSlots + static_cast<std::uint32_t>(k);
+        if (index < BvhNode::kSlotWideNodes)
+          model.nodes[slots[k]].slot = index * WideNode::kSlots + static_cast<std::uint32_t>(k);
       } else {
         clear_slot(k, w);
       }

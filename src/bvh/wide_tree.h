@@ -9,7 +9,8 @@
 
 namespace caliber::bvh {
 
-/// Builds model.wide and model.visit_nodes from model.nodes and model.filters (the BVH already built).
+/// Builds model.wide from model.nodes and model.filters (the BVH already built), and sets each
+/// node's slot and link.
 void build_wide_tree(ModelData& model);
 
 /// A wide node whose one slot is BVH node `node` as the wide node that holds it as a slot has it

@@ -29,7 +29,7 @@ bool root_test(const PairContext& ctx, NodePair n, RootTest how) {
   // As the wide parent's visit tests it: its own lane, the other lanes empty.
   const bool down_a = how == RootTest::child_of_a;
   const WideNode w = bvh::single_slot(down_a ? ctx.a() : ctx.b(), down_a ? n.a : n.b);
-  const VisitNode& staying = down_a ? ctx.b().visit_nodes[n.b] : ctx.a().visit_nodes[n.a];
+  const BvhNode& staying = down_a ? ctx.b().nodes[n.b] : ctx.a().nodes[n.a];
   return (wide_pass(ctx, n, WideVisit{&w, down_a ? n.b : n.a, down_a, &staying}, wide_lanes(ctx)) & 1u) != 0;
 }
 

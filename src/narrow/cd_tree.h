@@ -75,32 +75,30 @@ inline void cd_descend(const BvhNode& a, const BvhNode& b, double ratio, bool& d
 inline bool wide_cd_tree(const PairContext& ctx) { return ctx.request().kind != QueryKind::distance; }
 
 /// In the wide CD tree, whether node (a, b), not a pair of leaves, descends on A's side: A's node
-/// is not a leaf, and B's is one or its box is no larger than A's (VisitNode::size). Depends only
+/// is not a leaf, and B's is one or its box is no larger than A's (BvhNode::size). Depends only
 /// on object-space boxes, so the CD tree's shape does not depend on the poses.
-inline bool wide_descends_a(const VisitNode& a, const VisitNode& b) {
-  return !a.is_leaf() && (b.is_leaf() || a.size() >= b.size());
-}
+inline bool wide_descends_a(const BvhNode& a, const BvhNode& b) { return !a.is_leaf() && (b.is_leaf() || a.size() >= b.size()); }
 
 /// A visit of the wide CD tree's node n (not a pair of leaves): the side that descends
-/// (wide_descends_a), its wide node and the node that stays (its id and VisitNode); child k is
+/// (wide_descends_a), its wide node and the node that stays (its id and BvhNode); child k is
 /// slot k with that node.
 struct WideVisit {
   const WideNode* node;
   std::uint32_t stay;
   bool a_descends;
-  const VisitNode* staying;
+  const BvhNode* staying;
 
   [[nodiscard]] NodePair child(int k, NodePair n) const {
     return a_descends ? NodePair{node->node[k], n.b} : NodePair{n.a, node->node[k]};
   }
 };
 
-/// The wide visit of node n, whose visit nodes are a (of A) and b (of B).
-inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b) {
+/// The wide visit of node n, whose BVH nodes are a (of A) and b (of B).
+inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
   CALIBER_ASSERT(!(a.is_leaf() && b.is_leaf()), "a pair of leaves has no children");
   const bool down_a = wide_descends_a(a, b);
   const std::uint32_t link = down_a ? a.link : b.link;
-  CALIBER_ASSERT(link < VisitNode::kNoWide, "a node of the wide CD tree that descends has a wide node");
+  CALIBER_ASSERT(link < BvhNode::kNoWide, "a node of the wide CD tree that descends has a wide node");
   return WideVisit{&(down_a ? ctx.a() : ctx.b()).wide[link], down_a ? n.b : n.a, down_a, down_a ? &b : &a};
 }
 
@@ -110,7 +108,7 @@ inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const VisitNode&
 /// child j (or n.b), i major.
 inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChildren]) {
   if (wide_cd_tree(ctx)) {
-    const WideVisit v = wide_visit(ctx, n, ctx.a().visit_nodes[n.a], ctx.b().visit_nodes[n.b]);
+    const WideVisit v = wide_visit(ctx, n, ctx.a().nodes[n.a], ctx.b().nodes[n.b]);
     const int count = v.node->count();
     for (int k = 0; k < count; ++k) out[k] = v.child(k, n);
     return count;
@@ -140,7 +138,7 @@ extern const detail::WideTest kWideTest;
 /// called through a pointer: what a visit runs unless its caller names the form (Test below).
 struct ChosenWideTest {
   unsigned operator()(const detail::NodeTestFrame& f, const detail::WideLanes& l, bool a_descends, std::uint32_t stay,
-                      const VisitNode& sn, const WideNode& w, detail::StayingCache* cache) const {
+                      const BvhNode& sn, const WideNode& w, detail::StayingCache* cache) const {
     // (Null also before the library's constants are made: a query from another constant's constructor.)
     return (kWideTest != nullptr ? kWideTest : detail::wide_test_scalar)(f, l, a_descends, stay, sn, w, cache);
   }
@@ -154,14 +152,14 @@ template <class Test = ChosenWideTest>
 [[gnu::always_inline]] inline unsigned wide_pass(const PairContext& ctx, NodePair n, const WideVisit& v,
                                                  const detail::WideLanes& lanes, detail::StayingCache* cache = nullptr,
                                                  Test test = {}) {
-  CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).visit_nodes[v.stay], "the staying node is node stay");
+  CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).nodes[v.stay], "the staying node is node stay");
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
   if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
   // A pair of leaves skips them: its leaf test tests the triangles' groups and normals exactly
   // (PairContext::groups_allow, normals_allow), refusing all that the nodes' groups and cones would
   // (two thirds of the cone tests of a contact query, each reading two nodes' filters). Whether a
-  // slot is a leaf is read in its visit node, which the visit of that pair reads next.
-  const std::vector<VisitNode>& descending = (v.a_descends ? ctx.a() : ctx.b()).visit_nodes;
+  // slot is a leaf is read in its BVH node, which the visit of that pair reads next.
+  const std::vector<BvhNode>& descending = (v.a_descends ? ctx.a() : ctx.b()).nodes;
   const bool staying_leaf = v.staying->is_leaf();
   for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);

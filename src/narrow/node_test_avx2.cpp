@@ -20,7 +20,7 @@ namespace {
 /// node per lane, a0 a1 b0 b1), each float converted to double (exactly). The blocks' positions in
 /// BvhNode and BvhNodeFilter:
 static_assert(offsetof(BvhNode, center) == 0 && offsetof(BvhNode, radius) == 12 && offsetof(BvhNode, box_center) == 16 &&
-              offsetof(BvhNode, box_half) == 28 && sizeof(BvhNode) == 48);
+              offsetof(BvhNode, box_half) == 28 && sizeof(BvhNode) == 64);
 static_assert(offsetof(BvhNodeFilter, cone_axis) == 0 && offsetof(BvhNodeFilter, slab_lo) == 24 &&
               offsetof(BvhNodeFilter, slab_hi) == 28);
 

@@ -38,7 +38,7 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
 /// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
 /// reversed), every child counted but those on the taboo list (skipped and marked reached).
 template <bool kReversed, class Test = ChosenWideTest>
-[[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b,
+[[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
                                              const detail::WideLanes& lanes, detail::StayingCache* staying, Test test = {}) {
   const WideVisit v = wide_visit(ctx, n, a, b);
@@ -66,8 +66,8 @@ template <bool kReversed, class Test = ChosenWideTest>
 
 /// visit_wide for a visit without the traversal's lanes: made here.
 template <bool kReversed>
-[[gnu::noinline]] int visit_wide_alone(const PairContext& ctx, NodePair n, const VisitNode& a, const VisitNode& b,
-                                       QueryStats& stats, NodePair passed[], TabooView taboo) {
+[[gnu::noinline]] int visit_wide_alone(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b, QueryStats& stats,
+                                       NodePair passed[], TabooView taboo) {
   const detail::WideLanes made = wide_lanes(ctx);
   return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, made, nullptr);
 }
@@ -144,10 +144,10 @@ template <bool kReversed = false, class Test = ChosenWideTest>
     return -1;
   };
   if (wide_cd_tree(ctx)) {
-    // One line of each side (VisitNode): the leaves' triangles, the sizes, the wide node, the
+    // One line of each side (BvhNode): the leaves' triangles, the sizes, the wide node, the
     // staying box and slot.
-    const VisitNode& a = ctx.a().visit_nodes[n.a];
-    const VisitNode& b = ctx.b().visit_nodes[n.b];
+    const BvhNode& a = ctx.a().nodes[n.a];
+    const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
     return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);

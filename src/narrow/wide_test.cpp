@@ -132,7 +132,7 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
 
 }  // namespace
 
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const VisitNode& sn,
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
                           const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
   bool held;

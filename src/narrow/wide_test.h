@@ -133,10 +133,10 @@ struct StayingSlab {
   float axis[3], lo, hi;
 };
 /// The slab of node `stay` (sn), of B where A descends: read in the wide node that holds it
-/// (VisitNode::slot; the visit that reached it read that node), else in its filter.
+/// (BvhNode::slot; the visit that reached it read that node), else in its filter.
 inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                const VisitNode& sn) {
-  if (sn.slot != VisitNode::kNoSlot) {
+                                const BvhNode& sn) {
+  if (sn.slot != BvhNode::kNoSlot) {
     const WideNode& w = l.staying_wide[a_descends ? 0 : 1][sn.slot / WideNode::kSlots];
     const std::uint32_t k = sn.slot % WideNode::kSlots;
     return {{w.axis[0][k], w.axis[1][k], w.axis[2][k]}, w.slab_lo[k], w.slab_hi[k]};
@@ -146,7 +146,7 @@ inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool
 }
 
 /// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
-inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const VisitNode& sn, const StayingSlab& sf,
+inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const BvhNode& sn, const StayingSlab& sf,
                                     const double c[3]) {
   StayingFloats out;
   double nd[3];
@@ -168,7 +168,7 @@ inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const
 struct StayingBox {
   double c[3], h[3];
 };
-inline StayingBox staying_box(const VisitNode& sn) {
+inline StayingBox staying_box(const BvhNode& sn) {
   return StayingBox{{sn.box_center[0], sn.box_center[1], sn.box_center[2]}, {sn.box_half[0], sn.box_half[1], sn.box_half[2]}};
 }
 
@@ -182,7 +182,7 @@ inline StayingCache::Entry& staying_entry(StayingCache* cache, StayingCache::Ent
 
 /// Makes entry `kept`'s float values (stage 2's) for node `stay` (sn), unless made already.
 inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                const VisitNode& sn, StayingCache::Entry& kept) {
+                                const BvhNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
   kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, staying_slab(f, l, a_descends, stay, sn), kept.moved);
   kept.has_floats = true;
@@ -193,14 +193,14 @@ inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool
 WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b);
 
 /// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
-/// node `stay` stays; sn: its VisitNode) against the descending node's wide node w: bit k set where
+/// node `stay` stays; sn: its BvhNode) against the descending node's wide node w: bit k set where
 /// slot k passes (slots past the last never do). The staying node is read from `cache` where it
 /// holds it, else moved and kept there (null: moved for this test alone).
-using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                              const VisitNode& sn, const WideNode& w, StayingCache* cache);
+using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
+                              const WideNode& w, StayingCache* cache);
 
 /// The scalar form.
-unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const VisitNode& sn,
+unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
                           const WideNode& w, StayingCache* cache);
 
 /// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.

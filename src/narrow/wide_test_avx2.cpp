@@ -87,7 +87,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
 /// make_staying_floats (staying_floats) in double lanes (x, y, z, 0), each lane making its
 /// operations in its order; the offset and slab bounds as it computes them.
 CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const WideLanes& l, const WideSide& s, bool a_descends,
-                                                  std::uint32_t stay, const VisitNode& sn, StayingCache::Entry& kept) {
+                                                  std::uint32_t stay, const BvhNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
   const StayingSlab sf = staying_slab(f, l, a_descends, stay, sn);
   const D unit = _mm256_set1_pd(l.unit);
@@ -115,7 +115,7 @@ CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const 
 }
 
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                     const VisitNode& sn, const WideNode& w, StayingCache* cache) {
+                                     const BvhNode& sn, const WideNode& w, StayingCache* cache) {
   const WideSide& s = l.side[a_descends ? 0 : 1];
   bool held;
   StayingCache::Entry spare;
@@ -156,7 +156,7 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
 /// wide_test_avx2, inlined where a visit calls it.
 struct InlinedTest {
   CALIBER_AVX2 unsigned operator()(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                   const VisitNode& sn, const WideNode& w, StayingCache* cache) const {
+                                   const BvhNode& sn, const WideNode& w, StayingCache* cache) const {
     return wide_test_avx2(f, l, a_descends, stay, sn, w, cache);
   }
 };

@@ -92,6 +92,12 @@ TEST(BvhProblem, EachBreakIsFound) {
             }),
             "")
       << "a count past the slots";
+  EXPECT_NE(broken([&] { m.nodes[leaf].link = 0; }), "") << "a leaf naming a wide node";
+  EXPECT_NE(broken([&] { m.nodes[0].link = static_cast<std::uint32_t>(m.wide.size()); }), "") << "a wide node past the last";
+  ASSERT_NE(m.nodes[leaf].slot, BvhNode::kNoSlot);
+  EXPECT_NE(broken([&] { m.nodes[leaf].slot ^= 1u; }), "") << "a slot holding another node";
+  EXPECT_NE(broken([&] { m.nodes[leaf].slot = static_cast<std::uint32_t>(m.wide.size() * WideNode::kSlots); }), "")
+      << "a slot past the last wide node";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
 

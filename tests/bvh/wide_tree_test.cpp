@@ -20,20 +20,15 @@ namespace {
 
 /// The first broken property of m's wide tree, in words (empty when none).
 std::string wide_problem(const ModelData& m) {
-  if (m.visit_nodes.size() != m.nodes.size()) return "visit_nodes is not one a node";
   std::vector<int> seen(m.nodes.size(), 0);
   seen[0] = 1;
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
     // A visit reads the node's own box, its triangle or wide node, and its slot.
     const BvhNode& n = m.nodes[i];
-    const VisitNode& v = m.visit_nodes[i];
-    for (int a = 0; a < 3; ++a) {
-      if (v.box_center[a] != n.box_center[a] || v.box_half[a] != n.box_half[a]) return "a visit node's box is not its node's";
-    }
-    if (v.is_leaf() != n.is_leaf() || (n.is_leaf() && v.triangle() != n.index)) return "a visit node's leaf or triangle";
-    if (n.is_leaf() || !v.has_wide()) continue;
-    const std::uint32_t w = v.link;
-    if (w >= m.wide.size()) return "a visit node's wide node is out of range";
+    if (n.is_leaf() && n.has_wide()) return "a leaf names a wide node";
+    if (n.is_leaf() || !n.has_wide()) continue;
+    const std::uint32_t w = n.link;
+    if (w >= m.wide.size()) return "a node's wide node is out of range";
     const WideNode& node = m.wide[w];
     const int count = node.count();
     int exponent = 0;
@@ -53,9 +48,8 @@ std::string wide_problem(const ModelData& m) {
       if (s >= m.nodes.size() || seen[s]++ != 0) return "slot " + std::to_string(s) + " is bad or seen twice";
       if (m.first_leaf(s) != next) return "the slots' runs of leaves do not follow one another";
       next += m.nodes[s].count;
-      if (!m.nodes[s].is_leaf() && !m.visit_nodes[s].has_wide()) return "an inner slot without a wide node";
-      if (m.visit_nodes[s].slot != w * WideNode::kSlots + static_cast<std::uint32_t>(k))
-        return "a slot's visit node does not name it";
+      if (!m.nodes[s].is_leaf() && !m.nodes[s].has_wide()) return "an inner slot without a wide node";
+      if (m.nodes[s].slot != w * WideNode::kSlots + static_cast<std::uint32_t>(k)) return "a slot's node does not name it";
       const BvhNode& b = m.nodes[s];
       for (int a = 0; a < 3; ++a) {
         const double lo = double(b.box_center[a]) - b.box_half[a], hi = double(b.box_center[a]) + b.box_half[a];
@@ -87,8 +81,8 @@ std::string wide_problem(const ModelData& m) {
   // Every leaf is one slot; a node between a wide node and its slots is neither root nor slot.
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
     if (m.nodes[i].is_leaf() && seen[i] != 1) return "leaf " + std::to_string(i) + " is not one slot";
-    if (m.visit_nodes[i].has_wide() && seen[i] != 1) return "wide node " + std::to_string(i) + " is not the root or one slot";
-    if ((seen[i] == 0 || i == 0) && m.visit_nodes[i].slot != VisitNode::kNoSlot)
+    if (m.nodes[i].has_wide() && seen[i] != 1) return "wide node " + std::to_string(i) + " is not the root or one slot";
+    if ((seen[i] == 0 || i == 0) && m.nodes[i].slot != BvhNode::kNoSlot)
       return "node " + std::to_string(i) + " is no slot but names one";
   }
   return {};
@@ -114,8 +108,8 @@ TEST(WideTree, SlotsSplitTheirNodesLeavesInOrder) {
   EXPECT_EQ(data(*build_model(tiny)).wide[0].step, 0x1p-126f) << "the least step sets the root's grid";
 }
 
-// A wide node starts a cache line and a node's filter lies in one: a visit reads five lines of the
-// one and one of the other, not six and two.
+// A wide node and a BVH node start a cache line and a node's filter lies in one: a visit reads five
+// lines of the first, one of the second and one of the third, not six, two and two.
 TEST(WideTree, NodesLieOnCacheLines) {
   for (const Mesh& mesh : {make_torus(1.0, 0.35, 48, 24), make_sphere(0.5, 9, 11)}) {
     const auto model = build_model(mesh);
@@ -123,6 +117,8 @@ TEST(WideTree, NodesLieOnCacheLines) {
     ASSERT_FALSE(m.wide.empty());
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(m.wide.data()) % 64, 0u);
     EXPECT_EQ(sizeof(WideNode) % 64, 0u);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(m.nodes.data()) % 64, 0u);
+    EXPECT_EQ(sizeof(BvhNode), 64u);
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(m.filters.data()) % 32, 0u);
     EXPECT_EQ(64 % sizeof(BvhNodeFilter), 0u);
   }
@@ -134,16 +130,12 @@ TEST(WideTree, ARootLeafHasNoWideNode) {
   one.triangles = {{0, 1, 2}};
   const auto model = build_model(one);
   EXPECT_TRUE(data(*model).wide.empty());
-  ASSERT_EQ(data(*model).visit_nodes.size(), 1u);
-  const VisitNode& v = data(*model).visit_nodes[0];
+  ASSERT_EQ(data(*model).nodes.size(), 1u);
   const BvhNode& n = data(*model).nodes[0];
-  EXPECT_TRUE(v.is_leaf());
-  EXPECT_EQ(v.triangle(), 0u);
-  EXPECT_EQ(v.slot, VisitNode::kNoSlot);
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(v.box_center[k], n.box_center[k]);
-    EXPECT_EQ(v.box_half[k], n.box_half[k]);
-  }
+  EXPECT_TRUE(n.is_leaf());
+  EXPECT_EQ(n.triangle(), 0u);
+  EXPECT_EQ(n.slot, BvhNode::kNoSlot);
+  EXPECT_FALSE(n.has_wide());
 }
 
 // Subtrees that fit are opened to their leaves: the nodes hold more than half their slots on

@@ -47,8 +47,8 @@ void walk(const PairContext& ctx, const detail::WideLanes& lanes, std::size_t mo
   std::vector<NodePair> work{{0, 0}};
   for (std::size_t w = 0; w < work.size() && w < most; ++w) {
     const NodePair n = work[w];
-    const VisitNode& a = ctx.a().visit_nodes[n.a];
-    const VisitNode& b = ctx.b().visit_nodes[n.b];
+    const BvhNode& a = ctx.a().nodes[n.a];
+    const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) continue;
     const WideVisit v = wide_visit(ctx, n, a, b);
     const unsigned pass =
@@ -139,8 +139,8 @@ TEST(WideTest, AKeptStayingNodeDecidesAsAFreshOne) {
     while (!stack.empty() && visits < 20000) {
       const NodePair n = stack.back();
       stack.pop_back();
-      const VisitNode& na = ctx.a().visit_nodes[n.a];
-      const VisitNode& nb = ctx.b().visit_nodes[n.b];
+      const BvhNode& na = ctx.a().nodes[n.a];
+      const BvhNode& nb = ctx.b().nodes[n.b];
       if (na.is_leaf() && nb.is_leaf()) continue;
       const WideVisit v = wide_visit(ctx, n, na, nb);
       ++visits;
@@ -247,7 +247,7 @@ TEST(WideTest, TraversalsWithAndWithoutKeptNodesFindTheSamePairs) {
 /// The scalar form of the wide test, named as a visit's Test.
 struct ScalarWideTest {
   unsigned operator()(const detail::NodeTestFrame& f, const detail::WideLanes& l, bool a_descends, std::uint32_t stay,
-                      const VisitNode& sn, const WideNode& w, detail::StayingCache* cache) const {
+                      const BvhNode& sn, const WideNode& w, detail::StayingCache* cache) const {
     return detail::wide_test_scalar(f, l, a_descends, stay, sn, w, cache);
   }
 };
