@@ -54,6 +54,46 @@ bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
   return same;
 }
 
+/// Wide node w's slots: the count of those in use (they come first, the rest empty), each a node
+/// of m, an inner one with a wide node of its own; their triangles add up to node i's, whose wide
+/// node w is.
+std::string wide_slots_problem(const ModelData& m, std::size_t i, std::size_t w) {
+  const WideNode& node = m.wide[w];
+  const int used = node.count();
+  bool counted = used >= 1 && used <= WideNode::kSlots;
+  for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (node.node[k] != WideNode::kEmpty) == (k < used);
+  if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
+  std::uint64_t triangles = 0;
+  for (int k = 0; k < used; ++k) {
+    if (node.node[k] >= m.nodes.size()) return "wide node " + std::to_string(w) + ": a slot past the last node";
+    const BvhNode& slot = m.nodes[node.node[k]];
+    if (!slot.is_leaf() && !slot.has_wide()) return "wide node " + std::to_string(w) + ": an inner slot without a wide node";
+    triangles += slot.count;
+  }
+  if (triangles != m.nodes[i].count) return "wide node " + std::to_string(w) + ": its slots are not its node's triangles";
+  return {};
+}
+
+/// What a wide visit reads of each node (where the wide tree is built): its wide node, named by one
+/// node alone, an inner one; its slot, which holds it and stores its slab as its filter does.
+std::string wide_problem(const ModelData& m) {
+  std::vector<std::uint8_t> named(m.wide.size(), 0);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    const BvhNode& n = m.nodes[i];
+    if (n.has_wide()) {
+      if (n.is_leaf() || n.link >= m.wide.size() || named[n.link]++ != 0)
+        return "node " + std::to_string(i) + ": a bad wide node";
+      if (std::string p = wide_slots_problem(m, i, n.link); !p.empty()) return p;
+    }
+    if (n.slot != BvhNode::kNoSlot && !slot_holds(m, n.slot, i))
+      return "node " + std::to_string(i) + ": its slot does not hold it";
+  }
+  for (std::size_t w = 0; w < m.wide.size(); ++w) {
+    if (named[w] == 0) return "wide node " + std::to_string(w) + " is no node's";
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string bvh_problem(const ModelData& m) {
@@ -88,22 +128,7 @@ std::string bvh_problem(const ModelData& m) {
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
   }
-  // What a wide visit reads of each node (where the wide tree is built): its wide node, a wide
-  // node for none of the leaves; its slot, which holds it and stores its slab as its filter does.
-  for (std::size_t i = 0; i < size; ++i) {
-    const BvhNode& n = m.nodes[i];
-    if (n.has_wide() && (n.is_leaf() || n.link >= m.wide.size())) return "node " + std::to_string(i) + ": a bad wide node";
-    if (n.slot != BvhNode::kNoSlot && !slot_holds(m, n.slot, i))
-      return "node " + std::to_string(i) + ": its slot does not hold it";
-  }
-  // Each wide node's count: its slots in use come first, the rest are empty.
-  for (std::size_t w = 0; w < m.wide.size(); ++w) {
-    const int used = m.wide[w].count();
-    bool counted = used >= 1 && used <= WideNode::kSlots;
-    for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (m.wide[w].node[k] != WideNode::kEmpty) == (k < used);
-    if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
-  }
-  return {};
+  return wide_problem(m);
 }
 
 }  // namespace caliber::bvh

@@ -94,7 +94,7 @@ CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const 
   const D nd = fmad(_mm256_load_pd(s.col[2]), _mm256_set1_pd(sf.axis[2]),
                     fmad(_mm256_load_pd(s.col[1]), _mm256_set1_pd(sf.axis[1]),
                          _mm256_mul_pd(_mm256_load_pd(s.col[0]), _mm256_set1_pd(sf.axis[0]))));
-  // Four floats from box_center and box_half, their fourth lanes unused: box_half[0], and the slot
+  // Four floats from box_center and box_half, their fourth lanes unused: box_half[0], and `index`
   // (an integer, a subnormal or NaN as a float: zeroed, as such values cost assists).
   const D center = _mm256_cvtps_pd(_mm_loadu_ps(sn.box_center));
   const D half = _mm256_cvtps_pd(_mm_blend_ps(_mm_loadu_ps(sn.box_half), _mm_setzero_ps(), 8));

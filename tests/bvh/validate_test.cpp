@@ -3,6 +3,7 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -15,6 +16,10 @@ namespace caliber {
 namespace {
 
 TEST(BvhProblem, NoneOnBuiltModels) {
+  Mesh one;  // a root that is a leaf: no wide node, no slot
+  one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  one.triangles = {{0, 1, 2}};
+  EXPECT_EQ(bvh::bvh_problem(data(*build_model(one))), "");
   for (const Mesh& mesh : {make_torus(1.0, 0.3, 24, 16), make_sphere(0.5, 8, 12), make_box(1.0, 2.0, 3.0, 3)}) {
     EXPECT_EQ(bvh::bvh_problem(data(*build_model(mesh))), "");
   }
@@ -98,6 +103,12 @@ TEST(BvhProblem, EachBreakIsFound) {
   EXPECT_NE(broken([&] { m.nodes[leaf].slot ^= 1u; }), "") << "a slot holding another node";
   EXPECT_NE(broken([&] { m.nodes[leaf].slot = static_cast<std::uint32_t>(m.wide.size() * WideNode::kSlots); }), "")
       << "a slot past the last wide node";
+  std::uint32_t inner_slot = 0;  // an inner node that is a slot (and so has a wide node)
+  while (!(m.nodes[inner_slot].slot != BvhNode::kNoSlot && m.nodes[inner_slot].has_wide())) ++inner_slot;
+  EXPECT_NE(broken([&] { m.nodes[inner_slot].link = BvhNode::kNoWide; }), "") << "an inner slot without a wide node";
+  EXPECT_NE(broken([&] { std::swap(m.nodes[0].link, m.nodes[inner_slot].link); }), "") << "two wide nodes swapped";
+  EXPECT_NE(broken([&] { m.nodes[inner_slot].link = m.nodes[0].link; }), "") << "a wide node named twice";
+  EXPECT_NE(broken([&] { m.wide[0].node[0] = static_cast<std::uint32_t>(m.nodes.size()); }), "") << "a slot past the last node";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
 

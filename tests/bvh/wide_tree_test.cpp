@@ -11,9 +11,12 @@
 #include <gtest/gtest.h>
 
 #include "bvh/model_data.h"
+#include "bvh/validate.h"
 #include "bvh/wide_tree.h"
 #include "caliber/model.h"
 #include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "support/random_poses.h"
 
 namespace caliber {
 namespace {
@@ -136,6 +139,46 @@ TEST(WideTree, ARootLeafHasNoWideNode) {
   EXPECT_EQ(n.triangle(), 0u);
   EXPECT_EQ(n.slot, BvhNode::kNoSlot);
   EXPECT_FALSE(n.has_wide());
+}
+
+// A node whose wide node lies past BvhNode::kSlotWideNodes names no slot (kNoSlot): single_slot
+// finds its wide node from the root, and a visit reads its slab in its filter. With every slot
+// cleared, the same single slots and the same contacts.
+TEST(WideTree, NodesThatNameNoSlotGiveTheSameSingleSlotsAndContacts) {
+  const auto a = build_model(make_torus(1.0, 0.35, 48, 24)), b = build_model(make_sphere(0.5, 9, 11));
+  ModelData& ma = const_cast<ModelData&>(data(*a));
+  ModelData& mb = const_cast<ModelData&>(data(*b));
+  QueryRequest request;
+  request.kind = QueryKind::proximity;
+  request.tolerance = 0.05;
+  Pose pose_b;
+  pose_b.translation = Eigen::Vector3d(1.1, 0.2, 0.1);
+  pose_b.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  const QueryResult before = query(*a, Pose{}, *b, pose_b, request);
+  ASSERT_FALSE(before.contacts.empty());
+  std::vector<std::uint32_t> slotted;
+  std::vector<WideNode> singles;
+  for (std::uint32_t i = 0; i < ma.nodes.size(); ++i) {
+    if (ma.nodes[i].slot == BvhNode::kNoSlot) continue;
+    slotted.push_back(i);
+    singles.push_back(bvh::single_slot(ma, i));
+  }
+  ASSERT_GT(slotted.size(), ma.wide.size()) << "the slots of every wide node";
+  for (BvhNode& n : ma.nodes) n.slot = BvhNode::kNoSlot;
+  for (BvhNode& n : mb.nodes) n.slot = BvhNode::kNoSlot;
+  EXPECT_EQ(bvh::bvh_problem(ma), "");
+  for (std::size_t s = 0; s < slotted.size(); ++s) {
+    const WideNode found = bvh::single_slot(ma, slotted[s]), &want = singles[s];
+    ASSERT_EQ(found.count(), 1);
+    bool same = found.node[0] == want.node[0] && found.step == want.step && found.slab_lo[0] == want.slab_lo[0] &&
+                found.slab_hi[0] == want.slab_hi[0];
+    for (int i = 0; i < 3; ++i) {
+      same = same && found.origin[i] == want.origin[i] && found.lo[i][0] == want.lo[i][0] && found.hi[i][0] == want.hi[i][0] &&
+             found.axis[i][0] == want.axis[i][0];
+    }
+    EXPECT_TRUE(same) << "node " << slotted[s];
+  }
+  test::expect_identical(query(*a, Pose{}, *b, pose_b, request), before, "every slot cleared");
 }
 
 // Subtrees that fit are opened to their leaves: the nodes hold more than half their slots on
