@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
       const std::string name = file.substr(file.find_last_of('/') + 1);
       std::printf("| %s | %zu | %.1f | %.1f |\n", name.c_str(), mesh.triangles.size(), bytes, ms[ms.size() / 2]);
     } catch (const std::exception& e) {
-      fail(file + ": " + e.what());
+      const std::string what = e.what();  // (caliber's errors name the file already)
+      fail(what.find(file) != std::string::npos ? what : file + ": " + what);
     }
   }
   return 0;
