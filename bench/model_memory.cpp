@@ -1,6 +1,8 @@
 // Model memory and build time: for each mesh, the bytes a built model holds a triangle
 // (Model::memory_bytes: mesh, normals, BVH, wide tree, adjacency) and the median build time on
-// one thread over R builds. Public API only, so the same source measures any version.
+// one thread over R builds (the upper of the two middle ones for an even R): build_model's whole
+// call, the mesh's copy into the model included. Public API only, so the same source measures
+// any version. Mesh files given replace the default five (--meshes names where those lie).
 //   bench_model_memory [--meshes DIR] [--builds R] [MESH...]   (default: the five Embree pairs' meshes)
 
 #include <algorithm>

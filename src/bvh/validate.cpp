@@ -54,36 +54,39 @@ bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
   return same;
 }
 
-/// Wide node w's slots: the count of those in use (they come first, the rest empty), each a node
-/// of m, an inner one with a wide node of its own; their triangles add up to node i's, whose wide
-/// node w is.
-std::string wide_slots_problem(const ModelData& m, std::size_t i, std::size_t w) {
+/// Wide node w's slots: the count of those in use (2 or more; they come first, the rest empty),
+/// each a node of m, an inner one with a wide node of its own; their runs of leaves follow one
+/// another and cover node i's, whose wide node w is (`firsts`: where each node's run starts). So
+/// each slot lies strictly below node i, and no visit comes back to a node it left.
+std::string wide_slots_problem(const ModelData& m, const std::vector<std::uint32_t>& firsts, std::size_t i, std::size_t w) {
   const WideNode& node = m.wide[w];
   const int used = node.count();
-  bool counted = used >= 1 && used <= WideNode::kSlots;
+  bool counted = used >= 2 && used <= WideNode::kSlots;
   for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (node.node[k] != WideNode::kEmpty) == (k < used);
   if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
-  std::uint64_t triangles = 0;
+  std::uint64_t next = firsts[i];
   for (int k = 0; k < used; ++k) {
     if (node.node[k] >= m.nodes.size()) return "wide node " + std::to_string(w) + ": a slot past the last node";
     const BvhNode& slot = m.nodes[node.node[k]];
     if (!slot.is_leaf() && !slot.has_wide()) return "wide node " + std::to_string(w) + ": an inner slot without a wide node";
-    triangles += slot.count;
+    if (firsts[node.node[k]] != next) return "wide node " + std::to_string(w) + ": its slots' leaves do not follow one another";
+    next += slot.count;
   }
-  if (triangles != m.nodes[i].count) return "wide node " + std::to_string(w) + ": its slots are not its node's triangles";
+  if (next != std::uint64_t{firsts[i]} + m.nodes[i].count)
+    return "wide node " + std::to_string(w) + ": its slots are not its node's triangles";
   return {};
 }
 
 /// What a wide visit reads of each node (where the wide tree is built): its wide node, named by one
 /// node alone, an inner one; its slot, which holds it and stores its slab as its filter does.
-std::string wide_problem(const ModelData& m) {
+std::string wide_problem(const ModelData& m, const std::vector<std::uint32_t>& firsts) {
   std::vector<std::uint8_t> named(m.wide.size(), 0);
   for (std::size_t i = 0; i < m.nodes.size(); ++i) {
     const BvhNode& n = m.nodes[i];
     if (n.has_wide()) {
       if (n.is_leaf() || n.link >= m.wide.size() || named[n.link]++ != 0)
         return "node " + std::to_string(i) + ": a bad wide node";
-      if (std::string p = wide_slots_problem(m, i, n.link); !p.empty()) return p;
+      if (std::string p = wide_slots_problem(m, firsts, i, n.link); !p.empty()) return p;
     }
     if (n.slot != BvhNode::kNoSlot && !slot_holds(m, n.slot, i))
       return "node " + std::to_string(i) + ": its slot does not hold it";
@@ -107,12 +110,14 @@ std::string bvh_problem(const ModelData& m) {
   }
   if (m.nodes[0].count != triangles) return "the root does not hold every triangle";
   std::vector<std::uint8_t> reached(size, 0), placed(triangles, 0);
+  std::vector<std::uint32_t> firsts(size, 0);
   // Each node with where its run of leaves starts (ModelData::first_leaf).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0, 0}};
   while (!stack.empty()) {
     const auto [i, first] = stack.back();
     stack.pop_back();
     if (reached[i]++ != 0) return "node " + std::to_string(i) + " is reached twice";
+    firsts[i] = first;
     const BvhNode& n = m.nodes[i];
     if (n.is_leaf()) {
       if (n.index >= triangles || placed[n.index]++ != 0) return "leaf " + std::to_string(i) + ": a bad or repeated triangle";
@@ -128,7 +133,7 @@ std::string bvh_problem(const ModelData& m) {
   for (std::size_t i = 0; i < size; ++i) {
     if (reached[i] == 0) return "node " + std::to_string(i) + " is not reached from the root";
   }
-  return wide_problem(m);
+  return wide_problem(m, firsts);
 }
 
 }  // namespace caliber::bvh

@@ -15,9 +15,10 @@ namespace caliber::bvh {
 /// parent; counts that add up; every subtree a run of the leaf order (leaf_position);
 /// every triangle in one leaf; each leaf's sphere, box and slab around its triangle's vertices
 /// (relative to ModelData::origin); group masks the union of their children's; and where the wide
-/// tree is built, each wide node named by one inner node (BvhNode::link), its slots counted
-/// (WideNode::slots), each a node, an inner one with a wide node, their triangles the naming
-/// node's, and each node's slot (BvhNode::slot) holding it with its slab as its filter has it.
+/// tree is built, each wide node named by one inner node (BvhNode::link), its 2 to 8 slots counted
+/// (WideNode::slots), each a node, an inner one with a wide node, their runs of leaves following
+/// one another over the naming node's (so each lies below it), and each node's slot
+/// (BvhNode::slot) holding it with its slab as its filter has it.
 [[nodiscard]] std::string bvh_problem(const ModelData& model);
 
 }  // namespace caliber::bvh
