@@ -97,9 +97,9 @@ struct WideVisit {
 inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
   CALIBER_ASSERT(!(a.is_leaf() && b.is_leaf()), "a pair of leaves has no children");
   const bool down_a = wide_descends_a(a, b);
-  const std::uint32_t link = down_a ? a.link : b.link;
-  CALIBER_ASSERT(link < BvhNode::kNoWide, "a node of the wide CD tree that descends has a wide node");
-  return WideVisit{&(down_a ? ctx.a() : ctx.b()).wide[link], down_a ? n.b : n.a, down_a, down_a ? &b : &a};
+  const BvhNode& descending = down_a ? a : b;
+  CALIBER_ASSERT(descending.has_wide(), "a node of the wide CD tree that descends has a wide node");
+  return WideVisit{&(down_a ? ctx.a() : ctx.b()).wide[descending.link], down_a ? n.b : n.a, down_a, down_a ? &b : &a};
 }
 
 /// The children of CD-tree node n of pair context ctx (not a pair of leaves), written to out;

@@ -169,15 +169,14 @@ CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx
   visit_until_empty(ctx, base, top, bound, out, stats, taboo, buffer, lanes, InlinedTest{});
 }
 
+/// Whether this CPU runs what this file builds (AVX2 and FMA).
+bool avx2_and_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+
 }  // namespace
 
-WideTest wide_test_avx2_if_supported() {
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? wide_test_avx2 : nullptr;
-}
+WideTest wide_test_avx2_if_supported() { return avx2_and_fma() ? wide_test_avx2 : nullptr; }
 
-WideLoop wide_loop_avx2_if_supported() {
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? wide_loop_avx2 : nullptr;
-}
+WideLoop wide_loop_avx2_if_supported() { return avx2_and_fma() ? wide_loop_avx2 : nullptr; }
 
 }  // namespace caliber::narrow::detail
 
