@@ -161,7 +161,7 @@ void reset_keeping_storage(ScheduleRecord& r) {
 void remember(const EngineOptions& options, const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
               const plans::Plan& plan, const std::vector<std::vector<std::uint64_t>>& stage_root_tests, plans::History& history) {
   // Only what the method reads next step: the other methods keep nothing per pair.
-  if (options.method != Method::hybrid && options.method != Method::aposteriori) return;
+  if (options.method != Method::hybrid && options.method != Method::aposteriori && options.method != Method::stealing) return;
   history.node_tests.reset(pairs);
   for (std::size_t i = 0; i < pairs.size(); ++i) history.node_tests.value(i) = results[i].stats.node_tests;
   if (options.method == Method::aposteriori) {
@@ -205,7 +205,7 @@ schedule::PairsRun Engine::Impl::run_pairs(const EngineOptions& options, Method 
     // The contexts are made on the executor's threads, inside the call's first parallel region.
     state.contexts = contexts.build(n, make);
     if (method == Method::stealing) {
-      schedule::run_stealing(options.stealing_depth, cut_threads, state, record);
+      schedule::run_stealing(options.stealing_depth, cut_threads, pairs, plan_history, state, record);
     } else {
       const auto planning = util::Clock::now();
       // Cut for one thread, the calibrated methods have nothing to balance either: a task per pair.

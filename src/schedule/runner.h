@@ -22,13 +22,16 @@ namespace caliber::schedule {
 /// root (plans::subtree_counts reads them).
 std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record);
 
-/// Stealing: the CD tree of every heavy pair (a priori weight at least 1 / (64 x threads) of
-/// the total) split recursively into jobs down to `depth`, the other pairs whole, then each subtree
+/// Stealing: the CD tree of every heavy pair (weight at least 1 / (64 x threads) of the total: its
+/// node tests last step where `history`, keyed by `pairs`, has them, else its a priori weight)
+/// split recursively into jobs down to `depth` (in the wide CD tree, a pair with node tests last
+/// step only as deep as its share of them asks), the other pairs whole, then each subtree
 /// traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
 /// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.
 /// `threads`: the threads the work is cut for (EngineOptions::plan_threads, else the step's); on
 /// one, nothing is split (every pair runs whole: there is nothing to balance).
-void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& record);
+void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, const plans::History& history, StepState& state,
+                  ScheduleRecord& record);
 
 }  // namespace caliber::schedule

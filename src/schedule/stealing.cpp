@@ -4,6 +4,7 @@
 #include <functional>
 
 #include "schedule/runner.h"
+#include "plans/plan.h"
 #include "plans/weights.h"
 
 namespace caliber::schedule {
@@ -20,14 +21,17 @@ void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::
 
 /// In the wide CD tree a visit passes about three of its up to eight children (2.6 to 3.1 on the
 /// bunny, turbine and elephant pairs), and enough pieces for stealing to balance are about this
-/// many per thread: the depth at which 3^depth reaches that (4 on 2 threads, 6 on 16). Deeper, the
-/// jobs cost more than they balance: on those pairs on 2 threads, depth 3 or 4 was fastest, 7 a
-/// third slower than sequential's half, 10 slower than sequential.
+/// many per thread: a pair that holds all the work is split to the depth at which 3^depth reaches
+/// that (4 on 2 threads, 6 on 16). Deeper, the jobs cost more than they balance: on those pairs on
+/// 2 threads, depth 3 or 4 was fastest, 7 a third slower than sequential's half, 10 slower than
+/// sequential.
 constexpr long kWidePiecesPerThread = 32;
 
-int wide_depth(int threads) {
+/// The depth at which a pair holding `share` of the step's work gives its share of those pieces
+/// (share 1: 4 on 2 threads, 6 on 16; 1/24, as each of funnel's pairs: 1 on 2 threads).
+int wide_depth(int threads, double share) {
   int depth = 0;
-  for (long pieces = 1; pieces < kWidePiecesPerThread * threads; pieces *= 3) ++depth;
+  for (double pieces = 1.0; pieces < share * static_cast<double>(kWidePiecesPerThread * threads); pieces *= 3.0) ++depth;
   return depth;
 }
 
@@ -85,33 +89,49 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
 
 }  // namespace
 
-void run_stealing(int depth, int threads, StepState& state, ScheduleRecord& record) {
+void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, const plans::History& history, StepState& state,
+                  ScheduleRecord& record) {
   const auto start = util::Clock::now();
   const std::size_t n = state.contexts.size();
   state.candidates.assign(n, 0);
-  // Only a pair that may hold a good part of the step's work is split: one whose a priori weight
-  // is at least 1 / (64 x threads) of the total. The lighter ones run whole, in a parallel loop
-  // over them (splitting thousands of light pairs costs more than it balances), each finalized by
-  // the thread that traversed it, at once.
   // Cut for one thread there is nothing to balance: every pair runs whole (no depth to split to).
   if (threads <= 1) depth = 0;
-  if (n > 0 && narrow::wide_cd_tree(state.contexts[0])) depth = std::min(depth, wide_depth(threads));
+  const bool wide = n > 0 && narrow::wide_cd_tree(state.contexts[0]);
+  if (wide) depth = std::min(depth, wide_depth(threads, 1.0));
+  // Only a pair that may hold a good part of the step's work is split: one whose weight is at
+  // least 1 / (64 x threads) of the total (its node tests last step, else its a priori weight
+  // scaled as plans::initial_weights scales it). The lighter ones run whole, in a parallel loop
+  // over them (splitting thousands of light pairs costs more than it balances), each finalized by
+  // the thread that traversed it, at once. In the wide CD tree a heavy pair with node tests last
+  // step is split only as deep as its share of them asks (wide_depth): a scene of many heavy pairs
+  // splits each less. One without is split to the full depth: an a priori weight can be far from
+  // the work (front_car's two heaviest pairs: 55 % and 37 % of the node tests, 4.1 % and 1.9 % of
+  // the a priori weight).
   std::vector<std::uint32_t> heavy, light;
+  std::vector<int> cutoff;  // per heavy pair
   if (depth > 0 && n > 1) {
-    const std::vector<double> weight = plans::root_weights(state.contexts);
-    double total = 0.0;
-    for (const double w : weight) total += w;
-    const double threshold = total / (64.0 * threads);
-    for (std::uint32_t i = 0; i < n; ++i) (weight[i] >= threshold ? heavy : light).push_back(i);
+    const plans::InitialWeights w = plans::initial_weights(Method::stealing, pairs, state.contexts, history);
+    const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
+    const double threshold = w.total / (64.0 * threads);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (w.weight[i] < threshold) {
+        light.push_back(i);
+        continue;
+      }
+      heavy.push_back(i);
+      const bool measured = known[i] != nullptr && *known[i] > 0;
+      cutoff.push_back(wide && measured ? std::min(depth, wide_depth(threads, w.weight[i] / w.total)) : depth);
+    }
   } else {
     for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
+    cutoff.assign(heavy.size(), depth);
   }
   // A split pair's node-test lanes, made once by the job that tests its root and read by every
   // visit above the cut-off (declared before the jobs' group, which waits for them on the way out).
   std::vector<PairLanes> lanes(heavy.size());
   parallel::JobGroup group;
   for (std::size_t k = 0; k < heavy.size(); ++k) {
-    group.run([&state, &lanes, k, i = heavy[k], depth] {
+    group.run([&state, &lanes, k, i = heavy[k], depth = cutoff[k]] {
       // The root is tested above the cut-off: splitting work.
       WorkerSlots& w = local_slots(state);
       ++w.split_node_tests;

@@ -1,0 +1,78 @@
+// Stealing cuts each heavy pair by what it weighed last step: the cut changes, the contacts and
+// node tests do not.
+
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "caliber/engine.h"
+#include "caliber/procedural.h"
+#include "caliber/profile.h"
+#include "caliber/world.h"
+#include "support/reference_step.h"
+#include "support/temp_dir.h"
+
+namespace caliber {
+namespace {
+
+/// Whether two steps hold the same contacts, bit for bit, and the same work per pair.
+void expect_same_contacts(const StepResult& got, const StepResult& want, const std::string& what) {
+  ASSERT_EQ(got.pair_records.size(), want.pair_records.size()) << what;
+  for (std::size_t i = 0; i < want.pair_records.size(); ++i) {
+    EXPECT_EQ(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " pair " << i;
+  }
+  ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
+  for (std::size_t i = 0; i < want.contacts.size(); ++i) {
+    const Contact& g = got.contacts[i];
+    const Contact& w = want.contacts[i];
+    EXPECT_TRUE(g.object_a == w.object_a && g.object_b == w.object_b && g.tri_a == w.tri_a && g.tri_b == w.tri_b &&
+                g.point_a == w.point_a && g.point_b == w.point_b && g.normal == w.normal && g.distance == w.distance &&
+                g.depth == w.depth)
+        << what << ": contact " << i;
+  }
+}
+
+TEST(Stealing, SplitsPairsWithHistoryByTheirShare) {
+  // Four equal heavy pairs (a torus and a sphere overlapping), apart from one another and still.
+  // Cut for two threads, stealing splits each to the full depth at the first step (no history);
+  // from the second each holds a quarter of last step's node tests and is split less deep.
+  const test::TempDir temp{"stealing"};
+  save_off(make_sphere(0.6, 10, 14), temp.path() / "sphere.off");
+  save_off(make_torus(0.8, 0.25, 16, 10), temp.path() / "torus.off");
+  std::string json = R"({"query": {"kind": "proximity", "tolerance": 0.05}, "objects": [)";
+  for (int i = 0; i < 4; ++i) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  R"(%s{"name": "t%d", "mesh": "torus.off", "position": [%d, 0, 0]},)"
+                  R"({"name": "s%d", "mesh": "sphere.off", "position": [%g, 0, 0], "motion": {"type": "velocity"}})",
+                  i ? "," : "", i, 5 * i, i, 5 * i + 0.8);
+    json += buf;
+  }
+  json += "]}";
+  const World four(parse_scene(json, temp.path(), "four.json"));
+  ASSERT_EQ(four.broad_phase(four.poses_at(0)).size(), 4u);
+  EngineOptions options;
+  options.profile = true;  // the test reads the schedule
+  options.method = Method::stealing;
+  options.threads = 1;
+  options.plan_threads = 2;
+  Engine engine(options);
+  const StepResult first = step(four, engine, 0);
+  const StepResult second = step(four, engine, 1);
+  EXPECT_LT(second.schedule->task_node_tests.size(), first.schedule->task_node_tests.size());
+  EXPECT_GT(second.schedule->task_node_tests.size(), 4u) << "each pair is still split";
+  const StepResult reference = test::reference_step(four, 1);
+  EXPECT_GT(reference.contacts.size(), 0u) << "a test that compares empty answers proves nothing";
+  expect_same_contacts(first, reference, "the first step");
+  expect_same_contacts(second, reference, "the second step");
+  // On two threads, the same.
+  options.threads = 2;
+  options.plan_threads = 0;
+  Engine two(options);
+  (void)step(four, two, 0);
+  expect_same_contacts(step(four, two, 1), reference, "the second step on two threads");
+}
+
+}  // namespace
+}  // namespace caliber
