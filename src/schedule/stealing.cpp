@@ -103,10 +103,10 @@ void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, 
   // scaled as plans::initial_weights scales it). The lighter ones run whole, in a parallel loop
   // over them (splitting thousands of light pairs costs more than it balances), each finalized by
   // the thread that traversed it, at once. In the wide CD tree a heavy pair with node tests last
-  // step is split only as deep as its share of them asks (wide_depth): a scene of many heavy pairs
-  // splits each less. One without is split to the full depth: an a priori weight can be far from
-  // the work (front_car's two heaviest pairs: 55 % and 37 % of the node tests, 4.1 % and 1.9 % of
-  // the a priori weight).
+  // step is split only as deep as its share of them asks (wide_depth; depth 0: it runs whole, as
+  // a light one): a scene of many heavy pairs splits each less. One without is split to the full
+  // depth: an a priori weight can be far from the work (front_car's two heaviest pairs: 55 % and
+  // 37 % of the node tests, 4.1 % and 1.9 % of the a priori weight).
   std::vector<std::uint32_t> heavy, light;
   std::vector<int> cutoff;  // per heavy pair
   if (depth > 0 && n > 1) {
@@ -114,13 +114,15 @@ void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, 
     const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
     const double threshold = w.total / (64.0 * threads);
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (w.weight[i] < threshold) {
+      const bool measured = known[i] != nullptr && *known[i] > 0;
+      const int cut = wide && measured ? std::min(depth, wide_depth(threads, w.weight[i] / w.total)) : depth;
+      // A pair not worth a split runs whole with the light ones (finalized as soon as traversed).
+      if (w.weight[i] < threshold || cut == 0) {
         light.push_back(i);
         continue;
       }
       heavy.push_back(i);
-      const bool measured = known[i] != nullptr && *known[i] > 0;
-      cutoff.push_back(wide && measured ? std::min(depth, wide_depth(threads, w.weight[i] / w.total)) : depth);
+      cutoff.push_back(cut);
     }
   } else {
     for (std::uint32_t i = 0; i < n; ++i) (depth > 0 ? heavy : light).push_back(i);
