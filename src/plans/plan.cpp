@@ -27,7 +27,7 @@ InitialWeights initial_weights(Method method, const std::vector<ObjectPair>& pai
   InitialWeights w;
   w.weight.resize(n);
   w.scale.assign(n, 1.0);
-  if (method != Method::hybrid && method != Method::aposteriori && method != Method::stealing) {
+  if (method != Method::hybrid && method != Method::aposteriori) {
     w.weight = root_weights(contexts);
   } else {
     // A pair with history weighs its node tests of last step; its root is estimated only for the

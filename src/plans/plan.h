@@ -92,7 +92,7 @@ struct Plan {
 [[nodiscard]] Plan plan_pairs(std::size_t pairs);
 
 /// The weights of the pairs (docs/design.md section 3): the root's a priori estimate times a
-/// per-pair scale. A priori: scale 1. Hybrid, a posteriori and stealing: a pair with history weighs its node
+/// per-pair scale. A priori: scale 1. Hybrid and a posteriori: a pair with history weighs its node
 /// tests at the previous step (its scale: those over its estimate); a pair with none takes the ratio
 /// measured over the pairs that have one (over an evenly spaced sample of kRatioSample of them when
 /// more have one; 1 if none has). The roots of pairs with history outside the sample are not

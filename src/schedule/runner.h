@@ -22,11 +22,11 @@ namespace caliber::schedule {
 /// root (plans::subtree_counts reads them).
 std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record);
 
-/// Stealing: the CD tree of every heavy pair (weight at least 1 / (64 x threads) of the total: its
-/// node tests last step where `history`, keyed by `pairs`, has them, else its a priori weight)
-/// split recursively into jobs down to `depth` (in the wide CD tree, a pair with node tests last
-/// step only as deep as its share of them asks), the other pairs whole, then each subtree
-/// traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
+/// Stealing: the CD tree of every heavy pair (its share of the work at least 1 / (64 x threads):
+/// the larger of its share of the a priori weight and of the node tests last step, which
+/// `history`, keyed by `pairs`, holds) split recursively into jobs down to `depth` (in the wide CD
+/// tree, a pair with node tests last step only as deep as its share asks), the other pairs whole,
+/// then each subtree traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and
 /// finalize_ms. The node tests are exactly those of one depth-first traversal per pair.
 /// `threads`: the threads the work is cut for (EngineOptions::plan_threads, else the step's); on

@@ -4,7 +4,6 @@
 #include <functional>
 
 #include "schedule/runner.h"
-#include "plans/plan.h"
 #include "plans/weights.h"
 
 namespace caliber::schedule {
@@ -33,6 +32,42 @@ int wide_depth(int threads, double share) {
   int depth = 0;
   for (double pieces = 1.0; pieces < share * static_cast<double>(kWidePiecesPerThread * threads); pieces *= 3.0) ++depth;
   return depth;
+}
+
+/// Each pair's share of the step's work, as stealing cuts by it: the larger of its share of the a
+/// priori weight and its share of the weights that count node tests, last step's where the pair
+/// has some (else its a priori weight times the ratio of node tests to a priori weight over the
+/// pairs that have them). Either alone misleads: an a priori weight can be far from the work
+/// (front_car's two heaviest pairs take 55 % and 37 % of its node tests and weigh 4.1 % and 1.9 %
+/// a priori), and last step's node tests miss a pair that has just come into deep contact.
+/// `measured[i]`: whether pair i has node tests last step.
+std::vector<double> work_shares(const std::vector<ObjectPair>& pairs, const plans::History& history,
+                                narrow::PairContexts contexts, std::vector<char>& measured) {
+  const std::size_t n = pairs.size();
+  const std::vector<double> prior = plans::root_weights(contexts);
+  const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
+  measured.assign(n, 0);
+  double prior_total = 0.0, tests = 0.0, tests_prior = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    prior_total += prior[i];
+    if (known[i] != nullptr) {
+      measured[i] = 1;
+      tests += static_cast<double>(*known[i]);
+      tests_prior += prior[i];
+    }
+  }
+  const double ratio = tests > 0.0 && tests_prior > 0.0 ? tests / tests_prior : 1.0;
+  std::vector<double> weight(n);
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    weight[i] = known[i] != nullptr ? static_cast<double>(*known[i]) : ratio * prior[i];
+    total += weight[i];
+  }
+  std::vector<double> share(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    share[i] = std::max(total > 0.0 ? weight[i] / total : 0.0, prior_total > 0.0 ? prior[i] / prior_total : 0.0);
+  }
+  return share;
 }
 
 /// The lanes of a pair's node tests (narrow::VisitLanes), those of its CD tree's shape.
@@ -98,26 +133,21 @@ void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, 
   if (threads <= 1) depth = 0;
   const bool wide = n > 0 && narrow::wide_cd_tree(state.contexts[0]);
   if (wide) depth = std::min(depth, wide_depth(threads, 1.0));
-  // Only a pair that may hold a good part of the step's work is split: one whose weight is at
-  // least 1 / (64 x threads) of the total (its node tests last step, else its a priori weight
-  // scaled as plans::initial_weights scales it). The lighter ones run whole, in a parallel loop
-  // over them (splitting thousands of light pairs costs more than it balances), each finalized by
-  // the thread that traversed it, at once. In the wide CD tree a heavy pair with node tests last
-  // step is split only as deep as its share of them asks (wide_depth; depth 0: it runs whole, as
-  // a light one): a scene of many heavy pairs splits each less. One without is split to the full
-  // depth: an a priori weight can be far from the work (front_car's two heaviest pairs: 55 % and
-  // 37 % of the node tests, 4.1 % and 1.9 % of the a priori weight).
+  // Only a pair that may hold a good part of the step's work is split: one whose share of it is
+  // at least 1 / (64 x threads). The lighter ones run whole, in a parallel loop over them
+  // (splitting thousands of light pairs costs more than it balances), each finalized by the thread
+  // that traversed it, at once.
   std::vector<std::uint32_t> heavy, light;
   std::vector<int> cutoff;  // per heavy pair
   if (depth > 0 && n > 1) {
-    const plans::InitialWeights w = plans::initial_weights(Method::stealing, pairs, state.contexts, history);
-    const std::vector<const std::uint64_t*> known = history.node_tests.find_sorted(pairs);
-    const double threshold = w.total / (64.0 * threads);
+    std::vector<char> measured;
+    const std::vector<double> share = work_shares(pairs, history, state.contexts, measured);
     for (std::uint32_t i = 0; i < n; ++i) {
-      const bool measured = known[i] != nullptr && *known[i] > 0;
-      const int cut = wide && measured ? std::min(depth, wide_depth(threads, w.weight[i] / w.total)) : depth;
-      // A pair not worth a split runs whole with the light ones (finalized as soon as traversed).
-      if (w.weight[i] < threshold || cut == 0) {
+      // In the wide CD tree a pair with node tests last step is split only as deep as its share
+      // asks (depth 0: it runs whole, as a light one), so that a scene of many heavy pairs splits
+      // each less; one without, to the full depth.
+      const int cut = wide && measured[i] != 0 ? std::min(depth, wide_depth(threads, share[i])) : depth;
+      if (share[i] < 1.0 / (64.0 * threads) || cut == 0) {
         light.push_back(i);
         continue;
       }

@@ -23,7 +23,7 @@ TEST(Memory, PerPairStorageWithinTheStatedBound) {
   EXPECT_LE(result, 56u + 48u + 8u);
   const std::size_t broad = 2 * sizeof(ObjectPair);  // found, then sorted into the frame
   // The largest plan entry per pair: a task of its own (sequential, exploitation); a cart root, its
-  // two sort keys and its history entry (calibrated methods); stealing's 72 bytes are less.
+  // two sort keys and its history entry (calibrated methods); stealing's 65 bytes are less.
   const std::size_t plan = std::max(sizeof(plans::RunTask), sizeof(plans::Root) + 48 + 16);
   EXPECT_LE(plan, 184u);
   EXPECT_LE(context + static_cast<double>(result + broad + plan), 1100.0) << "bytes a pair, beside the threads' slots";

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "caliber/engine.h"
+#include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/profile.h"
 #include "caliber/world.h"
@@ -72,6 +73,36 @@ TEST(Stealing, SplitsPairsWithHistoryByTheirShare) {
   Engine two(options);
   (void)step(four, two, 0);
   expect_same_contacts(step(four, two, 1), reference, "the second step on two threads");
+}
+
+TEST(Stealing, SplitsAPairThatHasJustComeIntoDeepContact) {
+  // Two torus-sphere pairs. At the first step the first overlaps deeply and the second's sphere
+  // lies apart from its torus (its root refused: one node test); at the second both overlap
+  // alike. Last step's node tests alone would call the second light and run it whole; its share
+  // of the a priori weight has it split as the first is: about twice the pieces.
+  const std::shared_ptr<const Model> torus = build_model(make_torus(0.8, 0.25, 24, 12));
+  const std::shared_ptr<const Model> sphere = build_model(make_sphere(0.6, 12, 16));
+  Frame frame;
+  frame.models = {torus, sphere, torus, sphere};
+  const auto at = [](double x) { return Pose::from_values(x, 0, 0, 1, 0, 0, 0); };
+  frame.poses = {at(0), at(0.8), at(10), at(10 + 2.0)};
+  frame.pairs = {ObjectPair{0, 1}, ObjectPair{2, 3}};
+  frame.request.kind = QueryKind::proximity;
+  frame.request.tolerance = 0.05;
+  EngineOptions options;
+  options.profile = true;  // the test reads the schedule
+  options.method = Method::stealing;
+  options.threads = 1;
+  options.plan_threads = 2;
+  Engine engine(options);
+  const StepResult first = engine.step(frame);
+  ASSERT_LT(first.pair_records[1].stats.node_tests * 50, first.pair_records[0].stats.node_tests) << "the second pair is light";
+  frame.poses[3] = at(10.8);
+  const StepResult second = engine.step(frame);
+  EXPECT_EQ(second.pair_records[1].stats.node_tests, second.pair_records[0].stats.node_tests) << "the same work";
+  EXPECT_GT(2 * second.schedule->task_node_tests.size(), 3 * first.schedule->task_node_tests.size())
+      << "the second pair split as the first";
+  EXPECT_EQ(second.contacts.size(), 2 * first.pair_records[0].contacts);
 }
 
 }  // namespace
