@@ -24,7 +24,8 @@ namespace caliber {
 struct ScheduleRecord;  // caliber/profile.h: the instrumentation, opt-in
 
 /// An object pair to test (a < b) at a step. Its two object indices are also
-/// its identity from frame to frame (the temporal state of aposteriori and hybrid is keyed by them).
+/// its identity from frame to frame (the temporal state of aposteriori, hybrid and stealing is keyed
+/// by them).
 struct ObjectPair {
   std::uint32_t a;  ///< object id
   std::uint32_t b;  ///< object id, > a
@@ -126,8 +127,8 @@ struct EngineOptions {
   /// tree of interference, proximity and contact queries: at most the depth that gives about 32
   /// pieces a thread, 4 on 2 threads, 6 on 16, and for a pair with node tests last step the depth
   /// that gives its share of those pieces). Only pairs whose share of the work (the larger of their
-  /// share of the a priori weight and of last step's node tests) is at least 1 / (64 x plan
-  /// threads) are split; the others run whole, in a parallel loop over them.
+  /// share of the a priori weight and of last step's node tests, a pair without them counting its
+  /// a priori weight scaled to node tests) is at least 1 / (64 x plan threads) are split; the others run whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
   /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_beta.md): with 2 threads, beta = 2

@@ -23,8 +23,9 @@ namespace caliber::schedule {
 std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record);
 
 /// Stealing: the CD tree of every heavy pair (its share of the work at least 1 / (64 x threads):
-/// the larger of its share of the a priori weight and of the node tests last step, which
-/// `history`, keyed by `pairs`, holds) split recursively into jobs down to `depth` (in the wide CD
+/// the larger of its share of the a priori weight and of the weights that count node tests, last
+/// step's from `history`, keyed by `pairs`, else the a priori weight scaled to node tests) split
+/// recursively into jobs down to `depth` (in the wide CD
 /// tree, a pair with node tests last step only as deep as its share asks), the other pairs whole,
 /// then each subtree traversed depth first; oneTBB's scheduler steals the pieces. Fills state.results and,
 /// in `record`, the pieces' node tests (largest first), the splitting's node tests, traverse_ms and

@@ -40,7 +40,7 @@ int wide_depth(int threads, double share) {
 /// pairs that have them). Either alone misleads: an a priori weight can be far from the work
 /// (front_car's two heaviest pairs take 55 % and 37 % of its node tests and weigh 4.1 % and 1.9 %
 /// a priori), and last step's node tests miss a pair that has just come into deep contact.
-/// `measured[i]`: whether pair i has node tests last step.
+/// `measured[i]`: whether pair i has node tests last step (an entry in `history`).
 std::vector<double> work_shares(const std::vector<ObjectPair>& pairs, const plans::History& history,
                                 narrow::PairContexts contexts, std::vector<char>& measured) {
   const std::size_t n = pairs.size();
