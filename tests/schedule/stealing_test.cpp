@@ -1,5 +1,5 @@
 // Stealing cuts each heavy pair by its share of the work (a priori, and last step's node tests):
-// the cut changes, the contacts and node tests do not.
+// the cut changes, the contacts and node and leaf tests do not.
 
 #include <cstdio>
 #include <string>
@@ -12,27 +12,11 @@
 #include "caliber/profile.h"
 #include "caliber/world.h"
 #include "support/reference_step.h"
+#include "support/same_step.h"
 #include "support/temp_dir.h"
 
 namespace caliber {
 namespace {
-
-/// Whether two steps hold the same contacts, bit for bit, and the same work per pair.
-void expect_same_contacts(const StepResult& got, const StepResult& want, const std::string& what) {
-  ASSERT_EQ(got.pair_records.size(), want.pair_records.size()) << what;
-  for (std::size_t i = 0; i < want.pair_records.size(); ++i) {
-    EXPECT_EQ(got.pair_records[i].stats.node_tests, want.pair_records[i].stats.node_tests) << what << " pair " << i;
-  }
-  ASSERT_EQ(got.contacts.size(), want.contacts.size()) << what;
-  for (std::size_t i = 0; i < want.contacts.size(); ++i) {
-    const Contact& g = got.contacts[i];
-    const Contact& w = want.contacts[i];
-    EXPECT_TRUE(g.object_a == w.object_a && g.object_b == w.object_b && g.tri_a == w.tri_a && g.tri_b == w.tri_b &&
-                g.point_a == w.point_a && g.point_b == w.point_b && g.normal == w.normal && g.distance == w.distance &&
-                g.depth == w.depth)
-        << what << ": contact " << i;
-  }
-}
 
 /// Stealing with its schedule recorded, cut for two threads and run on one (the pieces do not
 /// depend on the threads' timing).
@@ -72,14 +56,14 @@ TEST(Stealing, SplitsPairsWithHistoryByTheirShare) {
   EXPECT_GT(second.schedule->task_node_tests.size(), 4u) << "each pair is still split";
   const StepResult reference = test::reference_step(four, 1);
   EXPECT_GT(reference.contacts.size(), 0u) << "a test that compares empty answers proves nothing";
-  expect_same_contacts(first, reference, "the first step");
-  expect_same_contacts(second, reference, "the second step");
+  test::expect_same_step(first, reference, "the first step");
+  test::expect_same_step(second, reference, "the second step");
   // On two threads, the same.
   options.threads = 2;
   options.plan_threads = 0;
   Engine two(options);
   (void)step(four, two, 0);
-  expect_same_contacts(step(four, two, 1), reference, "the second step on two threads");
+  test::expect_same_step(step(four, two, 1), reference, "the second step on two threads");
 }
 
 TEST(Stealing, SplitsAPairThatHasJustComeIntoDeepContact) {
