@@ -334,7 +334,8 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
     return;
   }
   gather_corners(buffer.refusal);
-  const unsigned apart = geometry::triangles_apart_batch(buffer.refusal.batch, mReach);
+  // Within an unbounded reach (a distance query that tests every pair) nothing is apart.
+  const unsigned apart = mReach < kUnbounded ? geometry::triangles_apart_batch(buffer.refusal.batch, mReach) : 0u;
   for (int l = 0; l < buffer.refusal.batch.size; ++l) {
     if ((apart >> l) & 1u) continue;
     buffer.closest.add(buffer.refusal, l);

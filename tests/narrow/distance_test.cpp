@@ -178,6 +178,62 @@ TEST(Distance, FacingPlatesTieAndTheLowestIdsWin) {
   EXPECT_EQ(cases, 20);
 }
 
+/// Two tetrahedra have 16 triangle pairs: the query tests them all once the roots are within reach
+/// (no traversal), so at distance 0 too it reports the lowest ids, the brute force's answer, and
+/// every method and thread count reports the same.
+TEST(Distance, FewTrianglePairsAreAllTestedAndTheLowestIdsWin) {
+  const auto tetra = build_model(mesh_from_buffers(std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1},
+                                                   std::vector<std::int64_t>{0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3}, "tetra"));
+  std::mt19937_64 rng(11);
+  int touching = 0, beyond_tolerance = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Pose pa = test::random_pose(rng, 0.0);
+    const Pose pb = test::random_pose(rng, 1.2);
+    for (const double tolerance : {kUnbounded, 0.2}) {
+      QueryRequest request = distance_request(tolerance);
+      const std::string what = "pose " + std::to_string(k) + " tolerance " + std::to_string(tolerance);
+      const QueryResult fast = query(*tetra, pa, *tetra, pb, request);
+      request.lowest_ids = true;
+      test::expect_identical(fast, query_brute_force(*tetra, pa, *tetra, pb, request), what);
+      if (fast.contacts.empty()) {
+        ++beyond_tolerance;
+        continue;
+      }
+      EXPECT_EQ(fast.stats.leaf_tests, 16u) << what;
+      touching += fast.contacts.front().distance == 0.0 ? 1 : 0;
+    }
+  }
+  EXPECT_GE(touching, 40) << "poses where the tetrahedra intersect";
+  EXPECT_GE(beyond_tolerance, 20) << "poses farther apart than the tolerance";
+
+  Frame frame;
+  frame.models = {tetra, tetra, tetra, tetra};
+  for (int i = 0; i < 4; ++i) frame.poses.push_back(test::random_pose(rng, 0.6));
+  for (std::uint32_t a = 0; a < 4; ++a) {
+    for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(ObjectPair{a, b});
+  }
+  frame.request = distance_request();
+  std::vector<Contact> want;
+  for (const ObjectPair& t : frame.pairs) {
+    const QueryResult r = query(*tetra, frame.poses[t.a], *tetra, frame.poses[t.b], frame.request);
+    for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
+  }
+  ASSERT_GE(std::count_if(want.begin(), want.end(), [](const Contact& c) { return c.distance == 0.0; }), 1);
+  for (const Method method : {Method::sequential, Method::stealing, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 2;
+    options.beta = 16;
+    Engine engine(options);
+    const StepResult got = engine.step(frame);
+    ASSERT_EQ(got.contacts.size(), want.size()) << to_string(method);
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
+                             QueryResult{QueryKind::distance, {want[i]}, {}}, std::string(to_string(method)));
+    }
+  }
+}
+
 TEST(Distance, TheToleranceBoundsTheAnswer) {
   std::mt19937_64 rng(3);
   const Model& a = *shapes().sphere;
