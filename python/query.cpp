@@ -111,8 +111,9 @@ PyMethodDef g_query_def{
     "query(a, pose_a, b, pose_b, kind='interference', tolerance=None, angle=30.0, max_pairs=0, *, lowest_ids=False)\n--\n\n"
     "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
     "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops past that many pairs and sets "
-    "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal, "
-    "or with lowest_ids=True the lowest ids at distance 0 (slower). Returns a caliber.Result."};
+    "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal "
+    "(the lowest ids on models with at most 16 triangle pairs), or with lowest_ids=True the lowest ids at "
+    "distance 0 (slower). Returns a caliber.Result."};
 
 std::string result_repr(const PyResult& r) {
   std::string what = std::string(caliber::to_string(r.kind)) + ", " + count_of(r.rows, "pair") + ", " +

@@ -13,6 +13,8 @@ import caliber
 DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests", "data")
 TETRA = caliber.Model.load(os.path.join(DATA, "tetra.off"))
 FAN = caliber.Model.load(os.path.join(DATA, "quad_fan.off"))
+# 8 triangles: with the tetrahedron, 32 pairs, more than a distance query tests without its traversal
+OCTA = caliber.Model.load(os.path.join(DATA, "octahedron.off"))
 
 
 def rows(n, seed):
@@ -24,10 +26,10 @@ def rows(n, seed):
     return out
 
 
-def expect_entries(batch, poses_b, kind, tolerance, max_pairs=0, lowest_ids=False):
+def expect_entries(batch, poses_b, kind, tolerance, max_pairs=0, lowest_ids=False, b=FAN):
     assert len(batch) == len(poses_b)
     for i, p in enumerate(poses_b):
-        r = caliber.query(TETRA, caliber.Pose(), FAN, p, kind=kind, tolerance=tolerance, max_pairs=max_pairs,
+        r = caliber.query(TETRA, caliber.Pose(), b, p, kind=kind, tolerance=tolerance, max_pairs=max_pairs,
                           lowest_ids=lowest_ids)
         lo, hi = batch.offsets[i], batch.offsets[i + 1]
         assert batch.pairs[lo:hi].tolist() == r.pairs.tolist()
@@ -58,14 +60,14 @@ def test_entries_equal_single_queries(kind, method, threads):
 
 @pytest.mark.parametrize("method,threads", [("sequential", 1), ("hybrid", 2)])
 def test_distance_at_contact_first_pair_or_lowest_ids(method, threads):
-    # Where the fan passes through the tetrahedron, several pairs are at distance 0: the default
-    # reports the traversal's first, lowest_ids=True the lowest ids (never higher); both are 0.
+    # Where the octahedron passes through the tetrahedron, several pairs are at distance 0: the
+    # default reports the traversal's first, lowest_ids=True the lowest ids (never higher); both 0.
     poses = [caliber.Pose(v[:3], v[3:]) for v in rows(60, 8)]
     engine = caliber.Engine(method, threads)
-    first = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind="distance")
-    lowest = engine.query_many(TETRA, caliber.Pose(), FAN, poses, kind="distance", lowest_ids=True)
-    expect_entries(first, poses, "distance", None)
-    expect_entries(lowest, poses, "distance", None, lowest_ids=True)
+    first = engine.query_many(TETRA, caliber.Pose(), OCTA, poses, kind="distance")
+    lowest = engine.query_many(TETRA, caliber.Pose(), OCTA, poses, kind="distance", lowest_ids=True)
+    expect_entries(first, poses, "distance", None, b=OCTA)
+    expect_entries(lowest, poses, "distance", None, lowest_ids=True, b=OCTA)
     touching = first.distance == 0
     assert touching.sum() > 5 and (lowest.distance[touching] == 0).all()
     assert (first.distance[~touching] == lowest.distance[~touching]).all()

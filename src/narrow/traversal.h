@@ -239,8 +239,9 @@ template <class Wait>
 /// children at gap 0 the most overlapping spheres go first (touching_first). Counts node
 /// and leaf tests like traverse_depth_first; honours a taboo list the same way. (A binary heap's
 /// sift took a large part of the bunny's time; the buckets are faster than a 4-ary heap too.)
-/// A whole traversal (from the root, no taboo list) of models with few triangles tests every pair
-/// once the root passes (nearest_of_all_pairs), ties at distance 0 too to the lowest ids.
+/// A whole traversal (from the root, tested as the root, no taboo list) of models with few
+/// triangle pairs tests every pair once the root passes (nearest_of_all_pairs), ties at distance 0
+/// too to the lowest ids.
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}) {
   using Reached = TraversalScratch::Reached;

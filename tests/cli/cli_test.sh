@@ -97,13 +97,14 @@ import json, sys
 a, b = json.loads(sys.argv[1]), json.loads(sys.argv[2])
 assert a["contacts"] == b["contacts"] and len(a["contacts"]) == 1, (a, b)
 PY
-# Intersecting meshes: distance 0 on the traversal's first intersecting pair, the same through the
-# engine; --lowest-ids reports the lowest ids at 0 (never higher than the first pair's).
-check distance-contact 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json
+# Intersecting meshes (a tetrahedron and an octahedron: 32 triangle pairs, traversed): distance 0
+# on the traversal's first intersecting pair, the same through the engine; --lowest-ids reports
+# the lowest ids at 0 (never higher than the first pair's).
+check distance-contact 0 "$cli" query "$data/tetra.off" "$data/octahedron.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json
 first="$out"
-check distance-contact-engine 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json --method apriori --threads 2
+check distance-contact-engine 0 "$cli" query "$data/tetra.off" "$data/octahedron.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json --method apriori --threads 2
 engine="$out"
-check distance-lowest-ids 0 "$cli" query "$data/tetra.off" "$data/tetra.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json --lowest-ids
+check distance-lowest-ids 0 "$cli" query "$data/tetra.off" "$data/octahedron.off" --pose-b "0.2 0.2 0.2 1 0 0 0" --kind distance --json --lowest-ids
 python3 - "$first" "$engine" "$out" <<'PY' || { echo "FAIL distance-contact"; failures=$((failures + 1)); }
 import json, sys
 first, engine, lowest = (json.loads(a) for a in sys.argv[1:])

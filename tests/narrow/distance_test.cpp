@@ -219,17 +219,35 @@ TEST(Distance, FewTrianglePairsAreAllTestedAndTheLowestIdsWin) {
     for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
   }
   ASSERT_GE(std::count_if(want.begin(), want.end(), [](const Contact& c) { return c.distance == 0.0; }), 1);
-  for (const Method method : {Method::sequential, Method::stealing, Method::hybrid}) {
-    EngineOptions options;
-    options.method = method;
-    options.threads = 2;
-    options.beta = 16;
-    Engine engine(options);
-    const StepResult got = engine.step(frame);
-    ASSERT_EQ(got.contacts.size(), want.size()) << to_string(method);
-    for (std::size_t i = 0; i < want.size(); ++i) {
-      test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
-                             QueryResult{QueryKind::distance, {want[i]}, {}}, std::string(to_string(method)));
+  const std::vector<Pose> poses_b(frame.poses.begin() + 1, frame.poses.end());
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+    for (const int threads : {1, 2, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      options.beta = 16;  // many tasks, so that pairs are split
+      Engine engine(options);
+      const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
+      for (int step = 0; step < 2; ++step) {  // the second step uses what the temporal methods learnt
+        const StepResult got = engine.step(frame);
+        ASSERT_EQ(got.contacts.size(), want.size()) << what;
+        for (std::size_t i = 0; i < want.size(); ++i) {
+          test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
+                                 QueryResult{QueryKind::distance, {want[i]}, {}}, what);
+        }
+      }
+      // A batch: object 0 against the others, entry by entry the query's answer.
+      const BatchResult batch = engine.query_many(*tetra, std::vector<Pose>{frame.poses[0]}, *tetra, poses_b, frame.request);
+      for (std::size_t e = 0; e < poses_b.size(); ++e) {
+        const QueryResult one = query(*tetra, frame.poses[0], *tetra, poses_b[e], frame.request);
+        const auto got = batch.contacts_of(e);
+        ASSERT_EQ(got.size(), one.contacts.size()) << what << " entry " << e;
+        for (std::size_t i = 0; i < got.size(); ++i) {
+          test::expect_identical(QueryResult{QueryKind::distance, {got[i]}, {}},
+                                 QueryResult{QueryKind::distance, {one.contacts[i]}, {}}, what + " batch");
+        }
+      }
     }
   }
 }
