@@ -178,6 +178,45 @@ TEST(Distance, FacingPlatesTieAndTheLowestIdsWin) {
   EXPECT_EQ(cases, 20);
 }
 
+/// The single queries' answers for the frame's pairs, in its order.
+std::vector<Contact> queries_of(const Frame& frame) {
+  std::vector<Contact> want;
+  for (const ObjectPair& t : frame.pairs) {
+    const QueryResult r = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+    for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
+  }
+  return want;
+}
+
+/// Every method on 1 to 3 threads, cut into many tasks, reports `want` bit for bit, two steps each
+/// (the second uses what the temporal methods learnt); then also(engine, what) on each engine.
+template <class Also>
+void expect_every_method(const Frame& frame, const std::vector<Contact>& want, Also&& also) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+    for (const int threads : {1, 2, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      options.beta = 16;  // many tasks, so that pairs are split
+      options.stealing_depth = 3;
+      Engine engine(options);
+      const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
+      for (int step = 0; step < 2; ++step) {
+        const StepResult got = engine.step(frame);
+        ASSERT_EQ(got.contacts.size(), want.size()) << what;
+        for (std::size_t i = 0; i < want.size(); ++i) {
+          EXPECT_EQ(got.contacts[i].object_a, want[i].object_a) << what;
+          EXPECT_EQ(got.contacts[i].object_b, want[i].object_b) << what;
+          test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
+                                 QueryResult{QueryKind::distance, {want[i]}, {}}, what);
+        }
+      }
+      also(engine, what);
+    }
+  }
+}
+
 /// Two tetrahedra have 16 triangle pairs: the query tests them all once the roots are within reach
 /// (no traversal), so at distance 0 too it reports the lowest ids, the brute force's answer, and
 /// every method and thread count reports the same.
@@ -213,43 +252,22 @@ TEST(Distance, FewTrianglePairsAreAllTestedAndTheLowestIdsWin) {
     for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(ObjectPair{a, b});
   }
   frame.request = distance_request();
-  std::vector<Contact> want;
-  for (const ObjectPair& t : frame.pairs) {
-    const QueryResult r = query(*tetra, frame.poses[t.a], *tetra, frame.poses[t.b], frame.request);
-    for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
-  }
+  const std::vector<Contact> want = queries_of(frame);
   ASSERT_GE(std::count_if(want.begin(), want.end(), [](const Contact& c) { return c.distance == 0.0; }), 1);
   const std::vector<Pose> poses_b(frame.poses.begin() + 1, frame.poses.end());
-  for (const Method method :
-       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
-    for (const int threads : {1, 2, 3}) {
-      EngineOptions options;
-      options.method = method;
-      options.threads = threads;
-      options.beta = 16;  // many tasks, so that pairs are split
-      Engine engine(options);
-      const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
-      for (int step = 0; step < 2; ++step) {  // the second step uses what the temporal methods learnt
-        const StepResult got = engine.step(frame);
-        ASSERT_EQ(got.contacts.size(), want.size()) << what;
-        for (std::size_t i = 0; i < want.size(); ++i) {
-          test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
-                                 QueryResult{QueryKind::distance, {want[i]}, {}}, what);
-        }
-      }
-      // A batch: object 0 against the others, entry by entry the query's answer.
-      const BatchResult batch = engine.query_many(*tetra, std::vector<Pose>{frame.poses[0]}, *tetra, poses_b, frame.request);
-      for (std::size_t e = 0; e < poses_b.size(); ++e) {
-        const QueryResult one = query(*tetra, frame.poses[0], *tetra, poses_b[e], frame.request);
-        const auto got = batch.contacts_of(e);
-        ASSERT_EQ(got.size(), one.contacts.size()) << what << " entry " << e;
-        for (std::size_t i = 0; i < got.size(); ++i) {
-          test::expect_identical(QueryResult{QueryKind::distance, {got[i]}, {}},
-                                 QueryResult{QueryKind::distance, {one.contacts[i]}, {}}, what + " batch");
-        }
+  expect_every_method(frame, want, [&](Engine& engine, const std::string& what) {
+    // A batch: object 0 against the others, entry by entry the query's answer.
+    const BatchResult batch = engine.query_many(*tetra, std::vector<Pose>{frame.poses[0]}, *tetra, poses_b, frame.request);
+    for (std::size_t e = 0; e < poses_b.size(); ++e) {
+      const QueryResult one = query(*tetra, frame.poses[0], *tetra, poses_b[e], frame.request);
+      const auto got = batch.contacts_of(e);
+      ASSERT_EQ(got.size(), one.contacts.size()) << what << " entry " << e;
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        test::expect_identical(QueryResult{QueryKind::distance, {got[i]}, {}},
+                               QueryResult{QueryKind::distance, {one.contacts[i]}, {}}, what + " batch");
       }
     }
-  }
+  });
 }
 
 TEST(Distance, TheToleranceBoundsTheAnswer) {
@@ -297,37 +315,12 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
   for (const auto& [tolerance, lowest_ids] : {std::pair{1.5, false}, std::pair{kUnbounded, false}, std::pair{kUnbounded, true}}) {
     frame.request = distance_request(tolerance);
     frame.request.lowest_ids = lowest_ids;
-    std::vector<Contact> want;
-    for (const ObjectPair& t : frame.pairs) {
-      const QueryResult r = query(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
-      for (const Contact& c : test::between(r, t.a, t.b)) want.push_back(c);
-    }
+    const std::vector<Contact> want = queries_of(frame);
     ASSERT_GE(want.size(), tolerance == kUnbounded ? 6u : 3u)
         << "most pairs must be within the tolerance for this to test anything";
     ASSERT_GE(std::count_if(want.begin(), want.end(), [](const Contact& c) { return c.distance == 0.0; }), 2)
         << "pairs that intersect: pieces of the split traversal stop at their own first contact";
-    for (const Method method :
-         {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
-      for (const int threads : {1, 2, 3}) {
-        EngineOptions options;
-        options.method = method;
-        options.threads = threads;
-        options.beta = 16;  // many tasks, so that pairs are split
-        options.stealing_depth = 3;
-        Engine engine(options);
-        for (int step = 0; step < 2; ++step) {  // the second step uses what the temporal methods learnt
-          const StepResult got = engine.step(frame);
-          const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
-          ASSERT_EQ(got.contacts.size(), want.size()) << what;
-          for (std::size_t i = 0; i < want.size(); ++i) {
-            EXPECT_EQ(got.contacts[i].object_a, want[i].object_a) << what;
-            EXPECT_EQ(got.contacts[i].object_b, want[i].object_b) << what;
-            test::expect_identical(QueryResult{QueryKind::distance, {got.contacts[i]}, {}},
-                                   QueryResult{QueryKind::distance, {want[i]}, {}}, what);
-          }
-        }
-      }
-    }
+    expect_every_method(frame, want, [](Engine&, const std::string&) {});
   }
 }
 
