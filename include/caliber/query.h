@@ -63,9 +63,9 @@ struct QueryRequest {
   /// query stops at the first intersecting pair of the traversal from the root, the pair every
   /// method and thread count reports (about the first hit's cost); two models with at most 16
   /// triangle pairs between them (two tetrahedra) have every pair tested, and report the lowest
-  /// ids. true: every pair at distance 0
-  /// is examined and the lowest triangle ids are reported, as for ties at any other distance
-  /// (query_brute_force's answer; on two intersecting meshes of 10^4-10^5 triangles, much slower).
+  /// ids. true: every pair at distance 0 is examined and the lowest triangle ids are reported, as
+  /// for ties at any other distance (query_brute_force's answer; on two intersecting meshes of
+  /// 10^4-10^5 triangles, much slower).
   /// Ignored by the other kinds.
   bool lowest_ids = false;
 };

@@ -19,9 +19,10 @@ inline constexpr std::size_t kFinalizeGrain = 128;
 
 /// Where a distance answer of 0 comes from. as_found: the candidates came from one traversal from
 /// the root (caliber::query's, whose first intersecting pair is the answer; on models with at most
-/// 16 triangle pairs, all tested, the lowest ids) or from the brute force (the lowest ids). from_root: they came from pieces of the traversal (a method's tasks), each
-/// stopped at its own first intersecting pair; the answer is the first intersecting pair of the
-/// traversal from the root, found again here, so that it does not depend on the cut.
+/// 16 triangle pairs, all tested, the lowest ids) or from the brute force (the lowest ids).
+/// from_root: they came from pieces of the traversal (a method's tasks), each stopped at its own
+/// first intersecting pair; the answer is the first intersecting pair of the traversal from the
+/// root, found again here, so that it does not depend on the cut.
 enum class ContactPair { as_found, from_root };
 
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one
@@ -34,8 +35,9 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
                      ContactPair contact_pair, bool parallel = false);
 
 /// The first intersecting pair of the distance traversal from the root (the pair caliber::query
-/// reports on meshes that intersect; the lowest ids on models with at most 16 triangle pairs), on the calling thread with its kept scratch. Its node and
-/// leaf tests are counted nowhere. The meshes must have a pair at distance 0.
+/// reports on meshes that intersect; the lowest ids on models with at most 16 triangle pairs), on
+/// the calling thread with its kept scratch. Its node and leaf tests are counted nowhere. The
+/// meshes must have a pair at distance 0.
 Candidate first_contact(const PairContext& ctx);
 
 /// One pair's whole query on the calling thread: the depth-first or distance traversal from the

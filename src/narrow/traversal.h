@@ -164,8 +164,8 @@ inline bool few_pairs(const PairContext& ctx) {
   return ctx.a().mesh.triangles.size() * ctx.b().mesh.triangles.size() <= kFewPairs;
 }
 
-/// The distance traversal of a pair of models with few triangles (few_pairs), from
-/// its root once the root's bound is within reach: every triangle pair through the batch kernels
+/// The distance traversal of a pair of models with few triangles (few_pairs), from its root once
+/// the root's bound is within reach: every triangle pair through the batch kernels
 /// (as the proximity query's leaf tests, ta then tb in order), each kept pair offered to `nearest`.
 /// So the nearest pair, ties (at distance 0 too) to the lowest ids: the brute force's answer.
 /// Counts a leaf test per pair.
