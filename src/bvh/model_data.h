@@ -247,8 +247,9 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
 /// `origin` on it, both floats, so that every bound origin + q step is a float, the same however
 /// computed; each bound is the grid's nearest outside the float bound nearest outside its BvhNode
 /// box's double bound (bvh::build_wide_tree). Slots past the last are empty: node kEmpty, low
-/// above high; `slots` counts those in use (every visit reads it). 320 bytes, aligned to a cache
-/// line: five lines.
+/// above high; `slots` counts those in use (every visit reads it), `leaves` marks the slots that
+/// are leaves (so a visit knows its children that are pairs of leaves before it reads their BVH
+/// nodes). 320 bytes, aligned to a cache line: five lines.
 struct alignas(64) WideNode {
   static constexpr int kSlots = 8;
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
@@ -263,6 +264,7 @@ struct alignas(64) WideNode {
   float origin[3];                            ///< the grid's origin (a multiple of step)
   float step;                                 ///< the grid's step, a power of two
   std::uint8_t slots = 0;                     ///< slots in use (they come first): count()
+  std::uint8_t leaves = 0;                    ///< bit k set where slot k is a leaf (one triangle)
   /// Slot k's low and high bounds along axis i (exact: origin + q step is a float).
   [[nodiscard]] float low(int i, int k) const { return static_cast<float>(lo[i][k]) * step + origin[i]; }
   [[nodiscard]] float high(int i, int k) const { return static_cast<float>(hi[i][k]) * step + origin[i]; }

@@ -64,12 +64,15 @@ std::string wide_slots_problem(const ModelData& m, const std::vector<std::uint32
   bool counted = used >= 2 && used <= WideNode::kSlots;
   for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (node.node[k] != WideNode::kEmpty) == (k < used);
   if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
+  if ((node.leaves >> used) != 0) return "wide node " + std::to_string(w) + ": a leaf mask past its slots";
   std::uint64_t next = firsts[i];
   for (int k = 0; k < used; ++k) {
     if (node.node[k] >= m.nodes.size()) return "wide node " + std::to_string(w) + ": a slot past the last node";
     const BvhNode& slot = m.nodes[node.node[k]];
     if (!slot.is_leaf() && !slot.has_wide()) return "wide node " + std::to_string(w) + ": an inner slot without a wide node";
     if (firsts[node.node[k]] != next) return "wide node " + std::to_string(w) + ": its slots' leaves do not follow one another";
+    if (((node.leaves >> k & 1u) != 0) != slot.is_leaf())
+      return "wide node " + std::to_string(w) + ": a leaf mask not its leaves";
     next += slot.count;
   }
   if (next != std::uint64_t{firsts[i]} + m.nodes[i].count)

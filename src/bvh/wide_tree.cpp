@@ -39,6 +39,7 @@ void clear_slot(int k, WideNode& out) {
   out.slab_lo[k] = out.slab_hi[k] = 0.0f;
   out.node[k] = WideNode::kEmpty;
   out.slots = static_cast<std::uint8_t>(std::min<int>(out.slots, k));
+  out.leaves = static_cast<std::uint8_t>(out.leaves & ~(1u << k));
 }
 
 /// A node's float box: along each axis, the nearest floats outside its double bounds.
@@ -106,6 +107,8 @@ void fill_slot(const ModelData& model, std::uint32_t node, const FloatBox& box, 
   out.slab_hi[k] = f.slab_hi;
   out.node[k] = node;
   out.slots = static_cast<std::uint8_t>(std::max<int>(out.slots, k + 1));
+  const unsigned leaf = model.nodes[node].is_leaf() ? 1u << k : 0u;
+  out.leaves = static_cast<std::uint8_t>((out.leaves & ~(1u << k)) | leaf);
 }
 
 /// The slots of internal node `root`: its two children, then, while there is room, one slot
@@ -154,6 +157,7 @@ WideNode with_slot_alone(const WideNode& w, int k) {
   out.slab_hi[0] = w.slab_hi[k];
   out.node[0] = w.node[k];
   out.slots = 1;
+  out.leaves = static_cast<std::uint8_t>(w.leaves >> k & 1u);
   return out;
 }
 

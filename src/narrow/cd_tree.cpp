@@ -30,7 +30,8 @@ bool root_test(const PairContext& ctx, NodePair n, RootTest how) {
   const bool down_a = how == RootTest::child_of_a;
   const WideNode w = bvh::single_slot(down_a ? ctx.a() : ctx.b(), down_a ? n.a : n.b);
   const BvhNode& staying = down_a ? ctx.b().nodes[n.b] : ctx.a().nodes[n.a];
-  return (wide_pass(ctx, n, WideVisit{&w, down_a ? n.b : n.a, down_a, &staying}, wide_lanes(ctx)) & 1u) != 0;
+  const WideVisit v{&w, down_a ? n.b : n.a, down_a, &staying, (down_a ? ctx.a() : ctx.b()).nodes.data()};
+  return (wide_pass(ctx, n, v, wide_lanes(ctx)) & 1u) != 0;
 }
 
 }  // namespace caliber::narrow

@@ -87,6 +87,7 @@ struct WideVisit {
   std::uint32_t stay;
   bool a_descends;
   const BvhNode* staying;
+  const BvhNode* descending_nodes;  ///< the BVH nodes of the side that descends (its slots')
 
   [[nodiscard]] NodePair child(int k, NodePair n) const {
     return a_descends ? NodePair{node->node[k], n.b} : NodePair{n.a, node->node[k]};
@@ -96,10 +97,13 @@ struct WideVisit {
 /// The wide visit of node n, whose BVH nodes are a (of A) and b (of B).
 inline WideVisit wide_visit(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b) {
   CALIBER_ASSERT(!(a.is_leaf() && b.is_leaf()), "a pair of leaves has no children");
+  // (Written as branches: chosen by index from arrays, the wide node's address waits for both BVH
+  // nodes to come from memory, where a predicted branch asks for it at once; queries were slower.)
   const bool down_a = wide_descends_a(a, b);
   const BvhNode& descending = down_a ? a : b;
+  const ModelData& m = down_a ? ctx.a() : ctx.b();
   CALIBER_ASSERT(descending.has_wide(), "a node of the wide CD tree that descends has a wide node");
-  return WideVisit{&(down_a ? ctx.a() : ctx.b()).wide[descending.link], down_a ? n.b : n.a, down_a, down_a ? &b : &a};
+  return WideVisit{&m.wide[descending.link], down_a ? n.b : n.a, down_a, down_a ? &b : &a, m.nodes.data()};
 }
 
 /// The children of CD-tree node n of pair context ctx (not a pair of leaves), written to out;
@@ -154,16 +158,14 @@ template <class Test = ChosenWideTest>
                                                  Test test = {}) {
   CALIBER_ASSERT(v.staying == &(v.a_descends ? ctx.b() : ctx.a()).nodes[v.stay], "the staying node is node stay");
   unsigned pass = test(ctx.node_test_frame(), lanes, v.a_descends, v.stay, *v.staying, *v.node, cache);
-  if (pass == 0 || !ctx.refuses_by_groups_or_cones()) return pass;
+  if (!ctx.refuses_by_groups_or_cones() || pass == 0) return pass;
   // A pair of leaves skips them: its leaf test tests the triangles' groups and normals exactly
   // (PairContext::groups_allow, normals_allow), refusing all that the nodes' groups and cones would
-  // (two thirds of the cone tests of a contact query, each reading two nodes' filters). Whether a
-  // slot is a leaf is read in its BVH node, which the visit of that pair reads next.
-  const std::vector<BvhNode>& descending = (v.a_descends ? ctx.a() : ctx.b()).nodes;
-  const bool staying_leaf = v.staying->is_leaf();
-  for (unsigned bits = pass; bits != 0; bits &= bits - 1) {
+  // (two thirds of the cone tests of a contact query, each reading two nodes' filters). Which
+  // slots are leaves, the wide node says.
+  const unsigned leaves = v.staying->is_leaf() ? v.node->leaves : 0u;
+  for (unsigned bits = pass & ~leaves; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
-    if (staying_leaf && descending[v.node->node[k]].is_leaf()) continue;
     const NodePair child = v.child(k, n);
     if (!ctx.groups_and_cones_allow(child.a, child.b)) pass &= ~(1u << k);
   }

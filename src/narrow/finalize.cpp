@@ -10,6 +10,7 @@
 #include "narrow/local_minima.h"
 #include "parallel/executor.h"
 #include "util/assert.h"
+#include "util/radix_sort.h"
 
 namespace caliber {
 namespace narrow {
@@ -65,16 +66,24 @@ Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidat
 }
 
 /// An interference result: the triangles meet, so a candidate is its ids alone (no points). They
-/// are sorted as one integer each (A's id in the high half: by_ids' order), which moves 8 bytes
-/// where sorting the candidates moves 64.
+/// are sorted as one integer each (A's id above B's, in as few bits as the largest ids need:
+/// by_ids' order), which moves 8 bytes where sorting the candidates moves 64; serially by radix.
 QueryResult interference_result(const std::vector<Candidate>& candidates, ObjectPair objects, bool parallel, QueryResult result) {
+  std::uint32_t most_a = 0, most_b = 0;
+  for (const Candidate& c : candidates) {
+    most_a = std::max(most_a, c.tri_a);
+    most_b = std::max(most_b, c.tri_b);
+  }
+  const int shift = util::bits_of(most_b);
+  const std::uint64_t low = (std::uint64_t{1} << shift) - 1;
   std::vector<std::uint64_t> keys(candidates.size());
-  for (std::size_t i = 0; i < candidates.size(); ++i) keys[i] = std::uint64_t{candidates[i].tri_a} << 32 | candidates[i].tri_b;
+  for (std::size_t i = 0; i < candidates.size(); ++i) keys[i] = std::uint64_t{candidates[i].tri_a} << shift | candidates[i].tri_b;
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && keys.size() >= kFinalizeGrain) {
     parallel::parallel_sort(keys.begin(), keys.end(), std::less<>());
   } else {
-    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint64_t> spare;
+    util::radix_sort(keys, shift + util::bits_of(most_a), spare);
   }
   CALIBER_ASSERT(std::adjacent_find(keys.begin(), keys.end()) == keys.end(), "each triangle pair is a candidate once");
   // Each contact made where it is written (a resize would clear them all in a pass of its own).
@@ -83,8 +92,8 @@ QueryResult interference_result(const std::vector<Candidate>& candidates, Object
     Contact& contact = result.contacts.emplace_back();
     contact.object_a = objects.a;
     contact.object_b = objects.b;
-    contact.tri_a = static_cast<std::uint32_t>(key >> 32);
-    contact.tri_b = static_cast<std::uint32_t>(key);
+    contact.tri_a = static_cast<std::uint32_t>(key >> shift);
+    contact.tri_b = static_cast<std::uint32_t>(key & low);
     contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
   }
   return result;

@@ -315,6 +315,9 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     BufferedPairs& waiting = buffer.refusal;
     waiting.ta[waiting.batch.size] = ta;
     waiting.tb[waiting.batch.size] = tb;
+    // Their corners' ids asked of memory now, read when the batch is full (gather_corners).
+    __builtin_prefetch(&mA.mesh.triangles[ta]);
+    __builtin_prefetch(&mB.mesh.triangles[tb]);
     if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
     return;
   }
@@ -325,6 +328,8 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   BufferedPairs& waiting = buffer.refusal;
   waiting.ta[waiting.batch.size] = ta;
   waiting.tb[waiting.batch.size] = tb;
+  __builtin_prefetch(&mA.mesh.triangles[ta]);
+  __builtin_prefetch(&mB.mesh.triangles[tb]);
   if (++waiting.batch.size == geometry::TriangleBatch::kLanes) refuse_buffered(buffer, out);
 }
 

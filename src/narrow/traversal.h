@@ -69,11 +69,12 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
                                  QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
                                  PairShared* limit = nullptr) {
   // Each visit pops one node and pushes at most eight, one level deeper in one of the trees: the
-  // stack never holds more than 7 * (height A + height B) + 1 nodes.
+  // depth-first stack never holds more than 7 * (height A + height B) + 1 nodes (the loop without
+  // a limit, whose visits wait a little, grows it where it must).
   std::vector<NodePair>& stack = scratch.stack;
   const auto bound = static_cast<std::size_t>(7 * (ctx.a().height + ctx.b().height) + 8);
   if (stack.size() < bound) stack.resize(bound);
-  NodePair* const base = stack.data();
+  NodePair* base = stack.data();
   NodePair* top = base;
   QueryStats counted;
   if (root_test == RootTest::done || test_root(ctx, root, counted, root_test)) *top++ = root;
@@ -94,16 +95,18 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   }
   std::size_t seen = out.size();
   // Without a limit, the leaf pairs wait in a buffer for the batch kernels, and the children that
-  // pass are written straight onto the stack, the first one on top (the order of cd_children).
+  // pass are written straight onto the stack, the first one on top (the order of cd_children), but
+  // the pairs of leaves a wide visit tests itself (visit_until_empty).
   // With one, each leaf test's pair is counted as it is kept.
   LeafBuffer buffer;
   if (limit == nullptr) {
+    const auto size = static_cast<std::size_t>(top - base);
     if (lanes.wide != nullptr && kWideLoop != nullptr) {
-      kWideLoop(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+      kWideLoop(ctx, stack, size, out, counted, taboo, buffer, lanes);
     } else {
-      visit_until_empty(ctx, base, top, bound, out, counted, taboo, buffer, lanes);
+      visit_until_empty(ctx, stack, size, out, counted, taboo, buffer, lanes);
     }
-    top = base;
+    top = base = stack.data();
   }
   while (limit != nullptr && top != base) {
     const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);

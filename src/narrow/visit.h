@@ -5,7 +5,9 @@
 /// one (visit_binary; cd_tree.h).
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "caliber/query.h"
@@ -36,11 +38,15 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
 
 /// The visit of a node of the wide CD tree (not a pair of leaves; narrow::visit): its children's
 /// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
-/// reversed), every child counted but those on the taboo list (skipped and marked reached).
-template <bool kReversed, class Test = ChosenWideTest>
+/// reversed), every child counted but those on the taboo list (skipped and marked reached). Given
+/// `leaf_pair` (a callable, not null), the children that pass and are pairs of leaves (the staying
+/// node a leaf, the slot one: WideNode::leaves) get their leaf test here, leaf_pair(ta, tb), in
+/// slot order, and are not written: they would be visited next only to be found leaves.
+template <bool kReversed, class Test = ChosenWideTest, class LeafPair = std::nullptr_t>
 [[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
-                                             const detail::WideLanes& lanes, detail::StayingCache* staying, Test test = {}) {
+                                             const detail::WideLanes& lanes, detail::StayingCache* staying, Test test = {},
+                                             LeafPair leaf_pair = nullptr) {
   const WideVisit v = wide_visit(ctx, n, a, b);
   unsigned pass = wide_pass(ctx, n, v, lanes, staying, test);
   const int count = v.node->count();
@@ -55,13 +61,31 @@ template <bool kReversed, class Test = ChosenWideTest>
   } else {
     stats.node_tests += static_cast<std::uint64_t>(count);
   }
-  int passing = 0;
-  while (pass != 0) {
-    const unsigned k = kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
-    pass ^= 1u << k;
-    passed[passing++] = v.child(static_cast<int>(k), n);
+  if constexpr (!std::is_same_v<LeafPair, std::nullptr_t>) {
+    const unsigned leaves = pass & v.node->leaves & (0u - static_cast<unsigned>(v.staying->is_leaf()));
+    pass &= ~leaves;
+    const std::uint32_t held = v.staying->triangle();
+    for (unsigned bits = leaves; bits != 0; bits &= bits - 1) {
+      const std::uint32_t t = v.descending_nodes[v.node->node[__builtin_ctz(bits)]].triangle();
+      if (v.a_descends) {
+        leaf_pair(t, held);
+      } else {
+        leaf_pair(held, t);
+      }
+    }
   }
-  return passing;
+  if constexpr (requires { test.template write_passed<kReversed>(v, pass, passed); }) {
+    return test.template write_passed<kReversed>(v, pass, passed);
+  } else {
+    int passing = 0;
+    while (pass != 0) {
+      const unsigned k =
+          kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
+      pass ^= 1u << k;
+      passed[passing++] = v.child(static_cast<int>(k), n);
+    }
+    return passing;
+  }
 }
 
 /// visit_wide for a visit without the traversal's lanes: made here.
@@ -125,7 +149,9 @@ template <bool kReversed>
 /// that pass are written to `passed` in cd_children order and the visit returns how many (0..8).
 /// So every CD node below a root is tested exactly once, by its parent's visit. With a buffer, a
 /// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
-/// reading `out`. `lanes`: the lanes of the node tests, made once by the traversal (null: made
+/// reading `out`; and a wide visit tests its children that are pairs of leaves itself (counted as
+/// leaf tests, not returned: visit_wide). `passed` has room for kMaxChildren children, however
+/// many pass (a form may write all its places). `lanes`: the lanes of the node tests, made once by the traversal (null: made
 /// here): wide_lanes(ctx) in the wide CD tree (visit_wide), ctx.node_lanes() in the binary one.
 /// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
 /// so, the first child on top). Test: the form of the wide node test (ChosenWideTest: the one the
@@ -150,6 +176,8 @@ template <bool kReversed = false, class Test = ChosenWideTest>
     const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
+    if (buffer != nullptr)
+      return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, leaf_pair);
     return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);
   }
   const BvhNode& a = ctx.a().nodes[n.a];
@@ -158,25 +186,64 @@ template <bool kReversed = false, class Test = ChosenWideTest>
   return visit_binary<kReversed>(ctx, n, a, b, stats, passed, taboo, lanes.binary);
 }
 
-/// A depth-first traversal's loop without a limit, from the stack [base, top) until it is empty:
-/// each node popped is visited (visit<true>, the leaf pairs waiting in `buffer`), the children
-/// that pass pushed (at most `bound` nodes on the stack). Test: the wide test's form, as visit's.
+/// Asks memory for the BVH nodes of CD-tree node n (a visit reads them first).
+inline void prefetch_nodes(const PairContext& ctx, NodePair n) {
+  __builtin_prefetch(ctx.a().nodes.data() + n.a);
+  __builtin_prefetch(ctx.b().nodes.data() + n.b);
+}
+
+/// Asks memory for what the wide visit of node n reads after its BVH nodes: the descending side's
+/// wide node (five lines). Reads the BVH nodes (asked for a visit before).
+inline void prefetch_wide(const PairContext& ctx, NodePair n) {
+  const BvhNode& a = ctx.a().nodes[n.a];
+  const BvhNode& b = ctx.b().nodes[n.b];
+  if (a.is_leaf() && b.is_leaf()) return;
+  const bool down_a = wide_descends_a(a, b);
+  const ModelData* const models[2] = {&ctx.b(), &ctx.a()};
+  const BvhNode* const nodes[2] = {&b, &a};
+  const char* const w = reinterpret_cast<const char*>(&models[down_a]->wide[nodes[down_a]->link]);
+  for (std::size_t line = 0; line < sizeof(WideNode); line += 64) __builtin_prefetch(w + line);
+}
+
+/// A depth-first traversal's loop without a limit, from the first `size` nodes of `stack` until
+/// none is left: each node visited (visit<true>, the leaf pairs waiting in `buffer`), the children
+/// that pass pushed (the stack grows where it must). Two nodes wait between the stack and their
+/// visit, so that memory is asked for what a visit reads a visit before it reads it: the BVH nodes
+/// of the node taken from the stack, then, once it is next, its wide node. So the order of the
+/// visits is the depth-first one but that a visit's children come after the two nodes waiting;
+/// every node is visited once, as in any order. Test: the wide test's form, as visit's.
 template <class Test = ChosenWideTest>
-[[gnu::always_inline]] inline void visit_until_empty(const PairContext& ctx, NodePair* const base, NodePair* top,
-                                                     std::size_t bound, std::vector<Candidate>& out, QueryStats& stats,
-                                                     TabooView taboo, LeafBuffer& buffer, VisitLanes lanes, Test test = {}) {
-  while (top != base) {
-    const NodePair n = *--top;
+[[gnu::always_inline]] inline void visit_until_empty(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size,
+                                                     std::vector<Candidate>& out, QueryStats& stats, TabooView taboo,
+                                                     LeafBuffer& buffer, VisitLanes lanes, Test test = {}) {
+  NodePair* base = stack.data();
+  NodePair* top = base + size;
+  constexpr int kWaiting = 2;
+  NodePair ahead[kWaiting] = {};
+  int waiting = 0;
+  while (waiting != 0 || top != base) {
+    if (waiting == 0) ahead[waiting++] = *--top;
+    const NodePair n = ahead[0];
+    for (int i = 0; i + 1 < kWaiting; ++i) ahead[i] = ahead[i + 1];
+    if (--waiting != 0 && lanes.wide != nullptr) prefetch_wide(ctx, ahead[0]);
+    while (waiting < kWaiting && top != base) {
+      ahead[waiting] = *--top;
+      prefetch_nodes(ctx, ahead[waiting++]);
+    }
+    if (static_cast<std::size_t>(top - base) + kMaxChildren > stack.size()) {
+      const auto at = top - base;
+      stack.resize(2 * stack.size() + kMaxChildren);
+      base = stack.data();
+      top = base + at;
+    }
     const int count = visit<true>(ctx, n, out, stats, top, taboo, &buffer, lanes, test);
     top += count > 0 ? count : 0;
-    CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
-  static_cast<void>(bound);  // (read by the assertion alone)
 }
 
 /// visit_until_empty on the wide CD tree, built for AVX2 with its wide test inlined
 /// (wide_test_avx2.cpp; the same visits and decisions), or null where the CPU has no AVX2.
-using WideLoop = void (*)(const PairContext& ctx, NodePair* base, NodePair* top, std::size_t bound, std::vector<Candidate>& out,
+using WideLoop = void (*)(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size, std::vector<Candidate>& out,
                           QueryStats& stats, TabooView taboo, LeafBuffer& buffer, VisitLanes lanes);
 namespace detail {
 WideLoop wide_loop_avx2_if_supported();

@@ -7,6 +7,7 @@
 #include "narrow/visit.h"
 
 #include <cmath>
+#include <cstddef>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -153,20 +154,62 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
   return bits & static_cast<unsigned>(_mm256_movemask_ps(floats_pass(l, s, w, cl, ch, kept.floats)));
 }
 
+/// For each mask of eight lanes, the lanes set in it, ascending (kReversed: descending), as byte
+/// indices, then zeros.
+template <bool kReversed>
+struct PackTable {
+  std::uint64_t order[256];
+  constexpr PackTable() : order() {
+    for (unsigned m = 0; m < 256; ++m) {
+      std::uint64_t packed = 0;
+      int at = 0;
+      for (int i = 0; i < 8; ++i) {
+        const int k = kReversed ? 7 - i : i;
+        if ((m >> k & 1u) != 0) packed |= std::uint64_t(k) << (8 * at++);
+      }
+      order[m] = packed;
+    }
+  }
+};
+template <bool kReversed>
+inline constexpr PackTable<kReversed> kPackTable{};
+
+static_assert(sizeof(NodePair) == 8 && offsetof(NodePair, a) == 0 && offsetof(NodePair, b) == 4,
+              "write_passed writes a NodePair as two 32-bit lanes, A's node first");
+
 /// wide_test_avx2, inlined where a visit calls it.
 struct InlinedTest {
   CALIBER_AVX2 unsigned operator()(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                    const BvhNode& sn, const WideNode& w, StayingCache* cache) const {
     return wide_test_avx2(f, l, a_descends, stay, sn, w, cache);
   }
+  /// Writes the children of visit v that `pass` names to `passed` as visit_wide's loop writes
+  /// them, with no branch on the bits: all eight places written, the first popcount(pass) of them
+  /// the children (passed has room for kMaxChildren).
+  template <bool kReversed>
+  CALIBER_AVX2 int write_passed(const WideVisit& v, unsigned pass, NodePair passed[]) const {
+    const __m256i ids = _mm256_load_si256(reinterpret_cast<const __m256i*>(v.node->node));
+    const __m256i order =
+        _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kPackTable<kReversed>.order[pass & 0xFFu])));
+    const __m256i slots = _mm256_permutevar8x32_epi32(ids, order);
+    const __m256i stay = _mm256_set1_epi32(static_cast<int>(v.stay));
+    // (a_descends: the slots are A's nodes, the first of each pair; chosen by mask, not by branch.)
+    const __m256i slots_first = _mm256_set1_epi32(-static_cast<int>(v.a_descends));
+    const __m256i first = _mm256_blendv_epi8(stay, slots, slots_first);
+    const __m256i second = _mm256_blendv_epi8(slots, stay, slots_first);
+    const __m256i lo = _mm256_unpacklo_epi32(first, second), hi = _mm256_unpackhi_epi32(first, second);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(passed), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(passed + 4), _mm256_permute2x128_si256(lo, hi, 0x31));
+    return __builtin_popcount(pass);
+  }
 };
 
 /// WideLoop built for AVX2: visit_until_empty with each visit's wide test inlined (no call through
 /// a pointer, its per-traversal values kept in registers across visits: flatten).
-CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx, NodePair* const base, NodePair* top,
-                                                          std::size_t bound, std::vector<Candidate>& out, QueryStats& stats,
-                                                          TabooView taboo, LeafBuffer& buffer, VisitLanes lanes) {
-  visit_until_empty(ctx, base, top, bound, out, stats, taboo, buffer, lanes, InlinedTest{});
+CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size,
+                                                          std::vector<Candidate>& out, QueryStats& stats, TabooView taboo,
+                                                          LeafBuffer& buffer, VisitLanes lanes) {
+  visit_until_empty(ctx, stack, size, out, stats, taboo, buffer, lanes, InlinedTest{});
 }
 
 /// Whether this CPU runs what this file builds (AVX2 and FMA).

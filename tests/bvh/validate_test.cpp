@@ -126,6 +126,9 @@ TEST(BvhProblem, EachBreakIsFound) {
       },
       "slot count"))
       << "a wide node whose one slot is its own node (a visit would come back to it)";
+  EXPECT_TRUE(says([&] { m.wide[0].leaves ^= 1u; }, "a leaf mask not its leaves")) << "a slot's leaf bit flipped";
+  EXPECT_TRUE(says([&] { m.wide[partial].leaves |= static_cast<std::uint8_t>(1u << m.wide[partial].count()); }, "past its slots"))
+      << "an empty slot marked a leaf";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
 
