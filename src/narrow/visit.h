@@ -207,11 +207,13 @@ inline void prefetch_wide(const PairContext& ctx, NodePair n) {
 
 /// A depth-first traversal's loop without a limit, from the first `size` nodes of `stack` until
 /// none is left: each node visited (visit<true>, the leaf pairs waiting in `buffer`), the children
-/// that pass pushed (the stack grows where it must). Two nodes wait between the stack and their
-/// visit, so that memory is asked for what a visit reads a visit before it reads it: the BVH nodes
-/// of the node taken from the stack, then, once it is next, its wide node. So the order of the
-/// visits is the depth-first one but that a visit's children come after the two nodes waiting;
-/// every node is visited once, as in any order. Test: the wide test's form, as visit's.
+/// that pass pushed (the stack grows where it must). But for a contact query, two nodes wait
+/// between the stack and their visit, so that memory is asked for what a visit reads a visit
+/// before it reads it: the BVH nodes of the node taken from the stack, then, once it is next, its
+/// wide node. So the order of the visits is the depth-first one but that a visit's children come
+/// after the two nodes waiting; every node is visited once, as in any order. (A contact query's
+/// reduction finds neighbours next to each other in the depth-first order of its candidates, and
+/// lost more than the waiting saved.) Test: the wide test's form, as visit's.
 template <class Test = ChosenWideTest>
 [[gnu::always_inline]] inline void visit_until_empty(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size,
                                                      std::vector<Candidate>& out, QueryStats& stats, TabooView taboo,
@@ -219,6 +221,7 @@ template <class Test = ChosenWideTest>
   NodePair* base = stack.data();
   NodePair* top = base + size;
   constexpr int kWaiting = 2;
+  const int most = ctx.request().kind == QueryKind::contact ? 0 : kWaiting;
   NodePair ahead[kWaiting] = {};
   int waiting = 0;
   while (waiting != 0 || top != base) {
@@ -226,7 +229,7 @@ template <class Test = ChosenWideTest>
     const NodePair n = ahead[0];
     for (int i = 0; i + 1 < kWaiting; ++i) ahead[i] = ahead[i + 1];
     if (--waiting != 0 && lanes.wide != nullptr) prefetch_wide(ctx, ahead[0]);
-    while (waiting < kWaiting && top != base) {
+    while (waiting < most && top != base) {
       ahead[waiting] = *--top;
       prefetch_nodes(ctx, ahead[waiting++]);
     }
