@@ -151,8 +151,9 @@ template <bool kReversed>
 /// leaf pair may wait there (PairContext::leaf_test with a buffer): the caller flushes it before
 /// reading `out`; and a wide visit tests its children that are pairs of leaves itself (counted as
 /// leaf tests, not returned: visit_wide). `passed` has room for kMaxChildren children, however
-/// many pass (a form may write all its places). `lanes`: the lanes of the node tests, made once by the traversal (null: made
-/// here): wide_lanes(ctx) in the wide CD tree (visit_wide), ctx.node_lanes() in the binary one.
+/// many pass (a form may write all its places). `lanes`: the lanes of the node tests, made once
+/// by the traversal (null: made here): wide_lanes(ctx) in the wide CD tree (visit_wide),
+/// ctx.node_lanes() in the binary one.
 /// kReversed: the children written in reverse cd_children order (a depth-first stack takes them
 /// so, the first child on top). Test: the form of the wide node test (ChosenWideTest: the one the
 /// library chose; a loop built for AVX2 names its own, inlined: the same decisions).
@@ -198,16 +199,13 @@ inline void prefetch_wide(const PairContext& ctx, NodePair n) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
   if (a.is_leaf() && b.is_leaf()) return;
-  const bool down_a = wide_descends_a(a, b);
-  const ModelData* const models[2] = {&ctx.b(), &ctx.a()};
-  const BvhNode* const nodes[2] = {&b, &a};
-  const char* const w = reinterpret_cast<const char*>(&models[down_a]->wide[nodes[down_a]->link]);
+  const char* const w = reinterpret_cast<const char*>(wide_visit(ctx, n, a, b).node);
   for (std::size_t line = 0; line < sizeof(WideNode); line += 64) __builtin_prefetch(w + line);
 }
 
 /// A depth-first traversal's loop without a limit, from the first `size` nodes of `stack` until
 /// none is left: each node visited (visit<true>, the leaf pairs waiting in `buffer`), the children
-/// that pass pushed (the stack grows where it must). But for a contact query, two nodes wait
+/// that pass pushed (the stack grows where it must). Except in a contact query, two nodes wait
 /// between the stack and their visit, so that memory is asked for what a visit reads a visit
 /// before it reads it: the BVH nodes of the node taken from the stack, then, once it is next, its
 /// wide node. So the order of the visits is the depth-first one but that a visit's children come
