@@ -9,6 +9,7 @@ namespace caliber::narrow {
 
 const detail::WideTest kWideTest = detail::wide_test_avx2_if_supported();
 const WideLoop kWideLoop = detail::wide_loop_avx2_if_supported();
+const detail::SlotOrderKeys kSlotOrderKeys = detail::slot_order_keys_avx2_if_supported();
 
 detail::WideLanes wide_lanes(const PairContext& ctx) {
   return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale(), ctx.a(), ctx.b());

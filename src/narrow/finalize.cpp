@@ -65,10 +65,29 @@ Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidat
   return again ? first_contact(ctx) : best;
 }
 
+/// Up to this many candidates, an interference result sorts the candidates themselves.
+constexpr std::size_t kFewCandidates = 8;
+
 /// An interference result: the triangles meet, so a candidate is its ids alone (no points). They
 /// are sorted as one integer each (A's id above B's, in as few bits as the largest ids need:
 /// by_ids' order), which moves 8 bytes where sorting the candidates moves 64; serially by radix.
-QueryResult interference_result(const std::vector<Candidate>& candidates, ObjectPair objects, bool parallel, QueryResult result) {
+/// But a few (kFewCandidates), sorted in place.
+QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair objects, bool parallel, QueryResult result) {
+  const auto add = [&](std::uint32_t tri_a, std::uint32_t tri_b) {
+    Contact& contact = result.contacts.emplace_back();
+    contact.object_a = objects.a;
+    contact.object_b = objects.b;
+    contact.tri_a = tri_a;
+    contact.tri_b = tri_b;
+    contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
+  };
+  // A few (a first hit's): sorted where they are, no keys made.
+  if (candidates.size() <= kFewCandidates) {
+    std::sort(candidates.begin(), candidates.end(), by_ids);
+    result.contacts.reserve(candidates.size());
+    for (const Candidate& c : candidates) add(c.tri_a, c.tri_b);
+    return result;
+  }
   std::uint32_t most_a = 0, most_b = 0;
   for (const Candidate& c : candidates) {
     most_a = std::max(most_a, c.tri_a);
@@ -88,14 +107,7 @@ QueryResult interference_result(const std::vector<Candidate>& candidates, Object
   CALIBER_ASSERT(std::adjacent_find(keys.begin(), keys.end()) == keys.end(), "each triangle pair is a candidate once");
   // Each contact made where it is written (a resize would clear them all in a pass of its own).
   result.contacts.reserve(keys.size());
-  for (const std::uint64_t key : keys) {
-    Contact& contact = result.contacts.emplace_back();
-    contact.object_a = objects.a;
-    contact.object_b = objects.b;
-    contact.tri_a = static_cast<std::uint32_t>(key >> shift);
-    contact.tri_b = static_cast<std::uint32_t>(key & low);
-    contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
-  }
+  for (const std::uint64_t key : keys) add(static_cast<std::uint32_t>(key >> shift), static_cast<std::uint32_t>(key & low));
   return result;
 }
 

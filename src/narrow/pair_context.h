@@ -131,26 +131,18 @@ class PairContext {
   [[nodiscard]] bool node_test(std::uint32_t ia, std::uint32_t ib) const { return node_test(prepare_a(ia), prepare_b(ib)); }
 
   /// How far apart the spheres of node ia of A and node ib of B are, relative to their size:
-  /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders a
-  /// traversal that stops early (max_pairs, or a distance query at contact): it enters the
-  /// children most likely to touch first (visit_order.h).
+  /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders the
+  /// distance traversal that stops at contact: it enters the touching children most likely to
+  /// touch first (visit_order.h).
   [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
-    double cb[3];
-    sphere_center_in_a(ib, cb);
-    return sphere_apart(ia, ib, cb);
-  }
-  /// The center of node ib of B's sphere in A's frame, as sphere_apart computes it.
-  void sphere_center_in_a(std::uint32_t ib, double out[3]) const {
-    const BvhNode& nb = mB.nodes[ib];
-    for (int i = 0; i < 3; ++i)
-      out[i] = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mNodeFrame.trans[i];
-  }
-  /// sphere_apart given cb, sphere_center_in_a(ib): the same value.
-  [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib, const double cb[3]) const {
     const BvhNode& na = mA.nodes[ia];
     const BvhNode& nb = mB.nodes[ib];
     double dist2 = 0.0;
-    for (int i = 0; i < 3; ++i) dist2 += square(na.center[i] - cb[i]);
+    for (int i = 0; i < 3; ++i) {
+      // B's center in A's frame.
+      const double cb = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mNodeFrame.trans[i];
+      dist2 += square(na.center[i] - cb);
+    }
     return dist2 / std::max(square(double(na.radius) + double(nb.radius)), std::numeric_limits<double>::min());
   }
 

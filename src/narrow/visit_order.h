@@ -1,12 +1,14 @@
 #pragma once
 /// \file
-/// The order in which a traversal that stops early takes a visit's children: the depth-first
-/// traversal with a limit (QueryRequest::max_pairs) and the distance traversal at contact enter
-/// first the child pairs whose spheres overlap the most relative to their size
-/// (PairContext::sphere_apart), so that they meet a touching pair after fewer tests. Which pair
-/// they meet first is theirs to choose (documented so); a traversal that visits every node keeps
+/// The order in which a traversal that stops early takes a visit's children, so that it meets a
+/// touching pair after fewer tests: the depth-first traversal with a limit
+/// (QueryRequest::max_pairs) enters first the child pairs whose boxes' centers lie nearest
+/// relative to their sizes (detail::SlotOrderKeys), the distance traversal at contact those whose
+/// spheres overlap the most relative to their size (PairContext::sphere_apart). Which pair they
+/// meet first is theirs to choose (documented so); a traversal that visits every node keeps
 /// cd_children order.
 
+#include <bit>
 #include <cstdint>
 #include <utility>
 
@@ -16,41 +18,46 @@
 
 namespace caliber::narrow {
 
-/// Pushes the `count` children of a visit (passed, 0..8 of them) onto a depth-first stack at `top`
-/// so that the one whose spheres overlap the most relative to their size (PairContext::sphere_apart)
-/// is popped first, ties in cd_children order; returns the new top. The order of a traversal that
-/// stops at a limit: it meets a touching pair after fewer tests (the first hit on bench_batch's
-/// colliding poses: bench/results/amd-epyc-2c/batch/README.md), which pair it meets first being
-/// the traversal's choice (QueryRequest::max_pairs). A traversal that visits every node keeps
-/// cd_children order.
-inline NodePair* push_nearest_first(const PairContext& ctx, NodePair passed[], int count, NodePair* top) {
+/// Pushes the `count` children of the wide visit of node n (passed, 0..8 of them, in cd_children
+/// order, as visit writes them) onto a depth-first stack at `top` so that the one whose box is
+/// nearest the staying node's box relative to their sizes (detail::SlotOrderKeys) is popped first, ties
+/// in cd_children order; returns the new top. The order of a traversal that stops at a limit: it
+/// meets a touching pair after fewer tests (the first hit on bench_batch's colliding poses:
+/// bench/results/amd-epyc-2c/batch/README.md), which pair it meets first being the traversal's
+/// choice (QueryRequest::max_pairs). The keys come from the visit's own test: the staying node as
+/// `staying` keeps it (the visit has just moved it there or found it there). A traversal that
+/// visits every node keeps cd_children order.
+inline NodePair* push_nearest_first(const PairContext& ctx, NodePair n, NodePair passed[], int count, NodePair* top,
+                                    detail::StayingCache& staying) {
   if (count < 2) {  // nothing to order
     if (count == 1) *top++ = passed[0];
     return top;
   }
-  // Each node of B among a visit's children has its center moved into A's frame once (a wide
-  // visit where B's side stays has one).
-  double apart[kMaxChildren], centers[kMaxChildren][3];
-  std::uint32_t moved[kMaxChildren];
-  int known = 0;
-  for (int k = 0; k < count; ++k) {
-    int c = 0;
-    while (c < known && moved[c] != passed[k].b) ++c;
-    if (c == known) {
-      ctx.sphere_center_in_a(passed[k].b, centers[c]);
-      moved[known++] = passed[k].b;
-    }
-    apart[k] = ctx.sphere_apart(passed[k].a, passed[k].b, centers[c]);
+  const WideVisit v = wide_visit(ctx, n, ctx.a().nodes[n.a], ctx.b().nodes[n.b]);
+  bool held = false;
+  const detail::StayingCache::Entry& kept = staying.find(v.stay, v.a_descends, held);
+  CALIBER_ASSERT(held, "the visit kept its staying node");
+  float slot_keys[WideNode::kSlots];
+  // (Null also before the library's constants are made: a query from another constant's constructor.)
+  (kSlotOrderKeys != nullptr ? kSlotOrderKeys : detail::slot_order_keys_portable)(kept, *v.node, slot_keys);
+  // Each child's key (a float at least 0: its bits order as it does) above its place, so that one
+  // integer orders both. The children in cd_children order are slots in ascending order: each
+  // one's slot found by a walk along them.
+  std::uint64_t order[kMaxChildren];
+  for (int k = 0, slot = 0; k < count; ++k, ++slot) {
+    const std::uint32_t node = v.a_descends ? passed[k].a : passed[k].b;
+    while (v.node->node[slot] != node) ++slot;
+    order[k] = std::uint64_t{std::bit_cast<std::uint32_t>(slot_keys[slot])} << 32 | static_cast<std::uint32_t>(k);
   }
   // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
-  // insertion sort of at most eight.
+  // insertion sort of at most eight, descending.
   for (int i = 1; i < count; ++i) {
-    for (int j = i; j > 0 && apart[j] >= apart[j - 1]; --j) {
-      std::swap(apart[j], apart[j - 1]);
-      std::swap(passed[j], passed[j - 1]);
-    }
+    const std::uint64_t x = order[i];
+    int j = i;
+    for (; j > 0 && order[j - 1] < x; --j) order[j] = order[j - 1];
+    order[j] = x;
   }
-  for (int k = 0; k < count; ++k) *top++ = passed[k];
+  for (int k = 0; k < count; ++k) *top++ = passed[order[k] & 0xFu];
   return top;
 }
 

@@ -15,6 +15,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
 namespace caliber::narrow::detail {
 
@@ -29,13 +31,17 @@ constexpr double kRoundShare = 0x1p-22, kFloorShare = 0x1p-32, kLeastFloor = 0x1
 constexpr float kParallel = 0.5f;
 
 void fill_side(double m[3][3], double abs_m[3][3], const double t[3], WideSide& s) {
+  // Four float lanes at a time (GCC's vector extension: one store each where the target has SSE).
+  using F4 = float __attribute__((vector_size(16)));
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       s.col[j][i] = m[i][j];
       s.abs_col[j][i] = abs_m[i][j];
-      for (int l = 0; l < 8; ++l) {
-        s.m[j][i][l] = static_cast<float>(m[j][i]);
-        s.abs_m[j][i][l] = std::abs(static_cast<float>(m[j][i]));
+      const float x = static_cast<float>(m[j][i]), y = std::abs(x);
+      const F4 lanes = {x, x, x, x}, magnitudes = {y, y, y, y};
+      for (int l = 0; l < 8; l += 4) {
+        std::memcpy(&s.m[j][i][l], &lanes, sizeof lanes);
+        std::memcpy(&s.abs_m[j][i][l], &magnitudes, sizeof magnitudes);
       }
     }
     s.col[j][3] = s.abs_col[j][3] = 0.0;
@@ -165,6 +171,19 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
     if ((pass >> k & 1u) != 0 && !floats_pass(l, s, w, k, kept.floats)) pass &= ~(1u << k);
   }
   return pass;
+}
+
+void slot_order_keys_portable(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]) {
+  for (int k = 0; k < WideNode::kSlots; ++k) {
+    float offset = 0.0f, extent = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+      const float lo = static_cast<float>(w.lo[i][k]) * w.step + w.origin[i];
+      const float hi = static_cast<float>(w.hi[i][k]) * w.step + w.origin[i];
+      offset += std::abs((lo + hi) - (kept.lo[i] + kept.hi[i]));
+      extent += (hi - lo) + (kept.hi[i] - kept.lo[i]);
+    }
+    keys[k] = offset / (extent + std::numeric_limits<float>::min());
+  }
 }
 
 }  // namespace caliber::narrow::detail

@@ -206,4 +206,16 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
 /// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
 WideTest wide_test_avx2_if_supported();
 
+/// The order keys of the slots of wide node w against the staying node whose stage-1 box `kept`
+/// holds (its box moved into w's frame, as floats): per slot, how far apart the two boxes' centers
+/// lie relative to their sizes, the sum over the axes of |(low + high) - (kept.lo + kept.hi)| over
+/// the sum of both boxes' extents (plus float's least normal: 0 for the same center, about 1 for
+/// boxes that touch). Every form makes each slot's operations in the same order, unfused: the same
+/// keys. Empty slots get whatever their bounds give.
+using SlotOrderKeys = void (*)(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]);
+/// The portable form.
+void slot_order_keys_portable(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]);
+/// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
+SlotOrderKeys slot_order_keys_avx2_if_supported();
+
 }  // namespace caliber::narrow::detail

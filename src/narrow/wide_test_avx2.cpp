@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -212,6 +213,19 @@ CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx
   visit_until_empty(ctx, stack, size, out, stats, taboo, buffer, lanes, InlinedTest{});
 }
 
+/// slot_order_keys_portable in eight lanes: each lane its operations, in its order, unfused.
+CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]) {
+  const V step = all(w.step), magnitude_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
+  V offset = _mm256_setzero_ps(), extent = _mm256_setzero_ps();
+  for (int i = 0; i < 3; ++i) {
+    const V lo = add(mul(steps(w.lo[i]), step), all(w.origin[i]));
+    const V hi = add(mul(steps(w.hi[i]), step), all(w.origin[i]));
+    offset = add(offset, _mm256_and_ps(sub(add(lo, hi), all(kept.lo[i] + kept.hi[i])), magnitude_bits));
+    extent = add(extent, add(sub(hi, lo), all(kept.hi[i] - kept.lo[i])));
+  }
+  _mm256_storeu_ps(keys, _mm256_div_ps(offset, add(extent, all(std::numeric_limits<float>::min()))));
+}
+
 /// Whether this CPU runs what this file builds (AVX2 and FMA).
 bool avx2_and_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
 
@@ -221,6 +235,8 @@ WideTest wide_test_avx2_if_supported() { return avx2_and_fma() ? wide_test_avx2 
 
 WideLoop wide_loop_avx2_if_supported() { return avx2_and_fma() ? wide_loop_avx2 : nullptr; }
 
+SlotOrderKeys slot_order_keys_avx2_if_supported() { return avx2_and_fma() ? slot_order_keys_avx2 : nullptr; }
+
 }  // namespace caliber::narrow::detail
 
 #else
@@ -228,6 +244,7 @@ WideLoop wide_loop_avx2_if_supported() { return avx2_and_fma() ? wide_loop_avx2 
 namespace caliber::narrow::detail {
 WideTest wide_test_avx2_if_supported() { return nullptr; }
 WideLoop wide_loop_avx2_if_supported() { return nullptr; }
+SlotOrderKeys slot_order_keys_avx2_if_supported() { return nullptr; }
 }  // namespace caliber::narrow::detail
 
 #endif

@@ -1,9 +1,12 @@
 // The order in which a traversal that stops early takes a visit's children: the depth-first one
-// with max_pairs (push_nearest_first), the distance one at contact (touching_first). Both by
-// PairContext::sphere_apart, ties in cd_children order. (Which pair such a traversal meets first
-// is its own choice; the answers' tests are elsewhere.)
+// with max_pairs (push_nearest_first, by the boxes' order keys), the distance one at contact
+// (touching_first, by PairContext::sphere_apart); ties in cd_children order. (Which pair such a
+// traversal meets first is its own choice; the answers' tests are elsewhere.)
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <iterator>
 #include <random>
 #include <vector>
@@ -14,6 +17,7 @@
 #include "caliber/query.h"
 #include "narrow/cd_tree.h"
 #include "narrow/traversal.h"
+#include "narrow/visit_order.h"
 #include "support/random_poses.h"
 #include "support/torus_sphere.h"
 
@@ -42,34 +46,87 @@ std::vector<narrow::NodePair> top_of_tree(const narrow::PairContext& ctx, int le
   return all;
 }
 
-TEST(VisitOrder, LimitedTraversalPopsTheNearestSpheresFirst) {
+/// The keys of w's slots as the definition says them, in double: the sum of the center offsets
+/// over the sum of the extents, from the slots' grid bounds and the staying box in `kept`.
+std::vector<double> keys_by_definition(const narrow::detail::StayingCache::Entry& kept, const WideNode& w) {
+  std::vector<double> keys;
+  for (int k = 0; k < w.count(); ++k) {
+    double offset = 0.0, extent = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      offset += std::abs((double(w.low(i, k)) + w.high(i, k)) - (double(kept.lo[i]) + kept.hi[i]));
+      extent += (double(w.high(i, k)) - w.low(i, k)) + (double(kept.hi[i]) - kept.lo[i]);
+    }
+    keys.push_back(offset / extent);
+  }
+  return keys;
+}
+
+TEST(VisitOrder, LimitedTraversalPopsTheNearestBoxesFirst) {
   std::mt19937_64 rng(4);
   int checked = 0, reordered = 0;
+  narrow::detail::StayingCache staying;
   for (int i = 0; i < 20; ++i) {
     const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
                                   QueryRequest{});
+    const narrow::detail::WideLanes lanes = narrow::wide_lanes(ctx);
+    staying.renew();
     for (const narrow::NodePair n : top_of_tree(ctx, 6)) {
       if (leaf_pair(ctx, n)) continue;
-      // The children pushed as a limited traversal pushes them, then popped.
+      // The visit's test (which keeps its staying node), then the children pushed as a limited
+      // traversal pushes them, then popped.
+      const narrow::WideVisit v = narrow::wide_visit(ctx, n, ctx.a().nodes[n.a], ctx.b().nodes[n.b]);
+      (void)narrow::wide_pass(ctx, n, v, lanes, &staying);
       narrow::NodePair kids[narrow::kMaxChildren], passed[narrow::kMaxChildren], stack[narrow::kMaxChildren];
       const int count = narrow::cd_children(ctx, n, kids);
       std::copy(kids, kids + count, passed);
-      narrow::NodePair* const top = narrow::push_nearest_first(ctx, passed, count, stack);
+      narrow::NodePair* const top = narrow::push_nearest_first(ctx, n, passed, count, stack, staying);
       ASSERT_EQ(top - stack, count);
       const std::vector<narrow::NodePair> popped(std::make_reverse_iterator(top), std::make_reverse_iterator(stack));
       for (int k = 0; k < count; ++k) ASSERT_EQ(std::count(popped.begin(), popped.end(), kids[k]), 1) << "every child once";
+      bool held = false;
+      const auto& kept = staying.find(v.stay, v.a_descends, held);
+      ASSERT_TRUE(held) << "the visit kept its staying node";
+      float keys[WideNode::kSlots];
+      narrow::detail::slot_order_keys_portable(kept, *v.node, keys);
+      const std::vector<double> defined = keys_by_definition(kept, *v.node);
+      for (int k = 0; k < count; ++k) EXPECT_NEAR(keys[k], defined[k], 1e-5 * (1.0 + defined[k])) << "the key is its definition";
+      const auto slot_of = [&](narrow::NodePair c) { return static_cast<int>(std::find(kids, kids + count, c) - kids); };
       for (int k = 1; k < count; ++k) {
-        const double before = ctx.sphere_apart(popped[k - 1].a, popped[k - 1].b);
-        const double after = ctx.sphere_apart(popped[k].a, popped[k].b);
-        ASSERT_LE(before, after) << "pose " << i << ": the nearer spheres first";
-        if (before == after) EXPECT_LT(popped[k - 1], popped[k]) << "ties in cd_children order";
+        const int before = slot_of(popped[k - 1]), after = slot_of(popped[k]);
+        ASSERT_LE(keys[before], keys[after]) << "pose " << i << ": the nearer boxes first";
+        if (keys[before] == keys[after]) EXPECT_LT(before, after) << "ties in cd_children order";
       }
       reordered += std::equal(kids, kids + count, popped.begin()) ? 0 : 1;
       ++checked;
     }
   }
   EXPECT_GT(checked, 1000);
-  EXPECT_GT(reordered, checked / 10) << "the order differs from cd_children's where spheres say so";
+  EXPECT_GT(reordered, checked / 10) << "the order differs from cd_children's where the keys say so";
+}
+
+TEST(VisitOrder, SlotOrderKeysAreTheSameInEveryForm) {
+  if (narrow::kSlotOrderKeys == nullptr) GTEST_SKIP() << "this CPU has one form";
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<float> coordinate(-2.0f, 2.0f);
+  int checked = 0;
+  for (const Model* model : {shapes().torus.get(), shapes().sphere.get()}) {
+    for (const WideNode& w : data(*model).wide) {
+      narrow::detail::StayingCache::Entry kept{};
+      for (int i = 0; i < 3; ++i) {
+        const float x = coordinate(rng), y = coordinate(rng);
+        kept.lo[i] = std::min(x, y);
+        kept.hi[i] = std::max(x, y);
+      }
+      float portable[WideNode::kSlots], chosen[WideNode::kSlots];
+      narrow::detail::slot_order_keys_portable(kept, w, portable);
+      narrow::kSlotOrderKeys(kept, w, chosen);
+      for (int k = 0; k < w.count(); ++k) {
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(portable[k]), std::bit_cast<std::uint32_t>(chosen[k])) << "slot " << k;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
 }
 
 TEST(VisitOrder, DistanceAtContactTakesTheMostOverlappingTouchingChildFirst) {
