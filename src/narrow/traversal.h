@@ -108,9 +108,11 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     }
     top = base = stack.data();
   }
+  // With a limit, the children's order keys (push_nearest_first).
+  float order[kMaxChildren];
+  if (limit != nullptr && lanes.wide != nullptr) lanes.order = order;
   while (limit != nullptr && top != base) {
-    const NodePair n = *--top;
-    const int count = visit(ctx, n, out, counted, passed, taboo, nullptr, lanes);
+    const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);
     // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
     if (count < 0) {
       if (out.size() != seen) {
@@ -120,9 +122,9 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
         break;
       }
     }
-    // Nearest boxes first (push_nearest_first; a pair-collecting query walks the wide tree).
-    CALIBER_ASSERT(lanes.staying != nullptr, "a traversal with a limit walks the wide tree");
-    top = push_nearest_first(ctx, n, passed, count, top, *lanes.staying);
+    // Nearest boxes first (a pair-collecting query walks the wide tree).
+    CALIBER_ASSERT(lanes.order != nullptr, "a traversal with a limit walks the wide tree");
+    top = push_nearest_first(passed, order, count, top);
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
   ctx.flush_leaves(buffer, out);

@@ -16,6 +16,7 @@
 #include "narrow/child_pairs.h"
 #include "narrow/leaf_buffer.h"
 #include "narrow/pair_context.h"
+#include "util/assert.h"
 
 namespace caliber::narrow {
 
@@ -27,6 +28,10 @@ struct VisitLanes {
   const detail::NodeLanes* binary = nullptr;
   const detail::WideLanes* wide = nullptr;
   detail::StayingCache* staying = nullptr;
+  /// Where given (with `staying`), a wide visit writes there the order key of each child it
+  /// writes to `passed`, in the same places (detail::SlotOrderKeys): what a traversal with a
+  /// limit orders them by (push_nearest_first).
+  float* order = nullptr;
 };
 
 /// Counts and makes the node test of CD-tree node n: the test of a node no parent tested (a root),
@@ -36,17 +41,28 @@ inline bool test_root(const PairContext& ctx, NodePair n, QueryStats& stats, Roo
   return root_test(ctx, n, how);
 }
 
+/// The order keys of the slots of visit v (detail::SlotOrderKeys) against its staying node, which
+/// `staying` holds (its visit's test has just moved it there, or found it there).
+inline void slot_order_keys(const WideVisit& v, detail::StayingCache& staying, float keys[WideNode::kSlots]) {
+  bool held = false;
+  const detail::StayingCache::Entry& kept = staying.find(v.stay, v.a_descends, held);
+  CALIBER_ASSERT(held, "the visit kept its staying node");
+  // (Null also before the library's constants are made: a query from another constant's constructor.)
+  (kSlotOrderKeys != nullptr ? kSlotOrderKeys : detail::slot_order_keys_portable)(kept, *v.node, keys);
+}
+
 /// The visit of a node of the wide CD tree (not a pair of leaves; narrow::visit): its children's
 /// tests at once (wide_pass), those that pass written to `passed` in cd_children order (kReversed:
 /// reversed), every child counted but those on the taboo list (skipped and marked reached). Given
 /// `leaf_pair` (a callable, not null), the children that pass and are pairs of leaves (the staying
 /// node a leaf, the slot one: WideNode::leaves) get their leaf test here, leaf_pair(ta, tb), in
-/// slot order, and are not written: they would be visited next only to be found leaves.
+/// slot order, and are not written: they would be visited next only to be found leaves. Given
+/// `order` (and `staying`), each child written gets its order key there (VisitLanes::order).
 template <bool kReversed, class Test = ChosenWideTest, class LeafPair = std::nullptr_t>
 [[gnu::always_inline]] inline int visit_wide(const PairContext& ctx, NodePair n, const BvhNode& a, const BvhNode& b,
                                              QueryStats& stats, NodePair passed[], TabooView taboo,
                                              const detail::WideLanes& lanes, detail::StayingCache* staying, Test test = {},
-                                             LeafPair leaf_pair = nullptr) {
+                                             LeafPair leaf_pair = nullptr, float* order = nullptr) {
   const WideVisit v = wide_visit(ctx, n, a, b);
   unsigned pass = wide_pass(ctx, n, v, lanes, staying, test);
   const int count = v.node->count();
@@ -75,13 +91,17 @@ template <bool kReversed, class Test = ChosenWideTest, class LeafPair = std::nul
     }
   }
   if constexpr (requires { test.template write_passed<kReversed>(v, pass, passed); }) {
+    CALIBER_ASSERT(order == nullptr, "a loop that writes its children at once orders none");
     return test.template write_passed<kReversed>(v, pass, passed);
   } else {
+    float keys[WideNode::kSlots];
+    if (order != nullptr && pass != 0) slot_order_keys(v, *staying, keys);
     int passing = 0;
     while (pass != 0) {
       const unsigned k =
           kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
       pass ^= 1u << k;
+      if (order != nullptr) order[passing] = keys[k];
       passed[passing++] = v.child(static_cast<int>(k), n);
     }
     return passing;
@@ -179,6 +199,8 @@ template <bool kReversed = false, class Test = ChosenWideTest>
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
     if (buffer != nullptr)
       return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, leaf_pair);
+    if (lanes.order != nullptr)
+      return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, nullptr, lanes.order);
     return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);
   }
   const BvhNode& a = ctx.a().nodes[n.a];

@@ -18,37 +18,24 @@
 
 namespace caliber::narrow {
 
-/// Pushes the `count` children of the wide visit of node n (passed, 0..8 of them, in cd_children
-/// order, as visit writes them) onto a depth-first stack at `top` so that the one whose box is
-/// nearest the staying node's box relative to their sizes (detail::SlotOrderKeys) is popped first, ties
-/// in cd_children order; returns the new top. The order of a traversal that stops at a limit: it
-/// meets a touching pair after fewer tests (the first hit on bench_batch's colliding poses:
-/// bench/results/amd-epyc-2c/batch/README.md), which pair it meets first being the traversal's
-/// choice (QueryRequest::max_pairs). The keys come from the visit's own test: the staying node as
-/// `staying` keeps it (the visit has just moved it there or found it there). A traversal that
-/// visits every node keeps cd_children order.
-inline NodePair* push_nearest_first(const PairContext& ctx, NodePair n, NodePair passed[], int count, NodePair* top,
-                                    detail::StayingCache& staying) {
+/// Pushes the `count` children of a visit (passed, 0..8 of them, in cd_children order) onto a
+/// depth-first stack at `top` so that the one whose box is nearest the staying node's box relative
+/// to their sizes (their order keys, `keys`, as the visit wrote them: VisitLanes::order,
+/// detail::SlotOrderKeys) is popped first, ties in cd_children order; returns the new top. The order
+/// of a traversal that stops at a limit: it meets a touching pair after fewer tests (the first hit
+/// on bench_batch's colliding poses: bench/results/amd-epyc-2c/batch/README.md), which pair it
+/// meets first being the traversal's choice (QueryRequest::max_pairs). A traversal that visits
+/// every node keeps cd_children order.
+inline NodePair* push_nearest_first(const NodePair passed[], const float keys[], int count, NodePair* top) {
   if (count < 2) {  // nothing to order
     if (count == 1) *top++ = passed[0];
     return top;
   }
-  const WideVisit v = wide_visit(ctx, n, ctx.a().nodes[n.a], ctx.b().nodes[n.b]);
-  bool held = false;
-  const detail::StayingCache::Entry& kept = staying.find(v.stay, v.a_descends, held);
-  CALIBER_ASSERT(held, "the visit kept its staying node");
-  float slot_keys[WideNode::kSlots];
-  // (Null also before the library's constants are made: a query from another constant's constructor.)
-  (kSlotOrderKeys != nullptr ? kSlotOrderKeys : detail::slot_order_keys_portable)(kept, *v.node, slot_keys);
   // Each child's key (a float at least 0: its bits order as it does) above its place, so that one
-  // integer orders both. The children in cd_children order are slots in ascending order: each
-  // one's slot found by a walk along them.
+  // integer orders both.
   std::uint64_t order[kMaxChildren];
-  for (int k = 0, slot = 0; k < count; ++k, ++slot) {
-    const std::uint32_t node = v.a_descends ? passed[k].a : passed[k].b;
-    while (v.node->node[slot] != node) ++slot;
-    order[k] = std::uint64_t{std::bit_cast<std::uint32_t>(slot_keys[slot])} << 32 | static_cast<std::uint32_t>(k);
-  }
+  for (int k = 0; k < count; ++k)
+    order[k] = std::uint64_t{std::bit_cast<std::uint32_t>(keys[k])} << 32 | static_cast<std::uint32_t>(k);
   // Farthest first on the stack, equals in reverse cd_children order (popped in that order): an
   // insertion sort of at most eight, descending.
   for (int i = 1; i < count; ++i) {

@@ -17,6 +17,7 @@
 #include "caliber/query.h"
 #include "narrow/cd_tree.h"
 #include "narrow/traversal.h"
+#include "narrow/visit.h"
 #include "narrow/visit_order.h"
 #include "support/random_poses.h"
 #include "support/torus_sphere.h"
@@ -63,7 +64,7 @@ std::vector<double> keys_by_definition(const narrow::detail::StayingCache::Entry
 
 TEST(VisitOrder, LimitedTraversalPopsTheNearestBoxesFirst) {
   std::mt19937_64 rng(4);
-  int checked = 0, reordered = 0;
+  int checked = 0, reordered = 0, written = 0;
   narrow::detail::StayingCache staying;
   for (int i = 0; i < 20; ++i) {
     const narrow::PairContext ctx(*shapes().torus, test::random_pose(rng, 0.5), *shapes().sphere, test::random_pose(rng, 0.5),
@@ -72,25 +73,31 @@ TEST(VisitOrder, LimitedTraversalPopsTheNearestBoxesFirst) {
     staying.renew();
     for (const narrow::NodePair n : top_of_tree(ctx, 6)) {
       if (leaf_pair(ctx, n)) continue;
-      // The visit's test (which keeps its staying node), then the children pushed as a limited
-      // traversal pushes them, then popped.
+      // The visit as a limited traversal makes it: the children that pass, each with its key.
+      std::vector<narrow::Candidate> out;
+      QueryStats stats;
+      narrow::NodePair passed[narrow::kMaxChildren];
+      float order[narrow::kMaxChildren];
+      const int passing = narrow::visit(ctx, n, out, stats, passed, {}, nullptr, {nullptr, &lanes, &staying, order});
       const narrow::WideVisit v = narrow::wide_visit(ctx, n, ctx.a().nodes[n.a], ctx.b().nodes[n.b]);
-      (void)narrow::wide_pass(ctx, n, v, lanes, &staying);
-      narrow::NodePair kids[narrow::kMaxChildren], passed[narrow::kMaxChildren], stack[narrow::kMaxChildren];
-      const int count = narrow::cd_children(ctx, n, kids);
-      std::copy(kids, kids + count, passed);
-      narrow::NodePair* const top = narrow::push_nearest_first(ctx, n, passed, count, stack, staying);
-      ASSERT_EQ(top - stack, count);
-      const std::vector<narrow::NodePair> popped(std::make_reverse_iterator(top), std::make_reverse_iterator(stack));
-      for (int k = 0; k < count; ++k) ASSERT_EQ(std::count(popped.begin(), popped.end(), kids[k]), 1) << "every child once";
       bool held = false;
       const auto& kept = staying.find(v.stay, v.a_descends, held);
       ASSERT_TRUE(held) << "the visit kept its staying node";
       float keys[WideNode::kSlots];
       narrow::detail::slot_order_keys_portable(kept, *v.node, keys);
       const std::vector<double> defined = keys_by_definition(kept, *v.node);
-      for (int k = 0; k < count; ++k) EXPECT_NEAR(keys[k], defined[k], 1e-5 * (1.0 + defined[k])) << "the key is its definition";
+      narrow::NodePair kids[narrow::kMaxChildren], stack[narrow::kMaxChildren];
+      const int count = narrow::cd_children(ctx, n, kids);
       const auto slot_of = [&](narrow::NodePair c) { return static_cast<int>(std::find(kids, kids + count, c) - kids); };
+      for (int k = 0; k < passing; ++k, ++written) {
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(order[k]), std::bit_cast<std::uint32_t>(keys[slot_of(passed[k])])) << "its key";
+      }
+      for (int k = 0; k < count; ++k) EXPECT_NEAR(keys[k], defined[k], 1e-5 * (1.0 + defined[k])) << "the key is its definition";
+      // Every child pushed with its key, as a limited traversal pushes them, then popped.
+      narrow::NodePair* const top = narrow::push_nearest_first(kids, keys, count, stack);
+      ASSERT_EQ(top - stack, count);
+      const std::vector<narrow::NodePair> popped(std::make_reverse_iterator(top), std::make_reverse_iterator(stack));
+      for (int k = 0; k < count; ++k) ASSERT_EQ(std::count(popped.begin(), popped.end(), kids[k]), 1) << "every child once";
       for (int k = 1; k < count; ++k) {
         const int before = slot_of(popped[k - 1]), after = slot_of(popped[k]);
         ASSERT_LE(keys[before], keys[after]) << "pose " << i << ": the nearer boxes first";
@@ -101,6 +108,7 @@ TEST(VisitOrder, LimitedTraversalPopsTheNearestBoxesFirst) {
     }
   }
   EXPECT_GT(checked, 1000);
+  EXPECT_GT(written, 1000);
   EXPECT_GT(reordered, checked / 10) << "the order differs from cd_children's where the keys say so";
 }
 
