@@ -138,8 +138,8 @@ detail::WideLanes wide_lanes(const PairContext& ctx);
 /// scalar form: the same decisions), chosen when the library loads.
 extern const detail::WideTest kWideTest;
 
-/// The AVX2 form of detail::slot_order_keys where this CPU has it, else null (the portable form
-/// then: the same keys), chosen when the library loads.
+/// The AVX2 form of detail::SlotOrderKeys where this CPU has it, else null (the portable form,
+/// detail::slot_order_keys_portable, then: the same keys), chosen when the library loads.
 extern const detail::SlotOrderKeys kSlotOrderKeys;
 
 /// The wide node test as the library chose it when it loaded (kWideTest, else the scalar form),

@@ -84,6 +84,9 @@ QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair o
   // A few (a first hit's): sorted where they are, no keys made.
   if (candidates.size() <= kFewCandidates) {
     std::sort(candidates.begin(), candidates.end(), by_ids);
+    CALIBER_ASSERT(std::adjacent_find(candidates.begin(), candidates.end(),
+                                      [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end(),
+                   "each triangle pair is a candidate once");
     result.contacts.reserve(candidates.size());
     for (const Candidate& c : candidates) add(c.tri_a, c.tri_b);
     return result;

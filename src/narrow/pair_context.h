@@ -132,8 +132,8 @@ class PairContext {
 
   /// How far apart the spheres of node ia of A and node ib of B are, relative to their size:
   /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders the
-  /// distance traversal that stops at contact: it enters the touching children most likely to
-  /// touch first (visit_order.h).
+  /// distance traversal that stops at contact: it enters the most overlapping touching children
+  /// first (visit_order.h).
   [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
     const BvhNode& na = mA.nodes[ia];
     const BvhNode& nb = mB.nodes[ib];

@@ -109,7 +109,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     top = base = stack.data();
   }
   // With a limit, the children's order keys (push_nearest_first).
-  float order[kMaxChildren];
+  float order[kMaxChildren] = {};
   if (limit != nullptr && lanes.wide != nullptr) lanes.order = order;
   while (limit != nullptr && top != base) {
     const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);

@@ -28,9 +28,9 @@ struct VisitLanes {
   const detail::NodeLanes* binary = nullptr;
   const detail::WideLanes* wide = nullptr;
   detail::StayingCache* staying = nullptr;
-  /// Where given (with `staying`), a wide visit writes there the order key of each child it
-  /// writes to `passed`, in the same places (detail::SlotOrderKeys): what a traversal with a
-  /// limit orders them by (push_nearest_first).
+  /// Where given (with `staying`), a wide visit that writes two children or more to `passed`
+  /// writes there the order key of each, in the same places (detail::SlotOrderKeys): what a
+  /// traversal with a limit orders them by (push_nearest_first).
   float* order = nullptr;
 };
 
@@ -91,21 +91,21 @@ template <bool kReversed, class Test = ChosenWideTest, class LeafPair = std::nul
     }
   }
   if constexpr (requires { test.template write_passed<kReversed>(v, pass, passed); }) {
-    CALIBER_ASSERT(order == nullptr, "a loop that writes its children at once orders none");
-    return test.template write_passed<kReversed>(v, pass, passed);
-  } else {
-    float keys[WideNode::kSlots];
-    if (order != nullptr && pass != 0) slot_order_keys(v, *staying, keys);
-    int passing = 0;
-    while (pass != 0) {
-      const unsigned k =
-          kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
-      pass ^= 1u << k;
-      if (order != nullptr) order[passing] = keys[k];
-      passed[passing++] = v.child(static_cast<int>(k), n);
-    }
-    return passing;
+    if (order == nullptr) return test.template write_passed<kReversed>(v, pass, passed);
   }
+  // The keys where two children or more pass (one needs no order).
+  const bool ordered = order != nullptr && (pass & (pass - 1)) != 0;
+  CALIBER_ASSERT(!ordered || staying != nullptr, "the keys read the staying node the test kept");
+  float keys[WideNode::kSlots];
+  if (ordered) slot_order_keys(v, *staying, keys);
+  int passing = 0;
+  while (pass != 0) {
+    const unsigned k = kReversed ? 31u - static_cast<unsigned>(__builtin_clz(pass)) : static_cast<unsigned>(__builtin_ctz(pass));
+    pass ^= 1u << k;
+    if (ordered) order[passing] = keys[k];
+    passed[passing++] = v.child(static_cast<int>(k), n);
+  }
+  return passing;
 }
 
 /// visit_wide for a visit without the traversal's lanes: made here.
@@ -198,7 +198,7 @@ template <bool kReversed = false, class Test = ChosenWideTest>
     if (a.is_leaf() && b.is_leaf()) return leaf_pair(a.triangle(), b.triangle());
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
     if (buffer != nullptr)
-      return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, leaf_pair);
+      return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, leaf_pair, lanes.order);
     if (lanes.order != nullptr)
       return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, nullptr, lanes.order);
     return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);

@@ -10,7 +10,6 @@
 
 #include <bit>
 #include <cstdint>
-#include <utility>
 
 #include "narrow/cd_tree.h"
 #include "narrow/pair_context.h"
@@ -31,8 +30,8 @@ inline NodePair* push_nearest_first(const NodePair passed[], const float keys[],
     if (count == 1) *top++ = passed[0];
     return top;
   }
-  // Each child's key (a float at least 0: its bits order as it does) above its place, so that one
-  // integer orders both.
+  // Each child's key (finite and at least 0 for validated input: its bits order as it does) above
+  // its place, so that one integer orders both. `passed` in cd_children order: equals keep it.
   std::uint64_t order[kMaxChildren];
   for (int k = 0; k < count; ++k)
     order[k] = std::uint64_t{std::bit_cast<std::uint32_t>(keys[k])} << 32 | static_cast<std::uint32_t>(k);

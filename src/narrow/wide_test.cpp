@@ -177,9 +177,9 @@ void slot_order_keys_portable(const StayingCache::Entry& kept, const WideNode& w
   for (int k = 0; k < WideNode::kSlots; ++k) {
     float offset = 0.0f, extent = 0.0f;
     for (int i = 0; i < 3; ++i) {
-      const float lo = static_cast<float>(w.lo[i][k]) * w.step + w.origin[i];
-      const float hi = static_cast<float>(w.hi[i][k]) * w.step + w.origin[i];
-      offset += std::abs((lo + hi) - (kept.lo[i] + kept.hi[i]));
+      // From the grid's origin: the slot's bounds exactly.
+      const float lo = static_cast<float>(w.lo[i][k]) * w.step, hi = static_cast<float>(w.hi[i][k]) * w.step;
+      offset += std::abs((lo + hi) - ((kept.lo[i] - w.origin[i]) + (kept.hi[i] - w.origin[i])));
       extent += (hi - lo) + (kept.hi[i] - kept.lo[i]);
     }
     keys[k] = offset / (extent + std::numeric_limits<float>::min());

@@ -209,9 +209,12 @@ WideTest wide_test_avx2_if_supported();
 /// The order keys of the slots of wide node w against the staying node whose stage-1 box `kept`
 /// holds (its box moved into w's frame, as floats): per slot, how far apart the two boxes' centers
 /// lie relative to their sizes, the sum over the axes of |(low + high) - (kept.lo + kept.hi)| over
-/// the sum of both boxes' extents (plus float's least normal: 0 for the same center, about 1 for
-/// boxes that touch). Every form makes each slot's operations in the same order, unfused: the same
-/// keys. Empty slots get whatever their bounds give.
+/// the sum of both boxes' extents (plus float's least normal: 0 for the same center, at most 1
+/// where the boxes overlap). The centers are taken from w's grid origin (the slots' exactly, as
+/// (q_lo + q_hi) step), so that a wide node far from its model's origin keeps the keys' precision.
+/// Finite and at least 0 for the finite boxes of validated input (coordinates up to 1e15). Every
+/// form makes each slot's operations in the same order, unfused: the same keys. Empty slots get
+/// whatever their bounds give.
 using SlotOrderKeys = void (*)(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]);
 /// The portable form.
 void slot_order_keys_portable(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]);

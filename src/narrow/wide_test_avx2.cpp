@@ -218,9 +218,9 @@ CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const Wi
   const V step = all(w.step), magnitude_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
   V offset = _mm256_setzero_ps(), extent = _mm256_setzero_ps();
   for (int i = 0; i < 3; ++i) {
-    const V lo = add(mul(steps(w.lo[i]), step), all(w.origin[i]));
-    const V hi = add(mul(steps(w.hi[i]), step), all(w.origin[i]));
-    offset = add(offset, _mm256_and_ps(sub(add(lo, hi), all(kept.lo[i] + kept.hi[i])), magnitude_bits));
+    const V lo = mul(steps(w.lo[i]), step), hi = mul(steps(w.hi[i]), step);
+    const float kept_sum = (kept.lo[i] - w.origin[i]) + (kept.hi[i] - w.origin[i]);
+    offset = add(offset, _mm256_and_ps(sub(add(lo, hi), all(kept_sum)), magnitude_bits));
     extent = add(extent, add(sub(hi, lo), all(kept.hi[i] - kept.lo[i])));
   }
   _mm256_storeu_ps(keys, _mm256_div_ps(offset, add(extent, all(std::numeric_limits<float>::min()))));
