@@ -82,7 +82,7 @@ struct SidePoses {
 struct PyBatch {
   py::array_t<std::int64_t> offsets;                ///< N + 1: entry i's rows are [offsets[i], offsets[i + 1])
   py::array_t<bool> hit;                            ///< N: the entry reported a pair
-  py::array_t<bool> limit_reached;                  ///< N: the entry found more than max_pairs
+  py::array_t<bool> limit_reached;                  ///< N: the entry found max_pairs and stopped
   py::array_t<double> distance;                     ///< N: the entry's smallest reported distance (inf: none)
   py::array_t<std::uint32_t> pairs;                 ///< k x 2 triangle ids
   py::array_t<std::int64_t> entries;                ///< k: the entry each row belongs to
@@ -281,7 +281,7 @@ inline py::class_<PyBatch> bind_batch(py::module_& m) {
                                  "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
           .def_property_readonly("hit", view_of<PyBatch, &PyBatch::hit>, "N bools: the entry reported a pair")
           .def_property_readonly("limit_reached", view_of<PyBatch, &PyBatch::limit_reached>,
-                                 "N bools: the entry found more than max_pairs")
+                                 "N bools: the entry found max_pairs pairs and stopped")
           .def_property_readonly(
               "distance", view_of<PyBatch, &PyBatch::distance>,
               "N: the entry's smallest reported distance (its closest pair's, for kind 'distance'); inf when none")

@@ -40,7 +40,7 @@ struct PyResult {
   std::vector<caliber::Contact> contacts;  ///< until the arrays are made
   std::size_t rows = 0;
   std::uint64_t node_tests = 0, leaf_tests = 0;
-  bool limit_reached = false;  ///< more than max_pairs were found: a partial answer
+  bool limit_reached = false;  ///< max_pairs were found: it stopped there (maybe a part)
   caliber::QueryKind kind = caliber::QueryKind::interference;
 
   struct Arrays {

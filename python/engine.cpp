@@ -180,7 +180,7 @@ void bind_frames(EngineClass& cls) {
               return to_result(std::move(s.contacts), s.stats, s.limit_reached, frame.request.kind);
             },
             py::arg("models"), py::arg("poses"), py::arg("pairs"), request..., py::kw_only(), py::arg("lowest_ids") = false,
-            "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair past that "
+            "One frame: every listed object pair (a < b, sorted) tested. max_pairs > 0 stops each object pair at that "
             "many triangle pairs and sets limit_reached (1: does each pair touch at all?).");
       },
       request_args());

@@ -179,7 +179,7 @@ void print_result(const QueryOptions& opt, const caliber::QueryRequest& request,
   }
   if (shown < result.contacts.size()) std::printf("  ... %zu more (use --json for all)\n", result.contacts.size() - shown);
   if (result.limit_reached) {
-    std::printf("  limit reached: more than %zu pairs; the query stopped early and reports %zu of them\n", request.max_pairs,
+    std::printf("  limit reached: the query stopped at %zu pairs and reports %zu (there may be more)\n", request.max_pairs,
                 result.contacts.size());
   }
 }
@@ -238,7 +238,7 @@ Runner add_query_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--max-pairs", opt->max_pairs,
-                  "Report at most N triangle pairs: past N the query stops early and says so (0: no limit)")
+                  "Report at most N triangle pairs: at N the query stops and says so (0: no limit)")
       ->check(at_least(0))
       ->capture_default_str()
       ->each([opt](const std::string&) { opt->max_pairs_given = true; });

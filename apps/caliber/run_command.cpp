@@ -317,7 +317,7 @@ int run_scene(const RunOptions& opt) {
   if (sinks.contacts_out) sinks.contacts_out->commit();
   if (sinks.exporter) sinks.exporter->commit();
   if (limited_steps > 0) {
-    std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts are partial\n", limited_steps,
+    std::printf("\n%zu of %zu steps reached max_pairs %zu (%s) on some pair: their contacts may be partial\n", limited_steps,
                 stats.steps(), sc.query.max_pairs, opt.max_pairs != 0 ? "--max-pairs" : "the scene's query");
   }
   close_report(sinks, world, stats, print_summary(opt, world, engine, stats, sims), stopped);
@@ -350,7 +350,7 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--json", opt->json, "Write a per-step JSON report to this file");
   cmd->add_option("--contacts", opt->contacts, "Write each step's contacts, one JSON line per step, to this file");
   cmd->add_option("--max-pairs", opt->max_pairs,
-                  "Per object pair and step, report at most N triangle pairs: past N it stops early and the step says "
+                  "Per object pair and step, report at most N triangle pairs: at N it stops and the step says "
                   "so (0: the scene's query.max_pairs, or no limit)")
       ->check(at_least(0))
       ->capture_default_str();

@@ -24,7 +24,7 @@ struct BatchResult {
   /// Every entry's contacts, entry after entry. A distance entry has one (its closest pair) or
   /// none (farther than the tolerance).
   std::vector<Contact> contacts;
-  /// Per entry: 1 when it found more than QueryRequest::max_pairs pairs (its contacts are a part).
+  /// Per entry: 1 when it found QueryRequest::max_pairs pairs and stopped (its contacts may be a part).
   std::vector<std::uint8_t> limit_reached;
   /// Node and leaf tests over the whole batch.
   QueryStats stats;

@@ -44,7 +44,7 @@ struct PairRecord {
   ObjectPair pair;             ///< the object pair
   QueryStats stats;            ///< node and leaf tests
   std::size_t contacts = 0;    ///< triangle pairs reported
-  bool limit_reached = false;  ///< more than QueryRequest::max_pairs were found: `contacts` is partial
+  bool limit_reached = false;  ///< QueryRequest::max_pairs were found: it stopped, `contacts` may be partial
   /// Triangle pairs the traversals kept, before the contact reduction and max_pairs: what the
   /// pair's finalization worked on.
   std::size_t candidates = 0;
@@ -63,7 +63,7 @@ struct StepResult {
   /// How the work was cut and scheduled (caliber/profile.h): null unless EngineOptions::profile
   /// (or timeline) is on.
   std::shared_ptr<const ScheduleRecord> schedule;
-  bool limit_reached = false;  ///< some pair reached QueryRequest::max_pairs (its contacts are partial)
+  bool limit_reached = false;  ///< some pair reached QueryRequest::max_pairs (its contacts may be partial)
 };
 
 /// One moment of a set of rigid objects, as the engine takes it: whatever produced it (a scene's

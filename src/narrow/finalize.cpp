@@ -123,11 +123,14 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
-  // Over the limit: the max_pairs lowest ids of what was found, flagged (a partial answer).
+  // At the limit: flagged (the traversals stopped there, so there may be more); over it (split
+  // traversals may keep a few more between them), the max_pairs lowest ids of what was found.
   const std::size_t max_pairs = ctx.request().max_pairs;
-  if (max_pairs != 0 && result.kind != QueryKind::distance && candidates.size() > max_pairs) {
-    std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(max_pairs), candidates.end(), by_ids);
-    candidates.resize(max_pairs);
+  if (max_pairs != 0 && result.kind != QueryKind::distance && candidates.size() >= max_pairs) {
+    if (candidates.size() > max_pairs) {
+      std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(max_pairs), candidates.end(), by_ids);
+      candidates.resize(max_pairs);
+    }
     result.limit_reached = true;
   }
   // Contacts: the local minima first (their verdicts do not depend on the order), so that only the

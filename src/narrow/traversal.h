@@ -22,7 +22,7 @@
 namespace caliber::narrow {
 
 /// What the traversals of one object pair share, whatever threads they run on: how many triangle
-/// pairs they have kept, against QueryRequest::max_pairs (they stop once it is exceeded; which
+/// pairs they have kept, against QueryRequest::max_pairs (they stop once it is reached; which
 /// pairs were kept by then depends on the schedule; finalize keeps max_pairs of them), and for a
 /// distance query the nearest distance any of them has found (each prunes by it: see Nearest).
 struct PairShared {
@@ -30,10 +30,10 @@ struct PairShared {
   std::size_t max = 0;  ///< 0: no limit
   std::atomic<double> nearest{std::numeric_limits<double>::infinity()};
 
-  /// Counts one more kept pair; true when the limit is now exceeded.
-  bool add() { return kept.fetch_add(1, std::memory_order_relaxed) + 1 > max; }
-  /// Whether some traversal has exceeded the limit.
-  [[nodiscard]] bool exceeded() const { return kept.load(std::memory_order_relaxed) > max; }
+  /// Counts one more kept pair; true when the limit is now reached.
+  bool add() { return kept.fetch_add(1, std::memory_order_relaxed) + 1 >= max && max != 0; }
+  /// Whether the traversals have kept max pairs or more between them (never without a limit).
+  [[nodiscard]] bool reached() const { return kept.load(std::memory_order_relaxed) >= max && max != 0; }
 };
 
 /// Per-thread scratch for traversals, reused across calls to avoid allocation.
@@ -113,12 +113,12 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   if (limit != nullptr && lanes.wide != nullptr) lanes.order = order;
   while (limit != nullptr && top != base) {
     const int count = visit(ctx, *--top, out, counted, passed, taboo, nullptr, lanes);
-    // With a limit, after each leaf test: count what it kept, stop once the pair has too many.
+    // With a limit, after each leaf test: count what it kept, stop once the pair has enough.
     if (count < 0) {
       if (out.size() != seen) {
         seen = out.size();
         if (limit->add()) break;
-      } else if (limit->exceeded()) {
+      } else if (limit->reached()) {
         break;
       }
     }

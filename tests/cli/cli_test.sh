@@ -132,7 +132,7 @@ r = json.loads(sys.argv[1])
 assert len(r["pairs"]) == 1 and r["limit_reached"] is True, r
 PY
 check max-pairs 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --max-pairs 3
-contains max-pairs "limit reached: more than 3 pairs"
+contains max-pairs "limit reached: the query stopped at 3 pairs"
 check max-pairs-roomy 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --max-pairs 1000 --json
 contains max-pairs-roomy '"limit_reached":false'
 check max-pairs-negative 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --max-pairs -1
