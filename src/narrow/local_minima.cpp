@@ -26,10 +26,15 @@ std::uint32_t tri_b(std::uint64_t key) { return static_cast<std::uint32_t>(key);
 /// `closer` on entries: the same order.
 bool closer(const Entry& x, const Entry& y) { return x.distance != y.distance ? x.distance < y.distance : x.key < y.key; }
 
+/// Below this many candidates the reduction's entries and table are made on the calling thread:
+/// a parallel pass over a few thousand costs more in waking threads (and, for the table, in
+/// compare-and-swaps on lines both threads write) than it saves.
+constexpr std::size_t kParallelFill = std::size_t{1} << 15;
+
 /// Where each entry sits, by its key: open addressing with linear probing, at most half full, four
 /// bytes a slot (the table of a pair's 70,000 candidates fits in 1 MiB, so that filling it stays
-/// in cache). Filled in parallel (a slot claimed by compare-and-swap; which slot an entry gets may
-/// vary, what a lookup finds does not), then only read.
+/// in cache). Filled in parallel from kParallelFill entries (a slot claimed by compare-and-swap;
+/// which slot an entry gets may vary, what a lookup finds does not), else in order; then only read.
 class EntryTable {
  public:
   EntryTable(const std::vector<Entry>& entries, std::size_t grain) : mEntries(entries) {
@@ -41,6 +46,14 @@ class EntryTable {
     }
     mMask = capacity - 1;
     mSlots.assign(capacity, kEmpty);
+    if (entries.size() < kParallelFill) {
+      for (std::size_t i = 0; i < entries.size(); ++i) {
+        std::size_t h = slot(entries[i].key);
+        while (mSlots[h] != kEmpty) h = (h + 1) & mMask;
+        mSlots[h] = static_cast<std::uint32_t>(i);
+      }
+      return;
+    }
     parallel::parallel_for(0, entries.size(), grain, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t i = lo; i != hi; ++i) {
         for (std::size_t h = slot(entries[i].key);; h = (h + 1) & mMask) {
@@ -142,10 +155,15 @@ struct Reduction {
 
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
   std::vector<Entry> entries(candidates.size());
-  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
+  const auto fill = [&](std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i != hi; ++i)
       entries[i] = {key_of(candidates[i].tri_a, candidates[i].tri_b), candidates[i].distance};
-  });
+  };
+  if (candidates.size() < kParallelFill) {
+    fill(0, candidates.size());
+  } else {
+    parallel::parallel_for(0, candidates.size(), grain, fill);
+  }
   const EntryTable table(entries, grain);
   const Reduction reduction{ctx.a(), ctx.b(), entries, table};
   std::vector<char> keep(candidates.size(), 0);
