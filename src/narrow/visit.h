@@ -199,9 +199,7 @@ template <bool kReversed = false, class Test = ChosenWideTest>
     if (lanes.wide == nullptr) return visit_wide_alone<kReversed>(ctx, n, a, b, stats, passed, taboo);
     if (buffer != nullptr)
       return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, leaf_pair, lanes.order);
-    if (lanes.order != nullptr)
-      return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, nullptr, lanes.order);
-    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test);
+    return visit_wide<kReversed>(ctx, n, a, b, stats, passed, taboo, *lanes.wide, lanes.staying, test, nullptr, lanes.order);
   }
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];
