@@ -274,9 +274,10 @@ inline caliber::QuaternionOrder parse_order(const std::string& order) {
 /// the class. Its arrays are read-only.
 inline py::class_<PyBatch> bind_batch(py::module_& m) {
   auto cls =
-      py::class_<PyBatch>(m, "Batch",
-                          "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
-                          "max_pairs cut it; per reported triangle pair, one row like Result's, with the entry it belongs to.")
+      py::class_<PyBatch>(
+          m, "Batch",
+          "The answers of a batch query: per entry (pose), whether it hit, its smallest distance and whether "
+          "it stopped at max_pairs; per reported triangle pair, one row like Result's, with the entry it belongs to.")
           .def_property_readonly("offsets", view_of<PyBatch, &PyBatch::offsets>,
                                  "N + 1: entry i's rows are offsets[i]:offsets[i + 1]")
           .def_property_readonly("hit", view_of<PyBatch, &PyBatch::hit>, "N bools: the entry reported a pair")

@@ -39,6 +39,8 @@ struct TaskRoot {
 /// How the engine cut and scheduled a step's work. The calibration fields are zero for the methods
 /// that do not calibrate; `task_node_tests` is filled by every engine method.
 struct ScheduleRecord {
+  /// The step's query kind, which sets how a heavy pair's finalization runs (predicted_step_ms).
+  QueryKind kind = QueryKind::interference;
   double omega = 0.0;                                ///< the caliber Omega (in weight units)
   std::size_t kept = 0;                              ///< pairs run as they are
   std::size_t split = 0;                             ///< pairs split by the weight-driven stage

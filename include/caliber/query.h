@@ -56,10 +56,11 @@ struct QueryRequest {
   /// The most triangle pairs to report per object pair; 0: no limit. A query stops as soon as it
   /// has found max_pairs pairs and sets QueryResult::limit_reached: it returns max_pairs of the
   /// pairs it found (the lowest ids among them; which pairs it found first depends on the
-  /// traversal and the method), and memory stays bounded. Fewer than max_pairs reported means the
-  /// answer is whole (ask for one more than you need to know it). 1 asks "do they touch at all?"
-  /// (any pair, or none), stopping at the first pair found. For contact queries the limit applies
-  /// before the local-minimum reduction. Ignored by distance queries.
+  /// traversal and the method), and memory stays bounded. An unflagged result is the whole
+  /// answer; a flagged one may be too (ask for one more pair than you need to know). 1 asks "do
+  /// they touch at all?" (any pair, or none), stopping at the first pair found. For contact
+  /// queries the limit applies before the local-minimum reduction (which may then report fewer).
+  /// Ignored by distance queries.
   std::size_t max_pairs = 0;
   /// Distance queries on meshes that intersect (distance 0, many pairs at 0). false (default): the
   /// query stops at the first intersecting pair of the traversal from the root, the pair every
@@ -117,7 +118,7 @@ struct QueryResult {
   std::vector<Contact> contacts;             ///< sorted by (tri_a, tri_b)
   QueryStats stats;                          ///< work done
   /// QueryRequest::max_pairs pairs were found: the query stopped there, and `contacts` (max_pairs
-  /// pairs) may be a part of the answer, not all of it.
+  /// pairs; a contact query, those of them its reduction keeps) may be a part of the answer.
   bool limit_reached = false;
 };
 

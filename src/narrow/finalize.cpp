@@ -67,9 +67,6 @@ Candidate closest(const PairContext& ctx, const std::vector<Candidate>& candidat
 
 /// Up to this many candidates, an interference result sorts the candidates themselves.
 constexpr std::size_t kFewCandidates = 8;
-/// From this many, an interference result's keys are sorted on the engine's threads (below, the
-/// serial radix sort is the faster).
-constexpr std::size_t kParallelSortKeys = std::size_t{1} << 20;
 
 /// An interference result: the triangles meet, so a candidate is its ids alone (no points). They
 /// are sorted as one integer each (A's id above B's, in as few bits as the largest ids need:
@@ -104,8 +101,7 @@ QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair o
   std::vector<std::uint64_t> keys(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i) keys[i] = std::uint64_t{candidates[i].tri_a} << shift | candidates[i].tri_b;
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
-  // Serial radix below kParallelSortKeys: a parallel comparison sort of a few thousand keys costs
-  // more than the serial radix sort, which also leaves the other threads to the traversals.
+  // Serial radix below kParallelSortKeys (finalize.h).
   if (parallel && keys.size() >= kParallelSortKeys) {
     parallel::parallel_sort(keys.begin(), keys.end(), std::less<>());
   } else {

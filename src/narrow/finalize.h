@@ -12,10 +12,24 @@
 
 namespace caliber::narrow {
 
-/// Below this many candidates a pair is finalized serially; above, its hash index, local-minimum
-/// test, sort and world transform run in chunks of this many on several threads (one heavy pair's
-/// finalization would otherwise be serial work).
+/// Below this many candidates a pair is finalized serially; above, its local-minimum test, sort
+/// and world transform run in chunks of this many on several threads (one heavy pair's
+/// finalization would otherwise be serial work). But an interference result's keys are sorted
+/// serially below kParallelSortKeys, and a contact reduction's hash index is filled serially below
+/// local_minima's own threshold (32,768 candidates).
 inline constexpr std::size_t kFinalizeGrain = 128;
+/// From this many, an interference result's keys are sorted on the engine's threads. Below, the
+/// serial radix sort: on 2 threads it was the faster on a few thousand keys (TBB's parallel sort
+/// cost more than it shared out); between that and this bound it was not measured.
+inline constexpr std::size_t kParallelSortKeys = std::size_t{1} << 20;
+
+/// How many pieces of work the finalization of a pair of `candidates` runs in, on the engine's
+/// threads (what the load-balance simulation replays): chunks of kFinalizeGrain, but one for an
+/// interference result below kParallelSortKeys (it is serial).
+inline std::size_t finalize_chunks(QueryKind kind, std::size_t candidates) {
+  if (candidates < kFinalizeGrain || (kind == QueryKind::interference && candidates < kParallelSortKeys)) return 1;
+  return (candidates + kFinalizeGrain - 1) / kFinalizeGrain;
+}
 
 /// Where a distance answer of 0 comes from. as_found: the candidates came from one traversal from
 /// the root (caliber::query's, whose first intersecting pair is the answer; on models with at most

@@ -258,6 +258,7 @@ StepResult Engine::step(const Frame& frame) {
   std::shared_ptr<ScheduleRecord> handed = profile ? std::make_shared<ScheduleRecord>() : nullptr;
   if (!profile) reset_keeping_storage(mImpl->record);
   ScheduleRecord& record = profile ? *handed : mImpl->record;
+  record.kind = frame.request.kind;
   const auto make = [&frame](std::size_t i, void* where) {
     const ObjectPair& t = frame.pairs[i];
     new (where) narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);

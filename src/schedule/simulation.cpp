@@ -171,8 +171,7 @@ double predicted_step_ms(const StepResult& step, Method method, int cores) {
   std::vector<double> finals;
   for (const TaskSpan* t : finalize) {
     const std::size_t candidates = t->unit < step.pair_records.size() ? step.pair_records[t->unit].candidates : 0;
-    const std::size_t chunks =
-        candidates >= narrow::kFinalizeGrain ? (candidates + narrow::kFinalizeGrain - 1) / narrow::kFinalizeGrain : 1;
+    const std::size_t chunks = narrow::finalize_chunks(r.kind, candidates);
     for (std::size_t c = 0; c < chunks; ++c) finals.push_back(length(t) / static_cast<double>(chunks));
   }
   const double serial = step.broad_ms + std::max(0.0, step.narrow_ms + step.reduce_ms - spans - split_ms);

@@ -124,7 +124,7 @@ done
 grep -q '"distance"' "$dtmp/sequential.jsonl" && passes=$((passes + 1)) || { echo "FAIL distance-run: no contacts"; failures=$((failures + 1)); }
 rm -rf "$dtmp"
 
-# --first and --max-pairs: a partial answer, flagged; a limit the answer does not reach changes nothing.
+# --first and --max-pairs: stopped at the limit, flagged; a limit the answer does not reach changes nothing.
 check first 0 "$cli" query "$data/tetra.off" "$data/quad_fan.off" --pose-b "0.2 0.2 0.3 0 1 0 0" --first --json
 python3 - "$out" <<'PY' || { echo "FAIL first-json"; failures=$((failures + 1)); }
 import json, sys

@@ -131,6 +131,41 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
   }
 }
 
+TEST(MaxPairs, EveryMethodFlagsALimitOfTheAnswersSizeAlike) {
+  // A limit the answer reaches exactly: every pair reported, flagged (no traversal can know there
+  // is no more); one more: every pair, unflagged. The same on every method and thread count.
+  Frame frame;
+  frame.models = {shapes().torus, shapes().sphere};
+  frame.poses = {Pose{}, Pose::from_values(0.9, 0.1, 0.05, 1, 0.2, 0.1, 0)};
+  frame.pairs = {ObjectPair{0, 1}};
+  frame.request.kind = QueryKind::proximity;
+  frame.request.tolerance = 0.02;
+  const QueryResult full = query(*frame.models[0], frame.poses[0], *frame.models[1], frame.poses[1], frame.request);
+  ASSERT_GT(full.contacts.size(), 20u);
+  for (const std::size_t limit : {full.contacts.size(), full.contacts.size() + 1}) {
+    frame.request.max_pairs = limit;
+    for (const Method method :
+         {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+      for (const int threads : {1, 3}) {
+        EngineOptions options;
+        options.method = method;
+        options.threads = threads;
+        Engine engine(options);
+        const std::string what =
+            std::string(to_string(method)) + " x" + std::to_string(threads) + " limit " + std::to_string(limit);
+        const StepResult step = engine.step(frame);
+        EXPECT_EQ(step.limit_reached, limit == full.contacts.size()) << what;
+        ASSERT_EQ(step.contacts.size(), full.contacts.size()) << what;
+        for (std::size_t k = 0; k < full.contacts.size(); ++k) {
+          EXPECT_EQ(step.contacts[k].tri_a, full.contacts[k].tri_a) << what;
+          EXPECT_EQ(step.contacts[k].tri_b, full.contacts[k].tri_b) << what;
+          EXPECT_EQ(step.contacts[k].distance, full.contacts[k].distance) << what;
+        }
+      }
+    }
+  }
+}
+
 TEST(MaxPairs, DistanceIgnoresIt) {
   QueryRequest request;
   request.kind = QueryKind::distance;

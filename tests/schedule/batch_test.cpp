@@ -114,7 +114,7 @@ TEST(Batch, MaxPairsEntriesAreTheQueriesFirstPairs) {
         expect_queries(batch, pa, pb, request, what);
         std::size_t cut = 0;
         for (const std::uint8_t r : batch.limit_reached) cut += r;
-        EXPECT_GT(cut, 0u) << what << ": some entries must find more pairs than the limit";
+        EXPECT_GT(cut, 0u) << what << ": some entries must find as many pairs as the limit";
       }
     }
   }

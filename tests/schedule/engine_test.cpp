@@ -396,7 +396,8 @@ TEST_F(EngineScenes, PredictedStepTimeReplaysTheMeasuredPieces) {
 TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   // A hand-made step: a split pair whose stage took 2 ms for 20 node tests (its root test, then
   // levels of 4 and 15 tests), four run-time tasks of 1 ms, the pair's finalization 0.4 ms over
-  // 256 candidates (two chunks), and 0.45 ms outside every piece (broad phase 0.1, the rest 0.35).
+  // 256 candidates (two chunks: a proximity query's), and 0.45 ms outside every piece (broad phase
+  // 0.1, the rest 0.35).
   StepResult step;
   step.pair_records.resize(2);
   step.pair_records[0].candidates = 256;
@@ -404,6 +405,7 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   auto record = std::make_shared<ScheduleRecord>();
   ScheduleRecord& r = *record;
   step.schedule = record;
+  r.kind = QueryKind::proximity;
   r.stage_pair_node_tests = {20};
   r.stage_levels = {{4}, {8, 7}};
   r.stage_level_pair = {0, 0};
@@ -418,6 +420,10 @@ TEST(LoadBalanceSimulation, PredictedStepTimeArithmetic) {
   // Four cores: the stage's levels in turn (0.1 ms a test: 1 + 4 + 8 tests deep), the four tasks at
   // once, the two finalization chunks at once.
   EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.2, 1e-12);
+  // An interference result of 256 pairs is sorted on one thread: its finalization is one piece.
+  r.kind = QueryKind::interference;
+  EXPECT_NEAR(predicted_step_ms(step, Method::hybrid, 4), 0.45 + 1.3 + 1.0 + 0.4, 1e-12);
+  r.kind = QueryKind::proximity;
   // The traversal took 0.4 ms more than its four tasks (handing them out): each thread hands out
   // the tasks it takes, so that time is spread over the cores, not serial.
   r.traverse_ms = 4.4;
