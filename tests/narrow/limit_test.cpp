@@ -92,6 +92,21 @@ TEST(MaxPairs, FirstAnswersWhetherTheyTouch) {
   EXPECT_LT(touching, 55);
 }
 
+/// Calls f(engine, name) with an engine of every method at 1 and at 3 threads.
+template <class F>
+void for_each_engine(F&& f) {
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+    for (const int threads : {1, 3}) {
+      EngineOptions options;
+      options.method = method;
+      options.threads = threads;
+      Engine engine(options);
+      f(engine, std::string(to_string(method)) + " x" + std::to_string(threads));
+    }
+  }
+}
+
 TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
   Frame frame;
   frame.models = {shapes().torus, shapes().sphere, shapes().torus};
@@ -106,29 +121,21 @@ TEST(MaxPairs, EveryMethodKeepsToTheLimit) {
     ASSERT_GT(f.contacts.size(), 30u) << t.a << "-" << t.b;
   }
   frame.request.max_pairs = 25;
-  for (const Method method :
-       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
-    for (const int threads : {1, 3}) {
-      EngineOptions options;
-      options.method = method;
-      options.threads = threads;
-      Engine engine(options);
-      const std::string what = std::string(to_string(method)) + " x" + std::to_string(threads);
-      const StepResult step = engine.step(frame);
-      EXPECT_TRUE(step.limit_reached) << what;
-      for (const PairRecord& t : step.pair_records) {
-        EXPECT_TRUE(t.limit_reached) << what;
-        EXPECT_EQ(t.contacts, 25u) << what;
-      }
-      for (const Contact& c : step.contacts) {
-        const QueryResult& f = full[{c.object_a, c.object_b}];
-        const std::vector<TrianglePair> f_pairs = test::pairs_of(f);
-        const auto it = std::lower_bound(f_pairs.begin(), f_pairs.end(), TrianglePair{c.tri_a, c.tri_b});
-        ASSERT_TRUE(it != f_pairs.end() && *it == (TrianglePair{c.tri_a, c.tri_b})) << what;
-        EXPECT_EQ(c.point_a, f.contacts[static_cast<std::size_t>(it - f_pairs.begin())].point_a) << what;
-      }
+  for_each_engine([&](Engine& engine, const std::string& what) {
+    const StepResult step = engine.step(frame);
+    EXPECT_TRUE(step.limit_reached) << what;
+    for (const PairRecord& t : step.pair_records) {
+      EXPECT_TRUE(t.limit_reached) << what;
+      EXPECT_EQ(t.contacts, 25u) << what;
     }
-  }
+    for (const Contact& c : step.contacts) {
+      const QueryResult& f = full[{c.object_a, c.object_b}];
+      const std::vector<TrianglePair> f_pairs = test::pairs_of(f);
+      const auto it = std::lower_bound(f_pairs.begin(), f_pairs.end(), TrianglePair{c.tri_a, c.tri_b});
+      ASSERT_TRUE(it != f_pairs.end() && *it == (TrianglePair{c.tri_a, c.tri_b})) << what;
+      EXPECT_EQ(c.point_a, f.contacts[static_cast<std::size_t>(it - f_pairs.begin())].point_a) << what;
+    }
+  });
 }
 
 TEST(MaxPairs, EveryMethodFlagsALimitOfTheAnswersSizeAlike) {
@@ -144,25 +151,17 @@ TEST(MaxPairs, EveryMethodFlagsALimitOfTheAnswersSizeAlike) {
   ASSERT_GT(full.contacts.size(), 20u);
   for (const std::size_t limit : {full.contacts.size(), full.contacts.size() + 1}) {
     frame.request.max_pairs = limit;
-    for (const Method method :
-         {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
-      for (const int threads : {1, 3}) {
-        EngineOptions options;
-        options.method = method;
-        options.threads = threads;
-        Engine engine(options);
-        const std::string what =
-            std::string(to_string(method)) + " x" + std::to_string(threads) + " limit " + std::to_string(limit);
-        const StepResult step = engine.step(frame);
-        EXPECT_EQ(step.limit_reached, limit == full.contacts.size()) << what;
-        ASSERT_EQ(step.contacts.size(), full.contacts.size()) << what;
-        for (std::size_t k = 0; k < full.contacts.size(); ++k) {
-          EXPECT_EQ(step.contacts[k].tri_a, full.contacts[k].tri_a) << what;
-          EXPECT_EQ(step.contacts[k].tri_b, full.contacts[k].tri_b) << what;
-          EXPECT_EQ(step.contacts[k].distance, full.contacts[k].distance) << what;
-        }
+    for_each_engine([&](Engine& engine, const std::string& name) {
+      const std::string what = name + " limit " + std::to_string(limit);
+      const StepResult step = engine.step(frame);
+      EXPECT_EQ(step.limit_reached, limit == full.contacts.size()) << what;
+      ASSERT_EQ(step.contacts.size(), full.contacts.size()) << what;
+      for (std::size_t k = 0; k < full.contacts.size(); ++k) {
+        EXPECT_EQ(step.contacts[k].tri_a, full.contacts[k].tri_a) << what;
+        EXPECT_EQ(step.contacts[k].tri_b, full.contacts[k].tri_b) << what;
+        EXPECT_EQ(step.contacts[k].distance, full.contacts[k].distance) << what;
       }
-    }
+    });
   }
 }
 
