@@ -236,8 +236,13 @@ template <class Test = ChosenWideTest>
 [[gnu::always_inline]] inline void visit_until_empty(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size,
                                                      std::vector<Candidate>& out, QueryStats& stats, TabooView taboo,
                                                      LeafBuffer& buffer, VisitLanes lanes, Test test = {}) {
+  CALIBER_ASSERT(size <= stack.size(), "the nodes to visit are on the stack");
+  if (stack.size() < size + kMaxChildren) stack.resize(size + kMaxChildren);
   NodePair* base = stack.data();
   NodePair* top = base + size;
+  // Where the stack must grow before a visit writes its children (kept here: the vector's own
+  // bounds would be read again after every store through `top`).
+  NodePair* limit = base + (stack.size() - kMaxChildren);
   constexpr int kWaiting = 2;
   const int most = ctx.request().kind == QueryKind::contact ? 0 : kWaiting;
   NodePair ahead[kWaiting] = {};
@@ -251,11 +256,12 @@ template <class Test = ChosenWideTest>
       ahead[waiting] = *--top;
       prefetch_nodes(ctx, ahead[waiting++]);
     }
-    if (static_cast<std::size_t>(top - base) + kMaxChildren > stack.size()) {
+    if (top > limit) {
       const auto at = top - base;
       stack.resize(2 * stack.size() + kMaxChildren);
       base = stack.data();
       top = base + at;
+      limit = base + (stack.size() - kMaxChildren);
     }
     const int count = visit<true>(ctx, n, out, stats, top, taboo, &buffer, lanes, test);
     top += count > 0 ? count : 0;

@@ -140,7 +140,7 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
 
 unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
                           const WideNode& w, StayingCache* cache) {
-  const WideSide& s = l.side[a_descends ? 0 : 1];
+  const WideSide& s = side_of(l, a_descends);
   bool held;
   StayingCache::Entry spare;
   StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
@@ -158,7 +158,6 @@ unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_des
       hi[i] = static_cast<float>(c[i] + g);
     }
     StayingCache::fill(kept, c, lo, hi);
-    if (cache != nullptr) cache->mark(stay, a_descends);
   }
   unsigned pass = 0;
   const int count = w.count();

@@ -61,6 +61,17 @@ struct alignas(32) WideLanes {
   const WideNode* staying_wide[2];
 };
 
+/// l.side[0] where A descends, else l.side[1], its address hidden from the optimizer: the test then
+/// reads each field from one base register, where the compiler would keep each field's offset for
+/// either side apart (spilled to the stack at every visit).
+inline const WideSide& side_of(const WideLanes& l, bool a_descends) {
+  const WideSide* s = &l.side[a_descends ? 0 : 1];
+#if defined(__GNUC__)
+  asm("" : "+r"(s));
+#endif
+  return *s;
+}
+
 /// The staying node as the float stage reads it, in the descending frame and in units (the same
 /// operations in every form): its own center plus M^T t, its half-extents plus the reach, its slab
 /// axis moved (nf) and the slab's offset, its center moved (cf), its half-extents (sh), its slab
@@ -73,8 +84,8 @@ struct StayingFloats {
 /// them: a staying node stays for the visits below it while the other side descends, and those
 /// visits read it here rather than move it again (the same values: the same operations on the
 /// same node). A table of kEntries, each node at one place (by its index and side), a newer node
-/// taking an older one's place. The test fills it. One thread's traversals use it one after the
-/// other (TraversalScratch::staying), each from renew on: one pair context and its lanes.
+/// taking an older one's place. The test claims and fills it. One thread's traversals use it one
+/// after the other (TraversalScratch::staying), each from renew on: one pair context and its lanes.
 struct StayingCache {
   static constexpr int kEntries = 64;
   /// One staying node moved.
@@ -99,16 +110,20 @@ struct StayingCache {
     }
   }
   /// The place of node `stay` moved for the side `a_descends` says; `held`: whether it holds that
-  /// node (else the caller fills it: fill, then mark).
+  /// node.
   Entry& find(std::uint32_t stay, bool a_descends, bool& held) {
     const std::uint64_t k = key_of(stay, a_descends);
     held = key[place(k)] == k;
     return entry[place(k)];
   }
-  /// Marks node `stay`'s place (filled) as holding it.
-  void mark(std::uint32_t stay, bool a_descends) {
+  /// find, and where the place does not hold the node, the place named its own: the caller fills it
+  /// (fill) before anything reads it.
+  Entry& claim(std::uint32_t stay, bool a_descends, bool& held) {
     const std::uint64_t k = key_of(stay, a_descends);
-    key[place(k)] = k;
+    const std::size_t at = place(k);
+    held = key[at] == k;
+    key[at] = k;
+    return entry[at];
   }
   /// Never 0 (generation >= 1); 2 stay + 1 < 2^33, below the generation's bits.
   [[nodiscard]] std::uint64_t key_of(std::uint32_t stay, bool a_descends) const {
@@ -173,18 +188,19 @@ inline StayingBox staying_box(const BvhNode& sn) {
 }
 
 /// A test's entry for node `stay`: its place in `cache` (`held`: whether it holds the node, else
-/// the test fills it and marks it), or `spare` without a cache.
+/// the place is claimed for it and the test fills it: StayingCache::claim), or `spare` without a
+/// cache.
 inline StayingCache::Entry& staying_entry(StayingCache* cache, StayingCache::Entry& spare, std::uint32_t stay, bool a_descends,
                                           bool& held) {
   held = false;
-  return cache != nullptr ? cache->find(stay, a_descends, held) : spare;
+  return cache != nullptr ? cache->claim(stay, a_descends, held) : spare;
 }
 
 /// Makes entry `kept`'s float values (stage 2's) for node `stay` (sn), unless made already.
 inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                 const BvhNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
-  kept.floats = staying_floats(l, l.side[a_descends ? 0 : 1], sn, staying_slab(f, l, a_descends, stay, sn), kept.moved);
+  kept.floats = staying_floats(l, side_of(l, a_descends), sn, staying_slab(f, l, a_descends, stay, sn), kept.moved);
   kept.has_floats = true;
 }
 

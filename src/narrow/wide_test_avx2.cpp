@@ -118,7 +118,7 @@ CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const 
 
 CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
                                      const BvhNode& sn, const WideNode& w, StayingCache* cache) {
-  const WideSide& s = l.side[a_descends ? 0 : 1];
+  const WideSide& s = side_of(l, a_descends);
   bool held;
   StayingCache::Entry spare;
   StayingCache::Entry& kept = staying_entry(cache, spare, stay, a_descends, held);
@@ -135,7 +135,6 @@ CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
     _mm_store_ps(lo, _mm256_cvtpd_ps(_mm256_sub_pd(c, g)));
     _mm_store_ps(hi, _mm256_cvtpd_ps(addd(c, g)));
     StayingCache::fill(kept, moved, lo, hi);
-    if (cache != nullptr) cache->mark(stay, a_descends);
   }
   // The slots' bounds from the grid (exact: origin + q step is a float), the empty slots refused.
   V cl[3], ch[3];
