@@ -18,6 +18,12 @@ namespace {
 
 bool by_ids(const Candidate& x, const Candidate& y) { return x.tri_a != y.tri_a ? x.tri_a < y.tri_a : x.tri_b < y.tri_b; }
 
+/// Whether `candidates` are strictly ascending in by_ids' order: sorted, each pair once (asserted).
+[[maybe_unused]] bool sorted_once(const std::vector<Candidate>& candidates) {
+  return std::adjacent_find(candidates.begin(), candidates.end(),
+                            [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end();
+}
+
 /// Contact::depth of an intersecting pair (A's frame): the largest depth of B's vertices behind
 /// the plane through A's closest point with the contact normal.
 double depth_estimate(const PairContext& ctx, const Candidate& c, const Eigen::Vector3d& normal) {
@@ -84,9 +90,7 @@ QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair o
   // A few (a first hit's): sorted where they are, no keys made.
   if (candidates.size() <= kFewCandidates) {
     std::sort(candidates.begin(), candidates.end(), by_ids);
-    CALIBER_ASSERT(std::adjacent_find(candidates.begin(), candidates.end(),
-                                      [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end(),
-                   "each triangle pair is a candidate once");
+    CALIBER_ASSERT(sorted_once(candidates), "each triangle pair is a candidate once");
     result.contacts.reserve(candidates.size());
     for (const Candidate& c : candidates) add(c.tri_a, c.tri_b);
     return result;
@@ -153,9 +157,7 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   } else {
     std::sort(candidates.begin(), candidates.end(), by_ids);
   }
-  CALIBER_ASSERT(std::adjacent_find(candidates.begin(), candidates.end(),
-                                    [](const Candidate& x, const Candidate& y) { return !by_ids(x, y); }) == candidates.end(),
-                 "a pair's candidates are sorted by triangle ids, each pair once");
+  CALIBER_ASSERT(sorted_once(candidates), "a pair's candidates are sorted by triangle ids, each pair once");
   const Eigen::Matrix3d ra = ctx.pose_a().rotation_matrix();
   result.contacts.resize(candidates.size());
   const auto contacts = [&](std::size_t lo, std::size_t hi) {
