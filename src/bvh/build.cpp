@@ -16,6 +16,7 @@
 #include "util/assert.h"
 #include "bvh/adjacency.h"
 #include "bvh/lateral.h"
+#include "bvh/leaf_shape.h"
 #include "bvh/partition.h"
 #include "bvh/volume_origin.h"
 #include "bvh/wide_tree.h"
@@ -365,6 +366,7 @@ std::shared_ptr<ModelData> build_on_this_thread(Mesh mesh, const BuildOptions& o
     const Mesh moved = model->origin == Vec3::Zero() ? Mesh{} : bvh::moved_by(mesh, -model->origin);
     Builder builder(model->origin == Vec3::Zero() ? mesh : moved, model->normals);
     builder.build(*model, options.oriented_boxes);
+    bvh::fill_leaf_shapes(model->origin == Vec3::Zero() ? mesh : moved, *model, kBuildGrain);
   }
   bvh::build_wide_tree(*model);
   model->extent = bvh::largest_norm(mesh, Vec3::Zero());

@@ -26,7 +26,7 @@ namespace caliber {
 /// test is a separating-axis test on six face axes. Then what a visit of the wide CD tree reads
 /// (narrow/visit.h): where the node's slab lies (`slot`: its place in the wide node that holds it,
 /// which stores its slab as its BvhNodeFilter does, and which the visit that reached it read last)
-/// and its wide node (`link`).
+/// and its wide node (`link`); for a leaf, where its triangle lies in its box (`shape`).
 ///
 /// Values are stored as floats, rounded outward at build time (the radius and half-extents cover
 /// the rounding of the centers), so every vertex below lies inside both volumes exactly as stored.
@@ -57,6 +57,11 @@ struct alignas(64) BvhNode {
   std::uint32_t slot = kNoSlot;
   /// The index of its wide node in ModelData::wide, or kNoWide (bvh::build_wide_tree sets it).
   std::uint32_t link = kNoWide;
+  /// A leaf's triangle within its box (leaf_corners decodes it; 0 for an internal node): per axis
+  /// i, bits 16i..16i+15 place the corner between the lowest and highest on the box's range in
+  /// steps of 1/65535 (rounded to the nearest), bits 48+4i..49+4i name the lowest corner and bits
+  /// 50+4i..51+4i the highest (the box's bounds). In the line's spare bytes: read with the box.
+  std::uint64_t shape = 0;
 
   /// True for a leaf (one triangle).
   [[nodiscard]] bool is_leaf() const { return count == 1; }
@@ -70,6 +75,25 @@ struct alignas(64) BvhNode {
   [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
 };
 static_assert(sizeof(BvhNode) == 64, "BvhNode is meant to stay one cache line");
+
+/// The corners of leaf n's triangle (relative to its model's origin, as its box is) decoded from
+/// n.shape and its box: corner[j][i], coordinate i of corner j, in the triangle's order. Each lies
+/// within `error` of the true corner along every axis: the box's float bounds stand for the
+/// extreme corners (as near as the box's own rounding), the middle one is rounded to 1/65535 of
+/// the box's range, and `error` is 2^-16 of the box's largest range, twice that rounding's bound.
+inline void leaf_corners(const BvhNode& n, double corner[3][3], double& error) {
+  error = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double lo = static_cast<double>(n.box_center[i]) - static_cast<double>(n.box_half[i]);
+    const double hi = static_cast<double>(n.box_center[i]) + static_cast<double>(n.box_half[i]);
+    const auto low = static_cast<int>(n.shape >> (48 + 4 * i) & 3u), high = static_cast<int>(n.shape >> (50 + 4 * i) & 3u);
+    const double q = static_cast<double>(n.shape >> (16 * i) & 0xFFFFu);
+    corner[low][i] = lo;
+    corner[high][i] = hi;
+    corner[3 - low - high][i] = lo + (hi - lo) * (q * (1.0 / 65535.0));
+    error = std::max(error, (hi - lo) * 0x1p-16);
+  }
+}
 
 /// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
 /// tests have passed; the cone only by contact queries): 32 bytes aligned to 32, two to a cache

@@ -9,7 +9,9 @@
 // and sum rounded once: a slot's center and half-extent from its bounds within 1 unit roundoff of
 // the scale, a projection on a staying axis within about 12, the slabs' positions and reaches
 // within about 20 (the staying slab's offset, computed in double, within 1). The slack is 512 unit
-// roundoffs of the scale (2^-15).
+// roundoffs of the scale (2^-15). A staying leaf's corners, decoded from its node (leaf_corners),
+// stand within their stated error (added to the comparison) plus its box's rounding, a few unit
+// roundoffs of the scale, of the true ones.
 
 #include "narrow/wide_test.h"
 
@@ -125,13 +127,23 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
     const float low = e0 < e1 ? e0 : e1, high = e0 > e1 ? e0 : e1;
     pass = pass && (at - r) + low <= st.slab_hi && (at + r) + high >= st.slab_lo;
   }
+  const float slot_hi_reach = std::fmaf(w.slab_hi[k], l.unit_f, l.slab_f);
+  const float slot_lo_reach = std::fmaf(w.slab_lo[k], l.unit_f, -l.slab_f);
+  if (st.triangle != 0) {  // the slot's slab against the staying triangle's corners
+    float low = 0.0f, high = 0.0f;
+    for (int j = 0; j < 3; ++j) {
+      const float at = std::fmaf(ax[2], st.corner[j][2], std::fmaf(ax[1], st.corner[j][1], ax[0] * st.corner[j][0]));
+      low = j == 0 ? at : std::min(low, at);
+      high = j == 0 ? at : std::max(high, at);
+    }
+    return pass && low - st.corner_error <= slot_hi_reach && high + st.corner_error >= slot_lo_reach;
+  }
   {  // the slot's slab against the staying box
     const float at = std::fmaf(ax[2], st.cf[2], std::fmaf(ax[1], st.cf[1], ax[0] * st.cf[0]));
     float on[3];
     for (int j = 0; j < 3; ++j) on[j] = std::fmaf(ax[2], s.m[2][j][0], std::fmaf(ax[1], s.m[1][j][0], ax[0] * s.m[0][j][0]));
     const float r = std::fmaf(std::abs(on[2]), st.sh[2], std::fmaf(std::abs(on[1]), st.sh[1], std::abs(on[0]) * st.sh[0]));
-    pass =
-        pass && at - r <= std::fmaf(w.slab_hi[k], l.unit_f, l.slab_f) && at + r >= std::fmaf(w.slab_lo[k], l.unit_f, -l.slab_f);
+    pass = pass && at - r <= slot_hi_reach && at + r >= slot_lo_reach;
   }
   return pass;
 }

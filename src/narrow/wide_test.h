@@ -11,7 +11,9 @@
 ///    are the empty slots. No slack: every float lies outside the double box it stands for.
 /// 2. Then, in float, against each threshold plus a slack far above float's rounding (as the float
 ///    four-pair test: 2^-15 of the scale): each slot's box along the staying node's own axes; each
-///    slot's slab against the staying box; the staying node's slab against each slot, projected
+///    slot's slab against the staying box, or where the staying node is a leaf against its
+///    triangle's corners, less and plus their error (staying_corners); the staying node's slab
+///    against each slot, projected
 ///    along it as lambda (the slot's slab) + the rest (the slot's box), lambda the axes' cosine
 ///    where the slabs are near parallel (|cos| >= 1/2; else 0: the slot's box alone), so that
 ///    parallel patches a hair apart are refused high in the tree. Refused only where surely
@@ -75,10 +77,17 @@ inline const WideSide& side_of(const WideLanes& l, bool a_descends) {
 /// The staying node as the float stage reads it, in the descending frame and in units (the same
 /// operations in every form): its own center plus M^T t, its half-extents plus the reach, its slab
 /// axis moved (nf) and the slab's offset, its center moved (cf), its half-extents (sh), its slab
-/// bounds less and plus the slab reach.
+/// bounds less and plus the slab reach; and where it is a leaf (`triangle`), its triangle's
+/// corners moved (corner[j][i]: coordinate i of corner j) and how far they may lie from the true
+/// ones along any unit axis (corner_error), which the slots' slabs are tested against in place of
+/// its box (staying_corners).
 struct StayingFloats {
   float co[3], ho[3], nf[3], off, cf[3], sh[3], slab_lo, slab_hi;
+  float corner[3][4];      ///< (the fourth lane 0; all 0 where the node is no leaf)
+  float corner_error;      ///< (0 where the node is no leaf)
+  std::uint32_t triangle;  ///< 1 for a leaf, else 0 (a whole word: the struct has no padding)
 };
+static_assert(sizeof(StayingFloats) == 32 * 4, "every byte of StayingFloats is a value (the forms compare them)");
 
 /// The staying nodes of a traversal's visits as the test moved them, kept for the visits after
 /// them: a staying node stays for the visits below it while the other side descends, and those
@@ -160,6 +169,29 @@ inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool
   return {{sf.cone_axis[0], sf.cone_axis[1], sf.cone_axis[2]}, sf.slab_lo, sf.slab_hi};
 }
 
+/// Where the staying node sn is a leaf, its triangle's corners as leaf_corners decodes them, in the
+/// descending frame and in units, moved as its box center is (M x + t, each step rounded once, then
+/// times the unit, rounded to float once; every form calls this), with their error along any unit
+/// axis (sqrt(3) times leaf_corners' along each, rounded up): out.corner, out.corner_error and
+/// out.triangle. The moved corners lie within that error, plus a few unit roundoffs of the scale
+/// (the slack covers those, as it does for the moved box center), of the points the leaf test
+/// reads.
+inline void staying_corners(const WideLanes& l, const WideSide& s, const BvhNode& sn, StayingFloats& out) {
+  out.triangle = sn.is_leaf() ? 1u : 0u;
+  out.corner_error = 0.0f;
+  for (float(&c)[4] : out.corner) c[0] = c[1] = c[2] = c[3] = 0.0f;
+  if (out.triangle == 0) return;
+  double p[3][3], error;
+  leaf_corners(sn, p, error);
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      const double x = std::fma(s.col[2][i], p[j][2], std::fma(s.col[1][i], p[j][1], std::fma(s.col[0][i], p[j][0], s.t[i])));
+      out.corner[j][i] = static_cast<float>(x * l.unit);
+    }
+  }
+  out.corner_error = static_cast<float>(1.75 * error * l.unit);
+}
+
 /// The staying node sn (slab sf) of a visit in direction s, its box center already moved (c).
 inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const BvhNode& sn, const StayingSlab& sf,
                                     const double c[3]) {
@@ -176,6 +208,7 @@ inline StayingFloats staying_floats(const WideLanes& l, const WideSide& s, const
   out.off = static_cast<float>(-((nd[0] * s.t[0] + nd[1] * s.t[1]) + nd[2] * s.t[2]) * l.unit);
   out.slab_lo = static_cast<float>(sf.lo * l.unit) - l.slab_f;
   out.slab_hi = static_cast<float>(sf.hi * l.unit) + l.slab_f;
+  staying_corners(l, s, sn, out);
   return out;
 }
 

@@ -75,15 +75,40 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
     const V low = _mm256_min_ps(e0, e1), high = _mm256_max_ps(e0, e1);
     pass = both(pass, both(at_most(add(sub(at, r), low), all(st.slab_hi)), at_least(add(add(at, r), high), all(st.slab_lo))));
   }
+  const V slot_hi_reach = fma(load(w.slab_hi), unit, slab_f);
+  const V slot_lo_reach = fma(load(w.slab_lo), unit, _mm256_sub_ps(_mm256_setzero_ps(), slab_f));
+  if (st.triangle != 0) {  // the slot's slab against the staying triangle's corners
+    V at[3];
+    for (int j = 0; j < 3; ++j) {
+      at[j] = fma(ax[2], all(st.corner[j][2]), fma(ax[1], all(st.corner[j][1]), mul(ax[0], all(st.corner[j][0]))));
+    }
+    const V low = _mm256_min_ps(_mm256_min_ps(at[0], at[1]), at[2]);
+    const V high = _mm256_max_ps(_mm256_max_ps(at[0], at[1]), at[2]);
+    const V error = all(st.corner_error);
+    return both(pass, both(at_most(sub(low, error), slot_hi_reach), at_least(add(high, error), slot_lo_reach)));
+  }
   {  // the slot's slab against the staying box
     const V at = fma(ax[2], all(st.cf[2]), fma(ax[1], all(st.cf[1]), mul(ax[0], all(st.cf[0]))));
     V on[3];
     for (int j = 0; j < 3; ++j) on[j] = fma(ax[2], load(s.m[2][j]), fma(ax[1], load(s.m[1][j]), mul(ax[0], load(s.m[0][j]))));
     const V r = fma(magnitude(on[2]), all(st.sh[2]), fma(magnitude(on[1]), all(st.sh[1]), mul(magnitude(on[0]), all(st.sh[0]))));
-    pass = both(pass, both(at_most(sub(at, r), fma(load(w.slab_hi), unit, slab_f)),
-                           at_least(add(at, r), fma(load(w.slab_lo), unit, _mm256_sub_ps(_mm256_setzero_ps(), slab_f)))));
+    pass = both(pass, both(at_most(sub(at, r), slot_hi_reach), at_least(add(at, r), slot_lo_reach)));
   }
   return pass;
+}
+
+/// staying_corners in double lanes (x, y, z, 0), each lane making its operations in its order.
+CALIBER_AVX2 inline void staying_corners_avx2(const WideLanes& l, const WideSide& s, const BvhNode& sn, StayingFloats& out) {
+  out.triangle = sn.is_leaf() ? 1u : 0u;
+  out.corner_error = 0.0f;
+  for (float(&c)[4] : out.corner) _mm_storeu_ps(c, _mm_setzero_ps());
+  if (out.triangle == 0) return;
+  double p[3][3], error;
+  leaf_corners(sn, p, error);
+  const D unit = _mm256_set1_pd(l.unit);
+  for (int j = 0; j < 3; ++j)
+    _mm_storeu_ps(out.corner[j], _mm256_cvtpd_ps(_mm256_mul_pd(times(s.col, p[j], _mm256_load_pd(s.t)), unit)));
+  out.corner_error = static_cast<float>(1.75 * error * l.unit);
 }
 
 /// make_staying_floats (staying_floats) in double lanes (x, y, z, 0), each lane making its
@@ -113,11 +138,15 @@ CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const 
   _mm_storeu_ps(out.sh, sh);
   out.slab_lo = static_cast<float>(sf.lo * l.unit) - l.slab_f;
   out.slab_hi = static_cast<float>(sf.hi * l.unit) + l.slab_f;
+  staying_corners_avx2(l, s, sn, out);
   kept.has_floats = true;
 }
 
-CALIBER_AVX2 unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                     const BvhNode& sn, const WideNode& w, StayingCache* cache) {
+/// The AVX2 wide test (WideTest). Always inlined where a visit's loop calls it: GCC's limit on an
+/// inlined call's stack frame would otherwise keep it out of line (its spare cache entry).
+CALIBER_AVX2 __attribute__((always_inline)) inline unsigned wide_test_avx2(const NodeTestFrame& f, const WideLanes& l,
+                                                                           bool a_descends, std::uint32_t stay, const BvhNode& sn,
+                                                                           const WideNode& w, StayingCache* cache) {
   const WideSide& s = side_of(l, a_descends);
   bool held;
   StayingCache::Entry spare;

@@ -29,6 +29,30 @@ int height_bound(std::uint32_t n) {
   return height;
 }
 
+/// Leaf `index`'s corners as leaf_corners decodes them: each the triangle's own corner (relative to
+/// the origin) within the error it states, plus along each axis what the box's rounding added to
+/// its range (the extreme corners decode to the box's bounds).
+void check_leaf_shape(const Model& m, const BvhNode& node, std::uint32_t index) {
+  double corner[3][3], error;
+  leaf_corners(node, corner, error);
+  const auto& t = m.mesh().triangles[node.triangle()];
+  for (int i = 0; i < 3; ++i) {
+    double lo = 0.0, hi = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      const double x = m.mesh().vertices[t[j]][i] - data(m).origin[i];
+      lo = j == 0 ? x : std::min(lo, x);
+      hi = j == 0 ? x : std::max(hi, x);
+    }
+    const double rounding = 2.0 * static_cast<double>(node.box_half[i]) - (hi - lo);
+    EXPECT_LE(error, 0x1p-16 * 2.0 * (static_cast<double>(node.box_half[0]) + node.box_half[1] + node.box_half[2]));
+    for (int j = 0; j < 3; ++j) {
+      const double x = m.mesh().vertices[t[j]][i] - data(m).origin[i];
+      EXPECT_LE(std::abs(corner[j][i] - x), error + rounding + 1e-12 * (std::abs(x) + 1.0))
+          << "leaf " << index << " corner " << j << " axis " << i << ": " << corner[j][i] << " for " << x;
+    }
+  }
+}
+
 /// Checks every invariant of the BVH; returns the triangles below `index`.
 std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   const BvhNode& node = data(m).nodes[index];
@@ -37,6 +61,7 @@ std::vector<std::uint32_t> check_subtree(const Model& m, std::uint32_t index) {
   std::vector<std::uint32_t> below;
   if (node.is_leaf()) {
     below.push_back(node.index);
+    check_leaf_shape(m, node, index);
   } else {
     EXPECT_GT(node.index, index) << "children after their parent";
     auto left = check_subtree(m, node.index);

@@ -295,6 +295,39 @@ TEST(WideTest, TheAvx2LoopVisitsAsTheScalarOne) {
   }
 }
 
+TEST(WideTest, AStayingLeafMeetsTheSlotsSlabsWithItsCornersNotItsBox) {
+  // A flat grid in the plane x + y + z = 0 and one triangle standing square to it, its lowest
+  // edge 0.1 above it: the triangle's box reaches through the plane, its corners do not, and its
+  // own plane (square to the grid's) refuses nothing. No pair meets; the wide test refuses each
+  // pair of the triangle with a grid triangle before any leaf test.
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 1, 1).normalized();
+  const Eigen::Vector3d u = Eigen::Vector3d(1, -1, 0).normalized(), w = n.cross(u);
+  Mesh grid;
+  grid.source = "grid";
+  constexpr int kCells = 8;
+  for (int i = 0; i <= kCells; ++i) {
+    for (int j = 0; j <= kCells; ++j) grid.vertices.push_back((i - kCells / 2) * 0.5 * u + (j - kCells / 2) * 0.5 * w);
+  }
+  for (std::uint32_t i = 0; i < kCells; ++i) {
+    for (std::uint32_t j = 0; j < kCells; ++j) {
+      const std::uint32_t c = i * (kCells + 1) + j;
+      grid.triangles.push_back({c, c + kCells + 1, c + 1});
+      grid.triangles.push_back({c + 1, c + kCells + 1, c + kCells + 2});
+    }
+  }
+  Mesh standing;
+  standing.source = "standing";
+  const Eigen::Vector3d a(1, -0.45, -0.45), b(-0.45, 1, -0.45);  // each 0.1 / sqrt(3) above the plane
+  standing.vertices = {a, b, 0.5 * (a + b) + 2.0 * n};
+  standing.triangles = {{0, 1, 2}};
+  const auto box_lo = a.cwiseMin(b);
+  ASSERT_LT(box_lo.sum(), 0.0) << "the triangle's box reaches below the grid's plane";
+  QueryRequest request;  // interference
+  const QueryResult r = query(*build_model(grid), Pose{}, *build_model(standing), Pose{}, request);
+  EXPECT_TRUE(r.contacts.empty());
+  EXPECT_EQ(r.stats.leaf_tests, 0u) << "the corners refused every pair of leaves";
+}
+
 /// The leaves (triangle ids) below BVH node i.
 std::vector<std::uint32_t> triangles_below(const ModelData& m, std::uint32_t i) {
   std::vector<std::uint32_t> out, todo{i};
