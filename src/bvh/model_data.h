@@ -15,6 +15,7 @@
 
 #include "caliber/mesh.h"
 #include "caliber/model.h"
+#include "util/assert.h"
 
 namespace caliber {
 
@@ -77,16 +78,18 @@ struct alignas(64) BvhNode {
 static_assert(sizeof(BvhNode) == 64, "BvhNode is meant to stay one cache line");
 
 /// The corners of leaf n's triangle (relative to its model's origin, as its box is) decoded from
-/// n.shape and its box: corner[j][i], coordinate i of corner j, in the triangle's order. Each lies
-/// within `error` of the true corner along every axis: the box's float bounds stand for the
-/// extreme corners (as near as the box's own rounding), the middle one is rounded to 1/65535 of
-/// the box's range, and `error` is 2^-16 of the box's largest range, twice that rounding's bound.
+/// n.shape and its box: corner[j][i], coordinate i of corner j, in the triangle's order. Along
+/// each axis the extreme corners are the box's float bounds, off the true ones by the box's own
+/// rounding (a few float roundoffs of the box's distance from the origin), and the middle one is
+/// rounded to 1/65535 of the box's range: `error`, 2^-16 of the box's largest range, is about
+/// twice that rounding's bound.
 inline void leaf_corners(const BvhNode& n, double corner[3][3], double& error) {
   error = 0.0;
   for (int i = 0; i < 3; ++i) {
     const double lo = static_cast<double>(n.box_center[i]) - static_cast<double>(n.box_half[i]);
     const double hi = static_cast<double>(n.box_center[i]) + static_cast<double>(n.box_half[i]);
     const auto low = static_cast<int>(n.shape >> (48 + 4 * i) & 3u), high = static_cast<int>(n.shape >> (50 + 4 * i) & 3u);
+    CALIBER_ASSERT(low != high && low < 3 && high < 3, "a leaf's shape names two of its corners on each axis");
     const double q = static_cast<double>(n.shape >> (16 * i) & 0xFFFFu);
     corner[low][i] = lo;
     corner[high][i] = hi;

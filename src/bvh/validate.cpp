@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "bvh/leaf_shape.h"
+
 namespace caliber::bvh {
 namespace {
 
@@ -17,6 +19,9 @@ std::string leaf_problem(const ModelData& m, std::uint32_t i) {
   const Eigen::Vector3d bc(n.box_center[0], n.box_center[1], n.box_center[2]);
   const Eigen::Vector3d bh(n.box_half[0], n.box_half[1], n.box_half[2]);
   const Eigen::Vector3d axis(f.cone_axis[0], f.cone_axis[1], f.cone_axis[2]);
+  Eigen::Vector3d corners[3];
+  for (int k = 0; k < 3; ++k) corners[k] = m.mesh.vertices[m.mesh.triangles[n.index][k]] - m.origin;
+  if (n.shape != bvh::leaf_shape(n, corners)) return "leaf " + std::to_string(i) + ": its shape is not its triangle's";
   for (const std::uint32_t v : m.mesh.triangles[n.index]) {
     const Eigen::Vector3d p = m.mesh.vertices[v] - m.origin;
     if (!((p - c).norm() <= n.radius)) return "leaf " + std::to_string(i) + ": its sphere misses a vertex";

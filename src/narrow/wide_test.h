@@ -171,11 +171,11 @@ inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool
 
 /// Where the staying node sn is a leaf, its triangle's corners as leaf_corners decodes them, in the
 /// descending frame and in units, moved as its box center is (M x + t, each step rounded once, then
-/// times the unit, rounded to float once; every form calls this), with their error along any unit
-/// axis (sqrt(3) times leaf_corners' along each, rounded up): out.corner, out.corner_error and
-/// out.triangle. The moved corners lie within that error, plus a few unit roundoffs of the scale
-/// (the slack covers those, as it does for the moved box center), of the points the leaf test
-/// reads.
+/// times the unit, rounded to float once; the AVX2 form makes the same operations in lanes), with
+/// their error along any unit axis (sqrt(3) times leaf_corners' along each, rounded up):
+/// out.corner, out.corner_error and out.triangle. The moved corners lie within that error, plus a
+/// few unit roundoffs of the scale (the box's rounding and the moves': the slack covers those, as
+/// it does for the moved box center), of the points the leaf test reads.
 inline void staying_corners(const WideLanes& l, const WideSide& s, const BvhNode& sn, StayingFloats& out) {
   out.triangle = sn.is_leaf() ? 1u : 0u;
   out.corner_error = 0.0f;

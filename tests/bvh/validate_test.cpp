@@ -57,6 +57,8 @@ TEST(BvhProblem, EachBreakIsFound) {
   EXPECT_NE(broken([&] { m.nodes[leaf].radius *= 0.5f; }), "");
   EXPECT_NE(broken([&] { m.nodes[leaf].box_half[1] = 0.0f; }), "");
   EXPECT_NE(broken([&] { m.filters[leaf].slab_hi = m.filters[leaf].slab_lo - 1.0f; }), "");
+  EXPECT_NE(broken([&] { m.nodes[leaf].shape = 0; }), "") << "a leaf's shape that names one corner twice";
+  EXPECT_NE(broken([&] { m.nodes[leaf].shape ^= 1; }), "") << "a leaf's middle corner one step off";
   EXPECT_NE(broken([&] { m.nodes[inner].count += 1; }), "");
   EXPECT_NE(broken([&] { m.nodes[inner].index = inner; }), "") << "a child before its parent";
   EXPECT_NE(broken([&] { std::swap(m.leaf_position[0], m.leaf_position[1]); }), "") << "triangles out of leaf order";
