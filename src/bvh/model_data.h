@@ -15,7 +15,6 @@
 
 #include "caliber/mesh.h"
 #include "caliber/model.h"
-#include "util/assert.h"
 
 namespace caliber {
 
@@ -58,7 +57,7 @@ struct alignas(64) BvhNode {
   std::uint32_t slot = kNoSlot;
   /// The index of its wide node in ModelData::wide, or kNoWide (bvh::build_wide_tree sets it).
   std::uint32_t link = kNoWide;
-  /// A leaf's triangle within its box (leaf_corners decodes it; 0 for an internal node): per axis
+  /// A leaf's triangle within its box (bvh/leaf_shape.h; 0 for an internal node): per axis
   /// i, bits 16i..16i+15 place the corner between the lowest and highest on the box's range in
   /// steps of 1/65535 (rounded to the nearest), bits 48+4i..49+4i name the lowest corner and bits
   /// 50+4i..51+4i the highest (the box's bounds). In the line's spare bytes: read with the box.
@@ -76,27 +75,6 @@ struct alignas(64) BvhNode {
   [[nodiscard]] float size() const { return (box_half[0] + box_half[1]) + box_half[2]; }
 };
 static_assert(sizeof(BvhNode) == 64, "BvhNode is meant to stay one cache line");
-
-/// The corners of leaf n's triangle (relative to its model's origin, as its box is) decoded from
-/// n.shape and its box: corner[j][i], coordinate i of corner j, in the triangle's order. Along
-/// each axis the extreme corners are the box's float bounds, off the true ones by the box's own
-/// rounding (a few float roundoffs of the box's distance from the origin), and the middle one is
-/// rounded to 1/65535 of the box's range: `error`, 2^-16 of the box's largest range, is about
-/// twice that rounding's bound.
-inline void leaf_corners(const BvhNode& n, double corner[3][3], double& error) {
-  error = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double lo = static_cast<double>(n.box_center[i]) - static_cast<double>(n.box_half[i]);
-    const double hi = static_cast<double>(n.box_center[i]) + static_cast<double>(n.box_half[i]);
-    const auto low = static_cast<int>(n.shape >> (48 + 4 * i) & 3u), high = static_cast<int>(n.shape >> (50 + 4 * i) & 3u);
-    CALIBER_ASSERT(low != high && low < 3 && high < 3, "a leaf's shape names two of its corners on each axis");
-    const double q = static_cast<double>(n.shape >> (16 * i) & 0xFFFFu);
-    corner[low][i] = lo;
-    corner[high][i] = hi;
-    corner[3 - low - high][i] = lo + (hi - lo) * (q * (1.0 / 65535.0));
-    error = std::max(error, (hi - lo) * 0x1p-16);
-  }
-}
 
 /// The rest of a node: its normal cone and slab (read by the node test once the sphere and box
 /// tests have passed; the cone only by contact queries): 32 bytes aligned to 32, two to a cache

@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "bvh/leaf_shape.h"
 #include "bvh/model_data.h"
 #include "narrow/node_test_avx2.h"
 
@@ -182,7 +183,7 @@ inline void staying_corners(const WideLanes& l, const WideSide& s, const BvhNode
   for (float(&c)[4] : out.corner) c[0] = c[1] = c[2] = c[3] = 0.0f;
   if (out.triangle == 0) return;
   double p[3][3], error;
-  leaf_corners(sn, p, error);
+  bvh::leaf_corners(sn, p, error);
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       const double x = std::fma(s.col[2][i], p[j][2], std::fma(s.col[1][i], p[j][1], std::fma(s.col[0][i], p[j][0], s.t[i])));

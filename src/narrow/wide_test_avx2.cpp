@@ -104,7 +104,7 @@ CALIBER_AVX2 inline void staying_corners_avx2(const WideLanes& l, const WideSide
   for (float(&c)[4] : out.corner) _mm_storeu_ps(c, _mm_setzero_ps());
   if (out.triangle == 0) return;
   double p[3][3], error;
-  leaf_corners(sn, p, error);
+  bvh::leaf_corners(sn, p, error);
   const D unit = _mm256_set1_pd(l.unit);
   for (int j = 0; j < 3; ++j)
     _mm_storeu_ps(out.corner[j], _mm256_cvtpd_ps(_mm256_mul_pd(times(s.col, p[j], _mm256_load_pd(s.t)), unit)));

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bvh/leaf_shape.h"
 #include "bvh/model_data.h"
 #include "caliber/error.h"
 #include "caliber/model.h"
@@ -34,7 +35,7 @@ int height_bound(std::uint32_t n) {
 /// its range (the extreme corners decode to the box's bounds).
 void check_leaf_shape(const Model& m, const BvhNode& node, std::uint32_t index) {
   double corner[3][3], error;
-  leaf_corners(node, corner, error);
+  bvh::leaf_corners(node, corner, error);
   const auto& t = m.mesh().triangles[node.triangle()];
   for (int i = 0; i < 3; ++i) {
     double lo = 0.0, hi = 0.0;
