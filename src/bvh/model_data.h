@@ -5,6 +5,7 @@
 /// read-only accessors (data() gives this view to caliber's own code).
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +16,7 @@
 
 #include "caliber/mesh.h"
 #include "caliber/model.h"
+#include "util/half_float.h"
 
 namespace caliber {
 
@@ -25,7 +27,7 @@ namespace caliber {
 /// share that frame, so the rotation between two meshes' boxes is one matrix per query and the box
 /// test is a separating-axis test on six face axes. Then what a visit of the wide CD tree reads
 /// (narrow/visit.h): where the node's slab lies (`slot`: its place in the wide node that holds it,
-/// which stores its slab as its BvhNodeFilter does, and which the visit that reached it read last)
+/// which stores its slab (bvh::slot_slab), and which the visit that reached it read last)
 /// and its wide node (`link`); for a leaf, where its triangle lies in its box (`shape`).
 ///
 /// Values are stored as floats, rounded outward at build time (the radius and half-extents cover
@@ -247,37 +249,49 @@ inline void node_oriented_box(const BvhNode& n, const BvhNodeFilter& f, const Bv
 /// below it (build_wide_tree: the slot of largest box surface that is not a leaf is replaced by its
 /// two children until the slots are full or all leaves; then each slot that is not a leaf gets a
 /// wide node of its own). A slot keeps its BVH node's id, so that the CD tree's nodes stay pairs
-/// of BVH nodes. Per slot, in lanes: its box as 16-bit bounds on the node's grid (low, high), its
-/// slab's axis and bounds as its BvhNodeFilter stores them. The grid: a power of two `step` and an
-/// `origin` on it, both floats, so that every bound origin + q step is a float, the same however
-/// computed; each bound is the grid's nearest outside the float bound nearest outside its BvhNode
-/// box's double bound (bvh::build_wide_tree). Slots past the last are empty: node kEmpty, low
-/// above high; `slots` counts those in use (every visit reads it), `leaves` marks the slots that
-/// are leaves (so a visit knows its children that are pairs of leaves before it reads their BVH
-/// nodes). 320 bytes, aligned to a cache line: five lines.
+/// of BVH nodes. Per slot, in lanes: its box as 16-bit bounds on the node's grid (low, high), and
+/// a slab: an axis in half floats (slab_axis: its BvhNodeFilter's axis, each component cut toward
+/// zero) with float bounds for that axis (bvh::slot_slab: the filter's, moved over the
+/// node's box and rounded outward). The grid: a power of two `step` and an `origin` on it, both
+/// floats, so that every bound origin + q step is a float, the same however computed; each bound
+/// is the grid's nearest outside the float bound nearest outside its BvhNode box's double bound
+/// (bvh::build_wide_tree). Slots past the last are empty: node kEmpty, low above high; count()
+/// says how many are in use (every visit reads it), leaves() which are leaves (so a visit knows
+/// its children that are pairs of leaves before it reads their BVH nodes): both in the step's
+/// word. 256 bytes, aligned to a cache line: four lines.
 struct alignas(64) WideNode {
   static constexpr int kSlots = 8;
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
   /// The most steps a bound lies from the origin.
   static constexpr int kSteps = 32767;
+  /// The bits of `grid` that hold the step (a power of two's float bits: its mantissa's low bits
+  /// are 0).
+  static constexpr std::uint32_t kStepBits = 0xFFFF0000u;
   // (The float and id arrays at multiples of 32 bytes, the 16-bit ones of 16: the test's aligned
   // loads.)
-  std::int16_t lo[3][kSlots], hi[3][kSlots];  ///< box bounds along the object axes, in steps
-  float axis[3][kSlots];                      ///< slab axis (BvhNodeFilter::cone_axis)
-  float slab_lo[kSlots], slab_hi[kSlots];     ///< slab bounds
+  float slab_lo[kSlots], slab_hi[kSlots];     ///< slab bounds along slab_axis
   std::uint32_t node[kSlots];                 ///< the slot's BVH node, kEmpty past the last
+  std::int16_t lo[3][kSlots], hi[3][kSlots];  ///< box bounds along the object axes, in steps
+  std::uint16_t axis[3][kSlots];              ///< slab axis, as half floats (util/half_float.h)
   float origin[3];                            ///< the grid's origin (a multiple of step)
-  float step;                                 ///< the grid's step, a power of two
-  std::uint8_t slots = 0;                     ///< slots in use (they come first): count()
-  std::uint8_t leaves = 0;                    ///< bit k set where slot k is a leaf (one triangle)
+  std::uint32_t grid = 0;                     ///< step's float bits | leaves() << 8 | count()
   /// Slot k's low and high bounds along axis i (exact: origin + q step is a float).
-  [[nodiscard]] float low(int i, int k) const { return static_cast<float>(lo[i][k]) * step + origin[i]; }
-  [[nodiscard]] float high(int i, int k) const { return static_cast<float>(hi[i][k]) * step + origin[i]; }
+  [[nodiscard]] float low(int i, int k) const { return static_cast<float>(lo[i][k]) * step() + origin[i]; }
+  [[nodiscard]] float high(int i, int k) const { return static_cast<float>(hi[i][k]) * step() + origin[i]; }
+  /// Component i of slot k's slab axis (exact).
+  [[nodiscard]] float slab_axis(int i, int k) const { return util::half_value(axis[i][k]); }
+  /// The grid's step, a power of two.
+  [[nodiscard]] float step() const { return std::bit_cast<float>(grid & kStepBits); }
   /// Number of slots in use (they come first): 2 .. kSlots, 1 in bvh::single_slot's.
-  [[nodiscard]] int count() const { return slots; }
+  [[nodiscard]] int count() const { return static_cast<int>(grid & 0xFFu); }
+  /// Bit k set where slot k is a leaf (one triangle).
+  [[nodiscard]] unsigned leaves() const { return grid >> 8 & 0xFFu; }
+  void set_step(float s) { grid = (std::bit_cast<std::uint32_t>(s) & kStepBits) | (grid & ~kStepBits); }
+  void set_count(int n) { grid = (grid & ~0xFFu) | static_cast<std::uint32_t>(n); }
+  void set_leaves(unsigned mask) { grid = (grid & ~0xFF00u) | (mask & 0xFFu) << 8; }
 };
-static_assert(sizeof(WideNode) == 320);
-static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 == 0 && offsetof(WideNode, axis) % 32 == 0 &&
+static_assert(sizeof(WideNode) == 256);
+static_assert(offsetof(WideNode, lo) % 16 == 0 && offsetof(WideNode, hi) % 16 == 0 && offsetof(WideNode, axis) % 16 == 0 &&
               offsetof(WideNode, slab_lo) % 32 == 0 && offsetof(WideNode, slab_hi) % 32 == 0 &&
               offsetof(WideNode, node) % 32 == 0);
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bvh/leaf_shape.h"
+#include "bvh/wide_tree.h"
 
 namespace caliber::bvh {
 namespace {
@@ -47,15 +48,16 @@ std::string children_problem(const ModelData& m, std::uint32_t i) {
   return {};
 }
 
-/// Whether slot `slot` (BvhNode::slot) of m's wide tree holds node i, with i's slab bit for bit.
+/// Whether slot `slot` (BvhNode::slot) of m's wide tree holds node i, with the slab bvh::slot_slab
+/// makes of i's, bit for bit.
 bool slot_holds(const ModelData& m, std::uint32_t slot, std::size_t i) {
   if (slot / WideNode::kSlots >= m.wide.size()) return false;
   const WideNode& w = m.wide[slot / WideNode::kSlots];
   const std::uint32_t k = slot % WideNode::kSlots;
-  const BvhNodeFilter& f = m.filters[i];
+  const SlotSlab slab = slot_slab(m.nodes[i], m.filters[i]);
   const auto bits = [](float x) { return std::bit_cast<std::uint32_t>(x); };
-  bool same = w.node[k] == i && bits(w.slab_lo[k]) == bits(f.slab_lo) && bits(w.slab_hi[k]) == bits(f.slab_hi);
-  for (int a = 0; a < 3; ++a) same = same && bits(w.axis[a][k]) == bits(f.cone_axis[a]);
+  bool same = w.node[k] == i && bits(w.slab_lo[k]) == bits(slab.lo) && bits(w.slab_hi[k]) == bits(slab.hi);
+  for (int a = 0; a < 3; ++a) same = same && w.axis[a][k] == slab.axis[a];
   return same;
 }
 
@@ -69,14 +71,14 @@ std::string wide_slots_problem(const ModelData& m, const std::vector<std::uint32
   bool counted = used >= 2 && used <= WideNode::kSlots;
   for (int k = 0; k < WideNode::kSlots && counted; ++k) counted = (node.node[k] != WideNode::kEmpty) == (k < used);
   if (!counted) return "wide node " + std::to_string(w) + ": its slot count is not its slots in use";
-  if ((node.leaves >> used) != 0) return "wide node " + std::to_string(w) + ": a leaf mask past its slots";
+  if ((node.leaves() >> used) != 0) return "wide node " + std::to_string(w) + ": a leaf mask past its slots";
   std::uint64_t next = firsts[i];
   for (int k = 0; k < used; ++k) {
     if (node.node[k] >= m.nodes.size()) return "wide node " + std::to_string(w) + ": a slot past the last node";
     const BvhNode& slot = m.nodes[node.node[k]];
     if (!slot.is_leaf() && !slot.has_wide()) return "wide node " + std::to_string(w) + ": an inner slot without a wide node";
     if (firsts[node.node[k]] != next) return "wide node " + std::to_string(w) + ": its slots' leaves do not follow one another";
-    if (((node.leaves >> k & 1u) != 0) != slot.is_leaf())
+    if (((node.leaves() >> k & 1u) != 0) != slot.is_leaf())
       return "wide node " + std::to_string(w) + ": a leaf mask not its leaves";
     next += slot.count;
   }
@@ -86,7 +88,7 @@ std::string wide_slots_problem(const ModelData& m, const std::vector<std::uint32
 }
 
 /// What a wide visit reads of each node (where the wide tree is built): its wide node, named by one
-/// node alone, an inner one; its slot, which holds it and stores its slab as its filter does.
+/// node alone, an inner one; its slot, which holds it and stores the slab bvh::slot_slab makes of its filter's.
 std::string wide_problem(const ModelData& m, const std::vector<std::uint32_t>& firsts) {
   std::vector<std::uint8_t> named(m.wide.size(), 0);
   for (std::size_t i = 0; i < m.nodes.size(); ++i) {

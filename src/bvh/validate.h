@@ -16,9 +16,9 @@ namespace caliber::bvh {
 /// every triangle in one leaf; each leaf's sphere, box and slab around its triangle's vertices
 /// (relative to ModelData::origin); group masks the union of their children's; and where the wide
 /// tree is built, each wide node named by one inner node (BvhNode::link), its 2 to 8 slots counted
-/// (WideNode::slots), each a node, an inner one with a wide node, their runs of leaves following
+/// (WideNode::count), each a node, an inner one with a wide node, their runs of leaves following
 /// one another over the naming node's (so each lies below it), and each node's slot
-/// (BvhNode::slot) holding it with its slab as its filter has it.
+/// (BvhNode::slot) holding it with the slab bvh::slot_slab makes of its filter's.
 [[nodiscard]] std::string bvh_problem(const ModelData& model);
 
 }  // namespace caliber::bvh

@@ -8,21 +8,10 @@
 #include <vector>
 
 #include "util/assert.h"
+#include "util/float_round.h"
 
 namespace caliber::bvh {
 namespace {
-
-/// The largest float at or below d, and the smallest at or above it.
-float float_below(double d) {
-  float f = static_cast<float>(d);
-  if (static_cast<double>(f) > d) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
-}
-float float_above(double d) {
-  float f = static_cast<float>(d);
-  if (static_cast<double>(f) < d) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
 
 /// Half the surface of node n's box: which slot opens first.
 double half_surface(const BvhNode& n) {
@@ -34,12 +23,12 @@ void clear_slot(int k, WideNode& out) {
   for (int i = 0; i < 3; ++i) {
     out.lo[i][k] = WideNode::kSteps;
     out.hi[i][k] = -WideNode::kSteps;
-    out.axis[i][k] = 0.0f;
+    out.axis[i][k] = 0;
   }
   out.slab_lo[k] = out.slab_hi[k] = 0.0f;
   out.node[k] = WideNode::kEmpty;
-  out.slots = static_cast<std::uint8_t>(std::min<int>(out.slots, k));
-  out.leaves = static_cast<std::uint8_t>(out.leaves & ~(1u << k));
+  out.set_count(std::min(out.count(), k));
+  out.set_leaves(out.leaves() & ~(1u << k));
 }
 
 /// A node's float box: along each axis, the nearest floats outside its double bounds.
@@ -50,8 +39,8 @@ FloatBox float_box(const BvhNode& n) {
   FloatBox out;
   for (int i = 0; i < 3; ++i) {
     const double center = n.box_center[i], half = n.box_half[i];
-    out.lo[i] = float_below(center - half);
-    out.hi[i] = float_above(center + half);
+    out.lo[i] = util::round_down(center - half);
+    out.hi[i] = util::round_up(center + half);
   }
   return out;
 }
@@ -80,14 +69,13 @@ void set_grid(const FloatBox* boxes, int n, WideNode& out) {
   const double least = std::max({reach / 32000.0, far * 0x1p-23, 0x1p-126});
   double step = std::ldexp(1.0, std::ilogb(least));
   if (step < least) step *= 2.0;
-  out.step = static_cast<float>(step);
+  out.set_step(static_cast<float>(step));
   for (int i = 0; i < 3; ++i) out.origin[i] = static_cast<float>(std::nearbyint(center[i] / step) * step);
 }
 
 /// Writes BVH node `node`, whose float box is `box`, into slot k of `out` (its grid set).
 void fill_slot(const ModelData& model, std::uint32_t node, const FloatBox& box, int k, WideNode& out) {
-  const BvhNodeFilter& f = model.filters[node];
-  const double step = out.step, per_step = 1.0 / step;  // (powers of two: exact)
+  const double step = out.step(), per_step = 1.0 / step;  // (powers of two: exact)
   for (int i = 0; i < 3; ++i) {
     // The grid's nearest bounds outside the float box: from the quotients (truncated; within a
     // step or two of them), then set exactly (origin + q step is exact in double).
@@ -101,14 +89,15 @@ void fill_slot(const ModelData& model, std::uint32_t node, const FloatBox& box, 
     CALIBER_ASSERT(q_lo >= -WideNode::kSteps && q_hi <= WideNode::kSteps, "a slot's box lies within its node's grid");
     out.lo[i][k] = static_cast<std::int16_t>(q_lo);
     out.hi[i][k] = static_cast<std::int16_t>(q_hi);
-    out.axis[i][k] = f.cone_axis[i];
   }
-  out.slab_lo[k] = f.slab_lo;
-  out.slab_hi[k] = f.slab_hi;
+  const SlotSlab slab = slot_slab(model.nodes[node], model.filters[node]);
+  for (int i = 0; i < 3; ++i) out.axis[i][k] = slab.axis[i];
+  out.slab_lo[k] = slab.lo;
+  out.slab_hi[k] = slab.hi;
   out.node[k] = node;
-  out.slots = static_cast<std::uint8_t>(std::max<int>(out.slots, k + 1));
+  out.set_count(std::max(out.count(), k + 1));
   const unsigned leaf = model.nodes[node].is_leaf() ? 1u << k : 0u;
-  out.leaves = static_cast<std::uint8_t>((out.leaves & ~(1u << k)) | leaf);
+  out.set_leaves((out.leaves() & ~(1u << k)) | leaf);
 }
 
 /// The slots of internal node `root`: its two children, then, while there is room, one slot
@@ -156,12 +145,30 @@ WideNode with_slot_alone(const WideNode& w, int k) {
   out.slab_lo[0] = w.slab_lo[k];
   out.slab_hi[0] = w.slab_hi[k];
   out.node[0] = w.node[k];
-  out.slots = 1;
-  out.leaves = static_cast<std::uint8_t>(w.leaves >> k & 1u);
+  out.set_count(1);
+  out.set_leaves(w.leaves() >> k & 1u);
   return out;
 }
 
 }  // namespace
+
+SlotSlab slot_slab(const BvhNode& n, const BvhNodeFilter& f) {
+  SlotSlab out{};
+  // For a vertex v of the box (center c, half-extents h): a' . v = a . v + d . v, where
+  // d = a' - a (exact in double), and d . v lies within d . c +- |d| . h.
+  double at = 0.0, reach = 0.0, magnitude = std::max(std::abs(double{f.slab_lo}), std::abs(double{f.slab_hi}));
+  for (int i = 0; i < 3; ++i) {
+    out.axis[i] = util::half_toward_zero(f.cone_axis[i]);
+    const double d = double{util::half_value(out.axis[i])} - f.cone_axis[i], c = n.box_center[i], h = n.box_half[i];
+    at += d * c;
+    reach += std::abs(d) * h;
+    magnitude += std::abs(d) * (std::abs(c) + h);
+  }
+  const double rounding = magnitude * 0x1p-48;  // (the few double roundings above: far below it)
+  out.lo = util::round_down(f.slab_lo + at - reach - rounding);
+  out.hi = util::round_up(f.slab_hi + at + reach + rounding);
+  return out;
+}
 
 WideNode single_slot(const ModelData& model, std::uint32_t node) {
   if (const std::uint32_t slot = model.nodes[node].slot; slot != BvhNode::kNoSlot) {

@@ -167,7 +167,7 @@ template <class Test = ChosenWideTest>
   // (PairContext::groups_allow, normals_allow), refusing all that the nodes' groups and cones would
   // (two thirds of the cone tests of a contact query, each reading two nodes' filters). Which
   // slots are leaves, the wide node says.
-  const unsigned leaves = v.staying->is_leaf() ? v.node->leaves : 0u;
+  const unsigned leaves = v.staying->is_leaf() ? v.node->leaves() : 0u;
   for (unsigned bits = pass & ~leaves; bits != 0; bits &= bits - 1) {
     const int k = __builtin_ctz(bits);
     const NodePair child = v.child(k, n);

@@ -78,7 +78,7 @@ template <bool kReversed, class Test = ChosenWideTest, class LeafPair = std::nul
     stats.node_tests += static_cast<std::uint64_t>(count);
   }
   if constexpr (!std::is_same_v<LeafPair, std::nullptr_t>) {
-    const unsigned leaves = pass & v.node->leaves & (0u - static_cast<unsigned>(v.staying->is_leaf()));
+    const unsigned leaves = pass & v.node->leaves() & (0u - static_cast<unsigned>(v.staying->is_leaf()));
     pass &= ~leaves;
     const std::uint32_t held = v.staying->triangle();
     for (unsigned bits = leaves; bits != 0; bits &= bits - 1) {

@@ -114,7 +114,7 @@ bool floats_pass(const WideLanes& l, const WideSide& s, const WideNode& w, int k
         std::fmaf(s.abs_m[2][i][0], hh[2], std::fmaf(s.abs_m[1][i][0], hh[1], std::fmaf(s.abs_m[0][i][0], hh[0], st.ho[i])));
     pass = pass && std::abs(p - st.co[i]) <= r;
   }
-  const float ax[3] = {w.axis[0][k], w.axis[1][k], w.axis[2][k]};
+  const float ax[3] = {w.slab_axis(0, k), w.slab_axis(1, k), w.slab_axis(2, k)};
   const float slot_lo = w.slab_lo[k] * l.unit_f, slot_hi = w.slab_hi[k] * l.unit_f;
   {  // the staying node's slab: lambda (the slot's slab) + the rest (its box) along the axis
     const float dot = std::fmaf(ax[2], st.nf[2], std::fmaf(ax[1], st.nf[1], ax[0] * st.nf[0]));
@@ -189,7 +189,7 @@ void slot_order_keys_portable(const StayingCache::Entry& kept, const WideNode& w
     float offset = 0.0f, extent = 0.0f;
     for (int i = 0; i < 3; ++i) {
       // From the grid's origin: the slot's bounds exactly.
-      const float lo = static_cast<float>(w.lo[i][k]) * w.step, hi = static_cast<float>(w.hi[i][k]) * w.step;
+      const float lo = static_cast<float>(w.lo[i][k]) * w.step(), hi = static_cast<float>(w.hi[i][k]) * w.step();
       offset += std::abs((lo + hi) - ((kept.lo[i] - w.origin[i]) + (kept.hi[i] - w.origin[i])));
       extent += (hi - lo) + (kept.hi[i] - kept.lo[i]);
     }

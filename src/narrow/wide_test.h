@@ -153,18 +153,21 @@ struct StayingCache {
   }
 };
 
-/// A staying node's slab: its axis and bounds, as its BvhNodeFilter stores them.
+/// A staying node's slab: its axis and bounds, as its slot (bvh::slot_slab) or its BvhNodeFilter
+/// stores them.
 struct StayingSlab {
   float axis[3], lo, hi;
 };
 /// The slab of node `stay` (sn), of B where A descends: read in the wide node that holds it
-/// (BvhNode::slot; the visit that reached it read that node), else in its filter.
+/// (BvhNode::slot; the visit that reached it read that node), its axis's half floats read by
+/// `half` (util::half_value, or the CPU's conversion: the same floats), else in its filter.
+template <class Half = float (*)(std::uint16_t)>
 inline StayingSlab staying_slab(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay,
-                                const BvhNode& sn) {
+                                const BvhNode& sn, Half half = util::half_value) {
   if (sn.slot != BvhNode::kNoSlot) {
     const WideNode& w = l.staying_wide[a_descends ? 0 : 1][sn.slot / WideNode::kSlots];
     const std::uint32_t k = sn.slot % WideNode::kSlots;
-    return {{w.axis[0][k], w.axis[1][k], w.axis[2][k]}, w.slab_lo[k], w.slab_hi[k]};
+    return {{half(w.axis[0][k]), half(w.axis[1][k]), half(w.axis[2][k])}, w.slab_lo[k], w.slab_hi[k]};
   }
   const BvhNodeFilter& sf = a_descends ? f.filters_b[stay] : f.filters_a[stay];
   return {{sf.cone_axis[0], sf.cone_axis[1], sf.cone_axis[2]}, sf.slab_lo, sf.slab_hi};

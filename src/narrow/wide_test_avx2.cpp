@@ -18,7 +18,7 @@
 namespace caliber::narrow::detail {
 namespace {
 
-#define CALIBER_AVX2 __attribute__((target("avx2,fma")))
+#define CALIBER_AVX2 __attribute__((target("avx2,fma,f16c")))
 
 using V = __m256;
 using D = __m256d;
@@ -41,6 +41,10 @@ CALIBER_AVX2 inline D times(const double col[3][4], const double x[3], D w) {
 CALIBER_AVX2 inline V steps(const std::int16_t* q) {
   return _mm256_cvtepi32_ps(_mm256_cvtepi16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(q))));
 }
+/// Eight half floats (16-byte aligned), as floats (exact).
+CALIBER_AVX2 inline V halves(const std::uint16_t* h) {
+  return _mm256_cvtph_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(h)));
+}
 /// m[2][i] x2 + (m[1][i] x1 + (m[0][i] x0 + w)), lane by lane, each step rounded once.
 CALIBER_AVX2 inline V project(const float m[3][3][8], int i, V x0, V x1, V x2, V w) {
   return fma(load(m[2][i]), x2, fma(load(m[1][i]), x1, fma(load(m[0][i]), x0, w)));
@@ -61,7 +65,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline V floats_pass(const WideLanes
     const V r = project(s.abs_m, i, hh[0], hh[1], hh[2], all(st.ho[i]));
     pass = both(pass, at_most(magnitude(sub(p, all(st.co[i]))), r));
   }
-  const V ax[3] = {load(w.axis[0]), load(w.axis[1]), load(w.axis[2])};
+  const V ax[3] = {halves(w.axis[0]), halves(w.axis[1]), halves(w.axis[2])};
   const V unit = all(l.unit_f), slab_f = all(l.slab_f);
   {  // the staying node's slab: lambda (the slot's slab) + the rest (its box) along the axis
     const V nf[3] = {all(st.nf[0]), all(st.nf[1]), all(st.nf[2])};
@@ -116,7 +120,7 @@ CALIBER_AVX2 inline void staying_corners_avx2(const WideLanes& l, const WideSide
 CALIBER_AVX2 inline void make_staying_floats_avx2(const NodeTestFrame& f, const WideLanes& l, const WideSide& s, bool a_descends,
                                                   std::uint32_t stay, const BvhNode& sn, StayingCache::Entry& kept) {
   if (kept.has_floats) return;
-  const StayingSlab sf = staying_slab(f, l, a_descends, stay, sn);
+  const StayingSlab sf = staying_slab(f, l, a_descends, stay, sn, [](std::uint16_t h) CALIBER_AVX2 { return _cvtsh_ss(h); });
   const D unit = _mm256_set1_pd(l.unit);
   const D nd = fmad(_mm256_load_pd(s.col[2]), _mm256_set1_pd(sf.axis[2]),
                     fmad(_mm256_load_pd(s.col[1]), _mm256_set1_pd(sf.axis[1]),
@@ -167,7 +171,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline unsigned wide_test_avx2(const
   }
   // The slots' bounds from the grid (exact: origin + q step is a float), the empty slots refused.
   V cl[3], ch[3];
-  const V step = all(w.step);
+  const V step = all(w.step());
   const __m256i ids = _mm256_load_si256(reinterpret_cast<const __m256i*>(w.node));
   V pass = _mm256_castsi256_ps(_mm256_xor_si256(_mm256_cmpeq_epi32(ids, _mm256_set1_epi32(-1)), _mm256_set1_epi32(-1)));
   for (int i = 0; i < 3; ++i) {
@@ -243,7 +247,7 @@ CALIBER_AVX2 __attribute__((flatten)) void wide_loop_avx2(const PairContext& ctx
 
 /// slot_order_keys_portable in eight lanes: each lane its operations, in its order, unfused.
 CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]) {
-  const V step = all(w.step), magnitude_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
+  const V step = all(w.step()), magnitude_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
   V offset = _mm256_setzero_ps(), extent = _mm256_setzero_ps();
   for (int i = 0; i < 3; ++i) {
     const V lo = mul(steps(w.lo[i]), step), hi = mul(steps(w.hi[i]), step);
@@ -254,8 +258,8 @@ CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const Wi
   _mm256_storeu_ps(keys, _mm256_div_ps(offset, add(extent, all(std::numeric_limits<float>::min()))));
 }
 
-/// Whether this CPU runs what this file builds (AVX2 and FMA).
-bool avx2_and_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"); }
+/// Whether this CPU runs what this file builds (AVX2, FMA and F16C).
+bool avx2_and_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c"); }
 
 }  // namespace
 

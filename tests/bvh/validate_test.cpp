@@ -91,11 +91,12 @@ TEST(BvhProblem, EachBreakIsFound) {
   std::size_t partial = 0;  // a wide node with an empty slot
   while (partial < m.wide.size() && m.wide[partial].count() == WideNode::kSlots) ++partial;
   ASSERT_LT(partial, m.wide.size());
-  EXPECT_NE(broken([&] { m.wide[0].slots -= 1; }), "") << "a wide node counting one slot fewer than it uses";
-  EXPECT_NE(broken([&] { m.wide[partial].slots += 1; }), "") << "a wide node counting an empty slot";
-  EXPECT_NE(broken([&] { m.wide[0].slots = 0; }), "") << "a wide node of no slot";
+  EXPECT_NE(broken([&] { m.wide[0].set_count(m.wide[0].count() - 1); }), "")
+      << "a wide node counting one slot fewer than it uses";
+  EXPECT_NE(broken([&] { m.wide[partial].set_count(m.wide[partial].count() + 1); }), "") << "a wide node counting an empty slot";
+  EXPECT_NE(broken([&] { m.wide[0].set_count(0); }), "") << "a wide node of no slot";
   EXPECT_NE(broken([&] {
-              m.wide[0].slots = WideNode::kSlots + 1;
+              m.wide[0].set_count(WideNode::kSlots + 1);
               for (std::uint32_t& node : m.wide[0].node) node = node == WideNode::kEmpty ? 0 : node;
             }),
             "")
@@ -104,6 +105,10 @@ TEST(BvhProblem, EachBreakIsFound) {
   EXPECT_NE(broken([&] { m.nodes[0].link = static_cast<std::uint32_t>(m.wide.size()); }), "") << "a wide node past the last";
   ASSERT_NE(m.nodes[leaf].slot, BvhNode::kNoSlot);
   EXPECT_NE(broken([&] { m.nodes[leaf].slot ^= 1u; }), "") << "a slot holding another node";
+  const std::uint32_t at = m.nodes[leaf].slot / WideNode::kSlots, k = m.nodes[leaf].slot % WideNode::kSlots;
+  EXPECT_NE(broken([&] { m.wide[at].slab_hi[k] = std::nextafter(m.wide[at].slab_hi[k], -1e30f); }), "")
+      << "a slot's slab narrowed";
+  EXPECT_NE(broken([&] { m.wide[at].axis[0][k] ^= 1u; }), "") << "a slot's slab axis moved";
   EXPECT_NE(broken([&] { m.nodes[leaf].slot = static_cast<std::uint32_t>(m.wide.size() * WideNode::kSlots); }), "")
       << "a slot past the last wide node";
   std::uint32_t inner_slot = 0;  // an inner node that is a slot (and so has a wide node)
@@ -124,12 +129,14 @@ TEST(BvhProblem, EachBreakIsFound) {
       [&] {
         for (std::uint32_t& slot : m.wide[own].node) slot = WideNode::kEmpty;
         m.wide[own].node[0] = inner_slot;
-        m.wide[own].slots = 1;
+        m.wide[own].set_count(1);
       },
       "slot count"))
       << "a wide node whose one slot is its own node (a visit would come back to it)";
-  EXPECT_TRUE(says([&] { m.wide[0].leaves ^= 1u; }, "a leaf mask not its leaves")) << "a slot's leaf bit flipped";
-  EXPECT_TRUE(says([&] { m.wide[partial].leaves |= static_cast<std::uint8_t>(1u << m.wide[partial].count()); }, "past its slots"))
+  EXPECT_TRUE(says([&] { m.wide[0].set_leaves(m.wide[0].leaves() ^ 1u); }, "a leaf mask not its leaves"))
+      << "a slot's leaf bit flipped";
+  EXPECT_TRUE(
+      says([&] { m.wide[partial].set_leaves(m.wide[partial].leaves() | 1u << m.wide[partial].count()); }, "past its slots"))
       << "an empty slot marked a leaf";
   EXPECT_EQ(bvh::bvh_problem(m), "") << "every change undone";
 }
