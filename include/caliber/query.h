@@ -63,8 +63,8 @@ struct QueryRequest {
   /// Ignored by distance queries.
   std::size_t max_pairs = 0;
   /// Distance queries on meshes that intersect (distance 0, many pairs at 0). false (default): the
-  /// query stops at the first intersecting pair of the traversal from the root, the pair every
-  /// method and thread count reports (about the first hit's cost); two models with at most 16
+  /// query reports the first hit (the pair an interference query with max_pairs = 1 stops at), the
+  /// pair every method and thread count reports, at about the first hit's cost; two models with at most 16
   /// triangle pairs between them (two tetrahedra) have every pair tested, and report the lowest
   /// ids. true: every pair at distance 0 is examined and the lowest triangle ids are reported, as
   /// for ties at any other distance (query_brute_force's answer; on two intersecting meshes of

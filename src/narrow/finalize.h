@@ -48,9 +48,9 @@ enum class ContactPair { as_found, from_root };
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
                      ContactPair contact_pair, bool parallel = false);
 
-/// The first intersecting pair of the distance traversal from the root (the pair caliber::query
-/// reports on meshes that intersect; the lowest ids on models with at most 16 triangle pairs), on
-/// the calling thread with its kept scratch. Its node and leaf tests are counted nowhere. The
+/// The intersecting pair the distance traversal from the root reports (its first hit: the pair
+/// caliber::query reports on meshes that intersect; the lowest ids on models with at most 16
+/// triangle pairs), on the calling thread with its kept scratch. Its node and leaf tests are counted nowhere. The
 /// meshes must have a pair at distance 0.
 Candidate first_contact(const PairContext& ctx);
 

@@ -11,11 +11,6 @@
 #include "geometry/triangle_intersect.h"
 
 namespace caliber::narrow {
-namespace {
-/// Margin on the cosine in the cone test: covers float-rounded cone axes (|axis| = 1 +- 2e-7).
-constexpr double kConeCosMargin = 1e-6;
-}  // namespace
-
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
     : mA(data(a)), mB(data(b)), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
   validate_request(request);
@@ -32,11 +27,7 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   mAbsRot = mRot.cwiseAbs().array() + kRotationHair;
   mScale = mA.local_extent + mB.local_extent + node_trans.norm();
   if (local) mScale += kAbsoluteShare * (mA.extent + mB.extent + mTrans.norm());
-  mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
-  mReach = reach_for(reach(request));
-  mSlabReach = mReach * (1.0 + 1e-6);
-  mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {}, kRotationHair,
-                mReach,          mSlabReach};
+  mNodeFrame = {mA.nodes.data(), mA.filters.data(), mB.nodes.data(), mB.filters.data(), {}, {}, {}, kRotationHair, 0.0, 0.0};
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       mNodeFrame.rot[i][j] = mRot(i, j);
@@ -44,6 +35,18 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
     }
     mNodeFrame.trans[i] = node_trans[i];
   }
+  ask(request);
+}
+
+void PairContext::ask(const QueryRequest& request) {
+  mRequest = request;
+  mKind = request.kind;
+  mGroups = request.groups;
+  mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
+  mReach = reach_for(reach(request));
+  mSlabReach = mReach * (1.0 + 1e-6);
+  mNodeFrame.reach = mReach;
+  mNodeFrame.slab_reach = mSlabReach;
   // The angle is read by the contact kind's tests alone (cones_can_face, normals_allow): the
   // other kinds skip the cosine and sine (a noticeable part of a small query's context).
   mTheta = request.angle_deg * std::numbers::pi / 180.0;
@@ -55,26 +58,14 @@ PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, con
   }
 }
 
-bool PairContext::cones_can_face(const BvhNodeFilter& na, const BvhNodeFilter& nb) const {
-  // Leaf normals n_a, n_b lie within their cones; a leaf passes when angle(n_a, -n_b) <= theta, so by
-  // the triangle inequality angle(axis_a, -axis_b) <= alpha_a + alpha_b + theta for any passing leaf.
-  if (na.cone_angle < 0.0f || nb.cone_angle < 0.0f) return false;  // only degenerate triangles below
-  const double total = static_cast<double>(na.cone_angle) + static_cast<double>(nb.cone_angle) + mTheta;
-  if (total >= std::numbers::pi) return true;
-  // B's axis in A's frame and its dot product with A's, each sum left to right (as the lanes of
-  // detail::cones_face_2x2 make them).
-  double moved[3];
-  for (int i = 0; i < 3; ++i) {
-    const double* r = mNodeFrame.rot[i];
-    moved[i] = (r[0] * nb.cone_axis[0] + r[1] * nb.cone_axis[1]) + r[2] * nb.cone_axis[2];
-  }
-  const double facing = -((na.cone_axis[0] * moved[0] + na.cone_axis[1] * moved[1]) + na.cone_axis[2] * moved[2]);
-  // cos(alpha_a + alpha_b + theta) by the angle-sum formulas on the stored cosines and sines
-  // (float-rounded: about 2.4e-7 of error at most, inside the 1e-6 margin).
-  const double ca = na.cone_cos, sa = na.cone_sin, cb = nb.cone_cos, sb = nb.cone_sin;
-  const double cos_ab = ca * cb - sa * sb, sin_ab = sa * cb + ca * sb;
-  const double cos_total = cos_ab * mCosTheta - sin_ab * mSinTheta;
-  return facing >= cos_total - kConeCosMargin;
+PairContext PairContext::first_hit() const {
+  QueryRequest request;
+  request.kind = QueryKind::interference;
+  request.max_pairs = 1;
+  request.groups = mRequest.groups;
+  PairContext out = *this;
+  out.ask(request);
+  return out;
 }
 
 bool PairContext::node_test_2x2_lane(std::uint32_t ia, std::uint32_t ib) const {
@@ -143,21 +134,6 @@ int PairContext::node_tests_one_side(std::uint32_t a0, std::uint32_t a1, std::ui
   return groups_and_cones(pass, a0, a1, b0, b1);
 }
 
-int PairContext::groups_and_cones(int pass, std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) const {
-  const std::uint32_t ia[2] = {a0, a1}, ib[2] = {b0, b1};
-  // What node_test adds to node_within's geometry, pair by pair: groups, then normal cones.
-  for (int left = pass; left != 0; left &= left - 1) {
-    const int k = __builtin_ctz(static_cast<unsigned>(left));
-    if (!groups_and_cones_allow(ia[k / 2], ib[k % 2])) pass &= ~(1 << k);
-  }
-  return pass;
-}
-
-bool PairContext::groups_and_cones_allow(std::uint32_t ia, std::uint32_t ib) const {
-  if (mGroups != nullptr && !groups_can_touch(mA.group_mask(ia), mB.group_mask(ib))) return false;
-  return mKind != QueryKind::contact || cones_can_face(mA.filters[ia], mB.filters[ib]);
-}
-
 void PairContext::prepare_disk_a(SideA& s) const {
   for (int i = 0; i < 3; ++i) s.center_from_b[i] = s.center[i] - mNodeFrame.trans[i];
   const double mid = s.slab_axis[0] * s.center[0] + s.slab_axis[1] * s.center[1] + s.slab_axis[2] * s.center[2];
@@ -205,28 +181,12 @@ void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, co
   }
 }
 
-bool PairContext::groups_can_touch(std::uint64_t ga, std::uint64_t gb) const {
-  while (ga != 0) {
-    const int g = __builtin_ctzll(ga);
-    if (mGroups->compatible[g] & gb) return true;
-    ga &= ga - 1;
-  }
-  return false;
-}
-
 void PairContext::corners(std::uint32_t ta, std::uint32_t tb, Eigen::Vector3d a[3], Eigen::Vector3d b[3]) const {
   const auto& tri_a = mA.mesh.triangles[ta];
   for (int k = 0; k < 3; ++k) {
     a[k] = mA.mesh.vertices[tri_a[k]];
     b[k] = b_vertex(tb, k);
   }
-}
-
-bool PairContext::groups_allow(std::uint32_t ta, std::uint32_t tb) const {
-  if (mGroups == nullptr) return true;
-  const unsigned ga = mA.mesh.groups.empty() ? 0 : mA.mesh.groups[ta];
-  const unsigned gb = mB.mesh.groups.empty() ? 0 : mB.mesh.groups[tb];
-  return mGroups->allows(ga, gb);
 }
 
 namespace {

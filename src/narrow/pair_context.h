@@ -41,6 +41,8 @@ inline constexpr double kDescendAloneRatioDistance = 4.0;
 class PairContext {
   /// Added to |rotation . axis| terms: covers rounding in the rotation and in the products.
   static constexpr double kRotationHair = 1e-12;
+  /// Margin on the cosine in the cone test: covers float-rounded cone axes (|axis| = 1 +- 2e-7).
+  static constexpr double kConeCosMargin = 1e-6;
   /// The distance bound's Frames have axes orthonormal to about 1e-15, and frames_apart divides
   /// its separation once by its direction's length (a square root and a division, each rounded):
   /// dividing by 1 + 1e-9 covers both; multiplying by 1 - 3e-9, below 1 / (1 + 1e-9) by far more
@@ -50,6 +52,9 @@ class PairContext {
  public:
   /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
+  /// The same pair and poses (and group table) asked for interference that stops at its first
+  /// pair (max_pairs 1): what a distance traversal from the root tries first (traverse_nearest).
+  [[nodiscard]] PairContext first_hit() const;
 
   using BoxA = narrow::BoxA;
   using BoxB = narrow::BoxB;
@@ -132,7 +137,7 @@ class PairContext {
 
   /// How far apart the spheres of node ia of A and node ib of B are, relative to their size:
   /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders the
-  /// distance traversal that stops at contact: it enters the most overlapping touching children
+  /// distance traversal's pieces that stop at contact: they enter the most overlapping touching children
   /// first (visit_order.h).
   [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
     const BvhNode& na = mA.nodes[ia];
@@ -366,6 +371,9 @@ class PairContext {
     const double reach = on[0] * half[0] + on[1] * half[1] + on[2] * half[2];
     return at - reach > hi + slab_reach || at + reach < lo - slab_reach;
   }
+
+  /// Sets what depends on the request: its kind, reach, angle and group table.
+  void ask(const QueryRequest& request);
 
   const ModelData& mA;
   const ModelData& mB;

@@ -92,7 +92,7 @@ QueryResult query_whole(const PairContext& ctx) {
 
 Candidate first_contact(const PairContext& ctx) {
   CALIBER_ASSERT(ctx.request().kind == QueryKind::distance && !ctx.request().lowest_ids,
-                 "the first contact is that of a distance traversal that stops at contact");
+                 "the first contact is that of a distance traversal from the root that stops at contact");
   Nearest nearest;
   QueryStats stats;
   traverse_nearest(ctx, NodePair{0, 0}, t_scratch, nearest, stats);

@@ -171,6 +171,23 @@ inline bool few_pairs(const PairContext& ctx) {
   return ctx.a().mesh.triangles.size() * ctx.b().mesh.triangles.size() <= kFewPairs;
 }
 
+/// Where the meshes intersect, the pair the interference traversal from the root meets first
+/// (PairContext::first_hit: the wide tree's first hit, far cheaper than the distance traversal's
+/// bounds), offered at distance 0: true. Else false (its tests counted in `stats` all the same).
+inline bool first_hit(const PairContext& ctx, TraversalScratch& scratch, Nearest& nearest, QueryStats& stats) {
+  const PairContext hit = ctx.first_hit();
+  PairShared limit;
+  limit.max = 1;
+  scratch.within.clear();
+  traverse_depth_first(hit, NodePair{0, 0}, scratch, scratch.within, stats, RootTest::as_root, {}, &limit);
+  if (scratch.within.empty()) return false;
+  Candidate c;
+  const bool kept = ctx.leaf_distance(scratch.within.front().tri_a, scratch.within.front().tri_b, nearest.bound(ctx), c);
+  CALIBER_ASSERT(kept && c.distance == 0.0, "an intersecting pair is at distance 0");
+  nearest.offer(c);
+  return true;
+}
+
 /// The distance traversal of a pair of models with few triangles (few_pairs), from its root once
 /// the root's bound is within reach: every triangle pair through the batch kernels
 /// (as the proximity query's leaf tests, ta then tb in order), each kept pair offered to `nearest`.
@@ -248,7 +265,9 @@ template <class Wait>
 /// sift took a large part of the bunny's time; the buckets are faster than a 4-ary heap too.)
 /// A whole traversal (from the root, tested as the root, no taboo list) of models with few
 /// triangle pairs tests every pair once the root passes (nearest_of_all_pairs), ties at distance 0
-/// too to the lowest ids.
+/// too to the lowest ids; of other models, unless it asks for the lowest ids, it first asks for
+/// the first hit (first_hit), which where the meshes intersect is its answer: so only a piece of
+/// a split traversal meets a contact itself.
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}) {
   using Reached = TraversalScratch::Reached;
@@ -271,10 +290,12 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       have_next = true;
     }
   }
-  if (have_next && root_test == RootTest::as_root && root == NodePair{0, 0} && taboo.taboo == nullptr && few_pairs(ctx)) {
+  const bool whole = have_next && root_test == RootTest::as_root && root == NodePair{0, 0} && taboo.taboo == nullptr;
+  if (whole && few_pairs(ctx)) {
     nearest_of_all_pairs(ctx, scratch, nearest, stats);
     return;
   }
+  if (whole && stop_at_contact && first_hit(ctx, scratch, nearest, stats)) return;
   for (;;) {
     const double reach = ctx.reach_for(nearest.bound(ctx));
     if (!have_next) {

@@ -155,6 +155,33 @@ TEST(Distance, RandomPosesAgreeWithTheOracleIncludingOverlaps) {
   EXPECT_GT(apart, 10);
 }
 
+// Where the meshes intersect, the distance query reports the first hit: the pair an interference
+// query stopping at one pair finds (and the oracle finds intersecting), at distance 0.
+TEST(Distance, AtContactTheFirstHitIsReported) {
+  std::mt19937_64 rng(23);
+  const auto torus = build_model(make_torus(1.0, 0.35, 24, 12));
+  const auto sphere = build_model(make_sphere(1.0, 12, 16));
+  QueryRequest first;
+  first.max_pairs = 1;
+  int hits = 0;
+  for (int i = 0; i < 60; ++i) {
+    const Model& b = i % 2 ? *sphere : *torus;
+    const Pose pa = test::random_pose(rng, 1.0), pb = test::random_pose(rng, 1.0);
+    const QueryResult hit = query(*torus, pa, b, pb, first);
+    const QueryResult near = query(*torus, pa, b, pb, distance_request());
+    ASSERT_EQ(near.contacts.size(), 1u);
+    if (hit.contacts.empty()) {
+      EXPECT_GT(near.contacts.front().distance, 0.0) << "pose " << i << ": no intersecting pair, no contact";
+      continue;
+    }
+    ++hits;
+    EXPECT_EQ(near.contacts.front().distance, 0.0) << "pose " << i;
+    EXPECT_EQ(near.contacts.front().tri_a, hit.contacts.front().tri_a) << "pose " << i;
+    EXPECT_EQ(near.contacts.front().tri_b, hit.contacts.front().tri_b) << "pose " << i;
+  }
+  EXPECT_GT(hits, 15) << "intersecting poses must be tested";
+}
+
 // Parallel plates facing each other, shifted sideways: every triangle pair across the gap that
 // overlaps sideways is exactly as close as the closest, so the answer is decided by the tie rule
 // (lowest ids), and the nodes' bounds in their slab's frame are as tight as they get (a prune
