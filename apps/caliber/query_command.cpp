@@ -245,7 +245,7 @@ Runner add_query_command(CLI::App& app) {
   cmd->add_flag("--first", opt->first, "Stop at the first pair found (any pair, or none): --max-pairs 1; not with --max-pairs");
   cmd->add_flag("--lowest-ids", opt->lowest_ids,
                 "Distance on intersecting meshes: report the intersecting pair with the lowest triangle ids (every "
-                "pair at distance 0 examined) instead of the traversal's first (the same on models with at most 16 "
+                "pair at distance 0 examined) instead of the first hit's (the same on models with at most 16 "
                 "triangle pairs, all of which are tested)");
   cmd->add_option("--repeat", opt->repeat,
                   "Run the query R times: stats.query_ms is the first (cold) run, stats.query_ms_warm the median of "
