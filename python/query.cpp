@@ -111,7 +111,7 @@ PyMethodDef g_query_def{
     "query(a, pose_a, b, pose_b, kind='interference', tolerance=None, angle=30.0, max_pairs=0, *, lowest_ids=False)\n--\n\n"
     "One pair: kind is 'interference', 'proximity', 'contact' or 'distance' (the closest pair: one row, or none "
     "beyond the tolerance; no tolerance: any distance). max_pairs > 0 stops at that many pairs and sets "
-    "limit_reached (1: any pair). Distance on intersecting meshes: the first intersecting pair of the traversal "
+    "limit_reached (1: any pair). Distance on intersecting meshes: the first hit (the pair max_pairs=1 stops at) "
     "(the lowest ids on models with at most 16 triangle pairs), or with lowest_ids=True the lowest ids at "
     "distance 0 (slower). Returns a caliber.Result."};
 

@@ -287,7 +287,7 @@ struct alignas(64) WideNode {
   /// Bit k set where slot k is a leaf (one triangle).
   [[nodiscard]] unsigned leaves() const { return grid >> 8 & 0xFFu; }
   void set_step(float s) { grid = (std::bit_cast<std::uint32_t>(s) & kStepBits) | (grid & ~kStepBits); }
-  void set_count(int n) { grid = (grid & ~0xFFu) | static_cast<std::uint32_t>(n); }
+  void set_count(int n) { grid = (grid & ~0xFFu) | (static_cast<std::uint32_t>(n) & 0xFFu); }
   void set_leaves(unsigned mask) { grid = (grid & ~0xFF00u) | (mask & 0xFFu) << 8; }
 };
 static_assert(sizeof(WideNode) == 256);

@@ -14,8 +14,9 @@ namespace caliber::bvh {
 void build_wide_tree(ModelData& model);
 
 /// The slab a wide node keeps of its slot n (filter f): f's axis with each component cut toward
-/// zero to a half float (so no longer than f's: the queries' slab reach holds along it), and bounds along that axis from f's, moved over n's box (which holds every vertex
-/// below n) and rounded outward. An axis of 0 keeps bounds of 0 (it prunes nothing).
+/// zero to a half float (so no longer than f's: the queries' slab reach holds along it), and
+/// bounds along that axis from f's, moved over n's box (which holds every vertex below n) and
+/// rounded outward. An axis of 0 keeps bounds of 0 (it prunes nothing).
 struct SlotSlab {
   std::uint16_t axis[3];  ///< (half floats)
   float lo, hi;

@@ -32,11 +32,12 @@ inline std::size_t finalize_chunks(QueryKind kind, std::size_t candidates) {
 }
 
 /// Where a distance answer of 0 comes from. as_found: the candidates came from one traversal from
-/// the root (caliber::query's, whose first intersecting pair is the answer; on models with at most
-/// 16 triangle pairs, all tested, the lowest ids) or from the brute force (the lowest ids).
+/// the root (caliber::query's, or a method's pair traversed whole, whose first hit is the answer;
+/// on models with at most 16 triangle pairs, all tested, the lowest ids) or from the brute force
+/// (the lowest ids).
 /// from_root: they came from pieces of the traversal (a method's tasks), each stopped at its own
-/// first intersecting pair; the answer is the first intersecting pair of the traversal from the
-/// root, found again here, so that it does not depend on the cut.
+/// first intersecting pair; the answer is that of the traversal from the root (its first hit),
+/// found again here, so that it does not depend on the cut.
 enum class ContactPair { as_found, from_root };
 
 /// Applies the contact reduction (local minima) for contact queries, sorts the candidates of one

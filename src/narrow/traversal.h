@@ -184,6 +184,7 @@ inline bool first_hit(const PairContext& ctx, TraversalScratch& scratch, Nearest
   Candidate c;
   const bool kept = ctx.leaf_distance(scratch.within.front().tri_a, scratch.within.front().tri_b, nearest.bound(ctx), c);
   CALIBER_ASSERT(kept && c.distance == 0.0, "an intersecting pair is at distance 0");
+  if (!kept || c.distance != 0.0) return false;  // (never: the best-first traversal would then answer)
   nearest.offer(c);
   return true;
 }
@@ -263,11 +264,12 @@ template <class Wait>
 /// children at gap 0 the most overlapping spheres go first (touching_first). Counts node
 /// and leaf tests like traverse_depth_first; honours a taboo list the same way. (A binary heap's
 /// sift took a large part of the bunny's time; the buckets are faster than a 4-ary heap too.)
-/// A whole traversal (from the root, tested as the root, no taboo list) of models with few
-/// triangle pairs tests every pair once the root passes (nearest_of_all_pairs), ties at distance 0
-/// too to the lowest ids; of other models, unless it asks for the lowest ids, it first asks for
-/// the first hit (first_hit), which where the meshes intersect is its answer: so only a piece of
-/// a split traversal meets a contact itself.
+/// A whole traversal (from the root, no taboo list; its root passed, or tested here) of models
+/// with few triangle pairs tests every pair (nearest_of_all_pairs), ties at distance 0 too to the
+/// lowest ids; of other models, unless it asks for the lowest ids, it first asks for the first hit
+/// (first_hit), which where the meshes intersect is its answer. Either way its answer is the
+/// pair's (as found: ContactPair::as_found); a piece of a split traversal meets a contact of its
+/// own, which the pair's finalization replaces (ContactPair::from_root).
 inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScratch& scratch, Nearest& nearest,
                              QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {}) {
   using Reached = TraversalScratch::Reached;
@@ -290,7 +292,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
       have_next = true;
     }
   }
-  const bool whole = have_next && root_test == RootTest::as_root && root == NodePair{0, 0} && taboo.taboo == nullptr;
+  const bool whole = have_next && root == NodePair{0, 0} && taboo.taboo == nullptr;
   if (whole && few_pairs(ctx)) {
     nearest_of_all_pairs(ctx, scratch, nearest, stats);
     return;

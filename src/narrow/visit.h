@@ -214,7 +214,7 @@ inline void prefetch_nodes(const PairContext& ctx, NodePair n) {
 }
 
 /// Asks memory for what the wide visit of node n reads after its BVH nodes: the descending side's
-/// wide node (five lines). Reads the BVH nodes (asked for a visit before).
+/// wide node (four lines). Reads the BVH nodes (asked for a visit before).
 inline void prefetch_wide(const PairContext& ctx, NodePair n) {
   const BvhNode& a = ctx.a().nodes[n.a];
   const BvhNode& b = ctx.b().nodes[n.b];

@@ -256,7 +256,7 @@ using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a
 unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
                           const WideNode& w, StayingCache* cache);
 
-/// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2.
+/// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2, FMA or F16C.
 WideTest wide_test_avx2_if_supported();
 
 /// The order keys of the slots of wide node w against the staying node whose stage-1 box `kept`

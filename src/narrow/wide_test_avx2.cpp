@@ -11,6 +11,7 @@
 #include <limits>
 
 #if defined(__x86_64__) && defined(__GNUC__)
+#include <cpuid.h>
 #include <immintrin.h>
 
 #include "narrow/lanes8_avx2.h"
@@ -258,8 +259,13 @@ CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const Wi
   _mm256_storeu_ps(keys, _mm256_div_ps(offset, add(extent, all(std::numeric_limits<float>::min()))));
 }
 
-/// Whether this CPU runs what this file builds (AVX2, FMA and F16C).
-bool avx2_and_fma() { return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c"); }
+/// Whether this CPU runs what this file builds (AVX2, FMA and F16C; F16C from CPUID leaf 1, as
+/// clang 14's __builtin_cpu_supports does not know it).
+bool avx2_and_fma() {
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  const bool f16c = __get_cpuid(1, &a, &b, &c, &d) != 0 && (c & bit_F16C) != 0;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c;
+}
 
 }  // namespace
 

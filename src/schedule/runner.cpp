@@ -12,10 +12,12 @@ namespace caliber::schedule {
 
 namespace {
 
-void finalize_into(StepState& state, std::size_t i, std::vector<narrow::Candidate>& all, const QueryStats& stats) {
+/// `contact_pair`: as_found where the pair was traversed whole (from its CD tree's root, one
+/// traversal on no taboo list: its contact at distance 0 is the pair's), else from_root.
+void finalize_into(StepState& state, std::size_t i, std::vector<narrow::Candidate>& all, const QueryStats& stats,
+                   narrow::ContactPair contact_pair) {
   state.candidates[i] = all.size();
-  state.results[i] =
-      narrow::finalize(state.contexts[i], all, stats, state.pairs[i], narrow::ContactPair::from_root, state.parallel_finalize);
+  state.results[i] = narrow::finalize(state.contexts[i], all, stats, state.pairs[i], contact_pair, state.parallel_finalize);
 }
 
 /// A pair that is one root of one task, from its CD tree's root and neither split nor on a taboo
@@ -44,7 +46,8 @@ std::vector<std::uint8_t> whole_pairs(const plans::Plan& plan, const std::vector
 }  // namespace
 
 void finalize_whole(StepState& state, std::size_t i, WorkerSlots& w) {
-  state.timeline.record(TaskSpan::Phase::finalize, i, [&] { finalize_into(state, i, w.candidates[i], w.stats[i]); });
+  state.timeline.record(TaskSpan::Phase::finalize, i,
+                        [&] { finalize_into(state, i, w.candidates[i], w.stats[i], narrow::ContactPair::as_found); });
 }
 
 void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
@@ -72,7 +75,7 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
         stats.node_tests += w->stats[i].node_tests;
         stats.leaf_tests += w->stats[i].leaf_tests;
       }
-      finalize_into(state, i, all, stats);
+      finalize_into(state, i, all, stats, narrow::ContactPair::from_root);
     });
   });
 }

@@ -9,13 +9,14 @@
 
 namespace caliber::util {
 
-/// The half nearest x toward zero (so no larger in magnitude), for finite x of magnitude below
-/// 65504; 0 below 2^-14 in magnitude, so that no half made here is subnormal.
+/// The half nearest x toward zero (so no larger in magnitude): 0 below 2^-14 in magnitude (and for
+/// NaN), so that no half made here is subnormal; the largest half (65504) beyond it.
 inline std::uint16_t half_toward_zero(float x) {
   const std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
   const auto sign = static_cast<std::uint16_t>(bits >> 16 & 0x8000u);
   const std::uint32_t magnitude = bits & 0x7FFFFFFFu;
-  if (!(std::abs(x) >= 0x1p-14f)) return 0;
+  if (!(std::abs(x) >= 0x1p-14f)) return 0;                                          // (NaN too)
+  if (!(std::abs(x) < 65520.0f)) return static_cast<std::uint16_t>(sign | 0x7BFFu);  // (never asked: the largest half)
   const std::uint32_t exponent = (magnitude >> 23) - 127u + 15u, mantissa = (magnitude >> 13) & 0x3FFu;
   return static_cast<std::uint16_t>(sign | exponent << 10 | mantissa);
 }

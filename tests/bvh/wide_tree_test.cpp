@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "bvh/model_data.h"
@@ -24,7 +25,8 @@ namespace {
 /// The first broken property of slot k of wide node w, BVH node s, in words: its slab axis is its
 /// filter's cut toward zero to a half float, and its bounds hold every vertex below s along that
 /// axis, no wider than the filter's by more than the axis's change can move them over s's box.
-std::string slot_slab_problem(const ModelData& m, std::uint32_t s, const WideNode& w, int k) {
+std::string slot_slab_problem(const ModelData& m, const std::vector<std::uint32_t>& by_place, std::uint32_t s, const WideNode& w,
+                              int k) {
   const BvhNodeFilter& f = m.filters[s];
   const BvhNode& n = m.nodes[s];
   double axis[3], moved = 0.0;
@@ -36,8 +38,6 @@ std::string slot_slab_problem(const ModelData& m, std::uint32_t s, const WideNod
       return "a slot's slab axis is not its node's cut to a half float";
     moved += std::abs(cut) * n.box_half[a];
   }
-  std::vector<std::uint32_t> by_place(m.leaf_position.size());
-  for (std::uint32_t t = 0; t < by_place.size(); ++t) by_place[m.leaf_position[t]] = t;
   const std::uint32_t first = m.first_leaf(s);
   for (std::uint32_t p = first; p < first + n.count; ++p) {
     for (const std::uint32_t v : m.mesh.triangles[by_place[p]]) {
@@ -57,6 +57,8 @@ std::string slot_slab_problem(const ModelData& m, std::uint32_t s, const WideNod
 std::string wide_problem(const ModelData& m) {
   std::vector<int> seen(m.nodes.size(), 0);
   seen[0] = 1;
+  std::vector<std::uint32_t> by_place(m.leaf_position.size());  // the triangle at each place of the leaf order
+  for (std::uint32_t t = 0; t < by_place.size(); ++t) by_place[m.leaf_position[t]] = t;
   for (std::uint32_t i = 0; i < m.nodes.size(); ++i) {
     // A visit reads the node's own box, its triangle or wide node, and its slot.
     const BvhNode& n = m.nodes[i];
@@ -100,7 +102,7 @@ std::string wide_problem(const ModelData& m) {
         box_lo[a] = std::min(box_lo[a], double(below));
         box_hi[a] = std::max(box_hi[a], double(above));
       }
-      if (std::string p = slot_slab_problem(m, s, node, k); !p.empty()) return p;
+      if (std::string p = slot_slab_problem(m, by_place, s, node, k); !p.empty()) return p;
     }
     if (next != m.first_leaf(i) + m.nodes[i].count) return "the slots do not cover their node's leaves";
     // The least step the grid's rules allow (wide_tree.cpp's set_grid).
@@ -130,16 +132,27 @@ TEST(WideTree, SlotsSplitTheirNodesLeavesInOrder) {
     const auto t = slivers.triangles[i * 3];
     slivers.triangles.push_back({t[0], t[1], t[0]});
   }
+  // A plate turned by 3e-5 about x: its faces' normals have a component below the least normal
+  // half (2^-14), which the slab axes drop (the slabs must still hold every vertex).
+  Mesh tilted = make_plate(2.0, 0.01, 16);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(3e-5, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (Eigen::Vector3d& v : tilted.vertices) v = turn * v;
   // A box so small that the grids' least step (2^-126) sets the steps of its upper nodes.
   Mesh tiny = make_box(1.0, 0.5, 0.25, 4);
   for (Eigen::Vector3d& v : tiny.vertices) v *= std::ldexp(1.0, -112);
   for (const Mesh& mesh : {make_torus(1.0, 0.35, 48, 24), make_sphere(0.5, 9, 11), make_box(1.0, 0.5, 0.25, 4),
-                           make_plate(2.0, 0.01, 16), far, slivers, tiny}) {
+                           make_plate(2.0, 0.01, 16), far, slivers, tiny, tilted}) {
     const auto model = build_model(mesh);
     EXPECT_EQ(wide_problem(data(*model)), "") << mesh.source;
     EXPECT_FALSE(data(*model).wide.empty());
   }
   EXPECT_EQ(data(*build_model(tiny)).wide[0].step(), 0x1p-126f) << "the least step sets the root's grid";
+  const auto turned = build_model(tilted);
+  std::size_t dropped = 0;  // axis components the halves drop
+  for (const BvhNodeFilter& f : data(*turned).filters) {
+    for (const float x : f.cone_axis) dropped += x != 0.0f && std::abs(x) < 0x1p-14f ? 1 : 0;
+  }
+  EXPECT_GT(dropped, 0u) << "the turned plate's slab axes have components below the least normal half";
 }
 
 // A wide node and a BVH node start a cache line and a node's filter lies in one: a visit reads four

@@ -62,7 +62,7 @@ void walk(const PairContext& ctx, const detail::WideLanes& lanes, std::size_t mo
 
 TEST(WideTest, ScalarAndAvx2FormsDecideAlike) {
   const detail::WideTest avx2 = detail::wide_test_avx2_if_supported();
-  if (avx2 == nullptr) GTEST_SKIP() << "no AVX2 and FMA on this CPU";
+  if (avx2 == nullptr) GTEST_SKIP() << "no AVX2, FMA and F16C on this CPU";
   const Mesh torus = make_torus(1.0, 0.35, 40, 24);
   const Eigen::Vector3d far(3e6, -2e6, 1e6);
   struct Case {
@@ -259,7 +259,7 @@ TEST(WideTest, TheAvx2LoopVisitsAsTheScalarOne) {
   // The traversal's loop built for AVX2 (its wide test inlined), as traverse_depth_first runs it,
   // against the same loop visiting with the scalar test: the same candidates in the same order,
   // the same counts.
-  if (kWideLoop == nullptr) GTEST_SKIP() << "no AVX2 and FMA on this CPU";
+  if (kWideLoop == nullptr) GTEST_SKIP() << "no AVX2, FMA and F16C on this CPU";
   const auto a = build_model(make_torus(1.0, 0.35, 30, 18));
   const auto b = build_model(sphere_with_slivers(20));
   std::mt19937_64 rng(9);
