@@ -56,6 +56,7 @@ QueryRequest sweep_distance_request(const GroupCompatibility* groups) {
   distance.groups = groups;
   distance.kind = QueryKind::distance;
   distance.tolerance = kUnbounded;
+  distance.first_hit = false;  // its poses are apart (the first one aside): the first hit would find nothing
   return distance;
 }
 

@@ -47,7 +47,8 @@ inline double sweep_tolerance(const SweepRequest& request, double radius, double
 }
 
 /// The distance request every query of a sweep makes: the closest pair, at any distance, among
-/// the triangle pairs whose groups may touch (`groups`: SweepRequest::groups).
+/// the triangle pairs whose groups may touch (`groups`: SweepRequest::groups), without the first
+/// hit (QueryRequest::first_hit: the sweep's poses are apart, but for the first).
 [[nodiscard]] QueryRequest sweep_distance_request(const GroupCompatibility* groups);
 
 /// A local advance first tries to prove this many global steps (the models' closest distance over

@@ -297,7 +297,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     nearest_of_all_pairs(ctx, scratch, nearest, stats);
     return;
   }
-  if (whole && stop_at_contact && first_hit(ctx, scratch, nearest, stats)) return;
+  if (whole && stop_at_contact && ctx.request().first_hit && first_hit(ctx, scratch, nearest, stats)) return;
   for (;;) {
     const double reach = ctx.reach_for(nearest.bound(ctx));
     if (!have_next) {

@@ -178,6 +178,18 @@ TEST(Distance, AtContactTheFirstHitIsReported) {
     EXPECT_EQ(near.contacts.front().distance, 0.0) << "pose " << i;
     EXPECT_EQ(near.contacts.front().tri_a, hit.contacts.front().tri_a) << "pose " << i;
     EXPECT_EQ(near.contacts.front().tri_b, hit.contacts.front().tri_b) << "pose " << i;
+    // Without the first hit: distance 0 too, on a pair the oracle's test finds intersecting.
+    QueryRequest alone = distance_request();
+    alone.first_hit = false;
+    const QueryResult own = query(*torus, pa, b, pb, alone);
+    ASSERT_EQ(own.contacts.size(), 1u);
+    EXPECT_EQ(own.contacts.front().distance, 0.0) << "pose " << i;
+    QueryRequest every;  // every intersecting pair
+    const QueryResult all = query(*torus, pa, b, pb, every);
+    EXPECT_TRUE(std::any_of(
+        all.contacts.begin(), all.contacts.end(),
+        [&](const Contact& x) { return x.tri_a == own.contacts.front().tri_a && x.tri_b == own.contacts.front().tri_b; }))
+        << "pose " << i;
   }
   EXPECT_GT(hits, 15) << "intersecting poses must be tested";
 }
@@ -337,11 +349,18 @@ TEST(Distance, EveryMethodAndThreadCountGivesTheQuerysAnswer) {
   for (std::uint32_t a = 0; a < 4; ++a) {
     for (std::uint32_t b = a + 1; b < 4; ++b) frame.pairs.push_back(ObjectPair{a, b});
   }
-  // Within a tolerance, and without one (any distance: every pair answers); the first contact at
-  // distance 0, and the lowest ids.
-  for (const auto& [tolerance, lowest_ids] : {std::pair{1.5, false}, std::pair{kUnbounded, false}, std::pair{kUnbounded, true}}) {
+  // Within a tolerance, and without one (any distance: every pair answers); at distance 0 the first
+  // hit, the distance traversal's own first contact (first_hit = false), and the lowest ids.
+  struct Case {
+    double tolerance;
+    bool lowest_ids, first_hit;
+  };
+  for (const Case c :
+       {Case{1.5, false, true}, Case{kUnbounded, false, true}, Case{kUnbounded, false, false}, Case{kUnbounded, true, true}}) {
+    const double tolerance = c.tolerance;
     frame.request = distance_request(tolerance);
-    frame.request.lowest_ids = lowest_ids;
+    frame.request.lowest_ids = c.lowest_ids;
+    frame.request.first_hit = c.first_hit;
     const std::vector<Contact> want = queries_of(frame);
     ASSERT_GE(want.size(), tolerance == kUnbounded ? 6u : 3u)
         << "most pairs must be within the tolerance for this to test anything";
