@@ -73,11 +73,12 @@ struct QueryRequest {
   bool lowest_ids = false;
   /// Distance queries without lowest_ids: true (default): the first hit is asked for before the
   /// distance traversal, and where the meshes intersect it is the answer (see lowest_ids). false:
-  /// the distance traversal runs alone and stops at the first intersecting pair it meets itself
-  /// (another pair than the first hit, the same for every method and thread count). For poses known
-  /// to be apart, where the first hit finds nothing and costs an interference query: caliber::sweep's
-  /// conservative advancement asks with false (its poses are apart but close, where that
-  /// interference query costs a fifth of a distance query). Ignored by the other kinds.
+  /// the distance traversal runs alone and stops at the first intersecting pairs it meets itself
+  /// (their lowest ids: another pair than the first hit, the same for every method and thread
+  /// count). For poses known to be apart, where the first hit finds nothing and costs an
+  /// interference query: caliber::sweep's conservative advancement asks with false (its poses are
+  /// apart but close, where that interference query costs a fifth of a distance query). Ignored by
+  /// the other kinds.
   bool first_hit = true;
 };
 

@@ -284,27 +284,31 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   // leaf_within's steps up to the refusal, which waits for the batch; the corners are read when it
   // is full, as above.
   if (mKind == QueryKind::contact && !normals_face(mA.normals[ta], mB.normals[tb], mRot, mCosTheta)) return;
-  if (mGroups != nullptr && !groups_allow(ta, tb)) return;
+  if (wait_leaf(ta, tb, buffer)) refuse_buffered(buffer, out, mRequest.tolerance, mReach);
+}
+
+bool PairContext::wait_leaf(std::uint32_t ta, std::uint32_t tb, LeafBuffer& buffer) const {
+  if (mGroups != nullptr && !groups_allow(ta, tb)) return false;
   BufferedPairs& waiting = buffer.refusal;
   waiting.ta[waiting.batch.size] = ta;
   waiting.tb[waiting.batch.size] = tb;
   __builtin_prefetch(&mA.mesh.triangles[ta]);
   __builtin_prefetch(&mB.mesh.triangles[tb]);
-  if (++waiting.batch.size == geometry::TriangleBatch::kLanes) refuse_buffered(buffer, out);
+  return ++waiting.batch.size == geometry::TriangleBatch::kLanes;
 }
 
-void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
+void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out, double bound, double reach) const {
   if (mKind == QueryKind::interference) {
     intersect_buffered(buffer.refusal, out);
     return;
   }
   gather_corners(buffer.refusal);
   // Within an unbounded reach (a distance query that tests every pair) nothing is apart.
-  const unsigned apart = mReach < kUnbounded ? geometry::triangles_apart_batch(buffer.refusal.batch, mReach) : 0u;
+  const unsigned apart = reach < kUnbounded ? geometry::triangles_apart_batch(buffer.refusal.batch, reach) : 0u;
   for (int l = 0; l < buffer.refusal.batch.size; ++l) {
     if ((apart >> l) & 1u) continue;
     buffer.closest.add(buffer.refusal, l);
-    if (buffer.closest.batch.full()) finish_buffered(buffer, out);
+    if (buffer.closest.batch.full()) finish_buffered(buffer, out, bound);
   }
   buffer.refusal.batch.size = 0;
 }
@@ -319,7 +323,7 @@ void PairContext::intersect_buffered(BufferedPairs& waiting, std::vector<Candida
   waiting.batch.size = 0;
 }
 
-void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const {
+void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out, double bound) const {
   BufferedPairs& waiting = buffer.closest;
   geometry::ClosestPointsBatch closest;
   geometry::closest_points_triangles_batch(waiting.batch, closest);
@@ -330,7 +334,7 @@ void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
     // "no").
     const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
     for (int l = 0; l < waiting.batch.size; ++l) {
-      keep_within(waiting.ta[l], waiting.tb[l], closest.get(l), ((meet >> l) & 1u) != 0, mRequest.tolerance, keep);
+      keep_within(waiting.ta[l], waiting.tb[l], closest.get(l), ((meet >> l) & 1u) != 0, bound, keep);
     }
     waiting.batch.size = 0;
     return;
@@ -338,15 +342,32 @@ void PairContext::finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
   for (int l = 0; l < waiting.batch.size; ++l) {
     Eigen::Vector3d a[3], b[3];
     waiting.batch.get(l, a, b);
-    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest.get(l), mRequest.tolerance, keep);
+    finish_leaf(waiting.ta[l], waiting.tb[l], a, b, closest.get(l), bound, keep);
   }
   waiting.batch.size = 0;
 }
 
 void PairContext::flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const {
   // An empty batch appends nothing: skipped (a traversal that reached no leaf pays nothing).
-  if (buffer.refusal.batch.size != 0) refuse_buffered(buffer, out);
-  if (buffer.closest.batch.size != 0) finish_buffered(buffer, out);
+  if (buffer.refusal.batch.size != 0) refuse_buffered(buffer, out, mRequest.tolerance, mReach);
+  if (buffer.closest.batch.size != 0) finish_buffered(buffer, out, mRequest.tolerance);
+}
+
+void PairContext::flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out, double bound) const {
+  if (buffer.refusal.batch.size != 0) refuse_buffered(buffer, out, bound, reach_for(bound));
+  if (buffer.closest.batch.size != 0) finish_buffered(buffer, out, bound);
+}
+
+double PairContext::sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
+  const BvhNode& na = mA.nodes[ia];
+  const BvhNode& nb = mB.nodes[ib];
+  double dist2 = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    // B's center in A's frame.
+    const double cb = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mNodeFrame.trans[i];
+    dist2 += square(na.center[i] - cb);
+  }
+  return dist2 / std::max(square(double(na.radius) + double(nb.radius)), std::numeric_limits<double>::min());
 }
 
 bool PairContext::leaf_distance(std::uint32_t ta, std::uint32_t tb, double bound, Candidate& out) const {

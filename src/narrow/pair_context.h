@@ -139,17 +139,7 @@ class PairContext {
   /// |c_a - c_b|^2 / (r_a + r_b)^2 (below 1 where they overlap, the less the deeper). Orders the
   /// distance traversal's pieces that stop at contact: they enter the most overlapping touching children
   /// first (visit_order.h).
-  [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const {
-    const BvhNode& na = mA.nodes[ia];
-    const BvhNode& nb = mB.nodes[ib];
-    double dist2 = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      // B's center in A's frame.
-      const double cb = mRot(i, 0) * nb.center[0] + mRot(i, 1) * nb.center[1] + mRot(i, 2) * nb.center[2] + mNodeFrame.trans[i];
-      dist2 += square(na.center[i] - cb);
-    }
-    return dist2 / std::max(square(double(na.radius) + double(nb.radius)), std::numeric_limits<double>::min());
-  }
+  [[nodiscard]] double sphere_apart(std::uint32_t ia, std::uint32_t ib) const;
 
   /// The CD tree's ratio for descending alone (cd_descend): kDescendAloneRatioDistance in a
   /// distance query, kDescendAloneRatio in the others.
@@ -235,6 +225,11 @@ class PairContext {
   void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
   /// Finishes the pairs waiting in `buffer` (their candidates appended to `out`) and empties it.
   void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const;
+  /// The same within `bound` (not the tolerance): leaf_distance's verdicts and candidates, in the
+  /// order the pairs came, for pairs put there by wait_leaf.
+  void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out, double bound) const;
+  /// Puts (ta, tb) in `buffer` unless groups refuse it: true when the batch is now full.
+  bool wait_leaf(std::uint32_t ta, std::uint32_t tb, LeafBuffer& buffer) const;
 
   /// The leaf test of a distance traversal: when the triangles are within `bound` (and allowed by
   /// groups), writes their distance and closest points to `out` and returns true. The arithmetic of
@@ -304,10 +299,10 @@ class PairContext {
   /// only place that calls it.
   template <class Keep>
   bool leaf_within(std::uint32_t ta, std::uint32_t tb, double bound, double reach, Keep&& keep) const;
-  /// The buffered refusal (the pairs it does not refuse move on), the buffered closest points (the
-  /// kept pairs appended to `out`).
-  void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
-  void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out) const;
+  /// The buffered refusal beyond `reach` (the pairs it does not refuse move on), the buffered
+  /// closest points (the pairs within `bound` appended to `out`).
+  void refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& out, double bound, double reach) const;
+  void finish_buffered(LeafBuffer& buffer, std::vector<Candidate>& out, double bound) const;
   /// The buffered interference tests (gather_corners, triangles_intersect_batch): the pairs that meet to `out`.
   void intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const;
   bool groups_can_touch(std::uint64_t ga, std::uint64_t gb) const;

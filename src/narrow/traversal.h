@@ -52,8 +52,11 @@ struct TraversalScratch {
   /// Wide traversals: the staying nodes moved, renewed by each (made by the first; 10.5 KB, kept
   /// off the thread's own storage).
   std::unique_ptr<detail::StayingCache> staying;
-  /// Distance traversal of a pair with few triangle pairs: the pairs within the tolerance.
+  /// Distance traversal of a pair with few triangle pairs: the pairs within the tolerance; of
+  /// others, what a batch of leaf pairs kept.
   std::vector<Candidate> within;
+  /// Distance traversal: the leaf pairs waiting for the batch kernels.
+  LeafBuffer leaves;
 
   /// Bytes held that grow with the largest traversal so far (not the buckets' fixed tables).
   [[nodiscard]] std::size_t footprint() const {
@@ -250,6 +253,33 @@ template <class Wait>
                  });
 }
 
+/// The leaf pairs of a distance traversal waiting in scratch.leaves (PairContext::wait_leaf),
+/// tested within the bound at once (the batch kernels), each kept pair offered to `nearest`: true
+/// where one is at distance 0 and the traversal stops at contact.
+inline bool nearest_of_leaves(const PairContext& ctx, TraversalScratch& scratch, Nearest& nearest, bool stop_at_contact) {
+  scratch.within.clear();
+  ctx.flush_leaves(scratch.leaves, scratch.within, nearest.bound(ctx));
+  bool contact = false;
+  for (const Candidate& c : scratch.within) {
+    nearest.offer(c);
+    contact = contact || c.distance == 0.0;
+  }
+  return stop_at_contact && contact;
+}
+
+/// A distance traversal's leaf pair (ta, tb): tested at once until one is kept (its bound prunes
+/// from then on), then waiting for the batch kernels, tested eight at a time when the batch is
+/// full or the traversal runs out of nodes (nearest_of_leaves), within the bound as it is then.
+/// True where the traversal stops (a pair at distance 0, stop_at_contact).
+inline bool leaf_pair(const PairContext& ctx, std::uint32_t ta, std::uint32_t tb, TraversalScratch& scratch, Nearest& nearest,
+                      bool stop_at_contact) {
+  if (nearest.found) return ctx.wait_leaf(ta, tb, scratch.leaves) && nearest_of_leaves(ctx, scratch, nearest, stop_at_contact);
+  Candidate c;
+  if (!ctx.leaf_distance(ta, tb, nearest.bound(ctx), c)) return false;
+  nearest.offer(c);
+  return stop_at_contact && c.distance == 0.0;
+}
+
 /// The distance traversal (branch and bound, best first) of the CD subtree rooted at `root`: the
 /// nodes that pass their test wait by their gap (PairContext::gap, a lower bound on the distance
 /// below them) in buckets of gaps within 1/256 of each other (util::GapBuckets); a node of the
@@ -259,10 +289,11 @@ template <class Wait>
 /// gap and the best distance, so any order within a bucket gives the same answer; a visited node's
 /// nearest child is visited next directly when no waiting node is in a nearer bucket. A node or
 /// pair exactly as close as the best is still examined, so ties go to the lowest ids; but at
-/// distance 0 (the meshes intersect) the traversal stops at the first pair it finds, unless the
-/// request asks for the lowest ids (QueryRequest::lowest_ids); so that it finds one sooner, among
-/// children at gap 0 the most overlapping spheres go first (touching_first). Counts node
-/// and leaf tests like traverse_depth_first; honours a taboo list the same way. (A binary heap's
+/// distance 0 (the meshes intersect) the traversal stops at the first batch of leaf pairs that
+/// holds one (leaf_pair), unless the request asks for the lowest ids (QueryRequest::lowest_ids);
+/// so that it finds one sooner, among children at gap 0 the most overlapping spheres go first
+/// (touching_first). Counts node and leaf tests like
+/// traverse_depth_first; honours a taboo list the same way. (A binary heap's
 /// sift took a large part of the bunny's time; the buckets are faster than a 4-ary heap too.)
 /// A whole traversal (from the root, no taboo list; its root passed, or tested here) of models
 /// with few triangle pairs tests every pair (nearest_of_all_pairs), ties at distance 0 too to the
@@ -298,11 +329,15 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     return;
   }
   if (whole && stop_at_contact && ctx.request().first_hit && first_hit(ctx, scratch, nearest, stats)) return;
+  scratch.leaves.refusal.batch.size = scratch.leaves.closest.batch.size = 0;
   for (;;) {
     const double reach = ctx.reach_for(nearest.bound(ctx));
     if (!have_next) {
-      // Done when every node still waiting is farther than the reach.
-      if (queue.empty() || queue.floor_of(queue.min_bucket()) > reach) break;
+      // Done when every node still waiting is farther than the reach, and no leaf pair waits.
+      if (queue.empty() || queue.floor_of(queue.min_bucket()) > reach) {
+        if (scratch.leaves.refusal.batch.size == 0 || nearest_of_leaves(ctx, scratch, nearest, stop_at_contact)) break;
+        continue;
+      }
       next = queue.pop();
     }
     have_next = false;
@@ -313,10 +348,7 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
     const BvhNode& b = ctx.b().nodes[n.b];
     if (a.is_leaf() && b.is_leaf()) {
       ++stats.leaf_tests;
-      if (Candidate c; ctx.leaf_distance(a.index, b.index, nearest.bound(ctx), c)) {
-        nearest.offer(c);
-        if (stop_at_contact && c.distance == 0.0) break;
-      }
+      if (leaf_pair(ctx, a.index, b.index, scratch, nearest, stop_at_contact)) break;
       continue;
     }
     Waiting kids[4];
