@@ -55,6 +55,15 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
 /// meshes must have a pair at distance 0.
 Candidate first_contact(const PairContext& ctx);
 
+/// Whether ctx's query is a distance query that asks for the first hit before its own traversal
+/// (not the lowest ids, QueryRequest::first_hit; more than kFewPairs triangle pairs).
+bool takes_first_hit(const PairContext& ctx);
+/// For such a query (takes_first_hit) on meshes that intersect: the first hit from the root, the
+/// pair's answer as caliber::query finds it, written to `hit` (its tests counted in `stats`), on
+/// the calling thread with its kept scratch: true. Else false. What a schedule asks before it cuts
+/// such a pair (its pieces would each look for a contact of their own).
+bool answered_by_first_hit(const PairContext& ctx, Candidate& hit, QueryStats& stats);
+
 /// One pair's whole query on the calling thread: the depth-first or distance traversal from the
 /// root (stopping at the request's max_pairs) and the finalization, with the thread's kept
 /// scratch and candidate storage (let go past 2 MiB). What caliber::query runs, and the batch for

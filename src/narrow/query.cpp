@@ -101,6 +101,20 @@ Candidate first_contact(const PairContext& ctx) {
   return nearest.best;
 }
 
+bool takes_first_hit(const PairContext& ctx) {
+  const QueryRequest& r = ctx.request();
+  return r.kind == QueryKind::distance && !r.lowest_ids && r.first_hit && !few_pairs(ctx);
+}
+
+bool answered_by_first_hit(const PairContext& ctx, Candidate& hit, QueryStats& stats) {
+  if (!takes_first_hit(ctx)) return false;
+  Nearest nearest;
+  const bool found = first_hit(ctx, t_scratch, nearest, stats);
+  let_go_if_large();
+  if (found) hit = nearest.best;
+  return found;
+}
+
 }  // namespace narrow
 
 QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "narrow/finalize.h"
 #include "parallel/executor.h"
 #include "plans/weights.h"
 
@@ -155,6 +156,7 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
   std::vector<Root> cart;
   cart.reserve(pairs.size());
   std::vector<std::size_t> to_split;
+  QueryStats unused;  // the first hits' tests: a kept pair's task counts its own
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Root whole{static_cast<std::uint32_t>(i), narrow::NodePair{0, 0}, false, w.weight[i]};
     switch (classify(w.weight[i], plan.omega, eps)) {
@@ -166,6 +168,13 @@ Plan plan_calibrated(const EngineOptions& options, const std::vector<ObjectPair>
         cart.push_back(whole);
         break;
       case Verdict::split:
+        // A distance pair the first hit answers (the meshes intersect): one task from the root,
+        // whose traversal finds that pair again (cut, its pieces would each look for a contact).
+        if (narrow::Candidate hit; narrow::answered_by_first_hit(contexts[i], hit, unused)) {
+          plan.run.push_back(RunTask{{whole}, w.weight[i]});
+          ++plan.kept;
+          break;
+        }
         to_split.push_back(i);
         break;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <functional>
 
+#include "narrow/finalize.h"
 #include "schedule/runner.h"
 #include "plans/weights.h"
 
@@ -70,24 +71,22 @@ std::vector<double> work_shares(const std::vector<ObjectPair>& pairs, const plan
   return share;
 }
 
-/// A heavy pair of a distance query that asks for the first hit (not the lowest ids; more than
-/// narrow::kFewPairs triangle pairs), its root passed: the first hit, as one piece on this worker.
-/// Where the meshes intersect it is the answer of the traversal from the root (caliber::query's:
-/// narrow::traverse_nearest), finalized here as found: true. Cut in pieces, each would look for a
-/// contact of its own with the distance bounds (two_small at 2 threads: 646 pieces and 8,125 node
-/// tests a step where the first hit takes 55). Else false (a pose apart: the pair is cut).
+/// A heavy pair of a distance query that narrow::answered_by_first_hit answers (meshes that
+/// intersect), its root passed: the first hit as one piece on this worker, finalized here as
+/// found: true. Cut in pieces, each would look for a contact of its own with the distance bounds
+/// (two_small at 2 threads: 646 pieces and 8,125 node tests a step where the first hit takes 55).
+/// Else false (the pair is cut).
 bool answered_by_first_hit(StepState& state, std::size_t pair, WorkerSlots& w) {
   const narrow::PairContext& ctx = state.contexts[pair];
-  const QueryRequest& r = ctx.request();
-  if (r.kind != QueryKind::distance || r.lowest_ids || !r.first_hit || narrow::few_pairs(ctx)) return false;
+  if (!narrow::takes_first_hit(ctx)) return false;
   bool found = false;
   state.timeline.record(TaskSpan::Phase::traverse, pair, [&] {
     const std::uint64_t before = w.stats[pair].node_tests;
-    narrow::Nearest nearest;
-    found = narrow::first_hit(ctx, w.scratch, nearest, w.stats[pair]);
+    narrow::Candidate hit;
+    found = narrow::answered_by_first_hit(ctx, hit, w.stats[pair]);
     w.pieces.push_back(w.stats[pair].node_tests - before);
     if (!found) return;
-    w.candidates[pair].push_back(nearest.best);
+    w.candidates[pair].push_back(hit);
     finalize_whole(state, pair, w);
   });
   return found;

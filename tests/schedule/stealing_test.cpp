@@ -94,32 +94,37 @@ TEST(Stealing, SplitsAPairThatHasJustComeIntoDeepContact) {
 
 TEST(Stealing, ADistancePairAtContactIsAnsweredByTheFirstHit) {
   // A torus through a sphere, a distance query: where the meshes intersect, caliber::query answers
-  // with the first hit. Cut for two threads, stealing asks for it too before it cuts the pair (its
-  // pieces would each look for a contact with the distance bounds): the same contact, the same
-  // node tests, one piece. Apart, the pair is cut as before.
+  // with the first hit. Cut for two threads, stealing and the calibrated methods ask for it too
+  // before they cut the pair (its pieces would each look for a contact with the distance bounds):
+  // the same contact, the same node tests, one piece. Apart, the pair is cut as before.
   const std::shared_ptr<const Model> torus = build_model(make_torus(0.8, 0.25, 48, 24));
   const std::shared_ptr<const Model> sphere = build_model(make_sphere(0.6, 24, 32));
-  Frame frame;
-  frame.models = {torus, sphere};
-  frame.poses = {Pose{}, Pose::from_values(0.75, 0, 0, 1, 0, 0, 0)};
-  frame.pairs = {ObjectPair{0, 1}};
-  frame.request.kind = QueryKind::distance;
-  frame.request.tolerance = kUnbounded;
-  Engine engine(cut_for_two_on_one());
-  const StepResult touching = engine.step(frame);
-  const QueryResult one = query(*torus, frame.poses[0], *sphere, frame.poses[1], frame.request);
-  ASSERT_EQ(one.contacts.size(), 1u);
-  ASSERT_EQ(one.contacts[0].distance, 0.0) << "the meshes must intersect";
-  ASSERT_EQ(touching.contacts.size(), 1u);
-  EXPECT_EQ(touching.contacts[0].tri_a, one.contacts[0].tri_a);
-  EXPECT_EQ(touching.contacts[0].tri_b, one.contacts[0].tri_b);
-  EXPECT_EQ(touching.pair_records[0].stats.node_tests, one.stats.node_tests);
-  EXPECT_EQ(touching.schedule->task_node_tests.size(), 1u) << "one piece: the first hit";
-  frame.poses[1] = Pose::from_values(2.5, 0, 0, 1, 0, 0, 0);
-  const StepResult apart = engine.step(frame);
-  ASSERT_EQ(apart.contacts.size(), 1u);
-  EXPECT_GT(apart.contacts[0].distance, 0.0);
-  EXPECT_GT(apart.schedule->task_node_tests.size(), 4u) << "apart, the pair is cut";
+  for (const Method method : {Method::stealing, Method::apriori, Method::aposteriori, Method::hybrid}) {
+    const std::string what{to_string(method)};
+    Frame frame;
+    frame.models = {torus, sphere};
+    frame.poses = {Pose{}, Pose::from_values(0.75, 0, 0, 1, 0, 0, 0)};
+    frame.pairs = {ObjectPair{0, 1}};
+    frame.request.kind = QueryKind::distance;
+    frame.request.tolerance = kUnbounded;
+    EngineOptions options = cut_for_two_on_one();
+    options.method = method;
+    Engine engine(options);
+    const StepResult touching = engine.step(frame);
+    const QueryResult one = query(*torus, frame.poses[0], *sphere, frame.poses[1], frame.request);
+    ASSERT_EQ(one.contacts.size(), 1u);
+    ASSERT_EQ(one.contacts[0].distance, 0.0) << "the meshes must intersect";
+    ASSERT_EQ(touching.contacts.size(), 1u) << what;
+    EXPECT_EQ(touching.contacts[0].tri_a, one.contacts[0].tri_a) << what;
+    EXPECT_EQ(touching.contacts[0].tri_b, one.contacts[0].tri_b) << what;
+    EXPECT_EQ(touching.pair_records[0].stats.node_tests, one.stats.node_tests) << what;
+    EXPECT_EQ(touching.schedule->task_node_tests.size(), 1u) << what << ": one piece, the first hit";
+    frame.poses[1] = Pose::from_values(2.5, 0, 0, 1, 0, 0, 0);
+    const StepResult apart = engine.step(frame);
+    ASSERT_EQ(apart.contacts.size(), 1u) << what;
+    EXPECT_GT(apart.contacts[0].distance, 0.0) << what;
+    EXPECT_GT(apart.schedule->task_node_tests.size(), 1u) << what << ": apart, the pair is cut";
+  }
 }
 
 }  // namespace
