@@ -120,7 +120,9 @@ inline constexpr std::size_t kCartFiner = 16;
 
 /// The calibrated methods (aposteriori, apriori, hybrid): weights, Omega = total / (beta * threads),
 /// keep, split (the weight-driven stage, or the a posteriori summary tree and taboo lists) or cart
-/// each pair, merge the cart, and hand the run-time tasks out heaviest first. `around_stage`,
+/// each pair, merge the cart, and hand the run-time tasks out heaviest first. A pair to split
+/// whose distance query the first hit answers (narrow::answered_by_first_hit, run here on the
+/// calling thread: the meshes intersect) is kept whole instead. `around_stage`,
 /// if set, is called with each split pair's index and its weight-driven stage, and must run it
 /// (the engine times it).
 using StageWrapper = std::function<void(std::size_t, const std::function<void()>&)>;

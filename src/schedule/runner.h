@@ -29,7 +29,9 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
 /// only as deep as its share asks), the other pairs whole, then each subtree traversed depth
 /// first; oneTBB's scheduler steals the pieces. Fills state.results and, in `record`, the pieces'
 /// node tests (largest first), the splitting's node tests, traverse_ms and finalize_ms. The node
-/// tests are exactly those of one depth-first traversal per pair.
+/// tests are exactly those of one depth-first traversal per pair. A heavy pair of a distance query
+/// that takes the first hit asks for it first (narrow::answered_by_first_hit, one piece): where
+/// the meshes intersect it is the pair's answer, finalized at once, and the pair is not cut.
 /// `threads`: the threads the work is cut for (EngineOptions::plan_threads, else the step's); on
 /// one, nothing is split (every pair runs whole: there is nothing to balance).
 void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, const plans::History& history, StepState& state,
