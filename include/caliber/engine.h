@@ -126,10 +126,11 @@ struct EngineOptions {
   /// Stealing: CD-tree depth from which a subtree is traversed serially by one job (the wide CD
   /// tree of interference, proximity and contact queries: at most the depth that gives about 32
   /// pieces a thread, 4 on 2 threads, 6 on 16, and for a pair with node tests last step the depth
-  /// that gives its share of those pieces). Only pairs whose share of the work (the larger of their
-  /// share of the a priori weight and of last step's node tests, a pair without them counting its
-  /// a priori weight scaled to node tests) is at least 1 / (64 x plan threads) are split; the
-  /// others run whole, in a parallel loop over them.
+  /// that gives its share of those pieces; the binary CD tree of distance queries at most the depth
+  /// whose 2^depth reaches 2 x threads, 2 on 2 threads, 5 on 16). Only pairs whose share of
+  /// the work (the larger of their share of the a priori weight and of last step's node tests, a
+  /// pair without them counting its a priori weight scaled to node tests) is at least
+  /// 1 / (64 x plan threads) are split; the others run whole, in a parallel loop over them.
   int stealing_depth = 10;
   /// Calibration: overthreading factor beta (> 0): Omega = total weight / (beta * threads).
   /// Default 6, measured (bench/results/amd-epyc-2c/engine/calibration_beta.md): with 2 threads, beta = 2

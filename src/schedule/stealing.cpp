@@ -35,6 +35,19 @@ int wide_depth(int threads, double share) {
   return depth;
 }
 
+/// A distance query's pieces each search best first with the pair's nearest distance so far, and
+/// until a piece finds a pair nothing bounds the others: cut deep, the pieces test far more than
+/// one traversal (two_small's knobs 0.001 to 0.26 apart on 2 threads: depth 10 took 2.5 to 3
+/// times depth 2's time, more than the pair run whole). So a distance pair is cut to the depth
+/// whose 2^depth reaches 2 x threads (a visit has two to four children: at least that many
+/// pieces where none is pruned): 2 on 2 threads (1.3 to 1.6 times faster than whole there), 5 on
+/// 16.
+int nearest_depth(int threads) {
+  int depth = 0;
+  while ((1L << depth) < 2L * threads) ++depth;
+  return depth;
+}
+
 /// Each pair's share of the step's work, as stealing cuts by it: the larger of its share of the a
 /// priori weight and its share of the weights that count node tests, last step's where the pair
 /// has some (else its a priori weight times the ratio of node tests to a priori weight over the
@@ -163,7 +176,7 @@ void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, 
   // Cut for one thread there is nothing to balance: every pair runs whole (no depth to split to).
   if (threads <= 1) depth = 0;
   const bool wide = n > 0 && narrow::wide_cd_tree(state.contexts[0]);
-  if (wide) depth = std::min(depth, wide_depth(threads, 1.0));
+  if (n > 0) depth = std::min(depth, wide ? wide_depth(threads, 1.0) : nearest_depth(threads));
   // Only a pair that may hold a good part of the step's work is split: one whose share of it is
   // at least 1 / (64 x threads). The lighter ones run whole, in a parallel loop over them
   // (splitting thousands of light pairs costs more than it balances), each finalized by the thread
