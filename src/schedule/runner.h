@@ -25,8 +25,9 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
 /// Stealing: the CD tree of every heavy pair (its share of the work at least 1 / (64 x threads):
 /// the larger of its share of the a priori weight and of the weights that count node tests, last
 /// step's from `history`, keyed by `pairs`, else the a priori weight scaled to node tests) split
-/// recursively into jobs down to `depth` (in the wide CD tree, a pair with node tests last step
-/// only as deep as its share asks), the other pairs whole, then each subtree traversed depth
+/// recursively into jobs down to `depth` (no deeper than wide_depth in the wide CD tree, where a
+/// pair with node tests last step goes only as deep as its share asks, and nearest_depth in a
+/// distance query's), the other pairs whole, then each subtree traversed depth
 /// first; oneTBB's scheduler steals the pieces. Fills state.results and, in `record`, the pieces'
 /// node tests (largest first), the splitting's node tests, traverse_ms and finalize_ms. The node
 /// tests are exactly those of one depth-first traversal per pair. A heavy pair of a distance query

@@ -37,10 +37,10 @@ int wide_depth(int threads, double share) {
 
 /// A distance query's pieces each search best first with the pair's nearest distance so far, and
 /// until a piece finds a pair nothing bounds the others: cut deep, the pieces test far more than
-/// one traversal (two_small's knobs 0.001 to 0.26 apart on 2 threads: depth 10 took 2.5 to 3
+/// one traversal (two_small's knobs 0.001 to 0.26 apart on 2 threads: depth 10 took 2.4 to 3.3
 /// times depth 2's time, more than the pair run whole). So a distance pair is cut to the depth
 /// whose 2^depth reaches 2 x threads (a visit has two to four children: at least that many
-/// pieces where none is pruned): 2 on 2 threads (1.3 to 1.6 times faster than whole there), 5 on
+/// pieces where none is pruned): 2 on 2 threads (1.2 to 1.5 times faster than whole there), 5 on
 /// 16.
 int nearest_depth(int threads) {
   int depth = 0;
