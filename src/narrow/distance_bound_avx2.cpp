@@ -1,4 +1,4 @@
-// The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
+// The distance bound of a visit's four child pairs in AVX2 lanes (built for AVX-512VL too) (a0 b0, a0 b1, a1 b0, a1 b1):
 // PairContext::gap's bounds (object-frame boxes, then frames_apart) in every lane, their larger,
 // frames_apart skipped once every lane is beyond the reach with the boxes' bound, each with
 // the scalar's operations in its order (this file is built with -ffp-contract=off, like the rest,
@@ -117,11 +117,21 @@ CALIBER_AVX2 void gaps_2x2(const BoundConstants& k, const NearA& a0, const NearA
 
 #undef CALIBER_AVX2
 
+/// The same bound built for AVX-512VL as well: the same operations on the same lanes
+/// (-ffp-contract=off fuses none), with 32 vector registers, where frames_apart's values fit.
+__attribute__((target("avx2,avx512f,avx512vl"), flatten)) void gaps_2x2_avx512vl(const BoundConstants& k, const NearA& a0,
+                                                                                 const NearA& a1, const NearB& b0,
+                                                                                 const NearB& b1, double reach, double out[4]) {
+  gaps_2x2(k, a0, a1, b0, b1, reach, out);
+}
+
 }  // namespace
 
-Gaps2x2 gaps_2x2_avx2_if_supported() {
+Gaps2x2 gaps_2x2_form(bool wide_registers) {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? &gaps_2x2 : nullptr;
+  if (!__builtin_cpu_supports("avx2")) return nullptr;
+  if (!wide_registers) return &gaps_2x2;
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") ? &gaps_2x2_avx512vl : nullptr;
 }
 
 }  // namespace caliber::narrow::detail
@@ -129,7 +139,7 @@ Gaps2x2 gaps_2x2_avx2_if_supported() {
 #else
 
 namespace caliber::narrow::detail {
-Gaps2x2 gaps_2x2_avx2_if_supported() { return nullptr; }
+Gaps2x2 gaps_2x2_form(bool) { return nullptr; }
 }  // namespace caliber::narrow::detail
 
 #endif

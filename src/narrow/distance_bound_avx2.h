@@ -21,7 +21,8 @@ struct BoundConstants {
 using Gaps2x2 = void (*)(const BoundConstants& constants, const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1,
                          double reach, double out[4]);
 
-/// The AVX2 form, or nullptr where this build or this CPU has none.
-Gaps2x2 gaps_2x2_avx2_if_supported();
+/// The AVX2 form, or (wide_registers) the same form built for AVX-512VL too (32 vector
+/// registers; the same values); nullptr where this build or this CPU has none.
+Gaps2x2 gaps_2x2_form(bool wide_registers);
 
 }  // namespace caliber::narrow::detail

@@ -273,9 +273,12 @@ template <class Test = ChosenWideTest>
 using WideLoop = void (*)(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size, std::vector<Candidate>& out,
                           QueryStats& stats, TabooView taboo, LeafBuffer& buffer, VisitLanes lanes);
 namespace detail {
-WideLoop wide_loop_avx2_if_supported();
+/// The loop built for AVX2, FMA and F16C, or (wide_registers) the same loop built for AVX-512VL
+/// too (32 vector registers); null where this CPU lacks what the form needs.
+WideLoop wide_loop_form(bool wide_registers);
 }  // namespace detail
-/// The AVX2 loop where this CPU has it (with kWideTest), else null, chosen when the library loads.
+/// The AVX-512VL loop where this CPU has it, else the AVX2 one, else null (with kWideTest),
+/// chosen when the library loads.
 extern const WideLoop kWideLoop;
 
 }  // namespace caliber::narrow

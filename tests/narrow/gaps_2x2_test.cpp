@@ -15,6 +15,7 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "narrow/distance_bound_avx2.h"
 #include "narrow/pair_context.h"
 #include "support/random_poses.h"
 
@@ -71,6 +72,34 @@ TEST(Gaps2x2, SameBoundsAsGap) {
   EXPECT_GT(within, 5000);
   EXPECT_GT(beyond, 5000);
   EXPECT_GT(forbidden, 100);
+}
+
+TEST(Gaps2x2, TheAvx512FormGivesTheAvx2FormsBits) {
+  // Both builds of the four-lane bound make the same operations: the same four values, bit for
+  // bit, within the reach and beyond it.
+  const detail::Gaps2x2 avx2 = detail::gaps_2x2_form(false), wide = detail::gaps_2x2_form(true);
+  if (avx2 == nullptr || wide == nullptr) GTEST_SKIP() << "no AVX-512VL on this CPU";
+  const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
+  const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
+  std::mt19937_64 rng(20261206);
+  QueryRequest request;
+  request.kind = QueryKind::distance;
+  const detail::BoundConstants constants{1e-12, 1.0 - 1e-12};
+  long compared = 0;
+  for (int p = 0; p < 24; ++p) {
+    const PairContext ctx(*a, test::random_pose(rng, 0.3), *b, test::random_pose(rng, p % 2 == 0 ? 1.2 : 3.0), request);
+    const double reach = ctx.reach_for(0.05 + 0.1 * (p % 5));
+    for (std::uint32_t i = 0; i + 1 < data(*a).nodes.size(); i += 7) {
+      for (std::uint32_t j = 0; j + 1 < data(*b).nodes.size(); j += 5) {
+        double x[4], y[4];
+        avx2(constants, ctx.near_a(i), ctx.near_a(i + 1), ctx.near_b(j), ctx.near_b(j + 1), reach, x);
+        wide(constants, ctx.near_a(i), ctx.near_a(i + 1), ctx.near_b(j), ctx.near_b(j + 1), reach, y);
+        for (int k = 0; k < 4; ++k) EXPECT_TRUE(same_bits(x[k], y[k])) << "pose " << p << " nodes " << i << ", " << j;
+        compared += 4;
+      }
+    }
+  }
+  EXPECT_GT(compared, 10000);
 }
 
 }  // namespace
