@@ -7,7 +7,8 @@
 
 namespace caliber::narrow {
 
-const detail::WideTest kWideTest = detail::wide_test_avx2_if_supported();
+const detail::WideTest kWideTest =
+    detail::wide_test_form(true) != nullptr ? detail::wide_test_form(true) : detail::wide_test_form(false);
 const WideLoop kWideLoop = detail::wide_loop_form(true) != nullptr ? detail::wide_loop_form(true) : detail::wide_loop_form(false);
 const detail::SlotOrderKeys kSlotOrderKeys = detail::slot_order_keys_avx2_if_supported();
 

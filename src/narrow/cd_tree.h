@@ -134,8 +134,9 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChil
 /// PairContext::node_lanes): made once by a traversal.
 detail::WideLanes wide_lanes(const PairContext& ctx);
 
-/// The AVX2 form of the wide node test where this CPU has it, else null (wide_pass then runs the
-/// scalar form: the same decisions), chosen when the library loads.
+/// The vector form of the wide node test where this CPU has one (built for AVX-512VL, else for
+/// AVX2), else null (wide_pass then runs the scalar form: the same decisions), chosen when the
+/// library loads.
 extern const detail::WideTest kWideTest;
 
 /// The AVX2 form of detail::SlotOrderKeys where this CPU has it, else null (the portable form,

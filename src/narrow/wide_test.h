@@ -256,8 +256,9 @@ using WideTest = unsigned (*)(const NodeTestFrame& f, const WideLanes& l, bool a
 unsigned wide_test_scalar(const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn,
                           const WideNode& w, StayingCache* cache);
 
-/// The AVX2 form, or nullptr where the CPU (or this build) has no AVX2, FMA or F16C.
-WideTest wide_test_avx2_if_supported();
+/// The AVX2 form, or (wide_registers) the same form built for AVX-512VL too (32 vector registers;
+/// the same decisions); nullptr where the CPU (or this build) lacks what the form needs.
+WideTest wide_test_form(bool wide_registers);
 
 /// The order keys of the slots of wide node w against the staying node whose stage-1 box `kept`
 /// holds (its box moved into w's frame, as floats): per slot, how far apart the two boxes' centers

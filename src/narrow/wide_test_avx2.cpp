@@ -255,6 +255,17 @@ __attribute__((target("avx2,fma,f16c,avx512f,avx512vl"), flatten)) void wide_loo
   visit_until_empty(ctx, stack, size, out, stats, taboo, buffer, lanes, InlinedTest{});
 }
 
+/// The wide test alone (where a visit calls it through kWideTest: a traversal with a limit, the
+/// cut of a split pair) built for AVX-512VL as well, as wide_loop_avx512vl.
+__attribute__((target("avx2,fma,f16c,avx512f,avx512vl"), flatten)) unsigned wide_test_avx512vl(
+    const NodeTestFrame& f, const WideLanes& l, bool a_descends, std::uint32_t stay, const BvhNode& sn, const WideNode& w,
+    StayingCache* cache) {
+  return wide_test_avx2(f, l, a_descends, stay, sn, w, cache);
+}
+
+/// Whether this CPU has AVX-512F and AVX-512VL (the forms built for their 32 registers).
+bool avx512vl() { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"); }
+
 /// slot_order_keys_portable in eight lanes: each lane its operations, in its order, unfused.
 CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const WideNode& w, float keys[WideNode::kSlots]) {
   const V step = all(w.step()), magnitude_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF));
@@ -278,12 +289,16 @@ bool avx2_and_fma() {
 
 }  // namespace
 
-WideTest wide_test_avx2_if_supported() { return avx2_and_fma() ? wide_test_avx2 : nullptr; }
+WideTest wide_test_form(bool wide_registers) {
+  if (!avx2_and_fma()) return nullptr;
+  if (!wide_registers) return wide_test_avx2;
+  return avx512vl() ? wide_test_avx512vl : nullptr;
+}
 
 WideLoop wide_loop_form(bool wide_registers) {
   if (!avx2_and_fma()) return nullptr;
   if (!wide_registers) return wide_loop_avx2;
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") ? wide_loop_avx512vl : nullptr;
+  return avx512vl() ? wide_loop_avx512vl : nullptr;
 }
 
 SlotOrderKeys slot_order_keys_avx2_if_supported() { return avx2_and_fma() ? slot_order_keys_avx2 : nullptr; }
@@ -293,7 +308,7 @@ SlotOrderKeys slot_order_keys_avx2_if_supported() { return avx2_and_fma() ? slot
 #else
 
 namespace caliber::narrow::detail {
-WideTest wide_test_avx2_if_supported() { return nullptr; }
+WideTest wide_test_form(bool) { return nullptr; }
 WideLoop wide_loop_form(bool) { return nullptr; }
 SlotOrderKeys slot_order_keys_avx2_if_supported() { return nullptr; }
 }  // namespace caliber::narrow::detail
