@@ -280,8 +280,10 @@ CALIBER_AVX2 void slot_order_keys_avx2(const StayingCache::Entry& kept, const Wi
 }
 
 /// Whether this CPU runs what this file builds (AVX2, FMA and F16C; F16C from CPUID leaf 1, as
-/// clang 14's __builtin_cpu_supports does not know it).
+/// clang 14's __builtin_cpu_supports does not know it). Called by the library's constants'
+/// initializers: the CPU's features are read first (__builtin_cpu_init), whatever runs before.
 bool avx2_and_fma() {
+  __builtin_cpu_init();
   unsigned a = 0, b = 0, c = 0, d = 0;
   const bool f16c = __get_cpuid(1, &a, &b, &c, &d) != 0 && (c & bit_F16C) != 0;
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c;
