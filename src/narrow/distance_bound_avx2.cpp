@@ -1,8 +1,9 @@
-// The distance bound of a visit's four child pairs in AVX2 lanes (built for AVX-512VL too) (a0 b0, a0 b1, a1 b0, a1 b1):
+// The distance bound of a visit's four child pairs in AVX2 lanes (a0 b0, a0 b1, a1 b0, a1 b1):
 // PairContext::gap's bounds (object-frame boxes, then frames_apart) in every lane, their larger,
 // frames_apart skipped once every lane is beyond the reach with the boxes' bound, each with
-// the scalar's operations in its order (this file is built with -ffp-contract=off, like the rest,
-// and only "avx2" is enabled here, not "fma").
+// the scalar's operations in its order: this file is built with -ffp-contract=off, like the rest,
+// so no multiply and add are fused, in the AVX2 build (which enables "avx2" alone, not "fma") or
+// in its AVX-512VL build (whose target would allow FMA instructions; none is emitted).
 
 #include "narrow/distance_bound_avx2.h"
 

@@ -164,15 +164,15 @@ int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::
 
 void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1, double reach,
                            double out[4]) const {
-  static const detail::Gaps2x2 avx2 =
+  static const detail::Gaps2x2 lanes =
       detail::gaps_2x2_form(true) != nullptr ? detail::gaps_2x2_form(true) : detail::gaps_2x2_form(false);
   const NearA* as[2] = {&a0, &a1};
   const NearB* bs[2] = {&b0, &b1};
-  if (avx2 == nullptr) {
+  if (lanes == nullptr) {
     for (int k = 0; k < 4; ++k) out[k] = gap(*as[k / 2], *bs[k % 2], reach);
     return;
   }
-  avx2(detail::BoundConstants{kRotationHair, kApartShrink}, a0, a1, b0, b1, reach, out);
+  lanes(detail::BoundConstants{kRotationHair, kApartShrink}, a0, a1, b0, b1, reach, out);
   // What gap adds to the geometry: groups that forbid every pair below.
   if (mGroups == nullptr) return;
   for (int k = 0; k < 4; ++k) {

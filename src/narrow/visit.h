@@ -268,8 +268,8 @@ template <class Test = ChosenWideTest>
   }
 }
 
-/// visit_until_empty on the wide CD tree, built for AVX2 with its wide test inlined
-/// (wide_test_avx2.cpp; the same visits and decisions), or null where the CPU has no AVX2.
+/// visit_until_empty on the wide CD tree with its wide test inlined, built for AVX2 or for
+/// AVX-512VL (wide_test_avx2.cpp; the same visits and decisions).
 using WideLoop = void (*)(const PairContext& ctx, std::vector<NodePair>& stack, std::size_t size, std::vector<Candidate>& out,
                           QueryStats& stats, TabooView taboo, LeafBuffer& buffer, VisitLanes lanes);
 namespace detail {

@@ -1,6 +1,7 @@
 // The wide node test in AVX2 (wide_test.h): the staying node moved in four double lanes, the
 // eight slots in eight float lanes; each lane makes wide_test_scalar's operations in its order
-// (the multiply-adds fused, as std::fma fuses them there).
+// (the multiply-adds fused, as std::fma fuses them there). The test and the traversal loop that
+// inlines it are built twice, for AVX2 and for AVX-512VL (its 32 registers): the same operations.
 
 #include "narrow/wide_test.h"
 

@@ -78,7 +78,7 @@ TEST(Gaps2x2, TheAvx512FormGivesTheAvx2FormsBits) {
   // Both builds of the four-lane bound make the same operations: the same four values, bit for
   // bit, within the reach and beyond it.
   const detail::Gaps2x2 avx2 = detail::gaps_2x2_form(false), wide = detail::gaps_2x2_form(true);
-  if (avx2 == nullptr || wide == nullptr) GTEST_SKIP() << "no AVX-512VL on this CPU";
+  if (avx2 == nullptr || wide == nullptr) GTEST_SKIP() << "no AVX2 or no AVX-512VL on this CPU";
   const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
   const auto b = build_model(make_box(0.6, 0.4, 0.3, 12));
   std::mt19937_64 rng(20261206);
