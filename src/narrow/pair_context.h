@@ -160,14 +160,23 @@ class PairContext {
   /// Prepares node ia of A for the distance bound.
   [[nodiscard]] NearA near_a(std::uint32_t ia) const {
     NearA s;
+    near_a(ia, s);
+    return s;
+  }
+  /// The same, written to s (a distance traversal prepares its nodes where it keeps them).
+  void near_a(std::uint32_t ia, NearA& s) const {
     fill_box_a(ia, s);
     OrientedBox computed;
     s.frame = own_frame(mA, ia, computed);
-    return s;
   }
   /// Prepares node ib of B for the distance bound.
   [[nodiscard]] NearB near_b(std::uint32_t ib) const {
     NearB s;
+    near_b(ib, s);
+    return s;
+  }
+  /// The same, written to s.
+  void near_b(std::uint32_t ib, NearB& s) const {
     fill_box_b(ib, s);
     OrientedBox computed;
     const OrientedBox& own = own_frame(mB, ib, computed);
@@ -181,7 +190,6 @@ class PairContext {
         s.frame.axis[k][i] = mRot(i, 0) * own.axis[k][0] + mRot(i, 1) * own.axis[k][1] + mRot(i, 2) * own.axis[k][2];
       }
     }
-    return s;
   }
 
   /// A lower bound on the distance between any triangles below two nodes, before the safety

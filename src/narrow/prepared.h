@@ -100,15 +100,18 @@ class PreparedTree {
   /// Bytes held, for a caller that keeps the scratch between calls.
   [[nodiscard]] std::size_t footprint() const { return mChunks.size() * kChunk * sizeof(Node); }
 
-  /// A new entry holding `prepared` (a traversal's root).
-  Node* root(const Prepared& prepared) { return hold(take(1), prepared); }
-  /// The entries of the children `first` and `first + 1` of `parent`'s node, made by prepare the
-  /// first time they are asked for (from then on, the same two).
+  /// A new entry for node `index` (a traversal's root), filled by prepare(index, entry).
+  template <class Prepare>
+  Node* root(std::uint32_t index, Prepare&& prepare) {
+    return hold(take(1), index, prepare);
+  }
+  /// The entries of the children `first` and `first + 1` of `parent`'s node, each filled by
+  /// prepare(index, entry) the first time they are asked for (from then on, the same two).
   template <class Prepare>
   Node* kids(Node& parent, std::uint32_t first, Prepare&& prepare) {
     if (parent.kids == nullptr) {
       Node* pair = take(2);
-      for (std::uint32_t i = 0; i < 2; ++i) hold(pair + i, prepare(first + i));
+      for (std::uint32_t i = 0; i < 2; ++i) hold(pair + i, first + i, prepare);
       parent.kids = pair;
     }
     return parent.kids;
@@ -116,9 +119,11 @@ class PreparedTree {
 
  private:
   static constexpr std::size_t kChunk = 64;
-  /// Fills a taken entry: the prepared node, no children yet.
-  static Node* hold(Node* node, const Prepared& prepared) {
-    static_cast<Prepared&>(*node) = prepared;
+  /// Fills a taken entry where it lies (no copy of the prepared node): node `index` prepared, no
+  /// children yet.
+  template <class Prepare>
+  static Node* hold(Node* node, std::uint32_t index, Prepare& prepare) {
+    prepare(index, static_cast<Prepared&>(*node));
     node->kids = nullptr;
     return node;
   }

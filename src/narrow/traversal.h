@@ -221,8 +221,8 @@ template <class Wait>
                                                  const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats,
                                                  TabooView taboo, Wait&& wait) {
   using Reached = TraversalScratch::Reached;
-  const auto prepare_a = [&](std::uint32_t i) { return ctx.near_a(i); };
-  const auto prepare_b = [&](std::uint32_t j) { return ctx.near_b(j); };
+  const auto prepare_a = [&](std::uint32_t i, PairContext::NearA& out) { ctx.near_a(i, out); };
+  const auto prepare_b = [&](std::uint32_t j, PairContext::NearB& out) { ctx.near_b(j, out); };
   bool descend_a, descend_b;
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
   TraversalScratch::NearA* const ka = descend_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
@@ -316,7 +316,8 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   bool have_next = false;
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
-    const Reached r{scratch.near_a.root(ctx.near_a(root.a)), scratch.near_b.root(ctx.near_b(root.b))};
+    const Reached r{scratch.near_a.root(root.a, [&](std::uint32_t i, PairContext::NearA& out) { ctx.near_a(i, out); }),
+                    scratch.near_b.root(root.b, [&](std::uint32_t j, PairContext::NearB& out) { ctx.near_b(j, out); })};
     const double root_gap = ctx.gap(*r.a, *r.b, reach);
     if (root_test == RootTest::done || (++stats.node_tests, root_gap <= reach)) {
       next = Waiting{root_gap, r};

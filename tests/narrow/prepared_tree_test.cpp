@@ -25,15 +25,15 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
   // random paths many times: far more entries than one chunk holds.
   constexpr std::uint32_t kDepth = 14;
   std::vector<int> made(std::size_t{1} << (kDepth + 1), 0);
-  const auto prepare = [&](std::uint32_t i) {
+  const auto prepare = [&](std::uint32_t i, Entry& out) {
     ++made[i];
-    return Entry{i, 0.5 * i};
+    out = Entry{i, 0.5 * i};
   };
   std::mt19937 rng(9);
   for (int round = 0; round < 2; ++round) {
     tree.clear();
     std::fill(made.begin(), made.end(), 0);
-    Tree::Node* root = tree.root(prepare(0));
+    Tree::Node* root = tree.root(0, prepare);
     std::vector<std::pair<Tree::Node*, Tree::Node*>> seen;  // (parent, its kids) as first made
     for (int walk = 0; walk < 3000; ++walk) {
       Tree::Node* node = root;
@@ -58,15 +58,15 @@ TEST(PreparedTree, EachNodePreparedOnceAndFoundAgain) {
 TEST(PreparedTree, ClearForgetsEveryEntry) {
   Tree tree;
   int made = 0;
-  const auto prepare = [&](std::uint32_t i) {
+  const auto prepare = [&](std::uint32_t i, Entry& out) {
     ++made;
-    return Entry{i, double(made)};
+    out = Entry{i, double(made)};
   };
-  Tree::Node* root = tree.root(prepare(7));
+  Tree::Node* root = tree.root(7, prepare);
   EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
   EXPECT_EQ(tree.kids(*root, 20, prepare)[1].value, 3.0);
   tree.clear();
-  root = tree.root(prepare(7));
+  root = tree.root(7, prepare);
   EXPECT_EQ(root->value, 4.0) << "made again after clear: a prepared node belongs to one pose";
   EXPECT_EQ(tree.kids(*root, 20, prepare)[0].value, 5.0);
   EXPECT_EQ(made, 6);
