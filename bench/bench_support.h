@@ -1,11 +1,14 @@
 #pragma once
-// What the mesh benches share without any peer library: where the meshes are, median timing and a
-// mesh's box. fcl_support.h adds FCL's side.
+// What the mesh benches share without any peer library: where the meshes are, median timing, the
+// checkout's commit and a mesh's box. fcl_support.h adds FCL's side.
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,6 +38,23 @@ inline double median_ms(int repeat, const std::function<void()>& f) {
   }
   std::sort(times.begin(), times.end());
   return times[times.size() / 2];
+}
+
+/// The median of v (the upper one of an even count).
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// The short hash of the checkout's HEAD ("unknown" outside one): a bench's commit when it is not given.
+inline std::string git_commit() {
+  char buffer[64] = "";
+  if (FILE* pipe = popen("git rev-parse --short HEAD 2>/dev/null", "r")) {
+    if (std::fgets(buffer, sizeof buffer, pipe) == nullptr) buffer[0] = '\0';
+    pclose(pipe);
+  }
+  const std::string out(buffer, std::strcspn(buffer, "\r\n"));
+  return out.empty() ? "unknown" : out;
 }
 
 /// The axis-aligned box of a mesh's vertices: its low and high corners.

@@ -3,7 +3,10 @@
 // triangle's float box) on 1 and 2 threads, its candidates through caliber's exact test, on five
 // posed pairs of CGAL meshes in interleaved rounds (medians); both pair sets and Embree's build of B.
 //
-//   bench_embree_compare [--meshes DIR] [--rounds R] [--out FILE.md] [--commit HASH]
+//   bench_embree_compare [--meshes DIR] [--rounds R] [--calls N] [--out FILE.md] [--commit HASH]
+//
+// --calls N: each contender's time in a round is the median of N calls in a row after its warm-up
+// call (1, the default: one call, with the caches as the other contenders left them).
 
 #include <algorithm>
 #include <array>
@@ -40,6 +43,8 @@
 
 namespace {
 
+using caliber::bench::git_commit;
+using caliber::bench::median;
 using caliber::bench::median_ms;
 using TriPair = std::pair<std::uint32_t, std::uint32_t>;  // (triangle of A, triangle of B)
 using Vertices = std::vector<Eigen::Vector3d>;
@@ -173,8 +178,8 @@ struct EmbreeRun {
 
 /// One Embree turn on a device of its own, the only one alive ("threads=N": Embree 3 on TBB caps all
 /// threads at the largest count of the live devices, one tbb::global_control). B's build (posing, then
-/// the scene) and rtcCollide (after an untimed warm-up call) are timed once each; A's build is not.
-EmbreeRun run_embree(const Prepared& p, int threads) {
+/// the scene) is timed once, rtcCollide (after an untimed warm-up call) `calls` times; A's build is not.
+EmbreeRun run_embree(const Prepared& p, int threads, int calls) {
   const std::string config = "threads=" + std::to_string(threads);
   RTCDevice device = rtcNewDevice(config.c_str());
   if (device == nullptr) fail("rtcNewDevice(\"" + config + "\") failed", 1);
@@ -190,14 +195,16 @@ EmbreeRun run_embree(const Prepared& p, int threads) {
   });
   Collector warm(ga, gb);
   rtcCollide(scene_a, scene_b, collide_pairs, &warm);
-  Collector timed(ga, gb);
-  run.collide_ms = median_ms(1, [&] { rtcCollide(scene_a, scene_b, collide_pairs, &timed); });
+  std::deque<Collector> timed;  // one a call, made before the clock starts
+  for (int k = 0; k < calls; ++k) timed.emplace_back(ga, gb);
+  std::size_t call = 0;
+  run.collide_ms = median_ms(calls, [&] { rtcCollide(scene_a, scene_b, collide_pairs, &timed[call++]); });
   if (rtcGetDeviceError(device) != RTC_ERROR_NONE) fail("Embree reported an error on " + p.c.name, 1);
-  for (const Collector::Hits& h : timed.hits) {
+  for (const Collector::Hits& h : timed.back().hits) {
     run.pairs.insert(run.pairs.end(), h.pairs.begin(), h.pairs.end());
     run.candidates += h.candidates;
   }
-  run.threads = timed.hits.size();
+  run.threads = timed.back().hits.size();
   std::sort(run.pairs.begin(), run.pairs.end());
   rtcReleaseScene(scene_b);
   rtcReleaseScene(scene_a);
@@ -241,31 +248,26 @@ void compare_sets(const Prepared& p, const std::vector<TriPair>& ours, const Emb
 }
 
 /// One round of one case: every contender once, each after an untimed warm-up call.
-void run_round(const Prepared& p, caliber::Engine& stealing, bool first, Row& row) {
+void run_round(const Prepared& p, caliber::Engine& stealing, bool first, int calls, Row& row) {
   const caliber::Pose identity;
   caliber::QueryRequest request;  // interference: every intersecting triangle pair
   caliber::QueryResult seq = caliber::query(*p.a, identity, *p.b, p.pose_b, request);
-  row.seq_ms.push_back(median_ms(1, [&] { seq = caliber::query(*p.a, identity, *p.b, p.pose_b, request); }));
+  row.seq_ms.push_back(median_ms(calls, [&] { seq = caliber::query(*p.a, identity, *p.b, p.pose_b, request); }));
   const std::vector<TriPair> ours = pairs_of(seq.contacts);
   row.leaf_tests = seq.stats.leaf_tests;
-  const EmbreeRun one = run_embree(p, 1);
+  const EmbreeRun one = run_embree(p, 1, calls);
   row.embree1_ms.push_back(one.collide_ms);
   row.build_ms.push_back(one.build_ms);
   if (first) compare_sets(p, ours, one, row);
   row.threads_1 = std::max(row.threads_1, one.threads);
   caliber::Frame frame{{p.a, p.b}, {identity, p.pose_b}, {{0, 1}}, request};
   caliber::StepResult step = stealing.step(frame);
-  row.stealing_ms.push_back(median_ms(1, [&] { step = stealing.step(frame); }));
+  row.stealing_ms.push_back(median_ms(calls, [&] { step = stealing.step(frame); }));
   row.stealing_same = row.stealing_same && pairs_of(step.contacts) == ours;
-  const EmbreeRun two = run_embree(p, 2);
+  const EmbreeRun two = run_embree(p, 2, calls);
   row.embree2_ms.push_back(two.collide_ms);
   row.embree_stable = row.embree_stable && two.pairs == one.pairs && one.pairs.size() == row.pairs_embree;
   row.threads_2 = std::max(row.threads_2, two.threads);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 /// Appends a case's line to the main table and to the details table.
@@ -285,7 +287,7 @@ void format_row(const Prepared& p, const Row& r, std::string& table, std::string
 
 struct Options {
   std::filesystem::path meshes = caliber::bench::default_meshes_dir();
-  int rounds = 5;
+  int rounds = 5, calls = 1;
   std::string out, commit, command;
 };
 
@@ -295,32 +297,21 @@ Options parse(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) o.command += std::string(" ") + argv[i];
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg != "--meshes" && arg != "--rounds" && arg != "--out" && arg != "--commit")
-      fail("unknown option " + arg + " (options: --meshes DIR --rounds R --out FILE.md --commit HASH)", 2);
+    if (arg != "--meshes" && arg != "--rounds" && arg != "--calls" && arg != "--out" && arg != "--commit")
+      fail("unknown option " + arg + " (options: --meshes DIR --rounds R --calls N --out FILE.md --commit HASH)", 2);
     if (i + 1 >= argc) fail(arg + " needs a value", 2);
     const std::string value = argv[++i];
     if (arg == "--meshes") o.meshes = value;
     if (arg == "--out") o.out = value;
     if (arg == "--commit") o.commit = value;
-    if (arg == "--rounds") {
+    if (arg == "--rounds" || arg == "--calls") {
       char* end = nullptr;
       const long r = std::strtol(value.c_str(), &end, 10);
-      if (value.empty() || *end != '\0' || r < 1 || r > 1000) fail("--rounds needs an integer in 1..1000, got " + value, 2);
-      o.rounds = static_cast<int>(r);
+      if (value.empty() || *end != '\0' || r < 1 || r > 1000) fail(arg + " needs an integer in 1..1000, got " + value, 2);
+      (arg == "--rounds" ? o.rounds : o.calls) = static_cast<int>(r);
     }
   }
   return o;
-}
-
-/// The short hash of the checkout's HEAD ("unknown" outside one), when --commit is not given.
-std::string git_commit() {
-  char buffer[64] = "";
-  if (FILE* pipe = popen("git rev-parse --short HEAD 2>/dev/null", "r")) {
-    if (std::fgets(buffer, sizeof buffer, pipe) == nullptr) buffer[0] = '\0';
-    pclose(pipe);
-  }
-  const std::string out(buffer, std::strcspn(buffer, "\r\n"));
-  return out.empty() ? "unknown" : out;
 }
 
 /// Loads each case whose meshes are in `dir` (a note on stderr for the others) and poses B.
@@ -348,7 +339,9 @@ std::string header_of(const Options& o) {
   std::strftime(today, sizeof today, "%Y-%m-%d", std::gmtime(&now));
   return "# caliber vs Embree " RTC_VERSION_STRING " rtcCollide: interference, every intersecting triangle pair\n\nMachine: " +
          caliber::bench::machine_description() + "\n\nDate: " + today + ", commit " + o.commit + ", " + std::to_string(o.rounds) +
-         " interleaved rounds, medians\n\nCommand: `" + o.command + "`\n\n" +
+         " interleaved rounds, medians" +
+         (o.calls > 1 ? " of " + std::to_string(o.calls) + " calls in a row in each" : std::string()) + "\n\nCommand: `" +
+         o.command + "`\n\n" +
          "A at the identity, B posed. Embree: user geometry (a triangle's double box rounded outward to floats), "
          "every candidate through caliber's exact test; one device alive at a time (`threads=1`, then `threads=2`), "
          "A's and B's scenes built at the start of its turn. B build: posing B's vertices and rtcCommitScene (caliber "
@@ -379,7 +372,7 @@ int main(int argc, char** argv) {
   caliber::Engine stealing(options);
   std::vector<Row> rows(prepared.size());
   for (int round = 0; round < o.rounds; ++round) {
-    for (std::size_t i = 0; i < prepared.size(); ++i) run_round(prepared[i], stealing, round == 0, rows[i]);
+    for (std::size_t i = 0; i < prepared.size(); ++i) run_round(prepared[i], stealing, round == 0, o.calls, rows[i]);
   }
   std::string table =
       "| pair | triangles A × B | contacts caliber | contacts Embree | only caliber | only Embree | caliber seq (ms) | "
