@@ -159,7 +159,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
   return stage_root_tests;
 }
 
-void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
+void gather_step(const std::vector<ObjectPair>& pairs, std::vector<QueryResult>& results,
                  const std::vector<std::size_t>& candidates, StepResult& out) {
   const std::size_t n = pairs.size();
   out.limit_reached = false;
@@ -174,16 +174,25 @@ void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryRe
     out.stats.leaf_tests += r.stats.leaf_tests;
   }
   out.pair_records.resize(n);
+  const auto record = [&](std::size_t i) {
+    const QueryResult& r = results[i];
+    out.pair_records[i] =
+        PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached, i < candidates.size() ? candidates[i] : 0};
+    CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
+                               [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
+                   "the finalization wrote the pair's object ids");
+  };
+  if (n == 1) {  // the pair's contacts are the step's: moved, not copied
+    record(0);
+    out.contacts = std::move(results[0].contacts);
+    return;
+  }
   out.contacts.resize(at[n]);
   parallel::parallel_for(0, n, 1024, [&](std::size_t first, std::size_t last) {
     for (std::size_t i = first; i != last; ++i) {
-      const QueryResult& r = results[i];
-      out.pair_records[i] =
-          PairRecord{pairs[i], r.stats, r.contacts.size(), r.limit_reached, i < candidates.size() ? candidates[i] : 0};
-      CALIBER_ASSERT(std::all_of(r.contacts.begin(), r.contacts.end(),
-                                 [&](const Contact& c) { return c.object_a == pairs[i].a && c.object_b == pairs[i].b; }),
-                     "the finalization wrote the pair's object ids");
-      std::copy(r.contacts.begin(), r.contacts.end(), out.contacts.begin() + static_cast<std::ptrdiff_t>(at[i]));
+      record(i);
+      std::copy(results[i].contacts.begin(), results[i].contacts.end(),
+                out.contacts.begin() + static_cast<std::ptrdiff_t>(at[i]));
     }
   });
 }

@@ -136,8 +136,9 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
 /// are sorted and each result is sorted, so the concatenation is canonical). Fills out.pair_records,
 /// out.contacts and out.stats (each record with its pair's entry of `candidates`, 0 past its
 /// end), the pairs in parallel on the executor the caller runs in. Each
-/// result's contacts carry its pair's object ids already.
-void gather_step(const std::vector<ObjectPair>& pairs, const std::vector<QueryResult>& results,
+/// result's contacts carry its pair's object ids already. A lone pair's contacts are moved out of
+/// its result (the step's contacts are its contacts), the others copied.
+void gather_step(const std::vector<ObjectPair>& pairs, std::vector<QueryResult>& results,
                  const std::vector<std::size_t>& candidates, StepResult& out);
 
 }  // namespace caliber::schedule

@@ -511,6 +511,40 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
   EXPECT_GT(contacts, 0u) << "a test that compares empty answers proves nothing";
 }
 
+TEST(EngineFrames, AFrameOfOnePairGivesThatPairsAnswerWithEveryMethod) {
+  // One pair: the step's contacts are the pair's (moved, not copied, into the step), as the query
+  // gives them, with the frame's object ids.
+  Frame frame = memory_frame(0.4);  // the torus's tube through the sphere
+  frame.pairs = {ObjectPair{0, 1}};
+  frame.request.kind = QueryKind::interference;
+  const QueryResult want = query(*frame.models[0], frame.poses[0], *frame.models[1], frame.poses[1], frame.request);
+  ASSERT_GT(want.contacts.size(), 0u) << "a test that compares empty answers proves nothing";
+  for (const Method method :
+       {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
+    EngineOptions options;
+    options.method = method;
+    options.threads = 2;
+    Engine engine(options);
+    for (int k = 0; k < 2; ++k) {
+      const StepResult got = engine.step(frame);
+      ASSERT_EQ(got.pair_records.size(), 1u);
+      EXPECT_EQ(got.pair_records[0].contacts, want.contacts.size()) << to_string(method);
+      EXPECT_EQ(got.stats.node_tests, got.pair_records[0].stats.node_tests) << to_string(method);
+      ASSERT_EQ(got.contacts.size(), want.contacts.size()) << to_string(method);
+      for (std::size_t i = 0; i < want.contacts.size(); ++i) {
+        const Contact &g = got.contacts[i], &c = want.contacts[i];
+        ASSERT_EQ(g.object_a, 0u);
+        ASSERT_EQ(g.object_b, 1u);
+        ASSERT_EQ(g.tri_a, c.tri_a) << to_string(method) << " contact " << i;
+        ASSERT_EQ(g.tri_b, c.tri_b) << to_string(method) << " contact " << i;
+        ASSERT_EQ(g.point_a, c.point_a);
+        ASSERT_EQ(g.normal, c.normal);
+        ASSERT_EQ(g.distance, c.distance);
+      }
+    }
+  }
+}
+
 TEST(EngineFrames, EveryMethodRecordsItsTraversalAndFinalization) {
   const Frame frame = memory_frame(0.8);
   for (const Method method :
