@@ -157,26 +157,14 @@ class PairContext {
   using NearA = narrow::NearA;
   using NearB = narrow::NearB;
 
-  /// Prepares node ia of A for the distance bound.
-  [[nodiscard]] NearA near_a(std::uint32_t ia) const {
-    NearA s;
-    near_a(ia, s);
-    return s;
-  }
-  /// The same, written to s (a distance traversal prepares its nodes where it keeps them).
-  void near_a(std::uint32_t ia, NearA& s) const {
+  /// Prepares node ia of A for the distance bound, in s (where a distance traversal keeps it).
+  void near(std::uint32_t ia, NearA& s) const {
     fill_box_a(ia, s);
     OrientedBox computed;
     s.frame = own_frame(mA, ia, computed);
   }
-  /// Prepares node ib of B for the distance bound.
-  [[nodiscard]] NearB near_b(std::uint32_t ib) const {
-    NearB s;
-    near_b(ib, s);
-    return s;
-  }
-  /// The same, written to s.
-  void near_b(std::uint32_t ib, NearB& s) const {
+  /// Prepares node ib of B for the distance bound, in s.
+  void near(std::uint32_t ib, NearB& s) const {
     fill_box_b(ib, s);
     OrientedBox computed;
     const OrientedBox& own = own_frame(mB, ib, computed);
@@ -199,9 +187,8 @@ class PairContext {
   /// box and the box around the other's along the first one's axes (in A's frame, then in B's;
   /// along orthonormal axes the squared gaps add up to a squared distance) and, when that is within
   /// `reach`, the Frames' separation along the direction between a point of each (frames_apart).
-  /// (The spheres' gap and the Frames' gaps along their own six axes were part of it up to stop
-  /// 35: counted on bench_fcl_distance's cases, they alone refused almost none of the child pairs
-  /// these two let through, for about a third of the bound's arithmetic.)
+  /// (The spheres' gap and the Frames' gaps along their own six axes refused almost none of the
+  /// child pairs these two let through on bench_fcl_distance's cases: not part of it.)
   [[nodiscard]] double gap(const NearA& a, const NearB& b, double reach) const {
     double boxes_a = 0.0, boxes_b = 0.0;
     for (int i = 0; i < 3; ++i) {

@@ -37,8 +37,10 @@ double triangle_reach(const Mesh& mesh, std::uint32_t t) {
 /// separates the boxes separates every pair below; infinity when groups forbid every pair.
 double node_advance(const PairContext& ctx, const LocalMotion& m, const Eigen::Vector3d& along_b, std::uint32_t ia,
                     std::uint32_t ib) {
-  const PairContext::NearA a = ctx.near_a(ia);
-  const PairContext::NearB b = ctx.near_b(ib);
+  PairContext::NearA a;
+  PairContext::NearB b;
+  ctx.near(ia, a);
+  ctx.near(ib, b);
   const double gap = ctx.gap(a, b, kUnbounded);
   if (gap == kUnbounded) return gap;
   const double turns = m.turn_a * node_reach(ctx.a(), ia) + m.turn_b * node_reach(ctx.b(), ib);

@@ -221,12 +221,11 @@ template <class Wait>
                                                  const BvhNode& a, const BvhNode& b, double reach, QueryStats& stats,
                                                  TabooView taboo, Wait&& wait) {
   using Reached = TraversalScratch::Reached;
-  const auto prepare_a = [&](std::uint32_t i, PairContext::NearA& out) { ctx.near_a(i, out); };
-  const auto prepare_b = [&](std::uint32_t j, PairContext::NearB& out) { ctx.near_b(j, out); };
+  const auto prepare = [&](std::uint32_t i, auto& out) { ctx.near(i, out); };
   bool descend_a, descend_b;
   cd_descend(a, b, ctx.descend_alone_ratio(), descend_a, descend_b);
-  TraversalScratch::NearA* const ka = descend_a ? scratch.near_a.kids(*r.a, a.index, prepare_a) : nullptr;
-  TraversalScratch::NearB* const kb = descend_b ? scratch.near_b.kids(*r.b, b.index, prepare_b) : nullptr;
+  TraversalScratch::NearA* const ka = descend_a ? scratch.near_a.kids(*r.a, a.index, prepare) : nullptr;
+  TraversalScratch::NearB* const kb = descend_b ? scratch.near_b.kids(*r.b, b.index, prepare) : nullptr;
   if (descend_a && descend_b) {
     // Both sides descend: the four child pairs' bounds at once, then taken in cd_children order
     // as for_each_child takes them (a child on the taboo list marked reached, not counted).
@@ -316,8 +315,8 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
   bool have_next = false;
   {
     const double reach = ctx.reach_for(nearest.bound(ctx));
-    const Reached r{scratch.near_a.root(root.a, [&](std::uint32_t i, PairContext::NearA& out) { ctx.near_a(i, out); }),
-                    scratch.near_b.root(root.b, [&](std::uint32_t j, PairContext::NearB& out) { ctx.near_b(j, out); })};
+    const auto prepare = [&](std::uint32_t i, auto& out) { ctx.near(i, out); };
+    const Reached r{scratch.near_a.root(root.a, prepare), scratch.near_b.root(root.b, prepare)};
     const double root_gap = ctx.gap(*r.a, *r.b, reach);
     if (root_test == RootTest::done || (++stats.node_tests, root_gap <= reach)) {
       next = Waiting{root_gap, r};

@@ -24,6 +24,14 @@ namespace {
 
 bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
 
+/// Node i of A (Near = NearA) or of B (NearB) prepared for the distance bound, as a value.
+template <class Near>
+Near near_of(const PairContext& ctx, std::uint32_t i) {
+  Near s;
+  ctx.near(i, s);
+  return s;
+}
+
 TEST(Gaps2x2, SameBoundsAsGap) {
   const auto a = build_model(make_torus(1.0, 0.35, 40, 24));
   Mesh box = make_box(0.6, 0.4, 0.3, 12);
@@ -50,8 +58,10 @@ TEST(Gaps2x2, SameBoundsAsGap) {
       const BvhNode& na = data(*a).nodes[work[w].first];
       const BvhNode& nb = data(*b).nodes[work[w].second];
       if (na.is_leaf() || nb.is_leaf()) continue;
-      const PairContext::NearA sa[2] = {ctx.near_a(na.index), ctx.near_a(na.index + 1)};
-      const PairContext::NearB sb[2] = {ctx.near_b(nb.index), ctx.near_b(nb.index + 1)};
+      const PairContext::NearA sa[2] = {near_of<PairContext::NearA>(ctx, na.index),
+                                        near_of<PairContext::NearA>(ctx, na.index + 1)};
+      const PairContext::NearB sb[2] = {near_of<PairContext::NearB>(ctx, nb.index),
+                                        near_of<PairContext::NearB>(ctx, nb.index + 1)};
       double gaps[4];
       ctx.gaps_2x2(sa[0], sa[1], sb[0], sb[1], reach, gaps);
       for (std::uint32_t k = 0; k < 4; ++k) {
@@ -92,8 +102,10 @@ TEST(Gaps2x2, TheAvx512FormGivesTheAvx2FormsBits) {
     for (std::uint32_t i = 0; i + 1 < data(*a).nodes.size(); i += 7) {
       for (std::uint32_t j = 0; j + 1 < data(*b).nodes.size(); j += 5) {
         double x[4], y[4];
-        avx2(constants, ctx.near_a(i), ctx.near_a(i + 1), ctx.near_b(j), ctx.near_b(j + 1), reach, x);
-        wide(constants, ctx.near_a(i), ctx.near_a(i + 1), ctx.near_b(j), ctx.near_b(j + 1), reach, y);
+        avx2(constants, near_of<PairContext::NearA>(ctx, i), near_of<PairContext::NearA>(ctx, i + 1),
+             near_of<PairContext::NearB>(ctx, j), near_of<PairContext::NearB>(ctx, j + 1), reach, x);
+        wide(constants, near_of<PairContext::NearA>(ctx, i), near_of<PairContext::NearA>(ctx, i + 1),
+             near_of<PairContext::NearB>(ctx, j), near_of<PairContext::NearB>(ctx, j + 1), reach, y);
         for (int k = 0; k < 4; ++k) EXPECT_TRUE(same_bits(x[k], y[k])) << "pose " << p << " nodes " << i << ", " << j;
         compared += 4;
       }

@@ -163,8 +163,8 @@ TEST(VisitOrder, DistanceAtContactTakesTheMostOverlappingTouchingChildFirst) {
         std::vector<narrow::TraversalScratch::NearA> na(static_cast<std::size_t>(count));
         std::vector<narrow::TraversalScratch::NearB> nb(static_cast<std::size_t>(count));
         for (int k = 0; k < count; ++k) {
-          static_cast<narrow::NearA&>(na[k]) = ctx.near_a(kids[k].a);
-          static_cast<narrow::NearB&>(nb[k]) = ctx.near_b(kids[k].b);
+          ctx.near(kids[k].a, static_cast<narrow::NearA&>(na[k]));
+          ctx.near(kids[k].b, static_cast<narrow::NearB&>(nb[k]));
         }
         Waiting waiting[4];
         for (int k = 0; k < count; ++k) waiting[k] = Waiting{(zeros >> k) & 1 ? 0.0 : 1.0 + k, Reached{&na[k], &nb[k]}};
@@ -191,8 +191,8 @@ TEST(VisitOrder, DistanceAtContactTakesTheMostOverlappingTouchingChildFirst) {
       // rest wait in reverse, to be popped in cd_children order.
       narrow::TraversalScratch::NearA a0;
       narrow::TraversalScratch::NearB b0;
-      static_cast<narrow::NearA&>(a0) = ctx.near_a(kids[0].a);
-      static_cast<narrow::NearB&>(b0) = ctx.near_b(kids[0].b);
+      ctx.near(kids[0].a, static_cast<narrow::NearA&>(a0));
+      ctx.near(kids[0].b, static_cast<narrow::NearB&>(b0));
       Waiting equal[4];
       for (int k = 0; k < count; ++k) equal[k] = Waiting{0.0, Reached{&a0, &b0}};
       int order[4] = {0, 1, 2, 3}, nearest = -1;
