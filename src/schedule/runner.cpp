@@ -164,7 +164,8 @@ void gather_step(const std::vector<ObjectPair>& pairs, std::vector<QueryResult>&
   const std::size_t n = pairs.size();
   out.limit_reached = false;
   out.stats = QueryStats{};
-  // Where each pair's contacts go (a prefix sum), then the records and contacts written in parallel.
+  // Where each pair's contacts go (a prefix sum), then the records and contacts written in parallel
+  // (a lone pair's moved).
   std::vector<std::size_t> at(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const QueryResult& r = results[i];

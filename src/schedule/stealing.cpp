@@ -147,11 +147,13 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
     // tolerance only, which for an unbounded distance query lets every one through.
     if (narrow::PairShared* shared = state.shared_of(pair); shared != nullptr && ctx.request().kind == QueryKind::distance) {
       const double reach = ctx.reach_for(std::min(ctx.request().tolerance, shared->nearest.load(std::memory_order_relaxed)));
-      narrow::PairContext::NearA a;
-      narrow::PairContext::NearB b;
-      ctx.near(n.a, a);
-      ctx.near(n.b, b);
-      if (reach < kUnbounded && ctx.gap(a, b, reach) > reach) return;
+      if (reach < kUnbounded) {
+        narrow::PairContext::NearA a;
+        narrow::PairContext::NearB b;
+        ctx.near(n.a, a);
+        ctx.near(n.b, b);
+        if (ctx.gap(a, b, reach) > reach) return;
+      }
     }
     if (depth >= cutoff) {
       state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested); });

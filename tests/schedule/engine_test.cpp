@@ -514,10 +514,15 @@ TEST(EngineFrames, InMemoryFramesGiveThePairwiseAnswerWithEveryMethod) {
 TEST(EngineFrames, AFrameOfOnePairGivesThatPairsAnswerWithEveryMethod) {
   // One pair: the step's contacts are the pair's (moved, not copied, into the step), as the query
   // gives them, with the frame's object ids.
+  // The box first, so that the pair's object ids (1, 2) are not the query's own (0, 1).
   Frame frame = memory_frame(0.4);  // the torus's tube through the sphere
-  frame.pairs = {ObjectPair{0, 1}};
+  std::swap(frame.models[0], frame.models[2]);
+  std::swap(frame.poses[0], frame.poses[2]);
+  std::swap(frame.models[1], frame.models[2]);
+  std::swap(frame.poses[1], frame.poses[2]);
+  frame.pairs = {ObjectPair{1, 2}};
   frame.request.kind = QueryKind::interference;
-  const QueryResult want = query(*frame.models[0], frame.poses[0], *frame.models[1], frame.poses[1], frame.request);
+  const QueryResult want = query(*frame.models[1], frame.poses[1], *frame.models[2], frame.poses[2], frame.request);
   ASSERT_GT(want.contacts.size(), 0u) << "a test that compares empty answers proves nothing";
   for (const Method method :
        {Method::sequential, Method::exploitation, Method::stealing, Method::aposteriori, Method::apriori, Method::hybrid}) {
@@ -533,8 +538,8 @@ TEST(EngineFrames, AFrameOfOnePairGivesThatPairsAnswerWithEveryMethod) {
       ASSERT_EQ(got.contacts.size(), want.contacts.size()) << to_string(method);
       for (std::size_t i = 0; i < want.contacts.size(); ++i) {
         const Contact &g = got.contacts[i], &c = want.contacts[i];
-        ASSERT_EQ(g.object_a, 0u);
-        ASSERT_EQ(g.object_b, 1u);
+        ASSERT_EQ(g.object_a, 1u) << to_string(method);
+        ASSERT_EQ(g.object_b, 2u) << to_string(method);
         ASSERT_EQ(g.tri_a, c.tri_a) << to_string(method) << " contact " << i;
         ASSERT_EQ(g.tri_b, c.tri_b) << to_string(method) << " contact " << i;
         ASSERT_EQ(g.point_a, c.point_a);
