@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,9 @@ inline double median_ms(int repeat, const std::function<void()>& f) {
   return times[times.size() / 2];
 }
 
-/// The median of v (the upper one of an even count).
+/// The median of v (the upper one of an even count); NaN for no value.
 inline double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }

@@ -15,7 +15,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <deque>
 #include <filesystem>
@@ -174,6 +173,7 @@ struct EmbreeRun {
   double build_ms = 0.0, collide_ms = 0.0;
   std::vector<TriPair> pairs;
   std::size_t candidates = 0, threads = 0;
+  bool same_calls = true;  ///< every timed call found the same pairs
 };
 
 /// One Embree turn on a device of its own, the only one alive ("threads=N": Embree 3 on TBB caps all
@@ -197,15 +197,21 @@ EmbreeRun run_embree(const Prepared& p, int threads, int calls) {
   rtcCollide(scene_a, scene_b, collide_pairs, &warm);
   std::deque<Collector> timed;  // one a call, made before the clock starts
   for (int k = 0; k < calls; ++k) timed.emplace_back(ga, gb);
-  std::size_t call = 0;
-  run.collide_ms = median_ms(calls, [&] { rtcCollide(scene_a, scene_b, collide_pairs, &timed[call++]); });
+  run.collide_ms =
+      median_ms(calls, [&, call = std::size_t{0}]() mutable { rtcCollide(scene_a, scene_b, collide_pairs, &timed[call++]); });
   if (rtcGetDeviceError(device) != RTC_ERROR_NONE) fail("Embree reported an error on " + p.c.name, 1);
-  for (const Collector::Hits& h : timed.back().hits) {
-    run.pairs.insert(run.pairs.end(), h.pairs.begin(), h.pairs.end());
-    run.candidates += h.candidates;
+  for (const Collector& c : timed) {  // each call's pairs compared with the call's before; the last kept
+    std::vector<TriPair> pairs;
+    run.candidates = 0;
+    for (const Collector::Hits& h : c.hits) {
+      pairs.insert(pairs.end(), h.pairs.begin(), h.pairs.end());
+      run.candidates += h.candidates;
+    }
+    std::sort(pairs.begin(), pairs.end());
+    run.same_calls = run.same_calls && (&c == &timed.front() || pairs == run.pairs);
+    run.pairs = std::move(pairs);
+    run.threads = std::max(run.threads, c.hits.size());
   }
-  run.threads = timed.back().hits.size();
-  std::sort(run.pairs.begin(), run.pairs.end());
   rtcReleaseScene(scene_b);
   rtcReleaseScene(scene_a);
   rtcReleaseDevice(device);
@@ -266,7 +272,8 @@ void run_round(const Prepared& p, caliber::Engine& stealing, bool first, int cal
   row.stealing_same = row.stealing_same && pairs_of(step.contacts) == ours;
   const EmbreeRun two = run_embree(p, 2, calls);
   row.embree2_ms.push_back(two.collide_ms);
-  row.embree_stable = row.embree_stable && two.pairs == one.pairs && one.pairs.size() == row.pairs_embree;
+  row.embree_stable =
+      row.embree_stable && one.same_calls && two.same_calls && two.pairs == one.pairs && one.pairs.size() == row.pairs_embree;
   row.threads_2 = std::max(row.threads_2, two.threads);
 }
 
