@@ -77,15 +77,18 @@ constexpr std::size_t kFewCandidates = 8;
 /// An interference result: the triangles meet, so a candidate is its ids alone (no points). They
 /// are sorted as one integer each (A's id above B's, in as few bits as the largest ids need:
 /// by_ids' order), which moves 8 bytes where sorting the candidates moves 64; serially by radix.
-/// But a few (kFewCandidates), sorted in place.
-QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair objects, bool parallel, QueryResult result) {
+/// But a few (kFewCandidates), sorted in place. Appends to result.contacts.
+void interference_result(std::vector<Candidate>& candidates, ObjectPair objects, bool parallel, QueryResult& result) {
+  // Each contact copied from one made here (an empty Contact is cleared byte by byte, a slow
+  // string store on 104 bytes, before its fields are written again).
+  Contact made;
+  made.object_a = objects.a;
+  made.object_b = objects.b;
+  made.point_a = made.point_b = made.normal = Eigen::Vector3d::Zero();
   const auto add = [&](std::uint32_t tri_a, std::uint32_t tri_b) {
-    Contact& contact = result.contacts.emplace_back();
-    contact.object_a = objects.a;
-    contact.object_b = objects.b;
-    contact.tri_a = tri_a;
-    contact.tri_b = tri_b;
-    contact.point_a = contact.point_b = contact.normal = Eigen::Vector3d::Zero();
+    made.tri_a = tri_a;
+    made.tri_b = tri_b;
+    result.contacts.push_back(made);
   };
   // A few (a first hit's): sorted where they are, no keys made.
   if (candidates.size() <= kFewCandidates) {
@@ -93,7 +96,7 @@ QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair o
     CALIBER_ASSERT(sorted_once(candidates), "each triangle pair is a candidate once");
     result.contacts.reserve(candidates.size());
     for (const Candidate& c : candidates) add(c.tri_a, c.tri_b);
-    return result;
+    return;
   }
   std::uint32_t most_a = 0, most_b = 0;
   for (const Candidate& c : candidates) {
@@ -113,21 +116,21 @@ QueryResult interference_result(std::vector<Candidate>& candidates, ObjectPair o
     util::radix_sort(keys, shift + util::bits_of(most_a), spare);
   }
   CALIBER_ASSERT(std::adjacent_find(keys.begin(), keys.end()) == keys.end(), "each triangle pair is a candidate once");
-  // Each contact made where it is written (a resize would clear them all in a pass of its own).
+  // Each contact written once (a resize would clear them all in a pass of its own).
   result.contacts.reserve(keys.size());
   for (const std::uint64_t key : keys) add(static_cast<std::uint32_t>(key >> shift), static_cast<std::uint32_t>(key & low));
-  return result;
 }
 
 }  // namespace
 
-QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
-                     ContactPair contact_pair, bool parallel) {
+void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
+              ContactPair contact_pair, bool parallel, QueryResult& result) {
   // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
   const std::size_t grain = parallel ? kFinalizeGrain : std::max<std::size_t>(candidates.size(), 1);
-  QueryResult result;
   result.kind = ctx.request().kind;
   result.stats = stats;
+  result.limit_reached = false;
+  result.contacts.clear();
   // At the limit: flagged (the traversals stopped there, so there may be more); over it (split
   // traversals may keep a few more between them), the max_pairs lowest ids of what was found.
   const std::size_t max_pairs = ctx.request().max_pairs;
@@ -150,7 +153,10 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
     const Candidate best = closest(ctx, candidates, contact_pair);
     candidates.assign(1, best);  // in the caller's storage (query_whole keeps it from call to call)
   }
-  if (result.kind == QueryKind::interference) return interference_result(candidates, objects, parallel, std::move(result));
+  if (result.kind == QueryKind::interference) {
+    interference_result(candidates, objects, parallel, result);
+    return;
+  }
   // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
   if (parallel && candidates.size() >= kFinalizeGrain) {
     parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
@@ -169,6 +175,12 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
   } else {
     parallel::parallel_for(0, candidates.size(), grain, contacts);
   }
+}
+
+QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
+                     ContactPair contact_pair, bool parallel) {
+  QueryResult result;
+  finalize(ctx, candidates, stats, objects, contact_pair, parallel, result);
   return result;
 }
 

@@ -48,6 +48,10 @@ enum class ContactPair { as_found, from_root };
 /// at distance 0 as `contact_pair` says (unless the request asks for the lowest ids).
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
                      ContactPair contact_pair, bool parallel = false);
+/// finalize into `result`, every field of it written, its contacts' storage reused (what a batch
+/// keeps from entry to entry: no allocation once it has grown).
+void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
+              ContactPair contact_pair, bool parallel, QueryResult& result);
 
 /// The intersecting pair the distance traversal from the root reports (its first hit: the pair
 /// caliber::query reports on meshes that intersect; the lowest ids on models with at most 16
@@ -69,5 +73,7 @@ bool answered_by_first_hit(const PairContext& ctx, Candidate& hit, QueryStats& s
 /// scratch and candidate storage (let go past 2 MiB). What caliber::query runs, and the batch for
 /// every entry it does not split.
 QueryResult query_whole(const PairContext& ctx);
+/// query_whole into `result` (finalize's form that reuses the result's storage).
+void query_whole(const PairContext& ctx, QueryResult& result);
 
 }  // namespace caliber::narrow

@@ -11,11 +11,22 @@
 #include "geometry/triangle_intersect.h"
 
 namespace caliber::narrow {
-PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
-    : mA(data(a)), mB(data(b)), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
+namespace {
+/// The request, once it and both poses are validated.
+const QueryRequest& validated(const Pose& pose_a, const Pose& pose_b, const QueryRequest& request) {
   validate_request(request);
   validate_pose(pose_a, "pose of A");
   validate_pose(pose_b, "pose of B");
+  return request;
+}
+}  // namespace
+
+PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
+    : PairContext(a, pose_a, b, pose_b, validated(pose_a, pose_b, request), Validated{}) {}
+
+PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request,
+                         Validated)
+    : mA(data(a)), mB(data(b)), mPoseA(pose_a), mRequest(request), mKind(request.kind), mGroups(request.groups) {
   const Eigen::Matrix3d ra = pose_a.rotation_matrix();
   const Eigen::Matrix3d rb = pose_b.rotation_matrix();
   mRot = ra.transpose() * rb;

@@ -50,8 +50,13 @@ class PairContext {
   static constexpr double kApartShrink = 1.0 - 3e-9;
 
  public:
-  /// Precomputes B's pose in A's frame and the safety margin. Validates the request.
+  /// Precomputes B's pose in A's frame and the safety margin. Validates the request and the poses.
   PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request);
+  /// Says that the caller has validated the request and the poses (validate_request,
+  /// validate_pose): an engine's frame, a batch's poses, checked once for all their pairs.
+  struct Validated {};
+  /// The same context, made without validating again.
+  PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request, Validated);
   /// The same pair and poses (and group table) asked for interference that stops at its first
   /// pair (max_pairs 1): what a distance traversal from the root tries first (traverse_nearest).
   [[nodiscard]] PairContext first_hit() const;

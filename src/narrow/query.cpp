@@ -77,7 +77,7 @@ void let_go_if_large() {
 
 }  // namespace
 
-QueryResult query_whole(const PairContext& ctx) {
+void query_whole(const PairContext& ctx, QueryResult& result) {
   std::vector<Candidate>& candidates = t_candidates;
   candidates.clear();
   QueryStats stats;
@@ -85,8 +85,13 @@ QueryResult query_whole(const PairContext& ctx) {
   limit.max = ctx.request().max_pairs;
   traverse(ctx, NodePair{0, 0}, t_scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
   let_go_if_large();
-  QueryResult result = finalize(ctx, candidates, stats, ObjectPair{0, 1}, ContactPair::as_found);
+  finalize(ctx, candidates, stats, ObjectPair{0, 1}, ContactPair::as_found, false, result);
   if (candidates.capacity() * sizeof(Candidate) > kKeptScratchBytes) candidates = {};
+}
+
+QueryResult query_whole(const PairContext& ctx) {
+  QueryResult result;
+  query_whole(ctx, result);
   return result;
 }
 

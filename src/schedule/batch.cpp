@@ -25,6 +25,10 @@ constexpr std::size_t kChunk = 8192;
 /// enough that a light entry's job costs little beside it).
 constexpr std::size_t kWholeGrain = 4;
 
+/// The contacts' storage a kept batch result may hold between chunks and calls (Engine::Impl::
+/// batch_results): beyond it, let go after the chunk.
+constexpr std::size_t kKeptContacts = 16;
+
 void validate_poses(std::span<const Pose> poses, const char* side) {
   for (std::size_t i = 0; i < poses.size(); ++i) {
     try {
@@ -55,23 +59,24 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   // Entries are not objects that persist from call to call: the calibrated methods plan with no
   // history, and the engine's is left as it is.
   const plans::History no_history;
-  std::vector<QueryResult> results;
+  std::vector<QueryResult>& results = mImpl->batch_results;
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {
     if (first > 0 && mOptions.between_chunks) mOptions.between_chunks();
     const std::size_t count = std::min(kChunk, n - first);
     const auto context = [&](std::size_t i) {  // entry first + i's
       const std::size_t e = first + i;
-      return narrow::PairContext(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e], request);
+      return narrow::PairContext(a, poses_a[poses_a.size() == 1 ? 0 : e], b, poses_b[poses_b.size() == 1 ? 0 : e], request,
+                                 narrow::PairContext::Validated{});
     };
     // With max_pairs, which pairs an entry keeps depends on the order its traversal met them: one
     // thread traverses each entry whole, in caliber::query's order. So does a run of many entries.
     if (request.max_pairs != 0 || count >= schedule::kEntriesPerThread * static_cast<std::size_t>(options.threads) ||
         mOptions.method == Method::sequential) {
-      results.assign(count, QueryResult{});
+      results.resize(count);  // each entry's result rewritten whole, its storage reused
       mImpl->executor.execute([&] {
         parallel::parallel_for(0, count, kWholeGrain, [&](std::size_t lo, std::size_t hi) {
-          for (std::size_t i = lo; i != hi; ++i) results[i] = narrow::query_whole(context(i));
+          for (std::size_t i = lo; i != hi; ++i) narrow::query_whole(context(i), results[i]);
         });
       });
     } else {
@@ -91,6 +96,9 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
       out.limit_reached.push_back(r.limit_reached ? 1 : 0);
       out.stats.node_tests += r.stats.node_tests;
       out.stats.leaf_tests += r.stats.leaf_tests;
+    }
+    for (QueryResult& r : results) {
+      if (r.contacts.capacity() > kKeptContacts) r.contacts = {};
     }
   }
   return out;

@@ -261,7 +261,8 @@ StepResult Engine::step(const Frame& frame) {
   record.kind = frame.request.kind;
   const auto make = [&frame](std::size_t i, void* where) {
     const ObjectPair& t = frame.pairs[i];
-    new (where) narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request);
+    new (where) narrow::PairContext(*frame.models[t.a], frame.poses[t.a], *frame.models[t.b], frame.poses[t.b], frame.request,
+                                    narrow::PairContext::Validated{});  // validate_frame checked them
   };
   const schedule::PairsRun run =
       mImpl->run_pairs(options, mOptions.method, frame.pairs, frame.request, mImpl->history, make, results, record);

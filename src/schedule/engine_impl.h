@@ -159,6 +159,10 @@ struct Engine::Impl {
   broad::State broad;
   /// This step's schedule record when nobody asked for it.
   ScheduleRecord record;
+  /// A batch's results, entry by entry, kept from chunk to chunk and call to call: an entry
+  /// traversed whole writes its contacts into storage already there (a batch of first hits or
+  /// distances makes no allocation an entry). Storage grown past a few contacts is let go.
+  std::vector<QueryResult> batch_results;
 
   /// Runs `method` over the pairs whose contexts `make` builds (schedule::ContextStore::build), on
   /// the engine's executor: fills results (one per pair; `pairs` are the object ids each pair's

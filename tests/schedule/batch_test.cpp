@@ -120,6 +120,28 @@ TEST(Batch, MaxPairsEntriesAreTheQueriesFirstPairs) {
   }
 }
 
+TEST(Batch, OneEngineAnswersEachCallAfresh) {
+  // Entries traversed whole write into results the engine keeps from call to call: each call's
+  // entries must be its own, whatever the call before left there (a limit reached, many contacts,
+  // another kind).
+  const std::vector<Pose> pa = poses_near(40, 8, 0.6);
+  const std::vector<Pose> pb = poses_near(40, 9, 0.6);
+  EngineOptions options;
+  options.threads = 1;
+  Engine engine(options);
+  for (const auto& [kind, limit] :
+       {std::pair{QueryKind::proximity, std::size_t{7}}, std::pair{QueryKind::proximity, std::size_t{0}},
+        std::pair{QueryKind::interference, std::size_t{1}}, std::pair{QueryKind::distance, std::size_t{0}},
+        std::pair{QueryKind::contact, std::size_t{0}}, std::pair{QueryKind::interference, std::size_t{0}}}) {
+    QueryRequest request;
+    request.kind = kind;
+    request.tolerance = kind == QueryKind::distance ? kUnbounded : 0.05;
+    request.max_pairs = limit;
+    const std::string what = std::string(to_string(kind)) + " max_pairs " + std::to_string(limit);
+    expect_queries(engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request), pa, pb, request, what);
+  }
+}
+
 TEST(Batch, ManyEntriesAcrossChunksAndEitherSideFixed) {
   // More entries than one run of the method takes (8192), cheap ones: the sphere far off most
   // of the time.

@@ -45,6 +45,18 @@ TEST(RadixSort, SortsKeysAlreadyInOrderAndReversed) {
   EXPECT_EQ(keys, want);
 }
 
+TEST(RadixSort, SortsKeysThatShareADigit) {
+  // 33 bits: three digits of 11; the middle one the same in every key (its pass moves nothing).
+  std::mt19937_64 rng(7);
+  std::vector<std::uint64_t> keys(4000);
+  for (std::uint64_t& k : keys) k = (rng() & 0x7ffu) << 22 | std::uint64_t{0x555} << 11 | (rng() & 0x7ffu);
+  std::vector<std::uint64_t> want = keys;
+  std::sort(want.begin(), want.end());
+  std::vector<std::uint64_t> spare;
+  radix_sort(keys, 33, spare);
+  EXPECT_EQ(keys, want);
+}
+
 TEST(RadixSort, BitsOf) {
   EXPECT_EQ(bits_of(0), 0);
   EXPECT_EQ(bits_of(1), 1);
