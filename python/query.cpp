@@ -38,7 +38,7 @@ PyResult::Arrays PyResult::make_arrays() {
     dd(i) = c.distance;
     dp(i) = c.depth;
   }
-  contacts = {};
+  std::vector<caliber::Contact>().swap(contacts);  // (`= {}` would clear, not free)
   return r;
 }
 

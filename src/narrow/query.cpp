@@ -86,7 +86,7 @@ void query_whole(const PairContext& ctx, QueryResult& result) {
   traverse(ctx, NodePair{0, 0}, t_scratch, candidates, stats, RootTest::as_root, {}, limit.max != 0 ? &limit : nullptr);
   let_go_if_large();
   finalize(ctx, candidates, stats, ObjectPair{0, 1}, ContactPair::as_found, false, result);
-  if (candidates.capacity() * sizeof(Candidate) > kKeptScratchBytes) candidates = {};
+  if (candidates.capacity() * sizeof(Candidate) > kKeptScratchBytes) std::vector<Candidate>().swap(candidates);
 }
 
 QueryResult query_whole(const PairContext& ctx) {

@@ -98,7 +98,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
       out.stats.leaf_tests += r.stats.leaf_tests;
     }
     for (QueryResult& r : results) {
-      if (r.contacts.capacity() > kKeptContacts) r.contacts = {};
+      if (r.contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(r.contacts);
     }
   }
   return out;

@@ -7,7 +7,10 @@
 //  (2) it does not grow with the traversal's work: the same scene with every mesh 4x finer (about
 //      7x the node tests, 19x the leaf tests, same pairs) allocates at most twice as much in the median
 //      step, so nothing allocates per node test, leaf test or summary node;
-//  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does (medians).
+//  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does (medians);
+//  (4) a batch of first hits (Engine::query_many, every entry a hit) allocates far fewer times than
+//      it has entries once the engine has run one, and a batch of many contacts an entry leaves
+//      the engine holding no more than a few contacts' storage an entry.
 // Prints the counts. Exit 0: all hold; 1: a check failed; 77: skipped (sanitizer build, whose
 // allocator hooks would count their own allocations).
 
@@ -16,6 +19,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <malloc.h>
 #include <new>
 #include <memory>
 #include <string>
@@ -27,30 +31,40 @@
 namespace {
 std::atomic<long> gAllocations{0};
 std::atomic<bool> gCounting{false};
+std::atomic<long> gLive{0};  // bytes in blocks operator new handed out and delete has not taken back
+
+void* counted(void* p) {
+  gLive.fetch_add(static_cast<long>(malloc_usable_size(p)), std::memory_order_relaxed);
+  return p;
+}
+void release(void* p) {
+  if (p != nullptr) gLive.fetch_sub(static_cast<long>(malloc_usable_size(p)), std::memory_order_relaxed);
+  std::free(p);
+}
 }  // namespace
 
 // Replaced global allocation functions: every form forwards to the two below.
 void* operator new(std::size_t size) {
   if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return counted(p);
   throw std::bad_alloc();
 }
 void* operator new(std::size_t size, std::align_val_t align) {
   if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1, std::memory_order_relaxed);
   const std::size_t a = static_cast<std::size_t>(align);
-  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
+  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return counted(p);
   throw std::bad_alloc();
 }
 void* operator new[](std::size_t size) { return operator new(size); }
 void* operator new[](std::size_t size, std::align_val_t align) { return operator new(size, align); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept { release(p); }
+void operator delete(void* p, std::size_t) noexcept { release(p); }
+void operator delete[](void* p) noexcept { release(p); }
+void operator delete[](void* p, std::size_t) noexcept { release(p); }
+void operator delete(void* p, std::align_val_t) noexcept { release(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { release(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { release(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { release(p); }
 
 namespace {
 
@@ -90,6 +104,55 @@ Counts count(const caliber::World& world, caliber::Method method, int threads, b
   }
   std::nth_element(per_step.begin(), per_step.begin() + static_cast<std::ptrdiff_t>(per_step.size() / 2), per_step.end());
   c.median = per_step[per_step.size() / 2];
+  return c;
+}
+
+/// What a batch allocates and leaves behind (check 4).
+struct BatchCounts {
+  std::size_t entries = 0;
+  std::size_t hits = 0;            // entries of the first-hit batch that found a pair
+  long first_hit_allocations = 0;  // the second first-hit batch's
+  std::size_t contacts = 0;        // of the batch of many contacts an entry
+  long kept_bytes = 0;             // live bytes after that batch's result is gone, less those before it
+  long allowed_bytes = 0;          // what check 4 allows: a few contacts' storage an entry, and the scratch
+};
+
+/// The box against the ball of the touching world, one entry per frame.
+BatchCounts count_batch(const caliber::World& world, int threads) {
+  constexpr std::size_t kEntries = 3000;
+  const caliber::Frame frame = world.frame(0);
+  std::vector<caliber::Pose> pa, pb;
+  for (std::size_t k = 0; k < kEntries; ++k) {
+    const caliber::Frame f = world.frame(static_cast<int>(k));
+    pa.push_back(f.poses[0]);
+    pb.push_back(f.poses[1]);
+  }
+  caliber::EngineOptions options;
+  options.threads = threads;
+  caliber::Engine engine(options);
+  caliber::QueryRequest first;
+  first.max_pairs = 1;
+  caliber::QueryRequest every;
+  every.kind = caliber::QueryKind::proximity;
+  every.tolerance = 0.01;
+  const auto batch = [&](const caliber::QueryRequest& request) {
+    return engine.query_many(*frame.models[0], pa, *frame.models[1], pb, request);
+  };
+  BatchCounts c;
+  c.entries = batch(first).size();
+  gAllocations = 0;
+  gCounting = true;
+  const caliber::BatchResult hits = batch(first);
+  gCounting = false;
+  c.first_hit_allocations = gAllocations.load();
+  for (std::size_t i = 0; i < hits.size(); ++i) c.hits += hits.hit(i) ? 1 : 0;
+  const long before = gLive.load();
+  c.contacts = batch(every).contacts.size();
+  c.kept_bytes = gLive.load() - before;
+  // Per entry its result and up to 16 contacts; per thread its kept traversal scratch and
+  // candidates (up to 2 MiB each).
+  c.allowed_bytes =
+      static_cast<long>(kEntries * (sizeof(caliber::QueryResult) + 16 * sizeof(caliber::Contact))) + threads * (4L << 20);
   return c;
 }
 
@@ -133,6 +196,15 @@ int main() {
       check(moving.median <= 2 * base.median, "moving frames allocate at most twice what a fixed one does");
       check(finer.most <= 4 * base.most + 100, "no step of the finer meshes allocates far beyond the coarse ones' worst");
     }
+  }
+  for (const int threads : {1, 2}) {
+    const BatchCounts b = count_batch(*coarse, threads);
+    std::printf("batch, %d threads: %zu entries; %zu first hits: %ld allocations; %zu contacts: %ld bytes kept (%ld allowed)\n",
+                threads, b.entries, b.hits, b.first_hit_allocations, b.contacts, b.kept_bytes, b.allowed_bytes);
+    check(b.hits >= b.entries / 2, "most entries of the first-hit batch are hits");
+    check(b.first_hit_allocations <= static_cast<long>(b.entries / 20), "a batch of first hits allocates far less than an entry");
+    check(b.contacts > 64 * b.entries, "the batch of many contacts has many an entry");
+    check(b.kept_bytes <= b.allowed_bytes, "the engine keeps a few contacts' storage an entry, no more");
   }
   std::printf("%s\n", failures == 0 ? "bounded and flat" : "FAILED");
   return failures == 0 ? 0 : 1;

@@ -5,6 +5,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -123,21 +124,26 @@ TEST(Batch, MaxPairsEntriesAreTheQueriesFirstPairs) {
 TEST(Batch, OneEngineAnswersEachCallAfresh) {
   // Entries traversed whole write into results the engine keeps from call to call: each call's
   // entries must be its own, whatever the call before left there (a limit reached, many contacts,
-  // another kind).
-  const std::vector<Pose> pa = poses_near(40, 8, 0.6);
-  const std::vector<Pose> pb = poses_near(40, 9, 0.6);
+  // another kind, more entries, entries the method split: 6 entries on 2 threads).
   EngineOptions options;
-  options.threads = 1;
+  options.threads = 2;
   Engine engine(options);
-  for (const auto& [kind, limit] :
-       {std::pair{QueryKind::proximity, std::size_t{7}}, std::pair{QueryKind::proximity, std::size_t{0}},
-        std::pair{QueryKind::interference, std::size_t{1}}, std::pair{QueryKind::distance, std::size_t{0}},
-        std::pair{QueryKind::contact, std::size_t{0}}, std::pair{QueryKind::interference, std::size_t{0}}}) {
+  std::uint64_t seed = 8;
+  for (const auto& [kind, limit, entries] : {std::tuple{QueryKind::proximity, std::size_t{7}, std::size_t{40}},
+                                             std::tuple{QueryKind::proximity, std::size_t{0}, std::size_t{40}},
+                                             std::tuple{QueryKind::interference, std::size_t{1}, std::size_t{24}},
+                                             std::tuple{QueryKind::distance, std::size_t{0}, std::size_t{6}},
+                                             std::tuple{QueryKind::contact, std::size_t{0}, std::size_t{40}},
+                                             std::tuple{QueryKind::interference, std::size_t{0}, std::size_t{17}},
+                                             std::tuple{QueryKind::interference, std::size_t{0}, std::size_t{6}}}) {
+    const std::vector<Pose> pa = poses_near(entries, ++seed, 0.6);
+    const std::vector<Pose> pb = poses_near(entries, ++seed, 0.6);
     QueryRequest request;
     request.kind = kind;
     request.tolerance = kind == QueryKind::distance ? kUnbounded : 0.05;
     request.max_pairs = limit;
-    const std::string what = std::string(to_string(kind)) + " max_pairs " + std::to_string(limit);
+    const std::string what =
+        std::string(to_string(kind)) + " max_pairs " + std::to_string(limit) + ", " + std::to_string(entries) + " entries";
     expect_queries(engine.query_many(*shapes().torus, pa, *shapes().sphere, pb, request), pa, pb, request, what);
   }
 }
