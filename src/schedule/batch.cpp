@@ -39,6 +39,15 @@ void validate_poses(std::span<const Pose> poses, const char* side) {
   }
 }
 
+/// Appends an entry's answer to the batch's.
+void append(BatchResult& out, const QueryResult& r) {
+  out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
+  out.offsets.push_back(out.contacts.size());
+  out.limit_reached.push_back(r.limit_reached ? 1 : 0);
+  out.stats.node_tests += r.stats.node_tests;
+  out.stats.leaf_tests += r.stats.leaf_tests;
+}
+
 }  // namespace
 
 BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, const Model& b, std::span<const Pose> poses_b,
@@ -73,12 +82,23 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     // thread traverses each entry whole, in caliber::query's order. So does a run of many entries.
     if (request.max_pairs != 0 || count >= schedule::kEntriesPerThread * static_cast<std::size_t>(options.threads) ||
         mOptions.method == Method::sequential) {
-      results.resize(count);  // each entry's result rewritten whole, its storage reused
+      // Each entry's result rewritten whole, its storage reused. On one thread the entries come in
+      // order: each answer goes straight into the batch's, through one result (none held an entry).
+      const bool in_order = options.threads == 1;
+      results.resize(in_order ? 1 : count);
       mImpl->executor.execute([&] {
+        if (in_order) {
+          for (std::size_t i = 0; i != count; ++i) {
+            narrow::query_whole(context(i), results[0]);
+            append(out, results[0]);
+          }
+          return;
+        }
         parallel::parallel_for(0, count, kWholeGrain, [&](std::size_t lo, std::size_t hi) {
           for (std::size_t i = lo; i != hi; ++i) narrow::query_whole(context(i), results[i]);
         });
       });
+      if (in_order) continue;
     } else {
       options.stealing_depth = schedule::stealing_cutoff(count, options.threads, mOptions.stealing_depth);
       const std::vector<ObjectPair> chunk_pairs(count, ObjectPair{0, 1});  // the object ids every contact carries
@@ -90,17 +110,12 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     for (const QueryResult& r : results) total += r.contacts.size();
     // Geometric growth: reserving the exact new size at every chunk copied every contact so far.
     if (total > out.contacts.capacity()) out.contacts.reserve(std::max(total, 2 * out.contacts.capacity()));
-    for (const QueryResult& r : results) {
-      out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
-      out.offsets.push_back(out.contacts.size());
-      out.limit_reached.push_back(r.limit_reached ? 1 : 0);
-      out.stats.node_tests += r.stats.node_tests;
-      out.stats.leaf_tests += r.stats.leaf_tests;
-    }
     for (QueryResult& r : results) {
+      append(out, r);
       if (r.contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(r.contacts);
     }
   }
+  if (!results.empty() && results[0].contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(results[0].contacts);
   return out;
 }
 
