@@ -39,6 +39,11 @@ void validate_poses(std::span<const Pose> poses, const char* side) {
   }
 }
 
+/// Lets go of a kept result's contacts' storage past kKeptContacts (`= {}` would only clear it).
+void let_go_if_large(QueryResult& r) {
+  if (r.contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(r.contacts);
+}
+
 /// Appends an entry's answer to the batch's.
 void append(BatchResult& out, const QueryResult& r) {
   out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
@@ -112,10 +117,10 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     if (total > out.contacts.capacity()) out.contacts.reserve(std::max(total, 2 * out.contacts.capacity()));
     for (QueryResult& r : results) {
       append(out, r);
-      if (r.contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(r.contacts);
+      let_go_if_large(r);
     }
   }
-  if (!results.empty() && results[0].contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(results[0].contacts);
+  if (!results.empty()) let_go_if_large(results[0]);  // the one result of entries taken in order
   return out;
 }
 
