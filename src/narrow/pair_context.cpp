@@ -317,9 +317,9 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
   gather_corners(buffer.refusal);
   // Within an unbounded reach (a distance query that tests every pair) nothing is apart.
   const unsigned apart = reach < kUnbounded ? geometry::triangles_apart_batch(buffer.refusal.batch, reach) : 0u;
-  for (int l = 0; l < buffer.refusal.batch.size; ++l) {
-    if ((apart >> l) & 1u) continue;
-    buffer.closest.add(buffer.refusal, l);
+  // The lanes not refused, in order (the lanes past the batch's pairs are dropped).
+  for (unsigned bits = ~apart & ((1u << buffer.refusal.batch.size) - 1u); bits != 0; bits &= bits - 1) {
+    buffer.closest.add(buffer.refusal, __builtin_ctz(bits));
     if (buffer.closest.batch.full()) finish_buffered(buffer, out, bound);
   }
   buffer.refusal.batch.size = 0;
@@ -328,9 +328,10 @@ void PairContext::refuse_buffered(LeafBuffer& buffer, std::vector<Candidate>& ou
 void PairContext::intersect_buffered(BufferedPairs& waiting, std::vector<Candidate>& out) const {
   gather_corners(waiting);
   const unsigned meet = geometry::triangles_intersect_batch(waiting.batch);
-  for (int l = 0; l < waiting.batch.size; ++l) {
-    if ((meet >> l) & 1u)
-      out.push_back(Candidate{waiting.ta[l], waiting.tb[l], 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  // The lanes that meet, in order (the lanes past the batch's pairs are dropped).
+  for (unsigned bits = meet & ((1u << waiting.batch.size) - 1u); bits != 0; bits &= bits - 1) {
+    const int l = __builtin_ctz(bits);
+    out.push_back(Candidate{waiting.ta[l], waiting.tb[l], 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   }
   waiting.batch.size = 0;
 }
