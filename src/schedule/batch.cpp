@@ -44,6 +44,18 @@ void let_go_if_large(QueryResult& r) {
   if (r.contacts.capacity() > kKeptContacts) std::vector<Contact>().swap(r.contacts);
 }
 
+/// Lets go of the large storage of an engine's kept results when a batch ends, however it ends: a
+/// between_chunks that throws stops the call, and what its entries held goes with their answers.
+struct LetGoOnExit {
+  std::vector<QueryResult>& results;
+  explicit LetGoOnExit(std::vector<QueryResult>& kept) : results(kept) {}
+  LetGoOnExit(const LetGoOnExit&) = delete;
+  LetGoOnExit& operator=(const LetGoOnExit&) = delete;
+  ~LetGoOnExit() {
+    for (QueryResult& r : results) let_go_if_large(r);
+  }
+};
+
 /// Appends an entry's answer to the batch's.
 void append(BatchResult& out, const QueryResult& r) {
   out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
@@ -63,7 +75,8 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   validate_poses(poses_a, "A");
   validate_poses(poses_b, "B");
   validate_request(request);
-  schedule::check_contact_models(request, a, b);
+  // (A contact query needs both models built with adjacency: refused before any work.)
+  narrow::check_contact_models(request, a, b, "model A", "model B");
   BatchResult out;
   out.kind = request.kind;
   out.offsets.reserve(n + 1);
@@ -74,6 +87,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   // history, and the engine's is left as it is.
   const plans::History no_history;
   std::vector<QueryResult>& results = mImpl->batch_results;
+  const LetGoOnExit let_go{results};
   mImpl->timeline.begin(false);
   for (std::size_t first = 0; first < n; first += kChunk) {
     if (first > 0 && mOptions.between_chunks) mOptions.between_chunks();
@@ -120,7 +134,6 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
       let_go_if_large(r);
     }
   }
-  if (!results.empty()) let_go_if_large(results[0]);  // the one result of entries taken in order
   return out;
 }
 

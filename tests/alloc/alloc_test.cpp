@@ -10,7 +10,8 @@
 //  (3) moving frames (contacts coming and going) allocate at most twice what the fixed frame does (medians);
 //  (4) a batch of first hits (Engine::query_many, every entry a hit) allocates far fewer times than
 //      it has entries once the engine has run one, and a batch of many contacts an entry leaves
-//      the engine holding no more than a few contacts' storage an entry.
+//      the engine holding no more than a few contacts' storage an entry, however the batch ends (a
+//      hook between its chunks that throws).
 // Prints the counts. Exit 0: all hold; 1: a check failed; 77: skipped (sanitizer build, whose
 // allocator hooks would count their own allocations).
 
@@ -25,6 +26,8 @@
 #include <string>
 
 #include "caliber/engine.h"
+#include "caliber/model.h"
+#include "caliber/procedural.h"
 #include "caliber/world.h"
 #include "support/touching_world.h"
 
@@ -156,6 +159,29 @@ BatchCounts count_batch(const caliber::World& world, int threads) {
   return c;
 }
 
+/// Live bytes an engine keeps after a batch that between_chunks stopped: one entry of many contacts
+/// (a sphere against itself, every triangle pair within the tolerance) among 8,192 apart, then the
+/// hook throws before the second chunk.
+long stopped_batch_kept_bytes(int threads) {
+  const auto ball = caliber::build_model(caliber::make_sphere(1.0, 12, 24));
+  std::vector<caliber::Pose> pb(8193, caliber::Pose::from_values(100, 0, 0, 1, 0, 0, 0));
+  pb[0] = caliber::Pose{};
+  const std::vector<caliber::Pose> pa{caliber::Pose{}};
+  caliber::QueryRequest every;
+  every.kind = caliber::QueryKind::proximity;
+  every.tolerance = 3.0;
+  struct Stop {};
+  caliber::EngineOptions options;
+  options.threads = threads;
+  options.between_chunks = [] { throw Stop{}; };
+  caliber::Engine engine(options);
+  const long before = gLive.load();
+  try {
+    (void)engine.query_many(*ball, pa, *ball, pb, every);
+  } catch (const Stop&) {}
+  return gLive.load() - before;
+}
+
 }  // namespace
 
 int main() {
@@ -205,6 +231,11 @@ int main() {
     check(b.first_hit_allocations <= static_cast<long>(b.entries / 20), "a batch of first hits allocates far less than an entry");
     check(b.contacts > 64 * b.entries, "the batch of many contacts has many an entry");
     check(b.kept_bytes <= b.allowed_bytes, "the engine keeps a few contacts' storage an entry, no more");
+    // 576 triangles a side: 331,776 contacts (34.5 MB) in the first entry's answer.
+    const long stopped = stopped_batch_kept_bytes(threads);
+    const long allowed = threads * (4L << 20) + (1L << 20);
+    std::printf("batch stopped between chunks, %d threads: %ld bytes kept (%ld allowed)\n", threads, stopped, allowed);
+    check(stopped <= allowed, "a batch stopped between its chunks leaves the engine its scratch, no answer's storage");
   }
   std::printf("%s\n", failures == 0 ? "bounded and flat" : "FAILED");
   return failures == 0 ? 0 : 1;
