@@ -35,8 +35,9 @@ struct BatchResult {
   [[nodiscard]] std::span<const Contact> contacts_of(std::size_t i) const {
     return std::span<const Contact>(contacts).subspan(offsets[i], offsets[i + 1] - offsets[i]);
   }
-  /// Whether entry i reported a pair: the meshes touch (within the tolerance, for proximity,
-  /// contact and distance).
+  /// Whether entry i reported a pair: for interference, the meshes touch; for proximity and
+  /// distance, they come within the tolerance; for contact, a pair of facing triangles does
+  /// (meshes that interpenetrate may have none).
   [[nodiscard]] bool hit(std::size_t i) const { return offsets[i + 1] != offsets[i]; }
 };
 

@@ -45,9 +45,10 @@ struct GroupCompatibility {
 struct QueryRequest {
   /// What to report.
   QueryKind kind = QueryKind::interference;
-  /// Distance d (world units) for proximity and contact; must be finite and >= 0. Ignored by
-  /// interference. For distance, the largest distance of interest ("not closer than d" is answered
-  /// without looking further): may be kUnbounded there, and only there.
+  /// Distance d (world units) for proximity and contact; must be finite and >= 0 (validated for
+  /// every kind, interference too, which does not use it). For distance, the largest distance of
+  /// interest ("not closer than d" is answered without looking further): may be kUnbounded there,
+  /// and only there.
   double tolerance = 0.0;
   /// Angle theta in degrees, [0, 180], for contact: normals must face each other within it.
   double angle_deg = 30.0;
@@ -59,8 +60,9 @@ struct QueryRequest {
   /// traversal and the method), and memory stays bounded. An unflagged result is the whole
   /// answer; a flagged one may be too (ask for one more pair than you need to know). 1 asks "do
   /// they touch at all?" (any pair, or none), stopping at the first pair found. For contact
-  /// queries the limit applies before the local-minimum reduction (which may then report fewer).
-  /// Ignored by distance queries.
+  /// queries the limit applies before the local-minimum reduction, which sees only the pairs found:
+  /// it may report fewer, and pairs the whole answer's reduction would drop (a closer neighbour of
+  /// theirs was not found). Ignored by distance queries.
   std::size_t max_pairs = 0;
   /// Distance queries on meshes that intersect (distance 0, many pairs at 0). false (default): the
   /// query reports the first hit (the pair an interference query with max_pairs = 1 stops at), the
@@ -120,19 +122,23 @@ struct QueryStats {
 };
 
 /// The result of a query: its contacts, one per reported triangle pair, sorted by (tri_a, tri_b).
-/// A distance query reports one, the closest pair (ties: the lowest triangle ids), or none when
-/// the meshes are farther apart than the tolerance.
+/// A distance query reports one, the closest pair (ties: the lowest triangle ids; at distance 0,
+/// the first hit unless QueryRequest::lowest_ids), or none when the meshes are farther apart than
+/// the tolerance.
 struct QueryResult {
   QueryKind kind = QueryKind::interference;  ///< the kind that produced it
   std::vector<Contact> contacts;             ///< sorted by (tri_a, tri_b)
   QueryStats stats;                          ///< work done
   /// QueryRequest::max_pairs pairs were found: the query stopped there, and `contacts` (max_pairs
-  /// pairs; a contact query, those of them its reduction keeps) may be a part of the answer.
+  /// pairs) may be a part of the answer; a contact query's are those its reduction keeps of the
+  /// pairs found, which the whole answer may not hold (QueryRequest::max_pairs).
   bool limit_reached = false;
 };
 
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
-/// the two BVHs. Exact: the same pairs as query_brute_force, always. Thread-safe on shared models.
+/// the two BVHs. Exact: the same pairs as query_brute_force, but where the request asks for less: a
+/// limit (max_pairs) returns some of them, and a distance query on meshes that intersect reports
+/// the first hit unless lowest_ids is set. Thread-safe on shared models.
 [[nodiscard]] CALIBER_EXPORT QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
                                                const QueryRequest& request);
 

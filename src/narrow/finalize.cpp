@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <string>
 
 #include "caliber/error.h"
 #include "narrow/local_minima.h"
@@ -123,6 +124,16 @@ void interference_result(std::vector<Candidate>& candidates, ObjectPair objects,
 
 }  // namespace
 
+void check_contact_models(const QueryRequest& request, const Model& a, const Model& b, std::string_view name_a,
+                          std::string_view name_b) {
+  if (request.kind != QueryKind::contact || (a.has_adjacency() && b.has_adjacency())) return;
+  const std::string which = !a.has_adjacency() && !b.has_adjacency()
+                                ? std::string(name_a) + " and " + std::string(name_b) + " were"
+                                : std::string(a.has_adjacency() ? name_b : name_a) + " was";
+  throw Error(ErrorCode::bad_argument, "contact query",
+              which + " built without adjacency (BuildOptions::adjacency), which the contacts' reduction needs");
+}
+
 void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
               ContactPair contact_pair, bool parallel, QueryResult& result) {
   // Serial unless asked: a grain as large as the input keeps parallel_for on this thread.
@@ -145,7 +156,8 @@ void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const 
   // few kept candidates are sorted, not every pair within the tolerance.
   if (result.kind == QueryKind::contact) {
     if (!ctx.a().has_adjacency() || !ctx.b().has_adjacency()) {
-      throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
+      // (Refused before any work by every caller: check_contact_models.)
+      throw Error(ErrorCode::bad_argument, "contact query", "a model was built without adjacency (BuildOptions::adjacency)");
     }
     candidates = local_minima(ctx, candidates, grain);
   }

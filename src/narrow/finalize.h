@@ -4,6 +4,7 @@
 /// of the engine, so that the contacts do not depend on how the traversal was cut.
 
 #include <cstddef>
+#include <string_view>
 #include <vector>
 
 #include "caliber/engine.h"
@@ -75,5 +76,11 @@ bool answered_by_first_hit(const PairContext& ctx, Candidate& hit, QueryStats& s
 QueryResult query_whole(const PairContext& ctx);
 /// query_whole into `result` (finalize's form that reuses the result's storage).
 void query_whole(const PairContext& ctx, QueryResult& result);
+
+/// Throws caliber::Error (bad_argument, "contact query") where `request` is a contact query and a
+/// model lacks adjacency (BuildOptions::adjacency), which the contacts' reduction needs, naming it
+/// as `name_a` or `name_b`. Made before any work by every caller of a contact query.
+void check_contact_models(const QueryRequest& request, const Model& a, const Model& b, std::string_view name_a,
+                          std::string_view name_b);
 
 }  // namespace caliber::narrow

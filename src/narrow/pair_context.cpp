@@ -8,21 +8,24 @@
 #include <Eigen/Geometry>
 
 #include "geometry/triangle_distance.h"
+#include "narrow/finalize.h"
 #include "geometry/triangle_intersect.h"
 
 namespace caliber::narrow {
 namespace {
 /// The request, once it and both poses are validated.
-const QueryRequest& validated(const Pose& pose_a, const Pose& pose_b, const QueryRequest& request) {
+const QueryRequest& validated(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
+                              const QueryRequest& request) {
   validate_request(request);
   validate_pose(pose_a, "pose of A");
   validate_pose(pose_b, "pose of B");
+  check_contact_models(request, a, b, "model A", "model B");
   return request;
 }
 }  // namespace
 
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
-    : PairContext(a, pose_a, b, pose_b, validated(pose_a, pose_b, request), Validated{}) {}
+    : PairContext(a, pose_a, b, pose_b, validated(a, pose_a, b, pose_b, request), Validated{}) {}
 
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request,
                          Validated)

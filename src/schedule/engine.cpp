@@ -23,6 +23,7 @@
 #include "caliber/error.h"
 #include "caliber/profile.h"
 #include "mesh/pose_check.h"
+#include "narrow/finalize.h"
 #include "narrow/pair_context.h"
 #include "parallel/executor.h"
 #include "schedule/engine_impl.h"
@@ -88,7 +89,14 @@ void validate_frame(const Frame& frame) {
     if (k > 0 && !(frame.pairs[k - 1] < p)) {
       throw Error(ErrorCode::bad_argument, "frame", "pairs must be sorted and distinct (pair " + std::to_string(k) + ")");
     }
-    schedule::check_contact_models(frame.request, *frame.models[p.a], *frame.models[p.b]);
+    // A contact query needs both models built with adjacency: refused before any work (the names
+    // made only then).
+    const Model& ma = *frame.models[p.a];
+    const Model& mb = *frame.models[p.b];
+    if (frame.request.kind == QueryKind::contact && (!ma.has_adjacency() || !mb.has_adjacency())) {
+      narrow::check_contact_models(frame.request, ma, mb, "object " + std::to_string(p.a) + "'s model",
+                                   "object " + std::to_string(p.b) + "'s model");
+    }
   }
   validate_request(frame.request);  // a distance query may be unbounded: the frame names its pairs
 }

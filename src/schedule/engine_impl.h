@@ -114,14 +114,6 @@ inline std::atomic<std::uint64_t> g_split_sweep_queries{0};
 /// The number of entries of a call whose sides give `na` and `nb` items (a batch's poses, a sweep's
 /// motions): both the same, or one side one item kept for every entry. Throws caliber::Error
 /// (source `items`) naming the counts, `hint` saying what to give instead.
-/// A contact query needs both models built with adjacency (BuildOptions::adjacency): refused
-/// before any work, not when the contacts are reduced.
-inline void check_contact_models(const QueryRequest& request, const Model& a, const Model& b) {
-  if (request.kind == QueryKind::contact && (!a.has_adjacency() || !b.has_adjacency())) {
-    throw Error(ErrorCode::bad_argument, "contact query", "models were built without adjacency");
-  }
-}
-
 inline std::size_t entry_count(std::size_t na, std::size_t nb, const char* items, const char* hint) {
   if (na == nb || nb == 1) return na;
   if (na == 1) return nb;

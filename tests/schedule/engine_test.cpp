@@ -671,10 +671,31 @@ TEST(EngineFrames, AContactQueryOnModelsWithoutAdjacencyIsRefusedBeforeAnyWork) 
     (void)engine.step(frame);
     FAIL() << "a contact query needs adjacency";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "contact query: models were built without adjacency");
+    EXPECT_EQ(std::string(e.what()),
+              "contact query: object 1's model was built without adjacency (BuildOptions::adjacency), which the contacts' "
+              "reduction needs");
   }
   const std::vector<Pose> fixed{Pose{}}, poses{Pose{}, Pose{}};
-  EXPECT_THROW((void)engine.query_many(*frame.models[0], fixed, *frame.models[1], poses, frame.request), Error);
+  try {
+    (void)engine.query_many(*frame.models[0], fixed, *frame.models[1], poses, frame.request);
+    FAIL() << "a contact batch needs adjacency";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "contact query: model B was built without adjacency (BuildOptions::adjacency), which the contacts' reduction "
+              "needs");
+  }
+  // A single query and the brute force refuse it before any work too, naming both models where both lack it.
+  const auto bare_a = build_model(make_sphere(0.5, 12, 16), bare);
+  for (const bool brute : {false, true}) {
+    try {
+      (void)(brute ? query_brute_force : query)(*bare_a, Pose{}, *frame.models[1], Pose{}, frame.request);
+      FAIL() << "a contact query needs adjacency";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "contact query: model A and model B were built without adjacency (BuildOptions::adjacency), which the "
+                "contacts' reduction needs");
+    }
+  }
 }
 
 TEST(EngineFrames, BadFramesAreRejectedWithTheProblem) {
