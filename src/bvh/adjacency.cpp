@@ -27,9 +27,10 @@ std::vector<Vec3> face_normals(const Mesh& mesh, std::size_t grain) {
   return normals;
 }
 
-void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint32_t>& corner_vertex,
-                      std::vector<std::uint64_t>& offsets, std::vector<std::uint32_t>& triangles) {
-  static_cast<void>(grain);
+void vertex_adjacency(const Mesh& mesh, std::size_t grain, ModelData& model) {
+  std::vector<std::uint32_t>& corner_vertex = model.corner_vertex;
+  std::vector<std::uint64_t>& offsets = model.vertex_offsets;
+  std::vector<std::uint32_t>& triangles = model.vertex_triangles;
   const std::size_t nv = mesh.vertices.size();
   std::vector<std::uint32_t> order(nv);
   std::iota(order.begin(), order.end(), 0u);
@@ -66,6 +67,8 @@ void vertex_adjacency(const Mesh& mesh, std::size_t grain, std::vector<std::uint
   triangles.resize(corner_vertex.size());
   std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
   for (std::size_t c = 0; c < corner_vertex.size(); ++c) triangles[fill[corner_vertex[c]]++] = static_cast<std::uint32_t>(c / 3);
+  model.largest_degree = 0;
+  for (std::size_t w = 0; w < nw; ++w) model.largest_degree = std::max(model.largest_degree, offsets[w + 1] - offsets[w]);
   if (nw == nv) std::vector<std::uint32_t>().swap(corner_vertex);  // every corner is its own vertex
 }
 

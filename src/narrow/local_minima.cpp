@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <unordered_map>
 
 #include "parallel/executor.h"
 
@@ -96,12 +98,58 @@ class EntryTable {
 /// How many candidates on each side of a candidate the reduction looks at before its lookups.
 constexpr std::size_t kNearby = 8;
 
+/// Above this many triangles around a welded vertex (a hub: the centre of a fan, as load_mesh makes
+/// of a large polygon), a candidate's pairs through it are not looked up one by one: the closest
+/// candidate of their group answers for them all (HubGroups), so that a fan of n triangles costs
+/// the reduction n lookups, not n^2.
+constexpr std::uint64_t kHubDegree = 32;
+
+/// The triangles around welded vertex w of model m.
+std::uint64_t degree(const ModelData& m, std::uint32_t w) { return m.vertex_offsets[w + 1] - m.vertex_offsets[w]; }
+
+/// For each hub w of one side and triangle t of the other, the closest candidate (its entry's
+/// index) of the group through them: those whose triangle on w's side has a corner at w and whose
+/// other triangle is t. A candidate of the group is dominated through w (its neighbours there are
+/// the group's other candidates) exactly where it is not the group's closest. Made on one thread
+/// before the reduction's lookups (empty, nothing allocated, where no candidate meets a hub).
+class HubGroups {
+ public:
+  /// Entry i is in the group of (w, t).
+  void offer(std::uint32_t w, std::uint32_t t, std::uint32_t i, const std::vector<Entry>& entries) {
+    const auto [at, fresh] = mClosest.try_emplace(key_of(w, t), i);
+    if (!fresh && closer(entries[i], entries[at->second])) at->second = i;
+  }
+  /// The closest of the group of (w, t), which an entry offered.
+  [[nodiscard]] std::uint32_t closest(std::uint32_t w, std::uint32_t t) const { return mClosest.at(key_of(w, t)); }
+
+ private:
+  std::unordered_map<std::uint64_t, std::uint32_t> mClosest;
+};
+
+/// The groups of both sides' hubs: (hub of A, triangle of B) and (hub of B, triangle of A).
+struct Hubs {
+  HubGroups of_a, of_b;
+
+  Hubs(const ModelData& a, const ModelData& b, const std::vector<Entry>& entries) {
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      const std::uint32_t ta = tri_a(entries[i].key), tb = tri_b(entries[i].key);
+      const std::uint32_t* ca = a.welded_corners(ta);
+      const std::uint32_t* cb = b.welded_corners(tb);
+      for (int k = 0; k < 3; ++k) {
+        if (degree(a, ca[k]) > kHubDegree) of_a.offer(ca[k], tb, static_cast<std::uint32_t>(i), entries);
+        if (degree(b, cb[k]) > kHubDegree) of_b.offer(cb[k], ta, static_cast<std::uint32_t>(i), entries);
+      }
+    }
+  }
+};
+
 /// The reduction's reading of a pair's candidates.
 struct Reduction {
   const ModelData& a;
   const ModelData& b;
   const std::vector<Entry>& entries;
   const EntryTable& table;
+  const Hubs* hubs;  ///< null where neither model has a hub
 
   /// Whether o is closer than c, shares one of its triangles and has the other vertex-adjacent.
   [[nodiscard]] bool dominates(const Entry& o, const Entry& c) const {
@@ -146,8 +194,28 @@ struct Reduction {
       count = 0;
       return any_closer(keys, kLookups, c);
     };
-    return a.any_neighbour(ta, [&](std::uint32_t u) { return add(key_of(u, tb)); }) ||
-           b.any_neighbour(tb, [&](std::uint32_t u) { return add(key_of(ta, u)); }) || any_closer(keys, count, c);
+    if (hubs == nullptr) {
+      return a.any_neighbour(ta, [&](std::uint32_t u) { return add(key_of(u, tb)); }) ||
+             b.any_neighbour(tb, [&](std::uint32_t u) { return add(key_of(ta, u)); }) || any_closer(keys, count, c);
+    }
+    // Corner by corner (ModelData::any_neighbour's walk), a hub answered by its group.
+    const auto through = [&](const ModelData& m, std::uint32_t t, const HubGroups& groups, std::uint32_t other, auto&& key) {
+      const std::uint32_t* corners = m.welded_corners(t);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t w = corners[k];
+        if (degree(m, w) > kHubDegree) {
+          if (groups.closest(w, other) != i) return true;
+          continue;
+        }
+        for (std::uint64_t j = m.vertex_offsets[w]; j < m.vertex_offsets[w + 1]; ++j) {
+          const std::uint32_t u = m.vertex_triangles[j];
+          if (u != t && add(key(u))) return true;
+        }
+      }
+      return false;
+    };
+    return through(a, ta, hubs->of_a, tb, [&](std::uint32_t u) { return key_of(u, tb); }) ||
+           through(b, tb, hubs->of_b, ta, [&](std::uint32_t u) { return key_of(ta, u); }) || any_closer(keys, count, c);
   }
 };
 
@@ -165,7 +233,10 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
     parallel::parallel_for(0, candidates.size(), grain, fill);
   }
   const EntryTable table(entries, grain);
-  const Reduction reduction{ctx.a(), ctx.b(), entries, table};
+  // The hubs' groups, where a model has a hub (a mesh of polygons fanned: rarely).
+  const bool any_hub = ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree;
+  const std::unique_ptr<const Hubs> hubs = any_hub ? std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries) : nullptr;
+  const Reduction reduction{ctx.a(), ctx.b(), entries, table, hubs.get()};
   std::vector<char> keep(candidates.size(), 0);
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i != hi; ++i) keep[i] = reduction.dominated(i) ? 0 : 1;

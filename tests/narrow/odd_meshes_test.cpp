@@ -139,5 +139,62 @@ TEST(OddMeshes, DegenerateTrianglesMakeNoContactAtAnyAngle) {
   }
 }
 
+/// A flat fan of n triangles around one centre vertex (a hub of degree n), its rim a circle of radius
+/// 1, bent down by `sag` at the rim: the triangles around the centre are the closest to a plane below.
+Mesh fan(int n, double sag) {
+  Mesh m;
+  m.source = "fan";
+  m.vertices.emplace_back(0, 0, 0);
+  for (int k = 0; k < n; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / n;
+    m.vertices.emplace_back(std::cos(a), std::sin(a), -sag * (1.0 + 0.5 * std::sin(3.0 * a)));
+  }
+  for (int k = 0; k < n; ++k) {
+    m.triangles.push_back({0, static_cast<std::uint32_t>(1 + k), static_cast<std::uint32_t>(1 + (k + 1) % n)});
+  }
+  return m;
+}
+
+/// A contact query's local minima where a vertex is shared by hundreds of triangles (the fans'
+/// centres, above the reduction's lookups one by one) equal an independent reduction: every pair
+/// within the tolerance (the proximity query; at 180 degrees the contact query's normal test passes
+/// every pair of these non-degenerate triangles) kept unless a closer pair (ties: lower ids) shares
+/// one of its triangles and has the other sharing a vertex with its own.
+TEST(OddMeshes, ContactsAroundAHubAreTheLocalMinima) {
+  const auto a = build_model(fan(300, 0.02));
+  const auto b = build_model(fan(200, -0.03));
+  const Pose pa, pb = Pose::from_values(0.05, -0.03, -0.12, 1, 0.02, 0.01, 0);
+  QueryRequest request;
+  request.kind = QueryKind::proximity;
+  request.tolerance = 0.3;
+  const QueryResult within = query(*a, pa, *b, pb, request);
+  ASSERT_GT(within.contacts.size(), 1000u);
+  const auto neighbours = [](const Mesh& m, std::uint32_t t, std::uint32_t u) {
+    if (t == u) return false;
+    for (const std::uint32_t v : m.triangles[t]) {
+      if (std::find(m.triangles[u].begin(), m.triangles[u].end(), v) != m.triangles[u].end()) return true;
+    }
+    return false;
+  };
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+  for (const Contact& c : within.contacts) {
+    const bool dominated = std::any_of(within.contacts.begin(), within.contacts.end(), [&](const Contact& o) {
+      const bool closer =
+          o.distance != c.distance ? o.distance < c.distance : std::pair(o.tri_a, o.tri_b) < std::pair(c.tri_a, c.tri_b);
+      return closer && ((o.tri_b == c.tri_b && neighbours(a->mesh(), o.tri_a, c.tri_a)) ||
+                        (o.tri_a == c.tri_a && neighbours(b->mesh(), o.tri_b, c.tri_b)));
+    });
+    if (!dominated) want.emplace_back(c.tri_a, c.tri_b);
+  }
+  request.kind = QueryKind::contact;
+  request.angle_deg = 180.0;
+  const QueryResult got = query(*a, pa, *b, pb, request);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (const Contact& c : got.contacts) pairs.emplace_back(c.tri_a, c.tri_b);
+  EXPECT_EQ(pairs, want);
+  EXPECT_GE(want.size(), 1u);
+  test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "fans");
+}
+
 }  // namespace
 }  // namespace caliber
