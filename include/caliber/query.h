@@ -122,9 +122,9 @@ struct QueryStats {
 };
 
 /// The result of a query: its contacts, one per reported triangle pair, sorted by (tri_a, tri_b).
-/// A distance query reports one, the closest pair (ties: the lowest triangle ids; at distance 0,
-/// the first hit unless QueryRequest::lowest_ids), or none when the meshes are farther apart than
-/// the tolerance.
+/// A distance query reports one, the closest pair (ties: the lowest triangle ids; at distance 0, as
+/// QueryRequest::lowest_ids and first_hit say), or none when the meshes are farther apart than the
+/// tolerance.
 struct QueryResult {
   QueryKind kind = QueryKind::interference;  ///< the kind that produced it
   std::vector<Contact> contacts;             ///< sorted by (tri_a, tri_b)
@@ -138,7 +138,7 @@ struct QueryResult {
 /// Runs the query between model A at pose_a and model B at pose_b: one depth-first traversal of
 /// the two BVHs. Exact: the same pairs as query_brute_force, but where the request asks for less: a
 /// limit (max_pairs) returns some of them, and a distance query on meshes that intersect reports
-/// the first hit unless lowest_ids is set. Thread-safe on shared models.
+/// the pair QueryRequest::lowest_ids and first_hit choose. Thread-safe on shared models.
 [[nodiscard]] CALIBER_EXPORT QueryResult query(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b,
                                                const QueryRequest& request);
 

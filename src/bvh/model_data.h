@@ -346,7 +346,7 @@ struct ModelData : Model {
   std::vector<std::uint64_t> vertex_offsets;
   /// See vertex_offsets.
   std::vector<std::uint32_t> vertex_triangles;
-  std::uint64_t largest_degree = 0;  ///< The most triangles around one welded vertex (0 without adjacency).
+  std::uint64_t largest_degree = 0;  ///< The most corners at one welded vertex (0 without adjacency).
   [[nodiscard]] bool has_adjacency() const { return !vertex_offsets.empty(); }  ///< Whether the vertex adjacency was built.
   /// The welded vertices of triangle t's three corners.
   [[nodiscard]] const std::uint32_t* welded_corners(std::uint32_t t) const {

@@ -98,8 +98,9 @@ class EntryTable {
 /// How many candidates on each side of a candidate the reduction looks at before its lookups.
 constexpr std::size_t kNearby = 8;
 
-/// Above this many triangles around a welded vertex (a hub: the centre of a fan, as load_mesh makes
-/// of a large polygon), a candidate's pairs through it are not looked up one by one: the closest
+/// Above this many corners at a welded vertex (a hub: the centre of a fan, as load_mesh makes of a
+/// large polygon, or the pole of a sphere of many segments; a triangle with two corners there
+/// counts twice), a candidate's pairs through it are not looked up one by one: the closest
 /// candidate of their group answers for them all (HubGroups), so that a fan of n triangles costs
 /// the reduction n lookups, not n^2.
 constexpr std::uint64_t kHubDegree = 32;
@@ -233,7 +234,7 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
     parallel::parallel_for(0, candidates.size(), grain, fill);
   }
   const EntryTable table(entries, grain);
-  // The hubs' groups, where a model has a hub (a mesh of polygons fanned: rarely).
+  // The hubs' groups, where a model has a hub (none on most meshes, a few on a sphere's poles).
   const bool any_hub = ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree;
   const std::unique_ptr<const Hubs> hubs = any_hub ? std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries) : nullptr;
   const Reduction reduction{ctx.a(), ctx.b(), entries, table, hubs.get()};

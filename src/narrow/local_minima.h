@@ -15,7 +15,7 @@ namespace caliber::narrow {
 /// (`closer`: ties to the lower ids). Each verdict depends only on the set of candidates, not on
 /// their order, so they need no sorting first; the kept ones are returned in the input's order.
 /// Linear in the candidates times the adjacency's degree, that degree taken at most 32 a vertex
-/// (a vertex around which more triangles lie answers for its candidates by their closest); in
+/// (a vertex with more corners at it answers for its candidates by their closest); in
 /// chunks of `grain` on the current executor (a grain as large as the input keeps it on this
 /// thread). Both models need adjacency.
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain);
