@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
     for (CLI::Option* option : command->get_options([](CLI::Option*) { return true; })) {
       if (option->get_type_size() != 0 && !option->get_positional()) option->check(non_empty);
+      if (option->get_type_size() != 0) caliber::cli::check_number_syntax(*option);
     }
   }
   try {

@@ -15,7 +15,6 @@
 
 namespace caliber {
 namespace {
-
 using Json = nlohmann::json;
 
 /// Reads values out of the JSON tree; every failure names the file and the key path.
@@ -118,7 +117,9 @@ Motion read_motion(const Reader& r, const Json& j, const std::string& where) {
       k.time = r.number(r.required(keys[i], at, "time"), at + ".time");
       if (keys[i].contains("position")) k.position = r.vec3(keys[i].at("position"), at + ".position");
       if (keys[i].contains("orientation")) k.orientation = r.quat(keys[i].at("orientation"), at + ".orientation");
-      if (!m.keys.empty() && !(k.time > m.keys.back().time)) r.fail(at + ".time", "key times must increase");
+      const bool after = m.keys.empty() || (k.time > m.keys.back().time && std::isfinite(k.time - m.keys.back().time));
+      if (!after)
+        r.fail(at + ".time", k.time > m.keys.back().time ? "is too far from the key before it" : "key times must increase");
       m.keys.push_back(k);
     }
   } else {
@@ -190,10 +191,9 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   return query;
 }
 
-/// A SAX pass that refuses a key given twice in one object (JSON parsers keep one of the two
-/// values, silently), naming its path ("objects[1].motion.type"), and turns a syntax error into
-/// caliber's. (A parser callback could do it while parsing, but nlohmann's callback parser scans
-/// the enclosing array at every object's end: quadratic in a scene of 40,000 objects.)
+/// A SAX pass that refuses a key given twice in one object (JSON parsers keep one of the two values,
+/// silently), naming its path ("objects[1].motion.type"), and turns a syntax error into caliber's.
+/// (nlohmann's callback parser scans the enclosing array at every object's end: quadratic.)
 class DuplicateKeys final : public nlohmann::json_sax<Json> {
  public:
   explicit DuplicateKeys(std::string source) : mSource(std::move(source)) {}

@@ -65,6 +65,10 @@ void check_scene(const Scene& scene) {
       if (!std::isfinite(key.time) || (k > 0 && !(key.time > m.keys[k - 1].time))) {
         throw Error(ErrorCode::bad_value, source, at + ": key times must be finite and increase");
       }
+      if (k > 0 && !std::isfinite(key.time - m.keys[k - 1].time)) {
+        throw Error(ErrorCode::bad_value, source,
+                    at + ": is too far from the key before it (their difference overflows a double)");
+      }
       if (!finite(key.position, key.orientation)) {
         throw Error(ErrorCode::bad_value, source, at + ": its pose must be finite, with a non-zero quaternion");
       }

@@ -601,6 +601,10 @@ json.dump({"steps": 3, "dt": 0.1, "query": {"kind": "proximity", "tolerance": 0.
                        {"name": "mover", "mesh": f"{data}/tetra.off", "refine": 2, "position": [0.2, 0.1, 0.1],
                         "motion": {"type": "velocity", "linear": [-0.1, 0, 0]}}]}, open(f"{h}/cut.json", "w"))
 json.dump({"steps": 3, "query": {"kind": 3}, "objects": [{"mesh": f"{data}/tetra.off"}]}, open(f"{h}/kind.json", "w"))
+json.dump({"steps": 2, "dt": 1, "objects": [{"name": "fixed", "mesh": f"{data}/tetra.off"},
+           {"name": "mover", "mesh": f"{data}/tetra.off", "motion": {"type": "keyframes", "keys": [
+               {"time": -1.7e308, "position": [-1000, 0, 0]}, {"time": 1.7e308, "position": [1000, 0, 0]}]}}]},
+          open(f"{h}/keyspan.json", "w"))
 PY
 check scene-nul 2 "$cli" run "$h/nul.json"
 contains scene-nul "holds a NUL byte at offset"
@@ -632,6 +636,16 @@ check query-threads-range 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --t
 check sweep-tolerance-nan 2 "$cli" run "$data/scenes/tetras.json" --sweep-tolerance nan
 check export-bad-threads-no-folder 2 "$cli" run "$data/scenes/tetras.json" --export "$h/e4" --threads 99999
 [ -e "$h/e4" ] && { echo "FAIL export-bad-threads-no-folder: created $h/e4"; failures=$((failures + 1)); }
+# Whole numbers in decimal (C's 010 was 8), no number that rounds to 0 from a non-zero value, no
+# keys too far apart to interpolate between (the mover stayed at the first key).
+check steps-leading-zero 0 "$cli" run "$data/scenes/tetras.json" --steps 010
+contains steps-leading-zero "summary over 10 steps"
+check steps-hex 2 "$cli" run "$data/scenes/tetras.json" --steps 0x10
+contains steps-hex "--steps: must be a whole number in decimal digits, not '0x10'"
+check tolerance-underflow 2 "$cli" query "$data/tetra.off" "$data/tetra.off" --kind proximity --tolerance 1e-400
+contains tolerance-underflow "--tolerance: is too small for a double (it would be read as 0): '1e-400'"
+check keys-too-far-apart 2 "$cli" run "$h/keyspan.json"
+contains keys-too-far-apart "'objects[1].motion.keys[1].time': is too far from the key before it"
 rm -rf "$h"
 
 echo "$passes passed, $failures failed"
