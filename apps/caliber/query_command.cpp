@@ -114,7 +114,7 @@ std::pair<caliber::QueryResult, std::vector<double>> timed_query(const QueryOpti
     caliber::EngineOptions options;
     options.method = method;
     options.threads = opt.threads;
-    engine = std::make_unique<caliber::Engine>(options);
+    engine = engine_from_options([&] { return std::make_unique<caliber::Engine>(options); });
     frame.models = {model_a, model_b};
     frame.poses = {pose_a, pose_b};
     frame.pairs = {caliber::ObjectPair{0, 1}};

@@ -23,29 +23,12 @@
 #include "output_file.h"
 #include "progress.h"
 #include "run_continuous.h"
+#include "run_options.h"
 #include "run_stats.h"
 #include "timing.h"
 
 namespace caliber::cli {
 namespace {
-
-struct RunOptions {
-  std::string scene;
-  std::string method{to_string(kDefaultMethod)};
-  int threads = 0;
-  int stealing_depth = EngineOptions{}.stealing_depth;
-  double beta = EngineOptions{}.beta;
-  double epsilon = EngineOptions{}.epsilon;
-  bool node_history = false;
-  std::vector<int> simulate = {2, 4, 8, 16, 32, 64};
-  int steps = -1;
-  std::string json;
-  std::string contacts;
-  ExportOptions exports;
-  std::size_t max_pairs = 0;
-  bool continuous = false;
-  double sweep_tolerance = 0.0;
-};
 
 nlohmann::json step_record(const StepResult& s) {
   nlohmann::json pairs = nlohmann::json::array();
@@ -115,45 +98,22 @@ std::string pair_name(const World& world, const ObjectPair& t) {
   return world.scene().objects[t.a].name + " / " + world.scene().objects[t.b].name;
 }
 
-/// The options checked before anything is loaded or written (the scene's own checks come later).
-void check_run_options(const RunOptions& opt) {
-  if (!(opt.sweep_tolerance >= 0.0) || opt.sweep_tolerance > kMaxCoordinate ||
-      (opt.sweep_tolerance != 0.0 && opt.sweep_tolerance < kMinCoordinate)) {
-    throw Error(ErrorCode::bad_value, "--sweep-tolerance", "must be 0 or in [2^-120, 1e15]");
-  }
-}
+/// The steps to run: the scene's, or --steps (checked by check_run_options).
+int steps_of(const RunOptions& opt, int scene_steps) { return opt.steps > 0 ? opt.steps : scene_steps; }
 
-/// The steps to run: the scene's, or --steps.
-int steps_of(const RunOptions& opt, int scene_steps) {
-  if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
-  if (opt.steps > 100000000) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
-  return opt.steps > 0 ? opt.steps : scene_steps;
-}
-
-/// The export steps, each listed once.
-void check_export_steps(const std::vector<int>& listed) {
-  for (auto k = listed.begin(); k != listed.end(); ++k) {
-    if (std::find(listed.begin(), k, *k) != k) {
-      throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*k) + " is listed twice");
-    }
-  }
-}
-
-/// The engine the options ask for (its options, and the simulated core counts, checked here, before
-/// any output is made).
+/// The engine the options ask for (its options checked by its constructor, before the scene is
+/// read or any output made). The steps' report says how the work was cut; the sweeps' has no use
+/// for it.
 Engine engine_of(const RunOptions& opt) {
-  for (const int p : opt.simulate) {
-    if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
-  }
   EngineOptions engine_options;
   engine_options.method = parse_method(opt.method);
-  engine_options.profile = true;  // the summary and the JSON report how the work was cut
+  engine_options.profile = !opt.continuous;
   engine_options.threads = opt.threads;
   engine_options.stealing_depth = opt.stealing_depth;
   engine_options.beta = opt.beta;
   engine_options.epsilon = opt.epsilon;
   engine_options.node_history = opt.node_history;
-  return Engine(engine_options);
+  return engine_from_options([&] { return Engine(engine_options); });
 }
 
 /// Where a run writes: the JSON report (streamed: what is known first, then each step as it ends,
@@ -279,18 +239,11 @@ void close_report(RunSinks& sinks, const World& world, const RunStats& stats, co
 
 int run_scene(const RunOptions& opt) {
   check_run_options(opt);
+  Engine engine = engine_of(opt);
   Scene scene = load_scene(opt.scene);
   scene.steps = steps_of(opt, scene.steps);
-  if (opt.continuous) {
-    if (!opt.contacts.empty() || !opt.exports.dir.empty() || opt.max_pairs != 0) {
-      throw Error(ErrorCode::bad_argument, "--continuous",
-                  "reports the pairs that touch between steps: it takes none of --contacts, --export, --max-pairs");
-    }
-    return run_continuous({opt.scene, opt.method, opt.threads, opt.sweep_tolerance, opt.json}, std::move(scene));
-  }
+  if (opt.continuous) return run_continuous({opt.scene, opt.sweep_tolerance, opt.json}, engine, std::move(scene));
   if (opt.max_pairs != 0) scene.query.max_pairs = opt.max_pairs;
-  Engine engine = engine_of(opt);
-  check_export_steps(opt.exports.steps);
   // SIGINT and SIGTERM handled from before the first output is made until every one is in place.
   const InterruptGuard interrupt;
   RunSinks sinks(opt, scene);
@@ -364,7 +317,13 @@ Runner add_run_command(CLI::App& app) {
   cmd->add_option("--sweep-tolerance", opt->sweep_tolerance,
                   "--continuous: the distance at which two objects touch (0: 1e-6 of the larger one's radius)")
       ->capture_default_str();
-  return [cmd, opt]() { return cmd->parsed() ? run_scene(*opt) : -1; };
+  return [cmd, opt]() {
+    if (!cmd->parsed()) return -1;
+    for (const CLI::Option* o : cmd->get_options()) {
+      if (o->count() > 0) opt->given.push_back(o->get_name());
+    }
+    return run_scene(*opt);
+  };
 }
 
 }  // namespace caliber::cli

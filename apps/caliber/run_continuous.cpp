@@ -67,7 +67,7 @@ void print_pairs(const World& world, int k, const std::vector<PairSweep>& pairs)
 
 }  // namespace
 
-int run_continuous(const ContinuousOptions& opt, Scene scene) {
+int run_continuous(const ContinuousOptions& opt, Engine& engine, Scene scene) {
   SweepRequest request;
   request.tolerance = opt.tolerance;
   validate_sweep_request(request);
@@ -78,11 +78,7 @@ int run_continuous(const ContinuousOptions& opt, Scene scene) {
     check_distinct_files({{"--json", opt.json}}, scene_inputs(opt.scene_file, scene));
     json_out = std::make_unique<OutputFile>(opt.json, "--json");
   }
-  EngineOptions engine_options;
-  engine_options.method = parse_method(opt.method);
-  engine_options.threads = opt.threads;
   const World world(std::move(scene));
-  Engine engine(engine_options);
   const Scene& sc = world.scene();
   std::printf("scene %s: %zu objects, %d steps of %g s: sweeping each step's motion to the next, method %s on %d thread(s)\n",
               sc.name.c_str(), world.object_count(), sc.steps, sc.dt, std::string(to_string(engine.options().method)).c_str(),

@@ -155,21 +155,23 @@ int view_scene(const ViewOptions& opt) {
                 "this build has no viewer: viewer/node_modules (three.js and esbuild from npm) was missing when it was "
                 "configured; run scripts/setup.sh, then rebuild");
   }
-  Scene scene = load_scene(opt.scene);
+  // The options checked (the engine's by its constructor) before the scene is read.
   if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
+  if (opt.steps > kMaxSceneSteps) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
   if (opt.max_boxes < 0) throw Error(ErrorCode::bad_value, "--max-boxes", "must be 0 or more");
-  if (opt.steps > 0) scene.steps = opt.steps;
   EngineOptions options;
   options.method = parse_method(opt.method);
   options.threads = opt.threads;
   options.timeline = true;
+  Engine engine = engine_from_options([&] { return Engine(options); });
+  Scene scene = load_scene(opt.scene);
+  if (opt.steps > 0) scene.steps = opt.steps;
   // SIGINT and SIGTERM handled from before the page is opened until it is in place (or removed).
   const InterruptGuard interrupt;
   check_distinct_files({{"--out", opt.out}}, scene_inputs(opt.scene, scene));
   OutputFile out(opt.out, "--out");
 
   const World world(std::move(scene));
-  Engine engine(options);
   const Scene& sc = world.scene();
   // The page is streamed: its head, the data (meshes and objects, then each step as it ends), its
   // tail; so its memory does not grow with the steps.

@@ -61,6 +61,9 @@ struct SceneObject {
   std::vector<GroupRange> groups;  ///< triangle ranges in other groups
 };
 
+/// The most time steps a scene file may ask for (and the command line's --steps).
+inline constexpr int kMaxSceneSteps = 100000000;
+
 /// A whole scene: objects, the query every pair runs, and the time steps.
 struct Scene {
   std::string name;                         ///< scene name (defaults to the file's stem)

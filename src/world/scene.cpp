@@ -5,13 +5,13 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "caliber/error.h"
 #include "caliber/scene.h"
+#include "world/json_scan.h"
 
 namespace caliber {
 namespace {
@@ -191,72 +191,6 @@ QueryRequest read_query(const Reader& r, const Json& q) {
   return query;
 }
 
-/// A SAX pass that refuses a key given twice in one object (JSON parsers keep one of the two values,
-/// silently), naming its path ("objects[1].motion.type"), and turns a syntax error into caliber's.
-/// (nlohmann's callback parser scans the enclosing array at every object's end: quadratic.)
-class DuplicateKeys final : public nlohmann::json_sax<Json> {
- public:
-  explicit DuplicateKeys(std::string source) : mSource(std::move(source)) {}
-  bool null() override { return element_done(); }
-  bool boolean(bool) override { return element_done(); }
-  bool number_integer(number_integer_t) override { return element_done(); }
-  bool number_unsigned(number_unsigned_t) override { return element_done(); }
-  bool number_float(number_float_t, const string_t&) override { return element_done(); }
-  bool string(string_t&) override { return element_done(); }
-  bool binary(binary_t&) override { return element_done(); }
-  bool start_object(std::size_t) override { return push(true); }
-  bool start_array(std::size_t) override { return push(false); }
-  bool end_object() override { return pop(); }
-  bool end_array() override { return pop(); }
-  bool key(string_t& key) override {
-    if (!mStack.back().keys.insert(key).second) {
-      std::string path;
-      const auto name = [&path](const std::string& part) {
-        if (!path.empty()) path.push_back('.');
-        path.append(part);
-      };
-      for (std::size_t i = 0; i + 1 < mStack.size(); ++i) {
-        if (mStack[i].object) {
-          name(mStack[i].key);
-        } else {
-          path.append("[").append(std::to_string(mStack[i].index)).append("]");
-        }
-      }
-      name(key);
-      throw Error(ErrorCode::unreadable, mSource,
-                  "'" + path + "': the key is given twice in one object (which value was meant?)");
-    }
-    mStack.back().key = key;
-    return true;
-  }
-  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
-    throw Error(ErrorCode::unreadable, mSource, std::string("not valid JSON: ") + e.what());
-  }
-
- private:
-  struct Level {
-    bool object = false;
-    std::set<std::string> keys;
-    std::string key;
-    std::size_t index = 0;
-  };
-  bool element_done() {
-    if (!mStack.empty() && !mStack.back().object) ++mStack.back().index;
-    return true;
-  }
-  bool push(bool object) {
-    mStack.push_back(Level{object, {}, {}, 0});
-    return true;
-  }
-  bool pop() {
-    mStack.pop_back();
-    return element_done();
-  }
-
-  std::string mSource;
-  std::vector<Level> mStack;
-};
-
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir, const std::string& source) {
@@ -267,7 +201,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
   }
   Json root;
   try {
-    DuplicateKeys check(source);
+    world::JsonScan check(source);
     Json::sax_parse(text, &check);
     root = Json::parse(text);
   } catch (const Json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
@@ -276,7 +210,7 @@ Scene parse_scene(const std::string& text, const std::filesystem::path& base_dir
   r.only_keys(root, "", {"name", "steps", "dt", "query", "groups", "ignore", "objects"});
   Scene scene;
   scene.name = root.contains("name") ? r.string(root.at("name"), "name") : std::filesystem::path(source).stem().string();
-  if (root.contains("steps")) scene.steps = r.integer(root.at("steps"), "steps", 1, 100000000);
+  if (root.contains("steps")) scene.steps = r.integer(root.at("steps"), "steps", 1, kMaxSceneSteps);
   scene.dt = r.number(root, "", "dt", scene.dt);
   if (!(scene.dt > 0.0)) r.fail("dt", "must be > 0");
 

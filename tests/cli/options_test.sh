@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The command line's options checked before any work, whatever the mode: an option the mode does
+# not read is refused by name, every value is checked before the scene is read, and a scene file's
+# number too small for a double or nesting too deep is refused with its path.
+set -u
+cli="$1"
+data="$2"
+source "$(dirname "$0")/check_lib.sh"
+scene="$data/scenes/tetras.json"
+h=$(mktemp -d)
+
+# Options --continuous does not read, and the steps' options without their mode.
+check continuous-beta 2 "$cli" run "$scene" --continuous --beta nan
+contains continuous-beta "--continuous: reports the pairs that touch between steps: it takes none of"
+contains continuous-beta "(--beta given)"
+check continuous-simulate 2 "$cli" run "$scene" --continuous --simulate-cores 0
+contains continuous-simulate "(--simulate-cores given)"
+check continuous-max-pairs-zero 2 "$cli" run "$scene" --continuous --max-pairs 0
+contains continuous-max-pairs-zero "(--max-pairs given)"
+check continuous-runs 0 "$cli" run "$scene" --continuous --steps 3 --sweep-tolerance 0.01 --method stealing --threads 2
+contains continuous-runs "summary over 2 step intervals"
+check sweep-tolerance-alone 2 "$cli" run "$scene" --sweep-tolerance 0.1
+contains sweep-tolerance-alone "--sweep-tolerance: is read only with --continuous"
+check bvh-depth-alone 2 "$cli" run "$scene" --bvh-depth -7
+contains bvh-depth-alone "--bvh-depth: is read only with --export DIR"
+check export-steps-alone 2 "$cli" run "$scene" --export-steps 3
+contains export-steps-alone "--export-steps: is read only with --export DIR"
+
+# Values checked before the scene is read (the scene named here does not exist), in the option's
+# own name.
+for mode in "" --continuous; do
+  check "threads-first$mode" 2 "$cli" run "$h/none.json" $mode --threads 99999
+  contains "threads-first$mode" "--threads: must be between 0 and 1024"
+done
+check view-threads-first 2 "$cli" view "$h/none.json" --out "$h/v.html" --threads 99999
+contains view-threads-first "--threads: must be between 0 and 1024"
+check stealing-depth 2 "$cli" run "$h/none.json" --stealing-depth -3
+contains stealing-depth "--stealing-depth: must be >= 0"
+check epsilon 2 "$cli" run "$h/none.json" --epsilon -1
+contains epsilon "--epsilon: must be a finite number >= 0"
+check simulate-cores 2 "$cli" run "$h/none.json" --simulate-cores 2,0
+contains simulate-cores "--simulate-cores: core counts must be in [1, 4096]"
+check view-steps-limit 2 "$cli" view "$h/none.json" --out "$h/v.html" --steps 200000000
+contains view-steps-limit "--steps: must be at most 100000000"
+[ -e "$h/v.html" ] && { echo "FAIL view-steps-limit: wrote $h/v.html"; failures=$((failures + 1)); }
+# A long --export-steps list (as long as one argument may be) with a step twice.
+steps=$(seq -s, 0 15999),7
+check export-steps-long 2 timeout 20 "$cli" run "$scene" --export "$h/e" --export-steps "$steps"
+contains export-steps-long "--export-steps: step 7 is listed twice"
+[ -e "$h/e" ] && { echo "FAIL export-steps-long: made $h/e"; failures=$((failures + 1)); }
+
+# Scene numbers below the doubles' range (read as 0 by the parser), and nesting too deep.
+printf '{"steps": 2, "dt": 1e-400, "objects": [{"mesh": "%s/tetra.off"}]}' "$data" > "$h/dt.json"
+check scene-underflow 2 "$cli" run "$h/dt.json"
+contains scene-underflow "dt.json: 'dt': is too small for a double (it would be read as 0): 1e-400"
+printf '{"objects": [{"mesh": "%s/tetra.off", "position": [0, -2.5e-999, 0]}]}' "$data" > "$h/pos.json"
+check scene-underflow-array 2 "$cli" run "$h/pos.json"
+contains scene-underflow-array "'objects[0].position[1]': is too small for a double"
+printf '{"steps": 2, "dt": 0e-5, "objects": [{"mesh": "%s/tetra.off"}]}' "$data" > "$h/zero.json"
+check scene-zero 2 "$cli" run "$h/zero.json"
+contains scene-zero "'dt': must be > 0"
+python3 -c "print('{\"a\":' * 100000 + '1' + '}' * 100000)" > "$h/deep.json"
+check scene-deep 2 "$cli" run "$h/deep.json"
+contains scene-deep "deep.json: nests deeper than 256 levels"
+rm -rf "$h"
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
