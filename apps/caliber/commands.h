@@ -14,6 +14,17 @@
 
 namespace caliber::cli {
 
+/// The method --method names (caliber::parse_method), a bad name refused as "--method: ...".
+inline Method method_option(const std::string& name) {
+  try {
+    return parse_method(name);
+  } catch (const Error& e) {
+    const std::string_view what = e.what();
+    const std::string_view prefix = "method: ";
+    throw Error(e.code(), "--method", std::string(what.substr(what.rfind(prefix, 0) == 0 ? prefix.size() : 0)));
+  }
+}
+
 /// make() (an engine made from options), an option the engine refuses named as the command line
 /// spells it (--threads, not the library's "threads").
 template <class Make>

@@ -107,7 +107,7 @@ std::pair<caliber::QueryResult, std::vector<double>> timed_query(const QueryOpti
                                                                  const caliber::Pose& pose_a, const caliber::Pose& pose_b,
                                                                  const std::shared_ptr<const caliber::Model>& model_a,
                                                                  const std::shared_ptr<const caliber::Model>& model_b) {
-  const caliber::Method method = caliber::parse_method(opt.method);
+  const caliber::Method method = method_option(opt.method);
   std::unique_ptr<caliber::Engine> engine;
   caliber::Frame frame;
   if (method != caliber::Method::sequential) {
@@ -188,7 +188,7 @@ int run_query(const QueryOptions& opt) {
   const caliber::QueryRequest request = request_of(opt);
   const caliber::Pose pose_a = caliber::parse_pose(opt.pose_a, "--pose-a");
   const caliber::Pose pose_b = caliber::parse_pose(opt.pose_b, "--pose-b");
-  (void)caliber::parse_method(opt.method);  // a bad method is refused before the models are built
+  (void)method_option(opt.method);  // a bad method is refused before the models are built
   const auto build_start = Clock::now();
   const auto [model_a, model_b] = models_of(opt, request.kind);
   const double build_ms = ms_since(build_start);

@@ -106,7 +106,7 @@ int steps_of(const RunOptions& opt, int scene_steps) { return opt.steps > 0 ? op
 /// for it.
 Engine engine_of(const RunOptions& opt) {
   EngineOptions engine_options;
-  engine_options.method = parse_method(opt.method);
+  engine_options.method = method_option(opt.method);
   engine_options.profile = !opt.continuous;
   engine_options.threads = opt.threads;
   engine_options.stealing_depth = opt.stealing_depth;

@@ -8,6 +8,7 @@
 
 #include "caliber/error.h"
 #include "caliber/scene.h"
+#include "commands.h"
 #include "caliber/mesh.h"
 
 namespace caliber::cli {
@@ -39,11 +40,32 @@ void check_mode_options(const RunOptions& opt) {
       throw Error(ErrorCode::bad_argument, std::string(name), "is read only with --export DIR");
     }
   }
+  // The methods' own options: the calibration's, the hybrid's history, stealing's depth.
+  const Method method = method_option(opt.method);
+  const bool calibrated = method == Method::aposteriori || method == Method::apriori || method == Method::hybrid;
+  const std::string by = " (--method " + opt.method + ")";
+  for (const std::string_view name : {std::string_view("--beta"), std::string_view("--epsilon")}) {
+    if (!calibrated && given(opt, name)) {
+      throw Error(ErrorCode::bad_argument, std::string(name),
+                  "is read only by the calibrated methods: aposteriori, apriori, hybrid" + by);
+    }
+  }
+  if (method != Method::hybrid && given(opt, "--node-history")) {
+    throw Error(ErrorCode::bad_argument, "--node-history", "is read only by --method hybrid" + by);
+  }
+  if (method != Method::stealing && given(opt, "--stealing-depth")) {
+    throw Error(ErrorCode::bad_argument, "--stealing-depth", "is read only by --method stealing" + by);
+  }
 }
 
-/// The export steps, each listed once (sorted: a long list is checked in n log n).
+/// The export steps: none negative (the last is checked against the scene's steps once it is
+/// read), each listed once (sorted: a long list is checked in n log n).
 void check_export_steps(std::vector<int> listed) {
   std::sort(listed.begin(), listed.end());
+  if (!listed.empty() && listed.front() < 0) {
+    throw Error(ErrorCode::bad_value, "--export-steps",
+                "step " + std::to_string(listed.front()) + " is negative: steps count from 0");
+  }
   const auto twice = std::adjacent_find(listed.begin(), listed.end());
   if (twice != listed.end()) {
     throw Error(ErrorCode::bad_value, "--export-steps", "step " + std::to_string(*twice) + " is listed twice");

@@ -160,7 +160,7 @@ int view_scene(const ViewOptions& opt) {
   if (opt.steps > kMaxSceneSteps) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
   if (opt.max_boxes < 0) throw Error(ErrorCode::bad_value, "--max-boxes", "must be 0 or more");
   EngineOptions options;
-  options.method = parse_method(opt.method);
+  options.method = method_option(opt.method);
   options.threads = opt.threads;
   options.timeline = true;
   Engine engine = engine_from_options([&] { return Engine(options); });

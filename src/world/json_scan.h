@@ -4,7 +4,8 @@
 /// parser accepts silently, each naming the file and the path of the value
 /// ("objects[1].motion.type"): a key given twice in one object (parsers keep one of the two values),
 /// a number too small for a double (1e-400, read as 0), nesting deeper than kMaxDepth (no scene
-/// nests more than a few levels; each level costs memory); and turns a syntax error into caliber's.
+/// nests more than a few levels; each level costs memory); and turns a syntax error into caliber's
+/// (a number beyond the doubles' range with its path). An empty key is shown as "".
 /// (nlohmann's callback parser scans the enclosing array at every object's end: quadratic.)
 
 #include <cstddef>
@@ -47,6 +48,8 @@ class JsonScan final : public nlohmann::json_sax<nlohmann::json> {
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
+    // A number beyond the doubles' range (out_of_range 406) is a value: its path is known.
+    if (e.id == 406) fail(path(nullptr), std::string("not valid JSON: ") + e.what());
     throw Error(ErrorCode::unreadable, mSource, std::string("not valid JSON: ") + e.what());
   }
 
@@ -66,7 +69,7 @@ class JsonScan final : public nlohmann::json_sax<nlohmann::json> {
     std::string out;
     const auto name = [&out](const std::string& part) {
       if (!out.empty()) out.push_back('.');
-      out.append(part);
+      out.append(part.empty() ? std::string("\"\"") : part);  // an empty key, seen
     };
     const std::size_t levels = key != nullptr ? mStack.size() - 1 : mStack.size();
     for (std::size_t i = 0; i < levels; ++i) {
@@ -84,7 +87,11 @@ class JsonScan final : public nlohmann::json_sax<nlohmann::json> {
     return true;
   }
   bool push(bool object) {
-    if (mStack.size() == kMaxDepth) fail("", "nests deeper than " + std::to_string(kMaxDepth) + " levels");
+    if (mStack.size() == kMaxDepth) {
+      // The problem first: the path, 256 levels long, is cut to fit the message.
+      throw Error(ErrorCode::unreadable, mSource,
+                  "nests deeper than " + std::to_string(kMaxDepth) + " levels, at '" + path(nullptr) + "'");
+    }
     mStack.push_back(Level{object, {}, {}, 0});
     return true;
   }

@@ -25,6 +25,15 @@ check bvh-depth-alone 2 "$cli" run "$scene" --bvh-depth -7
 contains bvh-depth-alone "--bvh-depth: is read only with --export DIR"
 check export-steps-alone 2 "$cli" run "$scene" --export-steps 3
 contains export-steps-alone "--export-steps: is read only with --export DIR"
+# The methods' own options, with another method (stealing is the default).
+check beta-stealing 2 "$cli" run "$scene" --beta 3
+contains beta-stealing "--beta: is read only by the calibrated methods: aposteriori, apriori, hybrid (--method stealing)"
+check depth-hybrid 2 "$cli" run "$scene" --method hybrid --stealing-depth 3
+contains depth-hybrid "--stealing-depth: is read only by --method stealing (--method hybrid)"
+check history-apriori 2 "$cli" run "$scene" --method apriori --node-history
+contains history-apriori "--node-history: is read only by --method hybrid"
+check hybrid-options 0 "$cli" run "$scene" --method hybrid --node-history --beta 3 --epsilon 0.5 --steps 2
+check stealing-depth-ok 0 "$cli" run "$scene" --stealing-depth 3 --steps 2
 
 # Values checked before the scene is read (the scene named here does not exist), in the option's
 # own name.
@@ -34,9 +43,15 @@ for mode in "" --continuous; do
 done
 check view-threads-first 2 "$cli" view "$h/none.json" --out "$h/v.html" --threads 99999
 contains view-threads-first "--threads: must be between 0 and 1024"
+check bad-method 2 "$cli" run "$h/none.json" --method bogus
+contains bad-method "--method: unknown method 'bogus'"
+check view-bad-method 2 "$cli" view "$h/none.json" --out "$h/v.html" --method bogus
+contains view-bad-method "--method: unknown method 'bogus'"
+check export-steps-negative 2 "$cli" run "$h/none.json" --export "$h/e" --export-steps 3,-1
+contains export-steps-negative "--export-steps: step -1 is negative"
 check stealing-depth 2 "$cli" run "$h/none.json" --stealing-depth -3
 contains stealing-depth "--stealing-depth: must be >= 0"
-check epsilon 2 "$cli" run "$h/none.json" --epsilon -1
+check epsilon 2 "$cli" run "$h/none.json" --method apriori --epsilon -1
 contains epsilon "--epsilon: must be a finite number >= 0"
 check simulate-cores 2 "$cli" run "$h/none.json" --simulate-cores 2,0
 contains simulate-cores "--simulate-cores: core counts must be in [1, 4096]"
@@ -61,7 +76,13 @@ check scene-zero 2 "$cli" run "$h/zero.json"
 contains scene-zero "'dt': must be > 0"
 python3 -c "print('{\"a\":' * 100000 + '1' + '}' * 100000)" > "$h/deep.json"
 check scene-deep 2 "$cli" run "$h/deep.json"
-contains scene-deep "deep.json: nests deeper than 256 levels"
+contains scene-deep "deep.json: nests deeper than 256 levels, at 'a.a.a."
+printf '{"dt": [1, 2, 1e400]}' > "$h/over.json"
+check scene-overflow 2 "$cli" run "$h/over.json"
+contains scene-overflow "over.json: 'dt[2]': not valid JSON:"
+printf '{"": 1, "": 2}' > "$h/empty_key.json"
+check scene-empty-key 2 "$cli" run "$h/empty_key.json"
+contains scene-empty-key "'\"\"': the key is given twice in one object"
 rm -rf "$h"
 
 echo "$passes passed, $failures failed"
