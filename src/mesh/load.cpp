@@ -46,6 +46,9 @@ void check_file(const std::filesystem::path& path) {
     throw Error(ErrorCode::bad_argument, path.string(), "the path holds a NUL byte");
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) {  // a loop of links, a folder without access
+    throw Error(ErrorCode::unreadable, path.string(), "cannot be read (" + ec.message() + ")");
+  }
   if (ec || !std::filesystem::exists(status)) {
     throw Error(ErrorCode::file_not_found, path.string(), "no such file");
   }

@@ -131,8 +131,10 @@ void scale_mesh(Mesh& mesh, double factor) {
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d scaled = mesh.vertices[v] * factor;
     if (!scaled.allFinite() || scaled.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      char f[32];
+      std::snprintf(f, sizeof f, "%g", factor);
       throw Error(ErrorCode::bad_value, mesh.source,
-                  "scaling by " + std::to_string(factor) + " puts vertex " + std::to_string(v) +
+                  std::string("scaling by ") + f + " puts vertex " + std::to_string(v) +
                       " beyond +-1e15 (caliber's limit on coordinates)");
     }
     for (int c = 0; c < 3; ++c) {

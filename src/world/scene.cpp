@@ -138,10 +138,14 @@ SceneObject read_object(const Reader& r, const Json& j, const std::string& where
   o.mesh = o.mesh.lexically_normal();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(o.mesh, ec)) {
-    const bool there = std::filesystem::exists(o.mesh, ec);
+    // A path that cannot be followed (a loop of links, a folder without access) is no missing file.
+    const bool unreachable = ec && ec != std::errc::no_such_file_or_directory;
+    const bool there = unreachable || std::filesystem::exists(o.mesh, ec);
     r.fail(where + ".mesh",
-           (there ? "not a regular mesh file: " : "no such mesh file: ") + o.mesh.string() +
-               (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
+           (unreachable ? "cannot be read (" + ec.message() + "): "
+            : there     ? "not a regular mesh file: "
+                        : "no such mesh file: ") +
+               o.mesh.string() + (std::filesystem::is_directory(o.mesh, ec) ? " (a directory)" : ""),
            there ? ErrorCode::unreadable : ErrorCode::file_not_found);
   }
   o.scale = r.number(j, where, "scale", 1.0);

@@ -126,7 +126,15 @@ World::World(Scene scene, const WorldOptions& options) : mScene(std::move(scene)
         auto file = loaded.find(o.mesh.string());
         if (file == loaded.end()) file = loaded.emplace(o.mesh.string(), load_mesh(o.mesh)).first;
         Mesh mesh = refine_mesh(file->second, o.refine);
-        if (o.scale != 1.0) scale_mesh(mesh, o.scale);
+        if (o.scale != 1.0) {
+          try {
+            scale_mesh(mesh, o.scale);
+          } catch (const Error& e) {  // the object and its key named, the mesh file in the message
+            throw Error(
+                e.code(), mScene.file.string(),
+                "object '" + o.name + "' (objects[" + std::to_string(&o - mScene.objects.data()) + "].scale): " + e.what());
+          }
+        }
         if (o.group != 0 || !o.groups.empty()) {
           mesh.groups.assign(mesh.triangles.size(), o.group);
           for (const GroupRange& g : o.groups) {
@@ -193,16 +201,19 @@ Pose World::object_pose(std::size_t i, double t, int step) const {
     for (int k = 0; k < 3; ++k) tiny = tiny || (at[k] != 0.0 && std::abs(at[k]) < kMinCoordinate);
     if (!far && !tiny && pose.rotation.coeffs().allFinite()) return pose;
     const std::string source = source_of(mScene);
-    const std::string key = "objects[" + std::to_string(i) + "].motion";
+    // An object that does not move is out of range where it stands.
+    const bool still = o.motion.type == Motion::Type::fixed;
+    const std::string key = "objects[" + std::to_string(i) + (still ? "].position" : "].motion");
     if (tiny && !far) {
       throw Error(ErrorCode::bad_value, source,
                   "object '" + o.name + "' (" + key + ") has a translation component below 2^-120 (about 7.5e-37, the smallest " +
-                      "non-zero coordinate caliber takes) at step " + std::to_string(step));
+                      "non-zero coordinate caliber takes)" + (still ? std::string() : " at step " + std::to_string(step)));
     }
     if (far) {
       throw Error(ErrorCode::bad_value, source,
-                  "object '" + o.name + "' (" + key + ") moves beyond +-1e15 (caliber's limit on coordinates) by step " +
-                      std::to_string(step));
+                  "object '" + o.name + "' (" + key + ") " +
+                      (still ? std::string("lies beyond +-1e15 (caliber's limit on coordinates)")
+                             : "moves beyond +-1e15 (caliber's limit on coordinates) by step " + std::to_string(step)));
     }
     throw Error(ErrorCode::bad_value, source,
                 "object '" + o.name + "' (" + key + ".angular): the turn by step " + std::to_string(step) +

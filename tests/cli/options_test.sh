@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The command line's options checked before any work, whatever the mode: an option the mode does
 # not read is refused by name, every value is checked before the scene is read, and a scene file's
-# number too small for a double or nesting too deep is refused with its path.
+# number too small for a double or nesting too deep is refused with its path; a scene's object is
+# named in the errors of its scale and position.
 set -u
 cli="$1"
-data="$2"
+data="$(cd "$2" && pwd)"
 source "$(dirname "$0")/check_lib.sh"
 scene="$data/scenes/tetras.json"
 h=$(mktemp -d)
@@ -83,6 +84,24 @@ contains scene-overflow "over.json: 'dt[2]': not valid JSON:"
 printf '{"": 1, "": 2}' > "$h/empty_key.json"
 check scene-empty-key 2 "$cli" run "$h/empty_key.json"
 contains scene-empty-key "'\"\"': the key is given twice in one object"
+
+# A scene's objects named in errors: a scale that takes a vertex out of range, a still object out
+# of range where it stands (it was said to move), a mesh behind a loop of links (it was "no such
+# file").
+printf '{"steps": 2, "objects": [{"name": "big", "mesh": "%s/tetra.off", "scale": 1e300}]}' "$data" > "$h/big.json"
+check scale-huge 2 "$cli" run "$h/big.json"
+contains scale-huge "big.json: object 'big' (objects[0].scale): "
+contains scale-huge "scaling by 1e+300 puts vertex"
+printf '{"steps": 2, "objects": [{"name": "far", "mesh": "%s/tetra.off", "position": [1e16, 0, 0]}]}' "$data" > "$h/far.json"
+check still-far 2 "$cli" run "$h/far.json"
+contains still-far "object 'far' (objects[0].position) lies beyond +-1e15"
+ln -s loop_b.off "$h/loop_a.off"
+ln -s loop_a.off "$h/loop_b.off"
+printf '{"objects": [{"mesh": "loop_a.off"}]}' > "$h/loop.json"
+check scene-link-loop 2 "$cli" run "$h/loop.json"
+contains scene-link-loop "'objects[0].mesh': cannot be read ("
+check query-link-loop 2 "$cli" query "$h/loop_a.off" "$data/tetra.off"
+contains query-link-loop "loop_a.off: cannot be read ("
 rm -rf "$h"
 
 echo "$passes passed, $failures failed"
