@@ -17,6 +17,7 @@
 #include "caliber/error.h"
 #include "caliber/version.h"
 #include "commands.h"
+#include "interrupt.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"caliber: exact collision detection between rigid triangle meshes"};
@@ -52,7 +53,7 @@ int main(int argc, char** argv) {
     }
   } catch (const caliber::Error& e) {
     std::cerr << "caliber: " << e.what() << "\n";
-    return 2;
+    return caliber::cli::interrupted() ? caliber::cli::interrupted_exit_code() : 2;  // a signal stopped it
   } catch (const std::bad_alloc&) {
     std::cerr << "caliber: out of memory (the input needs more memory than this machine or its limits give)\n";
     return 2;

@@ -9,10 +9,12 @@
 #include <iostream>
 #include <system_error>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "caliber/error.h"
 #include "caliber/scene.h"
+#include "interrupt.h"
 
 namespace caliber::cli {
 namespace {
@@ -53,6 +55,24 @@ std::string folder_problem(const std::filesystem::path& folder) {
   return "folder " + folder.string() + ": " + ec.message();
 }
 
+/// Waits until a reader has opened the named pipe `path`, so that opening it to write does not
+/// block where a signal could not stop it (the handlers restart system calls): a non-blocking
+/// open every 20 ms, until one succeeds or SIGINT or SIGTERM comes (then an Error, which the
+/// command reports and exits 128 + the signal's number on).
+void wait_for_reader(const std::filesystem::path& path, const std::string& option) {
+  for (bool told = false;; told = true) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd >= 0) {
+      ::close(fd);  // a reader is there: the blocking open that follows returns at once
+      return;
+    }
+    if (errno != ENXIO) fail(path, "cannot be opened for writing (" + option + "): " + system_reason());
+    if (interrupted()) fail(path, std::string("no reader opened the pipe (") + option + ") before " + interrupt_name());
+    if (!told) std::fprintf(stderr, "caliber: waiting for a reader of the pipe %s (%s)\n", path.c_str(), option.c_str());
+    ::usleep(20000);
+  }
+}
+
 }  // namespace
 
 OutputFile::OutputFile(const std::string& path, const std::string& option) : mPath(path) {
@@ -64,6 +84,7 @@ OutputFile::OutputFile(const std::string& path, const std::string& option) : mPa
     fail(mPath, "cannot be written (" + option + "): " + ec.message());
   if (!ec && std::filesystem::is_directory(status)) fail(mPath, "is a directory (" + option + " names the file to write)");
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    if (status.type() == std::filesystem::file_type::fifo) wait_for_reader(mPath, option);
     errno = 0;
     mOut.open(mPath, std::ios::binary | std::ios::trunc);  // a device or a pipe: no rename possible
     if (!mOut) fail(mPath, "cannot be opened for writing (" + option + "): " + system_reason());

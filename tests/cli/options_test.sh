@@ -102,6 +102,17 @@ check scene-link-loop 2 "$cli" run "$h/loop.json"
 contains scene-link-loop "'objects[0].mesh': cannot be read ("
 check query-link-loop 2 "$cli" query "$h/loop_a.off" "$data/tetra.off"
 contains query-link-loop "loop_a.off: cannot be read ("
+
+# An output that is a named pipe with no reader: waited for, and Ctrl-C stops the wait (the open
+# blocked where the signal could not stop it); with a reader, the report goes through the pipe.
+mkfifo "$h/pipe"
+check pipe-no-reader 130 timeout --preserve-status -k 10 -s INT 1 "$cli" run "$scene" --json "$h/pipe" --steps 2
+contains pipe-no-reader "no reader opened the pipe (--json) before SIGINT"
+cat "$h/pipe" > "$h/piped.json" &
+check pipe-reader 0 "$cli" run "$scene" --json "$h/pipe" --steps 2
+wait
+python3 -c "import json, sys; assert len(json.load(open(sys.argv[1]))['steps']) == 2" "$h/piped.json" && passes=$((passes + 1)) ||
+  { echo "FAIL pipe-reader: $(head -c 200 "$h/piped.json")"; failures=$((failures + 1)); }
 rm -rf "$h"
 
 echo "$passes passed, $failures failed"
