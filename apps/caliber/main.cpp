@@ -51,9 +51,12 @@ int main(int argc, char** argv) {
       const int rc = command();
       if (rc >= 0) return rc;
     }
+  } catch (const caliber::cli::Stopped& e) {
+    std::cerr << "caliber: " << e.what() << "\n";
+    return caliber::cli::interrupted_exit_code();
   } catch (const caliber::Error& e) {
     std::cerr << "caliber: " << e.what() << "\n";
-    return caliber::cli::interrupted() ? caliber::cli::interrupted_exit_code() : 2;  // a signal stopped it
+    return 2;
   } catch (const std::bad_alloc&) {
     std::cerr << "caliber: out of memory (the input needs more memory than this machine or its limits give)\n";
     return 2;

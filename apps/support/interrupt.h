@@ -10,6 +10,8 @@
 
 #include <signal.h>
 
+#include "caliber/error.h"
+
 namespace caliber::cli {
 
 /// The first SIGINT or SIGTERM received while an InterruptGuard lives (0: none).
@@ -29,6 +31,13 @@ extern "C" inline void on_interrupt(int signal) {
 /// The exit status of a command a signal stopped: 128 + the signal's number, as a shell reports a
 /// process the signal ended.
 [[nodiscard]] inline int interrupted_exit_code() { return 128 + gSignal.load(); }
+
+/// Thrown where a signal stopped a command before it had begun its work (waiting for a pipe's
+/// reader): the command reports it and exits interrupted_exit_code(), as a stopped run does.
+class Stopped : public Error {
+ public:
+  using Error::Error;
+};
 
 /// SIGINT and SIGTERM handled for the lifetime of the object (the previous handlers restored
 /// after). Made before the command opens (or creates) any output, and kept until its outputs are

@@ -67,7 +67,10 @@ void wait_for_reader(const std::filesystem::path& path, const std::string& optio
       return;
     }
     if (errno != ENXIO) fail(path, "cannot be opened for writing (" + option + "): " + system_reason());
-    if (interrupted()) fail(path, std::string("no reader opened the pipe (") + option + ") before " + interrupt_name());
+    if (interrupted()) {
+      throw Stopped(ErrorCode::unreadable, path.string(),
+                    std::string("no reader opened the pipe (") + option + ") before " + interrupt_name());
+    }
     if (!told) std::fprintf(stderr, "caliber: waiting for a reader of the pipe %s (%s)\n", path.c_str(), option.c_str());
     ::usleep(20000);
   }

@@ -10,6 +10,7 @@
 
 #include "bench_command.h"
 #include "caliber/error.h"
+#include "interrupt.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"caliber-bench: every scene x method x thread count: the paper's tables and figures, measured"};
@@ -23,6 +24,9 @@ int main(int argc, char** argv) {
   }
   try {
     return bench();
+  } catch (const caliber::cli::Stopped& e) {  // a signal before any work (a pipe without a reader)
+    std::cerr << "caliber-bench: " << e.what() << "\n";
+    return caliber::cli::interrupted_exit_code();
   } catch (const caliber::Error& e) {
     std::cerr << "caliber-bench: " << e.what() << "\n";
     return 2;
