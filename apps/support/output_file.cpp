@@ -58,14 +58,13 @@ std::string folder_problem(const std::filesystem::path& folder) {
 /// Waits until a reader has opened the named pipe `path`, so that opening it to write does not
 /// block where a signal could not stop it (the handlers restart system calls): a non-blocking
 /// open every 20 ms, until one succeeds or SIGINT or SIGTERM comes (then an Error, which the
-/// command reports and exits 128 + the signal's number on).
-void wait_for_reader(const std::filesystem::path& path, const std::string& option) {
+/// command reports and exits 128 + the signal's number on). Returns that open's descriptor, for
+/// the caller to close once its own open has returned: until then the reader sees a writer, not
+/// the end of the pipe.
+int wait_for_reader(const std::filesystem::path& path, const std::string& option) {
   for (bool told = false;; told = true) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd >= 0) {
-      ::close(fd);  // a reader is there: the blocking open that follows returns at once
-      return;
-    }
+    if (fd >= 0) return fd;
     if (errno != ENXIO) fail(path, "cannot be opened for writing (" + option + "): " + system_reason());
     if (interrupted()) {
       throw Stopped(ErrorCode::unreadable, path.string(),
@@ -87,10 +86,12 @@ OutputFile::OutputFile(const std::string& path, const std::string& option) : mPa
     fail(mPath, "cannot be written (" + option + "): " + ec.message());
   if (!ec && std::filesystem::is_directory(status)) fail(mPath, "is a directory (" + option + " names the file to write)");
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    if (status.type() == std::filesystem::file_type::fifo) wait_for_reader(mPath, option);
+    const int held = status.type() == std::filesystem::file_type::fifo ? wait_for_reader(mPath, option) : -1;
     errno = 0;
     mOut.open(mPath, std::ios::binary | std::ios::trunc);  // a device or a pipe: no rename possible
-    if (!mOut) fail(mPath, "cannot be opened for writing (" + option + "): " + system_reason());
+    const std::string why = mOut ? std::string() : system_reason();
+    if (held >= 0) ::close(held);
+    if (!mOut) fail(mPath, "cannot be opened for writing (" + option + "): " + why);
     return;
   }
   const std::filesystem::path folder = mPath.has_parent_path() ? mPath.parent_path() : std::filesystem::path(".");
