@@ -10,18 +10,26 @@
 
 #include "caliber/engine.h"
 #include "caliber/error.h"
+#include "caliber/scene.h"
 #include "options.h"
 
 namespace caliber::cli {
+
+/// Error e of the library (its source a name of the library's, "threads") as the command line's
+/// option `option` ("--threads"): the same code and problem.
+inline Error renamed(const Error& e, std::string option) {
+  std::string_view problem = e.what();
+  const std::string prefix = e.source() + ": ";
+  if (problem.rfind(prefix, 0) == 0) problem.remove_prefix(prefix.size());
+  return Error(e.code(), std::move(option), std::string(problem));
+}
 
 /// The method --method names (caliber::parse_method), a bad name refused as "--method: ...".
 inline Method method_option(const std::string& name) {
   try {
     return parse_method(name);
   } catch (const Error& e) {
-    const std::string_view what = e.what();
-    const std::string_view prefix = "method: ";
-    throw Error(e.code(), "--method", std::string(what.substr(what.rfind(prefix, 0) == 0 ? prefix.size() : 0)));
+    throw renamed(e, "--method");
   }
 }
 
@@ -34,14 +42,17 @@ auto engine_from_options(Make&& make) -> decltype(make()) {
   } catch (const Error& e) {
     static constexpr std::pair<std::string_view, std::string_view> kNames[] = {
         {"threads", "--threads"}, {"stealing depth", "--stealing-depth"}, {"beta", "--beta"}, {"epsilon", "--epsilon"}};
-    const std::string_view what = e.what();
     for (const auto& [library, option] : kNames) {
-      if (e.source() == library && what.size() > library.size() + 2) {
-        throw Error(e.code(), std::string(option), std::string(what.substr(library.size() + 2)));
-      }
+      if (e.source() == library) throw renamed(e, std::string(option));
     }
     throw;
   }
+}
+
+/// --steps of run and view: -1 (the scene's steps, the default) or 1 .. kMaxSceneSteps.
+inline void check_steps_option(int steps) {
+  if (steps == 0 || steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
+  if (steps > kMaxSceneSteps) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
 }
 
 Runner add_query_command(CLI::App& app);

@@ -80,8 +80,7 @@ void check_run_options(const RunOptions& opt) {
       (opt.sweep_tolerance != 0.0 && opt.sweep_tolerance < kMinCoordinate)) {
     throw Error(ErrorCode::bad_value, "--sweep-tolerance", "must be 0 or in [2^-120, 1e15]");
   }
-  if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
-  if (opt.steps > kMaxSceneSteps) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
+  check_steps_option(opt.steps);
   for (const int p : opt.simulate) {
     if (p < 1 || p > 4096) throw Error(ErrorCode::bad_value, "--simulate-cores", "core counts must be in [1, 4096]");
   }

@@ -156,8 +156,7 @@ int view_scene(const ViewOptions& opt) {
                 "configured; run scripts/setup.sh, then rebuild");
   }
   // The options checked (the engine's by its constructor) before the scene is read.
-  if (opt.steps == 0 || opt.steps < -1) throw Error(ErrorCode::bad_value, "--steps", "must be a positive number of steps");
-  if (opt.steps > kMaxSceneSteps) throw Error(ErrorCode::bad_value, "--steps", "must be at most 100000000, as in a scene file");
+  check_steps_option(opt.steps);
   if (opt.max_boxes < 0) throw Error(ErrorCode::bad_value, "--max-boxes", "must be 0 or more");
   EngineOptions options;
   options.method = method_option(opt.method);

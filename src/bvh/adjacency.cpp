@@ -27,8 +27,7 @@ std::vector<Vec3> face_normals(const Mesh& mesh, std::size_t grain) {
   return normals;
 }
 
-void vertex_adjacency(const Mesh& mesh, std::size_t grain, ModelData& model) {
-  static_cast<void>(grain);
+void vertex_adjacency(const Mesh& mesh, ModelData& model) {
   std::vector<std::uint32_t>& corner_vertex = model.corner_vertex;
   std::vector<std::uint64_t>& offsets = model.vertex_offsets;
   std::vector<std::uint32_t>& triangles = model.vertex_triangles;

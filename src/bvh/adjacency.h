@@ -24,6 +24,6 @@ std::vector<Eigen::Vector3d> face_normals(const Mesh& mesh, std::size_t grain);
 /// position (each corner's welded vertex is then its own vertex index). Time
 /// O(V log V + corners) and memory linear in the corners, whatever a vertex's degree (a polygon
 /// of 100,000 corners fanned from one vertex costs no more than 100,000 separate triangles).
-void vertex_adjacency(const Mesh& mesh, std::size_t grain, ModelData& model);
+void vertex_adjacency(const Mesh& mesh, ModelData& model);
 
 }  // namespace caliber::bvh

@@ -371,7 +371,7 @@ std::shared_ptr<ModelData> build_on_this_thread(Mesh mesh, const BuildOptions& o
   bvh::build_wide_tree(*model);
   model->extent = bvh::largest_norm(mesh, Vec3::Zero());
   model->local_extent = bvh::largest_norm(mesh, model->origin);
-  if (options.adjacency) bvh::vertex_adjacency(mesh, kBuildGrain, *model);
+  if (options.adjacency) bvh::vertex_adjacency(mesh, *model);
   model->mesh = std::move(mesh);
   return model;
 }
