@@ -9,9 +9,14 @@
 #include <memory>
 #include <unordered_map>
 
+#include "narrow/nearby_look.h"
 #include "parallel/executor.h"
 
 namespace caliber::narrow {
+
+const detail::NearbyLook kNearbyLook =
+    detail::nearby_look_form(16) != nullptr ? detail::nearby_look_form(16) : detail::nearby_look_form(8);
+
 namespace {
 
 /// A candidate as the reduction reads it, 16 of its 64 bytes: its triangle pair as one key (A's id
@@ -95,9 +100,6 @@ class EntryTable {
   int mShift = 60;  ///< 64 - log2(capacity)
 };
 
-/// How many candidates on each side of a candidate the reduction looks at before its lookups.
-constexpr std::size_t kNearby = 8;
-
 /// Above this many corners at a welded vertex (a hub: the centre of a fan, as load_mesh makes of a
 /// large polygon, or the pole of a sphere of many segments; a triangle with two corners there
 /// counts twice), a candidate's pairs through it are not looked up one by one: the closest
@@ -152,24 +154,6 @@ struct Reduction {
   const EntryTable& table;
   const Hubs* hubs;  ///< null where neither model has a hub
 
-  /// Whether o is closer than c, shares one of its triangles and has the other vertex-adjacent.
-  [[nodiscard]] bool dominates(const Entry& o, const Entry& c) const {
-    return closer(o, c) && ((tri_b(o.key) == tri_b(c.key) && a.are_neighbours(tri_a(o.key), tri_a(c.key))) ||
-                            (tri_a(o.key) == tri_a(c.key) && b.are_neighbours(tri_b(o.key), tri_b(c.key))));
-  }
-
-  /// Whether a candidate among the kNearby on each side of entry i in the list (nearest first)
-  /// dominates it. The traversals list nearby pairs together, so one often does, and it is one
-  /// the lookups would find: the same verdict, without them.
-  [[nodiscard]] bool dominated_nearby(std::size_t i) const {
-    const Entry& c = entries[i];
-    for (std::size_t d = 1; d <= kNearby; ++d) {
-      if (d <= i && dominates(entries[i - d], c)) return true;
-      if (i + d < entries.size() && dominates(entries[i + d], c)) return true;
-    }
-    return false;
-  }
-
   /// Whether one of the pairs keys[0 .. count) is a candidate closer than c (their slots prefetched).
   [[nodiscard]] bool any_closer(const std::uint64_t* keys, int count, const Entry& c) const {
     return std::any_of(keys, keys + count, [&](std::uint64_t key) {
@@ -180,9 +164,9 @@ struct Reduction {
 
   /// Whether a candidate dominates entry i: its pairs with a neighbour of either triangle looked
   /// up kLookups at a time, each batch's slots prefetched before the first lookup; the walk over
-  /// the neighbours stops at the first batch that finds one.
+  /// the neighbours stops at the first batch that finds one. (What the list's look, done first,
+  /// did not settle.)
   [[nodiscard]] bool dominated(std::size_t i) const {
-    if (dominated_nearby(i)) return true;
     const Entry& c = entries[i];
     const std::uint32_t ta = tri_a(c.key), tb = tri_b(c.key);
     constexpr int kLookups = 4;
@@ -224,9 +208,13 @@ struct Reduction {
 
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
   std::vector<Entry> entries(candidates.size());
+  detail::NearbyColumns columns(candidates.size());
   const auto fill = [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i)
-      entries[i] = {key_of(candidates[i].tri_a, candidates[i].tri_b), candidates[i].distance};
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = candidates[i];
+      entries[i] = {key_of(c.tri_a, c.tri_b), c.distance};
+      columns.set(i, c.tri_a, c.tri_b, c.distance, ctx.a().welded_corners(c.tri_a), ctx.b().welded_corners(c.tri_b));
+    }
   };
   if (candidates.size() < kParallelFill) {
     fill(0, candidates.size());
@@ -238,9 +226,13 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   const bool any_hub = ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree;
   const std::unique_ptr<const Hubs> hubs = any_hub ? std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries) : nullptr;
   const Reduction reduction{ctx.a(), ctx.b(), entries, table, hubs.get()};
+  // The list's look first, for a chunk at a time (null also before the library's constants are
+  // made: a query from another constant's constructor), then the lookups of what it left.
+  const detail::NearbyLook look = kNearbyLook != nullptr ? kNearbyLook : detail::nearby_look_portable;
   std::vector<char> keep(candidates.size(), 0);
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) keep[i] = reduction.dominated(i) ? 0 : 1;
+    look(columns, lo, hi, keep.data());  // 1 where a neighbour in the list dominates
+    for (std::size_t i = lo; i != hi; ++i) keep[i] = keep[i] == 0 && !reduction.dominated(i) ? 1 : 0;
   });
   std::vector<Candidate> kept;
   for (std::size_t i = 0; i < candidates.size(); ++i) {

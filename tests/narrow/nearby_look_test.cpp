@@ -1,0 +1,135 @@
+// The contact reduction's look at each candidate's neighbours in the list (narrow/nearby_look.h):
+// every vector form against the portable one on random lists whose ids and distances repeat (ties,
+// shared triangles, shared corners, both at once), and the whole reduction against an independent
+// one on meshes without hubs.
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "caliber/model.h"
+#include "caliber/procedural.h"
+#include "caliber/query.h"
+#include "narrow/nearby_look.h"
+#include "support/random_poses.h"
+
+namespace caliber::narrow {
+namespace {
+
+/// n random candidates: triangles from `tris` ids, each triangle's welded corners from `corners`
+/// ids (fixed per triangle, as a mesh's are), distances from a few values (ties).
+detail::NearbyColumns random_columns(std::mt19937_64& rng, std::size_t n, std::uint32_t tris, std::uint32_t corners) {
+  std::uniform_int_distribution<std::uint32_t> tri(0, tris - 1), corner(0, corners - 1);
+  std::vector<std::uint32_t> welded_a(3 * tris), welded_b(3 * tris);
+  for (auto* w : {&welded_a, &welded_b}) {
+    for (std::uint32_t& v : *w) v = corner(rng);
+  }
+  const double distances[] = {0.0, 0.25, 0.25, 0.5, 1.0, 1e-300};
+  std::uniform_int_distribution<int> pick(0, 5);
+  detail::NearbyColumns c(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t ta = tri(rng), tb = tri(rng);
+    c.set(i, ta, tb, distances[pick(rng)], &welded_a[3 * ta], &welded_b[3 * tb]);
+  }
+  return c;
+}
+
+TEST(NearbyLook, EveryFormGivesThePortableVerdicts) {
+  std::mt19937_64 rng(20261207);
+  int forms = 0, settled = 0;
+  for (const int lanes : {8, 16}) {
+    const detail::NearbyLook form = detail::nearby_look_form(lanes);
+    if (form == nullptr) continue;
+    ++forms;
+    for (const std::size_t n :
+         {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{17}, std::size_t{400}}) {
+      for (const std::uint32_t tris : {2u, 5u, 40u}) {
+        const detail::NearbyColumns c = random_columns(rng, n, tris, tris + 3);
+        std::vector<char> want(n + 1, 7), got(n + 1, 7);
+        detail::nearby_look_portable(c, 0, n, want.data());
+        // In two calls, as chunks: each place written once, nothing past hi.
+        form(c, 0, n / 2, got.data());
+        form(c, n / 2, n, got.data());
+        EXPECT_EQ(got, want) << lanes << " lanes, " << n << " candidates of " << tris << " triangles";
+        settled += static_cast<int>(std::count(want.begin(), want.end() - 1, 1));
+      }
+    }
+  }
+  EXPECT_GT(settled, 100) << "the lists have candidates the look settles";
+  if (forms == 0) GTEST_SKIP() << "this CPU has no vector form of the look";
+}
+
+TEST(NearbyLook, PortableVerdictsFollowTheirDefinition) {
+  // Candidate 1 dominates 0 (the same B triangle, A's triangles share corner 7, closer); 2 shares
+  // no corner with 0; 3 shares A's triangle with 0 but its B triangle shares no corner.
+  detail::NearbyColumns c(4);
+  const std::uint32_t a0[] = {1, 2, 7}, a1[] = {7, 8, 9}, a2[] = {3, 4, 5}, b0[] = {1, 2, 3}, b3[] = {4, 5, 6};
+  c.set(0, 10, 20, 0.5, a0, b0);
+  c.set(1, 11, 20, 0.25, a1, b0);
+  c.set(2, 12, 20, 0.0, a2, b0);
+  c.set(3, 10, 21, 0.0, a0, b3);
+  char got[4];
+  detail::nearby_look_portable(c, 0, 4, got);
+  EXPECT_EQ(got[0], 1);
+  EXPECT_EQ(got[1], 0);  // 0 is farther; 2 shares nothing with 1
+  EXPECT_EQ(got[2], 0);
+  EXPECT_EQ(got[3], 0);
+  // A tie is settled by the ids: at equal distances the lower key dominates.
+  detail::NearbyColumns tie(2);
+  tie.set(0, 11, 20, 0.5, a1, b0);
+  tie.set(1, 10, 20, 0.5, a0, b0);
+  detail::nearby_look_portable(tie, 0, 2, got);
+  EXPECT_EQ(got[0], 1);
+  EXPECT_EQ(got[1], 0);
+}
+
+/// The contact query's local minima on meshes without hubs (every vertex with a few triangles)
+/// equal an independent reduction of every pair within the tolerance: kept unless a closer pair
+/// (ties: lower ids) shares one of its triangles and has the other sharing a vertex with its own.
+TEST(NearbyLook, ContactsAreTheLocalMinimaOfTheProximityPairs) {
+  const Mesh ma = make_torus(1.0, 0.35, 48, 24), mb = make_sphere(0.6, 16, 24);
+  const auto a = build_model(ma);
+  const auto b = build_model(mb);
+  const Pose pa, pb = Pose::from_values(1.05, 0.1, 0.2, 1, 0.1, 0.05, 0.02);
+  QueryRequest request;
+  request.kind = QueryKind::proximity;
+  request.tolerance = 0.15;
+  const QueryResult within = query(*a, pa, *b, pb, request);
+  ASSERT_GT(within.contacts.size(), 500u);
+  // Sharing a vertex position (the adjacency welds a seam's repeated vertices).
+  const auto neighbours = [](const Mesh& m, std::uint32_t t, std::uint32_t u) {
+    if (t == u) return false;
+    for (const std::uint32_t v : m.triangles[t]) {
+      for (const std::uint32_t w : m.triangles[u]) {
+        if (m.vertices[v] == m.vertices[w]) return true;
+      }
+    }
+    return false;
+  };
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+  for (const Contact& c : within.contacts) {
+    const bool dominated = std::any_of(within.contacts.begin(), within.contacts.end(), [&](const Contact& o) {
+      const bool closer =
+          o.distance != c.distance ? o.distance < c.distance : std::pair(o.tri_a, o.tri_b) < std::pair(c.tri_a, c.tri_b);
+      return closer && ((o.tri_b == c.tri_b && neighbours(ma, o.tri_a, c.tri_a)) ||
+                        (o.tri_a == c.tri_a && neighbours(mb, o.tri_b, c.tri_b)));
+    });
+    if (!dominated) want.emplace_back(c.tri_a, c.tri_b);
+  }
+  request.kind = QueryKind::contact;
+  request.angle_deg = 180.0;
+  const QueryResult got = query(*a, pa, *b, pb, request);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (const Contact& c : got.contacts) pairs.emplace_back(c.tri_a, c.tri_b);
+  EXPECT_EQ(pairs, want);
+  EXPECT_GE(want.size(), 2u);
+  EXPECT_LT(want.size(), within.contacts.size() / 10) << "the reduction dropped most pairs";
+  test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "torus and sphere");
+}
+
+}  // namespace
+}  // namespace caliber::narrow
