@@ -14,6 +14,7 @@
 #include "narrow/cd_tree.h"
 #include "narrow/child_pairs.h"
 #include "narrow/pair_context.h"
+#include "narrow/traversal_scratch.h"
 #include "narrow/visit.h"
 #include "narrow/visit_order.h"
 #include "util/assert.h"
@@ -36,41 +37,16 @@ struct PairShared {
   [[nodiscard]] bool reached() const { return kept.load(std::memory_order_relaxed) >= max && max != 0; }
 };
 
-/// Per-thread scratch for traversals, reused across calls to avoid allocation.
-struct TraversalScratch {
-  std::vector<NodePair> stack;  ///< explicit depth-first stack
-  using NearA = PreparedTree<PairContext::NearA>::Node;
-  using NearB = PreparedTree<PairContext::NearB>::Node;
-  /// A CD-tree node waiting in the distance traversal: its prepared nodes of A and of B.
-  struct Reached {
-    NearA* a;
-    NearB* b;
-  };
-  util::GapBuckets<Reached> waiting;        ///< distance traversal: the nodes waiting, by gap
-  PreparedTree<PairContext::NearA> near_a;  ///< distance traversal: A's nodes prepared so far
-  PreparedTree<PairContext::NearB> near_b;  ///< distance traversal: B's nodes prepared so far
-  /// Wide traversals: the staying nodes moved, renewed by each (made by the first; 10.5 KB, kept
-  /// off the thread's own storage).
-  std::unique_ptr<detail::StayingCache> staying;
-  /// Distance traversal of a pair with few triangle pairs: the pairs within the tolerance; of
-  /// others, what a batch of leaf pairs kept.
-  std::vector<Candidate> within;
-  /// Distance traversal: the leaf pairs waiting for the batch kernels.
-  LeafBuffer leaves;
-
-  /// Bytes held that grow with the largest traversal so far (not the buckets' fixed tables).
-  [[nodiscard]] std::size_t footprint() const {
-    return stack.capacity() * sizeof(NodePair) + waiting.footprint() + near_a.footprint() + near_b.footprint() +
-           within.capacity() * sizeof(Candidate);
-  }
-};
-
 /// Depth-first traversal of the CD subtree at `root`: tests root as `root_test` says, then visits every
 /// node that passes (narrow::visit), the kept pairs appended to `out`, every node and leaf test
 /// counted in `stats`. With a taboo list, a child on it is neither tested nor entered, only marked.
+/// Given `piece`, the pair's wide lanes (made once for its pieces), the traversal is one piece of a
+/// split pair: without a limit, its last leaf pairs stay waiting in `scratch` for the next piece
+/// of the pair on this thread (PieceCarry), and the caller has them finished
+/// (TraversalScratch::flush_pieces) before it reads `out`.
 inline void traverse_depth_first(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                                  QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
-                                 PairShared* limit = nullptr) {
+                                 PairShared* limit = nullptr, const detail::WideLanes* piece = nullptr) {
   // Each visit pops one node and pushes at most eight, one level deeper in one of the trees: the
   // depth-first stack never holds more than 7 * (height A + height B) + 1 nodes (the loop without
   // a limit, whose visits wait a little, grows it where it must).
@@ -86,12 +62,15 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   detail::WideLanes wide;
   detail::NodeLanes binary;
   VisitLanes lanes;
+  // A piece without a limit carries its staying nodes and waiting leaf pairs to the next piece of
+  // its pair on this thread (PieceCarry).
+  const bool carried = piece != nullptr && limit == nullptr && top != base && wide_cd_tree(ctx);
+  LeafBuffer own;
+  LeafBuffer& buffer = carried ? scratch.piece_leaves(ctx, out) : own;
   if (top != base && wide_cd_tree(ctx)) {
-    wide = wide_lanes(ctx);
-    lanes.wide = &wide;
-    if (scratch.staying == nullptr) scratch.staying = std::make_unique<detail::StayingCache>();
-    scratch.staying->renew();
-    lanes.staying = scratch.staying.get();
+    if (piece == nullptr) wide = wide_lanes(ctx);
+    lanes.wide = piece != nullptr ? piece : &wide;
+    lanes.staying = &scratch.staying_for(carried ? piece : nullptr);
   } else if (top != base) {
     binary = ctx.node_lanes();
     lanes.binary = &binary;
@@ -101,7 +80,6 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   // pass are written straight onto the stack, the first one on top (the order of cd_children), but
   // the pairs of leaves a wide visit tests itself (visit_until_empty).
   // With one, each leaf test's pair is counted as it is kept.
-  LeafBuffer buffer;
   if (limit == nullptr) {
     const auto size = static_cast<std::size_t>(top - base);
     if (lanes.wide != nullptr && kWideLoop != nullptr) {
@@ -130,7 +108,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
     top = push_nearest_first(passed, order, count, top);
     CALIBER_ASSERT(static_cast<std::size_t>(top - base) <= bound, "the depth-first stack stays within its bound");
   }
-  ctx.flush_leaves(buffer, out);
+  if (!carried) ctx.flush_leaves(buffer, out);
   stats.node_tests += counted.node_tests;
   stats.leaf_tests += counted.leaf_tests;
 }
@@ -383,10 +361,10 @@ inline void traverse_nearest(const PairContext& ctx, NodePair root, TraversalScr
 /// The traversal every schedule runs on its pieces: for a distance query, traverse_nearest (the
 /// piece's closest pair, if any, appended to `out`; pruning by the pair's nearest distance so far,
 /// if `shared` is given), otherwise traverse_depth_first (stopping early at the pair's limit, if
-/// `shared` is given).
+/// `shared` is given; a piece that carries its leaf pairs to the next where `piece` is given).
 inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& scratch, std::vector<Candidate>& out,
                      QueryStats& stats, RootTest root_test = RootTest::as_root, TabooView taboo = {},
-                     PairShared* shared = nullptr) {
+                     PairShared* shared = nullptr, const detail::WideLanes* piece = nullptr) {
   if (ctx.request().kind == QueryKind::distance) {
     Nearest nearest;
     nearest.shared = shared != nullptr ? &shared->nearest : nullptr;
@@ -394,7 +372,7 @@ inline void traverse(const PairContext& ctx, NodePair root, TraversalScratch& sc
     if (nearest.found) out.push_back(nearest.best);
     return;
   }
-  traverse_depth_first(ctx, root, scratch, out, stats, root_test, taboo, shared);
+  traverse_depth_first(ctx, root, scratch, out, stats, root_test, taboo, shared, piece);
 }
 
 }  // namespace caliber::narrow

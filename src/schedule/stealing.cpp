@@ -11,11 +11,14 @@ namespace caliber::schedule {
 namespace {
 
 /// One depth-first traversal of pair `pair` from n, on this thread (which tests n unless `tested`),
-/// recorded as one piece.
-void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::NodePair n, bool tested) {
+/// recorded as one piece. `split`: the lanes of a split pair's pieces, which carry their waiting
+/// leaf pairs from one to the next (narrow::PieceCarry: finished once every piece is done), or
+/// null for a pair traversed whole.
+void traverse_piece(StepState& state, WorkerSlots& w, std::size_t pair, narrow::NodePair n, bool tested,
+                    const narrow::detail::WideLanes* split = nullptr) {
   const std::uint64_t before = w.stats[pair].node_tests;
   narrow::traverse(state.contexts[pair], n, w.scratch, w.candidates[pair], w.stats[pair],
-                   tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.shared_of(pair));
+                   tested ? narrow::RootTest::done : narrow::RootTest::as_root, {}, state.shared_of(pair), split);
   w.pieces.push_back(w.stats[pair].node_tests - before);
 }
 
@@ -156,7 +159,7 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
       }
     }
     if (depth >= cutoff) {
-      state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested); });
+      state.timeline.record(TaskSpan::Phase::traverse, pair, [&] { traverse_piece(state, w, pair, n, tested, lanes.wide); });
       return;
     }
     const std::uint64_t before = w.stats[pair].node_tests;
@@ -170,6 +173,17 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
   }
   if (count > 0) steal(state, pair, kids[0], depth + 1, cutoff, true, lanes);
   group.wait();
+}
+
+/// The split pairs' last leaf pairs, which each worker's pieces carried (narrow::PieceCarry),
+/// finished into its slots, a worker a job: once every piece is done.
+void flush_pieces(StepState& state) {
+  const std::vector<WorkerSlots*> slots = state.workers.all();
+  parallel::parallel_for(0, slots.size(), 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k != hi; ++k) {
+      if (state.current(*slots[k])) slots[k]->scratch.flush_pieces();
+    }
+  });
 }
 
 }  // namespace
@@ -241,6 +255,7 @@ void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, 
     });
   }
   group.wait();
+  flush_pieces(state);
   record.traverse_ms = util::ms_since(start);
   const auto finalize_start = util::Clock::now();
   finalize_pairs(state, unanswered(heavy, answered), {});

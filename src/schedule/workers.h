@@ -29,6 +29,7 @@ struct WorkerSlots {
   std::uint64_t run = 0;
 
   void reset(std::size_t pairs) {
+    scratch.drop_pieces();  // (what an earlier run stopped by an error left)
     candidates.resize(pairs);
     stats.assign(pairs, QueryStats{});
     for (auto& c : candidates) c.clear();
