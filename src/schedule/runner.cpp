@@ -43,7 +43,47 @@ std::vector<std::uint8_t> whole_pairs(const plans::Plan& plan, const std::vector
   return roots_of;
 }
 
+/// The wide lanes of the pairs cut into pieces (`rest`), made once and shared by their pieces
+/// (narrow::PieceCarry); none for the others, nor for a distance query's binary CD tree.
+class PieceLanes {
+ public:
+  PieceLanes(const StepState& state, const std::vector<std::uint32_t>& rest) : mAt(state.contexts.size(), -1) {
+    for (const std::uint32_t i : rest) {
+      if (!narrow::wide_cd_tree(state.contexts[i])) continue;
+      mAt[i] = static_cast<std::int32_t>(mLanes.size());
+      mLanes.push_back(narrow::wide_lanes(state.contexts[i]));
+    }
+  }
+  /// Pair i's lanes, or null (its pieces carry nothing).
+  [[nodiscard]] const narrow::detail::WideLanes* of(std::size_t i) const { return mAt[i] >= 0 ? &mLanes[mAt[i]] : nullptr; }
+
+ private:
+  std::vector<std::int32_t> mAt;
+  std::vector<narrow::detail::WideLanes> mLanes;
+};
+
+/// The record's fields the plan sets before it runs.
+void record_plan(const plans::Plan& plan, ScheduleRecord& record) {
+  record.omega = plan.omega;
+  record.kept = plan.kept;
+  record.split = plan.split;
+  record.carted = plan.carted;
+  record.taboo = plan.taboo_nodes;
+  record.generated = plan.run.size();
+  record.task_node_tests.assign(plan.run.size(), 0);
+  if (plan.weighted) record.task_weights.resize(plan.run.size());
+}
+
 }  // namespace
+
+void flush_pieces(StepState& state) {
+  const std::vector<WorkerSlots*> slots = state.workers.all();
+  parallel::parallel_for(0, slots.size(), 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k != hi; ++k) {
+      if (state.current(*slots[k])) slots[k]->scratch.flush_pieces();
+    }
+  });
+}
 
 void finalize_whole(StepState& state, std::size_t i, WorkerSlots& w) {
   state.timeline.record(TaskSpan::Phase::finalize, i,
@@ -83,14 +123,7 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
 std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepState& state, ScheduleRecord& record) {
   const std::size_t n = state.contexts.size();
   const auto phase = util::Clock::now();
-  record.omega = plan.omega;
-  record.kept = plan.kept;
-  record.split = plan.split;
-  record.carted = plan.carted;
-  record.taboo = plan.taboo_nodes;
-  record.generated = plan.run.size();
-  record.task_node_tests.assign(plan.run.size(), 0);
-  if (plan.weighted) record.task_weights.resize(plan.run.size());
+  record_plan(plan, record);
   if (state.timeline.on) {
     record.task_roots.resize(plan.run.size());
     for (std::size_t t = 0; t < plan.run.size(); ++t) {
@@ -121,6 +154,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
   }
   std::vector<std::uint32_t> rest;
   const std::vector<std::uint8_t> whole = whole_pairs(plan, split_of, rest);
+  const PieceLanes lanes(state, rest);
   // In plan order, each task to the next free thread: the list schedule the simulation replays.
   parallel::for_each_in_order(plan.run.size(), [&](std::size_t t) {
     state.timeline.record(TaskSpan::Phase::traverse, t, [&] {
@@ -132,7 +166,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
         const narrow::TabooView taboo =
             root.taboo >= 0 ? narrow::TabooView{&plan.taboos[root.taboo], reached[root.taboo].data()} : narrow::TabooView{};
         narrow::traverse(state.contexts[root.pair], root.node, w.scratch, w.candidates[root.pair], stats, root.root_test(), taboo,
-                         state.shared_of(root.pair));
+                         state.shared_of(root.pair), lanes.of(root.pair));
         tests += stats.node_tests - before;
         if (root.owner >= 0) sub_tests[root.owner][root.slot] = stats.node_tests - before;
         if (root.stage >= 0) stage_root_tests[split_of[root.pair]][root.stage] = stats.node_tests - before;
@@ -142,6 +176,7 @@ std::vector<std::vector<std::uint64_t>> run_plan(const plans::Plan& plan, StepSt
       if (plan.weighted) record.task_weights[t] = plan.run[t].weight;
     });
   });
+  flush_pieces(state);
   record.traverse_ms = util::ms_since(phase);
   const auto finalize_start = util::Clock::now();
   for (std::size_t t = 0; t < plan.taboos.size(); ++t) {

@@ -16,6 +16,11 @@
 
 namespace caliber::schedule {
 
+/// The split pairs' last leaf pairs, which each worker's pieces carried (narrow::PieceCarry),
+/// finished into its slots, a worker a job: what a runner calls once every piece is done, before
+/// the pairs are finalized.
+void flush_pieces(StepState& state);
+
 /// Runs `plan` on the current executor; fills state.results and, in `record`, the plan's counts,
 /// the node tests and weight of every run-time task, the stage's counts, traverse_ms and
 /// finalize_ms. Returns, per split of the plan, the depth-first node tests of each stage record's

@@ -175,17 +175,6 @@ void steal(StepState& state, std::size_t pair, narrow::NodePair n, int depth, in
   group.wait();
 }
 
-/// The split pairs' last leaf pairs, which each worker's pieces carried (narrow::PieceCarry),
-/// finished into its slots, a worker a job: once every piece is done.
-void flush_pieces(StepState& state) {
-  const std::vector<WorkerSlots*> slots = state.workers.all();
-  parallel::parallel_for(0, slots.size(), 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t k = lo; k != hi; ++k) {
-      if (state.current(*slots[k])) slots[k]->scratch.flush_pieces();
-    }
-  });
-}
-
 }  // namespace
 
 void run_stealing(int depth, int threads, const std::vector<ObjectPair>& pairs, const plans::History& history, StepState& state,
