@@ -100,6 +100,9 @@ class EntryTable {
   int mShift = 60;  ///< 64 - log2(capacity)
 };
 
+/// The candidates the list's look is given at a time (their columns, 48 bytes a candidate).
+constexpr std::size_t kLookRun = 1024;
+
 /// Above this many corners at a welded vertex (a hub: the centre of a fan, as load_mesh makes of a
 /// large polygon, or the pole of a sphere of many segments; a triangle with two corners there
 /// counts twice), a candidate's pairs through it are not looked up one by one: the closest
@@ -208,13 +211,9 @@ struct Reduction {
 
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
   std::vector<Entry> entries(candidates.size());
-  detail::NearbyColumns columns(candidates.size());
   const auto fill = [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) {
-      const Candidate& c = candidates[i];
-      entries[i] = {key_of(c.tri_a, c.tri_b), c.distance};
-      columns.set(i, c.tri_a, c.tri_b, c.distance, ctx.a().welded_corners(c.tri_a), ctx.b().welded_corners(c.tri_b));
-    }
+    for (std::size_t i = lo; i != hi; ++i)
+      entries[i] = {key_of(candidates[i].tri_a, candidates[i].tri_b), candidates[i].distance};
   };
   if (candidates.size() < kParallelFill) {
     fill(0, candidates.size());
@@ -229,9 +228,20 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   // The list's look first, for a chunk at a time (null also before the library's constants are
   // made: a query from another constant's constructor), then the lookups of what it left.
   const detail::NearbyLook look = kNearbyLook != nullptr ? kNearbyLook : detail::nearby_look_portable;
+  const auto candidate = [&](std::size_t g) {
+    const Candidate& c = candidates[g];
+    return detail::NearbyCandidate{c.tri_a, c.tri_b, c.distance, ctx.a().welded_corners(c.tri_a),
+                                   ctx.b().welded_corners(c.tri_b)};
+  };
   std::vector<char> keep(candidates.size(), 0);
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    look(columns, lo, hi, keep.data());  // 1 where a neighbour in the list dominates
+    // The look's columns made here, by each chunk for its runs (not for the whole list first).
+    detail::NearbyColumns columns(std::min(hi - lo, kLookRun));
+    for (std::size_t at = lo; at < hi; at += kLookRun) {
+      const std::size_t count = std::min(hi - at, kLookRun);
+      columns.load(at, count, candidates.size(), candidate);
+      look(columns, 0, count, keep.data() + at);  // 1 where a neighbour in the list dominates
+    }
     for (std::size_t i = lo; i != hi; ++i) keep[i] = keep[i] == 0 && !reduction.dominated(i) ? 1 : 0;
   });
   std::vector<Candidate> kept;

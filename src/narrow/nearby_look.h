@@ -13,9 +13,19 @@
 
 namespace caliber::narrow::detail {
 
-/// A pair's candidates as the look reads them, a column per field, each with kPad places before
-/// the first candidate and after the last that dominate none (distance +inf, every id all ones).
-/// Candidate i is at place i + kPad of every column.
+/// One candidate as the look reads it: its triangles, its distance and each triangle's welded
+/// corners.
+struct NearbyCandidate {
+  std::uint32_t ta, tb;
+  double distance;
+  const std::uint32_t* corners_a;
+  const std::uint32_t* corners_b;
+};
+
+/// A run of a pair's candidates as the look reads them, a column per field, each with kPad places
+/// before the run's first candidate and after its last: the list's candidates there, or where the
+/// list ends, pads that dominate none (distance +inf, every id all ones). The run's candidate i is
+/// at place i + kPad of every column.
 class NearbyColumns {
  public:
   /// The look reads the candidates from kPad places before a candidate to kPad - 1 after it.
@@ -23,33 +33,43 @@ class NearbyColumns {
   /// Columns of a u32 field: the triangles of A and B, the welded corners of each.
   enum Field { kTriA, kTriB, kCornerA0, kCornerA1, kCornerA2, kCornerB0, kCornerB1, kCornerB2, kFields };
 
-  /// Room for n candidates, their places left to set, the pads set.
-  explicit NearbyColumns(std::size_t n)
-      : mCount(n),
-        mStride(n + 2 * kPad),
+  /// Room for runs of up to `capacity` candidates; a run of that many, padded on both sides, its
+  /// places left to set.
+  explicit NearbyColumns(std::size_t capacity)
+      : mCount(capacity),
+        mStride(capacity + 2 * kPad),
         mDistance(new double[mStride]),
         mKey(new std::uint64_t[mStride]),
         mIds(new std::uint32_t[mStride * kFields]) {
-    for (const std::size_t from : {std::size_t{0}, n + kPad}) {
-      for (std::size_t p = from; p != from + kPad; ++p) {
-        mDistance[p] = std::numeric_limits<double>::infinity();
-        mKey[p] = ~std::uint64_t{0};
-        for (std::size_t f = 0; f != kFields; ++f) mIds[f * mStride + p] = ~std::uint32_t{0};
-      }
+    for (std::size_t p = 0; p != kPad; ++p) {
+      pad(p);
+      pad(capacity + kPad + p);
     }
   }
-  /// Candidate i: triangles ta and tb (its key: ta in the high half), its distance, the welded
-  /// corners of each triangle.
-  void set(std::size_t i, std::uint32_t ta, std::uint32_t tb, double distance, const std::uint32_t* corners_a,
-           const std::uint32_t* corners_b) {
-    const std::size_t p = i + kPad;
-    mDistance[p] = distance;
-    mKey[p] = (std::uint64_t{ta} << 32) | tb;
-    mIds[kTriA * mStride + p] = ta;
-    mIds[kTriB * mStride + p] = tb;
+  /// Candidate i of the run (-kPad <= i < size() + kPad: the places around it too).
+  void set(std::ptrdiff_t i, const NearbyCandidate& c) {
+    const auto p = static_cast<std::size_t>(i + static_cast<std::ptrdiff_t>(kPad));
+    mDistance[p] = c.distance;
+    mKey[p] = (std::uint64_t{c.ta} << 32) | c.tb;
+    mIds[kTriA * mStride + p] = c.ta;
+    mIds[kTriB * mStride + p] = c.tb;
     for (int k = 0; k < 3; ++k) {
-      mIds[(kCornerA0 + k) * mStride + p] = corners_a[k];
-      mIds[(kCornerB0 + k) * mStride + p] = corners_b[k];
+      mIds[(kCornerA0 + k) * mStride + p] = c.corners_a[k];
+      mIds[(kCornerB0 + k) * mStride + p] = c.corners_b[k];
+    }
+  }
+  /// The run of candidates first .. first + count - 1 (count at most the capacity) of a list of
+  /// `total`, with the list's kPad on each side: get(g) gives candidate g (a NearbyCandidate).
+  template <class Get>
+  void load(std::size_t first, std::size_t count, std::size_t total, Get&& get) {
+    mCount = count;
+    for (std::size_t p = 0; p != count + 2 * kPad; ++p) {
+      const std::size_t g = first + p - kPad;  // (wraps past the list's start: then >= total)
+      if (first + p >= kPad && g < total) {
+        set(static_cast<std::ptrdiff_t>(p) - static_cast<std::ptrdiff_t>(kPad), get(g));
+      } else {
+        pad(p);
+      }
     }
   }
   [[nodiscard]] std::size_t size() const { return mCount; }
@@ -59,8 +79,14 @@ class NearbyColumns {
   [[nodiscard]] const std::uint32_t* ids(Field f) const { return mIds.get() + f * mStride; }
 
  private:
+  void pad(std::size_t p) {
+    mDistance[p] = std::numeric_limits<double>::infinity();
+    mKey[p] = ~std::uint64_t{0};
+    for (std::size_t f = 0; f != kFields; ++f) mIds[f * mStride + p] = ~std::uint32_t{0};
+  }
+
   std::size_t mCount, mStride;
-  // (Not value-initialized: every place is set once, by set or by the constructor's pads.)
+  // (Not value-initialized: every place is set, by set, load or the pads.)
   std::unique_ptr<double[]> mDistance;
   std::unique_ptr<std::uint64_t[]> mKey;
   std::unique_ptr<std::uint32_t[]> mIds;

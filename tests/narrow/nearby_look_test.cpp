@@ -20,23 +20,32 @@
 namespace caliber::narrow {
 namespace {
 
-/// n random candidates: triangles from `tris` ids, each triangle's welded corners from `corners`
-/// ids (fixed per triangle, as a mesh's are), distances from a few values (ties).
-detail::NearbyColumns random_columns(std::mt19937_64& rng, std::size_t n, std::uint32_t tris, std::uint32_t corners) {
-  std::uniform_int_distribution<std::uint32_t> tri(0, tris - 1), corner(0, corners - 1);
-  std::vector<std::uint32_t> welded_a(3 * tris), welded_b(3 * tris);
-  for (auto* w : {&welded_a, &welded_b}) {
-    for (std::uint32_t& v : *w) v = corner(rng);
+/// Random candidates: triangles from `tris` ids, each triangle's welded corners from `corners` ids
+/// (fixed per triangle, as a mesh's are), distances from a few values (ties).
+struct RandomList {
+  std::vector<std::uint32_t> welded_a, welded_b;
+  std::vector<detail::NearbyCandidate> list;
+
+  RandomList(std::mt19937_64& rng, std::size_t n, std::uint32_t tris, std::uint32_t corners)
+      : welded_a(3 * tris), welded_b(3 * tris) {
+    std::uniform_int_distribution<std::uint32_t> tri(0, tris - 1), corner(0, corners - 1);
+    for (auto* w : {&welded_a, &welded_b}) {
+      for (std::uint32_t& v : *w) v = corner(rng);
+    }
+    const double distances[] = {0.0, 0.25, 0.25, 0.5, 1.0, 1e-300};
+    std::uniform_int_distribution<int> pick(0, 5);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t ta = tri(rng), tb = tri(rng);
+      list.push_back({ta, tb, distances[pick(rng)], &welded_a[3 * ta], &welded_b[3 * tb]});
+    }
   }
-  const double distances[] = {0.0, 0.25, 0.25, 0.5, 1.0, 1e-300};
-  std::uniform_int_distribution<int> pick(0, 5);
-  detail::NearbyColumns c(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t ta = tri(rng), tb = tri(rng);
-    c.set(i, ta, tb, distances[pick(rng)], &welded_a[3 * ta], &welded_b[3 * tb]);
+  /// The whole list as one run.
+  [[nodiscard]] detail::NearbyColumns columns() const {
+    detail::NearbyColumns c(list.size());
+    for (std::size_t i = 0; i < list.size(); ++i) c.set(static_cast<std::ptrdiff_t>(i), list[i]);
+    return c;
   }
-  return c;
-}
+};
 
 TEST(NearbyLook, EveryFormGivesThePortableVerdicts) {
   std::mt19937_64 rng(20261207);
@@ -45,10 +54,10 @@ TEST(NearbyLook, EveryFormGivesThePortableVerdicts) {
     const detail::NearbyLook form = detail::nearby_look_form(lanes);
     if (form == nullptr) continue;
     ++forms;
-    for (const std::size_t n :
-         {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{17}, std::size_t{400}}) {
+    for (const std::size_t n : {0, 1, 2, 9, 17, 400}) {
       for (const std::uint32_t tris : {2u, 5u, 40u}) {
-        const detail::NearbyColumns c = random_columns(rng, n, tris, tris + 3);
+        const RandomList r(rng, n, tris, tris + 3);
+        const detail::NearbyColumns c = r.columns();
         std::vector<char> want(n + 1, 7), got(n + 1, 7);
         detail::nearby_look_portable(c, 0, n, want.data());
         // In two calls, as chunks: each place written once, nothing past hi.
@@ -63,15 +72,39 @@ TEST(NearbyLook, EveryFormGivesThePortableVerdicts) {
   if (forms == 0) GTEST_SKIP() << "this CPU has no vector form of the look";
 }
 
+TEST(NearbyLook, RunsOfAListGiveTheWholeListsVerdicts) {
+  // A run loaded from a longer list reads the list's candidates around it, pads past its ends.
+  std::mt19937_64 rng(7);
+  const RandomList r(rng, 300, 6, 9);
+  const detail::NearbyColumns whole = r.columns();
+  std::vector<char> want(300);
+  detail::nearby_look_portable(whole, 0, 300, want.data());
+  EXPECT_GT(std::count(want.begin(), want.end(), 1), 30);
+  for (const std::size_t run : {1, 7, 64, 300}) {
+    for (const detail::NearbyLook form :
+         {detail::nearby_look_portable, detail::nearby_look_form(8), detail::nearby_look_form(16)}) {
+      if (form == nullptr) continue;
+      detail::NearbyColumns c(run);
+      std::vector<char> got(300, 7);
+      for (std::size_t at = 0; at < 300; at += run) {
+        const std::size_t count = std::min<std::size_t>(run, 300 - at);
+        c.load(at, count, 300, [&](std::size_t g) { return r.list[g]; });
+        form(c, 0, count, got.data() + at);
+      }
+      EXPECT_EQ(got, want) << "runs of " << run;
+    }
+  }
+}
+
 TEST(NearbyLook, PortableVerdictsFollowTheirDefinition) {
   // Candidate 1 dominates 0 (the same B triangle, A's triangles share corner 7, closer); 2 shares
   // no corner with 0; 3 shares A's triangle with 0 but its B triangle shares no corner.
-  detail::NearbyColumns c(4);
+  detail::NearbyColumns c(4);  // (its candidates set below)
   const std::uint32_t a0[] = {1, 2, 7}, a1[] = {7, 8, 9}, a2[] = {3, 4, 5}, b0[] = {1, 2, 3}, b3[] = {4, 5, 6};
-  c.set(0, 10, 20, 0.5, a0, b0);
-  c.set(1, 11, 20, 0.25, a1, b0);
-  c.set(2, 12, 20, 0.0, a2, b0);
-  c.set(3, 10, 21, 0.0, a0, b3);
+  c.set(0, {10, 20, 0.5, a0, b0});
+  c.set(1, {11, 20, 0.25, a1, b0});
+  c.set(2, {12, 20, 0.0, a2, b0});
+  c.set(3, {10, 21, 0.0, a0, b3});
   char got[4];
   detail::nearby_look_portable(c, 0, 4, got);
   EXPECT_EQ(got[0], 1);
@@ -80,8 +113,8 @@ TEST(NearbyLook, PortableVerdictsFollowTheirDefinition) {
   EXPECT_EQ(got[3], 0);
   // A tie is settled by the ids: at equal distances the lower key dominates.
   detail::NearbyColumns tie(2);
-  tie.set(0, 11, 20, 0.5, a1, b0);
-  tie.set(1, 10, 20, 0.5, a0, b0);
+  tie.set(0, {11, 20, 0.5, a1, b0});
+  tie.set(1, {10, 20, 0.5, a0, b0});
   detail::nearby_look_portable(tie, 0, 2, got);
   EXPECT_EQ(got[0], 1);
   EXPECT_EQ(got[1], 0);
