@@ -100,7 +100,8 @@ class EntryTable {
   int mShift = 60;  ///< 64 - log2(capacity)
 };
 
-/// The candidates the list's look is given at a time (their columns, 48 bytes a candidate).
+/// The candidates the list's look is given at a time (their columns, 48 bytes a candidate: 50 KB
+/// kept by each thread that has made verdicts).
 constexpr std::size_t kLookRun = 1024;
 
 /// Above this many corners at a welded vertex (a hub: the centre of a fan, as load_mesh makes of a
@@ -235,8 +236,9 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
   };
   std::vector<char> keep(candidates.size(), 0);
   parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    // The look's columns made here, by each chunk for its runs (not for the whole list first).
-    detail::NearbyColumns columns(std::min(hi - lo, kLookRun));
+    // The look's columns made here, by each chunk for its runs (not for the whole list first), in
+    // the thread's own (made once: no allocation a chunk).
+    thread_local detail::NearbyColumns columns(kLookRun);
     for (std::size_t at = lo; at < hi; at += kLookRun) {
       const std::size_t count = std::min(hi - at, kLookRun);
       columns.load(at, count, candidates.size(), candidate);
