@@ -48,7 +48,8 @@ CALIBER_AVX2 inline unsigned dominating(const F& c, std::size_t w, const Broadca
   const I by_a = _mm256_and_si256(same_b, _mm256_andnot_si256(same_a, shares_corner(c, F::kCornerA0, w, b.corner_a)));
   const I by_b = _mm256_and_si256(same_a, _mm256_andnot_si256(same_b, shares_corner(c, F::kCornerB0, w, b.corner_b)));
   const auto side = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(by_a, by_b))));
-  // Closer: a smaller distance, or the same and a smaller key (never a pad's +inf, nor NaN).
+  // Closer: a smaller distance, or the same and a smaller key (as the scalar's `!=` and `<`: a NaN
+  // is never closer nor passed; a pad, +inf with the largest key, never closer than a candidate).
   const I sign = _mm256_set1_epi64x(static_cast<long long>(std::uint64_t{1} << 63));
   unsigned closer = 0;
   for (int h = 0; h < 2; ++h) {

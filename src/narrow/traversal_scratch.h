@@ -84,7 +84,10 @@ struct TraversalScratch {
     if (carry.ctx != nullptr) carry.ctx->flush_leaves(carry.leaves, *carry.out);
     drop_pieces();
   }
-  /// Forgets what was carried, unfinished (a new run: the pair contexts it named may be gone).
+  /// Forgets what was carried, unfinished (a new run: the pair contexts it named may be gone, so
+  /// that a scratch left by a run that stopped is never flushed). A traversal given `piece`
+  /// appends its last leaf pairs' candidates only once flushed: every caller that gives pieces
+  /// flushes them before it reads their candidates.
   void drop_pieces() {
     carry.leaves.refusal.batch.size = carry.leaves.closest.batch.size = 0;
     carry.ctx = nullptr;

@@ -77,11 +77,14 @@ void record_plan(const plans::Plan& plan, ScheduleRecord& record) {
 }  // namespace
 
 void flush_pieces(StepState& state) {
-  const std::vector<WorkerSlots*> slots = state.workers.all();
-  parallel::parallel_for(0, slots.size(), 1, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t k = lo; k != hi; ++k) {
-      if (state.current(*slots[k])) slots[k]->scratch.flush_pieces();
-    }
+  std::vector<WorkerSlots*> carrying;  // (none where no pair was cut, or none carries: a limit, distance)
+  state.workers.for_each([&](WorkerSlots& w) {
+    if (state.current(w) && w.scratch.carry.ctx != nullptr) carrying.push_back(&w);
+  });
+  if (carrying.size() == 1) carrying.front()->scratch.flush_pieces();
+  if (carrying.size() < 2) return;
+  parallel::parallel_for(0, carrying.size(), 1, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k != hi; ++k) carrying[k]->scratch.flush_pieces();
   });
 }
 
