@@ -122,6 +122,38 @@ void interference_result(std::vector<Candidate>& candidates, ObjectPair objects,
   for (const std::uint64_t key : keys) add(static_cast<std::uint32_t>(key >> shift), static_cast<std::uint32_t>(key & low));
 }
 
+/// The reduction's models have adjacency (refused before any work by every caller:
+/// check_contact_models).
+void check_adjacency(const PairContext& ctx) {
+  if (!ctx.a().has_adjacency() || !ctx.b().has_adjacency()) {
+    throw Error(ErrorCode::bad_argument, "contact query", "a model was built without adjacency (BuildOptions::adjacency)");
+  }
+}
+
+/// The kept candidates sorted by ids (each pair once) and written to result.contacts in world
+/// coordinates, in chunks of `grain` where `parallel` (a grain of the whole list: this thread).
+void sort_and_place(const PairContext& ctx, std::vector<Candidate>& candidates, ObjectPair objects, bool parallel,
+                    std::size_t grain, QueryResult& result) {
+  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
+  if (parallel && candidates.size() >= kFinalizeGrain) {
+    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
+  } else {
+    std::sort(candidates.begin(), candidates.end(), by_ids);
+  }
+  CALIBER_ASSERT(sorted_once(candidates), "a pair's candidates are sorted by triangle ids, each pair once");
+  const Eigen::Matrix3d ra = ctx.pose_a().rotation_matrix();
+  result.contacts.resize(candidates.size());
+  const auto contacts = [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i != hi; ++i) result.contacts[i] = world_contact(ctx, candidates[i], objects, ra);
+  };
+  // Serial: called here, not through parallel_for's std::function (an allocation per query).
+  if (candidates.size() <= grain) {
+    contacts(0, candidates.size());
+  } else {
+    parallel::parallel_for(0, candidates.size(), grain, contacts);
+  }
+}
+
 }  // namespace
 
 void check_contact_models(const QueryRequest& request, const Model& a, const Model& b, std::string_view name_a,
@@ -155,10 +187,7 @@ void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const 
   // Contacts: the local minima first (their verdicts do not depend on the order), so that only the
   // few kept candidates are sorted, not every pair within the tolerance.
   if (result.kind == QueryKind::contact) {
-    if (!ctx.a().has_adjacency() || !ctx.b().has_adjacency()) {
-      // (Refused before any work by every caller: check_contact_models.)
-      throw Error(ErrorCode::bad_argument, "contact query", "a model was built without adjacency (BuildOptions::adjacency)");
-    }
+    check_adjacency(ctx);
     candidates = local_minima(ctx, candidates, grain);
   }
   if (result.kind == QueryKind::distance && !candidates.empty()) {
@@ -169,24 +198,22 @@ void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const 
     interference_result(candidates, objects, parallel, result);
     return;
   }
-  // Ids are unique, so every sort gives the same order: the parallel one is safe for determinism.
-  if (parallel && candidates.size() >= kFinalizeGrain) {
-    parallel::parallel_sort(candidates.begin(), candidates.end(), by_ids);
-  } else {
-    std::sort(candidates.begin(), candidates.end(), by_ids);
-  }
-  CALIBER_ASSERT(sorted_once(candidates), "a pair's candidates are sorted by triangle ids, each pair once");
-  const Eigen::Matrix3d ra = ctx.pose_a().rotation_matrix();
-  result.contacts.resize(candidates.size());
-  const auto contacts = [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) result.contacts[i] = world_contact(ctx, candidates[i], objects, ra);
-  };
-  // Serial: called here, not through parallel_for's std::function (an allocation per query).
-  if (candidates.size() <= grain) {
-    contacts(0, candidates.size());
-  } else {
-    parallel::parallel_for(0, candidates.size(), grain, contacts);
-  }
+  sort_and_place(ctx, candidates, objects, parallel, grain, result);
+}
+
+QueryResult finalize_contacts(const PairContext& ctx, const CandidateLists& lists, const QueryStats& stats, ObjectPair objects,
+                              bool parallel) {
+  CALIBER_ASSERT(ctx.request().kind == QueryKind::contact && ctx.request().max_pairs == 0,
+                 "a contact query without a limit: its candidates all go to the reduction");
+  check_adjacency(ctx);
+  const std::size_t grain = parallel ? kFinalizeGrain : std::max<std::size_t>(lists.size(), 1);
+  QueryResult result;
+  result.kind = QueryKind::contact;
+  result.stats = stats;
+  result.limit_reached = false;
+  std::vector<Candidate> kept = local_minima(ctx, lists, grain);
+  sort_and_place(ctx, kept, objects, parallel, grain, result);
+  return result;
 }
 
 QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,

@@ -9,6 +9,7 @@
 
 #include "caliber/engine.h"
 #include "caliber/query.h"
+#include "narrow/local_minima.h"
 #include "narrow/pair_context.h"
 
 namespace caliber::narrow {
@@ -53,6 +54,12 @@ QueryResult finalize(const PairContext& ctx, std::vector<Candidate>& candidates,
 /// keeps from entry to entry: no allocation once it has grown).
 void finalize(const PairContext& ctx, std::vector<Candidate>& candidates, const QueryStats& stats, ObjectPair objects,
               ContactPair contact_pair, bool parallel, QueryResult& result);
+
+/// finalize for a contact query without a limit (QueryRequest::max_pairs 0) whose candidates are
+/// the concatenation of `lists`: the local minima read where the candidates are (not copied into
+/// one list first), then sorted and in world coordinates, as finalize makes them.
+QueryResult finalize_contacts(const PairContext& ctx, const CandidateLists& lists, const QueryStats& stats, ObjectPair objects,
+                              bool parallel);
 
 /// The intersecting pair the distance traversal from the root reports (its first hit: the pair
 /// caliber::query reports on meshes that intersect; the lowest ids on models with at most 16

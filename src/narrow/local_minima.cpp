@@ -208,13 +208,15 @@ struct Reduction {
   }
 };
 
-}  // namespace
-
-std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
+/// local_minima on the candidates `candidates` (a vector or CandidateLists: size and operator[]).
+template <class List>
+std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, std::size_t grain) {
   std::vector<Entry> entries(candidates.size());
   const auto fill = [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i)
-      entries[i] = {key_of(candidates[i].tri_a, candidates[i].tri_b), candidates[i].distance};
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = candidates[i];
+      entries[i] = {key_of(c.tri_a, c.tri_b), c.distance};
+    }
   };
   if (candidates.size() < kParallelFill) {
     fill(0, candidates.size());
@@ -251,6 +253,16 @@ std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Ca
     if (keep[i]) kept.push_back(candidates[i]);
   }
   return kept;
+}
+
+}  // namespace
+
+std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain) {
+  return reduce(ctx, candidates, grain);
+}
+
+std::vector<Candidate> local_minima(const PairContext& ctx, const CandidateLists& lists, std::size_t grain) {
+  return reduce(ctx, lists, grain);
 }
 
 }  // namespace caliber::narrow

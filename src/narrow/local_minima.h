@@ -2,6 +2,7 @@
 /// \file
 /// The contact query's reduction of a pair's candidates to their local minima.
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -16,6 +17,28 @@ namespace caliber::narrow {
 /// when the library loads.
 extern const detail::NearbyLook kNearbyLook;
 
+/// A pair's candidates in the lists they were gathered in (a stage's, the workers'), read as their
+/// concatenation in order: what a reduction reads where they are, not copied into one list first.
+class CandidateLists {
+ public:
+  /// Appends `list` (kept by the caller, unchanged while this is read).
+  void add(const std::vector<Candidate>& list) {
+    if (list.empty()) return;
+    mLists.push_back(&list);
+    mEnd.push_back(size() + list.size());
+  }
+  [[nodiscard]] std::size_t size() const { return mEnd.empty() ? 0 : mEnd.back(); }
+  /// Candidate g of the concatenation.
+  [[nodiscard]] const Candidate& operator[](std::size_t g) const {
+    const auto k = static_cast<std::size_t>(std::upper_bound(mEnd.begin(), mEnd.end(), g) - mEnd.begin());
+    return (*mLists[k])[k == 0 ? g : g - mEnd[k - 1]];
+  }
+
+ private:
+  std::vector<const std::vector<Candidate>*> mLists;
+  std::vector<std::size_t> mEnd;  ///< where each list ends in the concatenation
+};
+
 /// Quasi-LMD reduction: keeps a candidate unless a candidate that shares one of its triangles and
 /// whose other triangle is vertex-adjacent to its own (ModelData::are_neighbours) is closer
 /// (`closer`: ties to the lower ids). Each verdict depends only on the set of candidates, not on
@@ -25,5 +48,7 @@ extern const detail::NearbyLook kNearbyLook;
 /// chunks of `grain` on the current executor (a grain as large as the input keeps it on this
 /// thread). Both models need adjacency.
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain);
+/// The same on the concatenation of `lists`.
+std::vector<Candidate> local_minima(const PairContext& ctx, const CandidateLists& lists, std::size_t grain);
 
 }  // namespace caliber::narrow

@@ -74,6 +74,38 @@ void record_plan(const plans::Plan& plan, ScheduleRecord& record) {
   if (plan.weighted) record.task_weights.resize(plan.run.size());
 }
 
+/// Pair i, cut into pieces, finalized from what `start` seeds and every current worker's slots
+/// (`count` candidates in all): a contact query without a limit reads them where they are
+/// (narrow::finalize_contacts: its reduction keeps few), any other gathers them into one list.
+void finalize_split(StepState& state, const std::vector<WorkerSlots*>& slots, std::size_t i,
+                    const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start,
+                    std::size_t count) {
+  std::vector<narrow::Candidate> all;
+  QueryStats stats;
+  if (start) start(i, all, stats);
+  for (const WorkerSlots* w : slots) {
+    if (!state.current(*w)) continue;
+    stats.node_tests += w->stats[i].node_tests;
+    stats.leaf_tests += w->stats[i].leaf_tests;
+  }
+  const narrow::PairContext& ctx = state.contexts[i];
+  if (ctx.request().kind == QueryKind::contact && ctx.request().max_pairs == 0) {
+    narrow::CandidateLists lists;
+    lists.add(all);
+    for (const WorkerSlots* w : slots) {
+      if (state.current(*w)) lists.add(w->candidates[i]);
+    }
+    state.candidates[i] = lists.size();
+    state.results[i] = narrow::finalize_contacts(ctx, lists, stats, state.pairs[i], state.parallel_finalize);
+    return;
+  }
+  all.reserve(all.size() + count);
+  for (const WorkerSlots* w : slots) {
+    if (state.current(*w)) all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
+  }
+  finalize_into(state, i, all, stats, narrow::ContactPair::from_root);
+}
+
 }  // namespace
 
 void flush_pieces(StepState& state) {
@@ -107,19 +139,7 @@ void finalize_pairs(StepState& state, const std::vector<std::uint32_t>& rest,
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return candidates[x] > candidates[y]; });
   parallel::for_each_in_order(rest.size(), [&](std::size_t k) {
     const std::size_t i = rest[order[k]];
-    state.timeline.record(TaskSpan::Phase::finalize, i, [&] {
-      std::vector<narrow::Candidate> all;
-      QueryStats stats;
-      if (start) start(i, all, stats);
-      all.reserve(all.size() + candidates[order[k]]);
-      for (const WorkerSlots* w : slots) {
-        if (!state.current(*w)) continue;
-        all.insert(all.end(), w->candidates[i].begin(), w->candidates[i].end());
-        stats.node_tests += w->stats[i].node_tests;
-        stats.leaf_tests += w->stats[i].leaf_tests;
-      }
-      finalize_into(state, i, all, stats, narrow::ContactPair::from_root);
-    });
+    state.timeline.record(TaskSpan::Phase::finalize, i, [&] { finalize_split(state, slots, i, start, candidates[order[k]]); });
   });
 }
 

@@ -14,7 +14,9 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "narrow/local_minima.h"
 #include "narrow/nearby_look.h"
+#include "narrow/traversal.h"
 #include "support/random_poses.h"
 
 namespace caliber::narrow {
@@ -162,6 +164,48 @@ TEST(NearbyLook, ContactsAreTheLocalMinimaOfTheProximityPairs) {
   EXPECT_GE(want.size(), 2u);
   EXPECT_LT(want.size(), within.contacts.size() / 10) << "the reduction dropped most pairs";
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "torus and sphere");
+}
+
+/// The reduction of a pair's candidates read where they are, in lists (CandidateLists: the
+/// workers' of a cut pair), keeps what it keeps of them gathered into one list, in that order.
+TEST(NearbyLook, ListsKeepWhatTheirConcatenationKeeps) {
+  const auto a = build_model(make_torus(1.0, 0.35, 48, 24));
+  const auto b = build_model(make_sphere(0.6, 16, 24));
+  QueryRequest request;
+  request.kind = QueryKind::contact;
+  request.tolerance = 0.15;
+  request.angle_deg = 180.0;
+  const Pose pa, pb = Pose::from_values(1.05, 0.1, 0.2, 1, 0.1, 0.05, 0.02);
+  const PairContext ctx(*a, pa, *b, pb, request);
+  TraversalScratch scratch;
+  std::vector<Candidate> all;
+  QueryStats stats;
+  traverse(ctx, NodePair{0, 0}, scratch, all, stats);
+  ASSERT_GT(all.size(), 2000u) << "runs of the look across lists and chunks";
+  const std::vector<Candidate> want = local_minima(ctx, all, 128);
+  ASSERT_GT(want.size(), 2u);
+  const auto ids = [](const std::vector<Candidate>& c) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+    for (const Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
+    return out;
+  };
+  std::mt19937_64 rng(11);
+  for (int split = 0; split < 6; ++split) {
+    // Up to five lists (an empty one among them), cut at random places.
+    std::vector<std::size_t> cuts = {0, all.size()};
+    std::uniform_int_distribution<std::size_t> at(0, all.size());
+    for (int k = 0; k < split; ++k) cuts.push_back(at(rng));
+    cuts.push_back(cuts[1]);  // an empty list
+    std::sort(cuts.begin(), cuts.end());
+    std::vector<std::vector<Candidate>> parts;
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) parts.emplace_back(all.begin() + cuts[k], all.begin() + cuts[k + 1]);
+    CandidateLists lists;
+    for (const std::vector<Candidate>& p : parts) lists.add(p);
+    ASSERT_EQ(lists.size(), all.size());
+    for (const std::size_t grain : {std::size_t{128}, all.size()}) {
+      EXPECT_EQ(ids(local_minima(ctx, lists, grain)), ids(want)) << split << " cuts, grain " << grain;
+    }
+  }
 }
 
 }  // namespace
