@@ -17,6 +17,7 @@
 #include "narrow/local_minima.h"
 #include "narrow/nearby_look.h"
 #include "narrow/traversal.h"
+#include "support/local_minima_oracle.h"
 #include "support/random_poses.h"
 
 namespace caliber::narrow {
@@ -135,32 +136,11 @@ TEST(NearbyLook, ContactsAreTheLocalMinimaOfTheProximityPairs) {
   request.tolerance = 0.15;
   const QueryResult within = query(*a, pa, *b, pb, request);
   ASSERT_GT(within.contacts.size(), 500u);
-  // Sharing a vertex position (the adjacency welds a seam's repeated vertices).
-  const auto neighbours = [](const Mesh& m, std::uint32_t t, std::uint32_t u) {
-    if (t == u) return false;
-    for (const std::uint32_t v : m.triangles[t]) {
-      for (const std::uint32_t w : m.triangles[u]) {
-        if (m.vertices[v] == m.vertices[w]) return true;
-      }
-    }
-    return false;
-  };
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
-  for (const Contact& c : within.contacts) {
-    const bool dominated = std::any_of(within.contacts.begin(), within.contacts.end(), [&](const Contact& o) {
-      const bool closer =
-          o.distance != c.distance ? o.distance < c.distance : std::pair(o.tri_a, o.tri_b) < std::pair(c.tri_a, c.tri_b);
-      return closer && ((o.tri_b == c.tri_b && neighbours(ma, o.tri_a, c.tri_a)) ||
-                        (o.tri_a == c.tri_a && neighbours(mb, o.tri_b, c.tri_b)));
-    });
-    if (!dominated) want.emplace_back(c.tri_a, c.tri_b);
-  }
+  const auto want = test::local_minima_oracle(within.contacts, ma, mb);
   request.kind = QueryKind::contact;
   request.angle_deg = 180.0;
   const QueryResult got = query(*a, pa, *b, pb, request);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  for (const Contact& c : got.contacts) pairs.emplace_back(c.tri_a, c.tri_b);
-  EXPECT_EQ(pairs, want);
+  EXPECT_EQ(test::pair_ids(got.contacts), want);
   EXPECT_GE(want.size(), 2u);
   EXPECT_LT(want.size(), within.contacts.size() / 10) << "the reduction dropped most pairs";
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "torus and sphere");

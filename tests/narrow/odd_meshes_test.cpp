@@ -13,6 +13,7 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "support/local_minima_oracle.h"
 #include "support/random_poses.h"
 
 namespace caliber {
@@ -169,29 +170,11 @@ TEST(OddMeshes, ContactsAroundAHubAreTheLocalMinima) {
   request.tolerance = 0.3;
   const QueryResult within = query(*a, pa, *b, pb, request);
   ASSERT_GT(within.contacts.size(), 1000u);
-  const auto neighbours = [](const Mesh& m, std::uint32_t t, std::uint32_t u) {
-    if (t == u) return false;
-    for (const std::uint32_t v : m.triangles[t]) {
-      if (std::find(m.triangles[u].begin(), m.triangles[u].end(), v) != m.triangles[u].end()) return true;
-    }
-    return false;
-  };
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
-  for (const Contact& c : within.contacts) {
-    const bool dominated = std::any_of(within.contacts.begin(), within.contacts.end(), [&](const Contact& o) {
-      const bool closer =
-          o.distance != c.distance ? o.distance < c.distance : std::pair(o.tri_a, o.tri_b) < std::pair(c.tri_a, c.tri_b);
-      return closer && ((o.tri_b == c.tri_b && neighbours(a->mesh(), o.tri_a, c.tri_a)) ||
-                        (o.tri_a == c.tri_a && neighbours(b->mesh(), o.tri_b, c.tri_b)));
-    });
-    if (!dominated) want.emplace_back(c.tri_a, c.tri_b);
-  }
+  const auto want = test::local_minima_oracle(within.contacts, a->mesh(), b->mesh());
   request.kind = QueryKind::contact;
   request.angle_deg = 180.0;
   const QueryResult got = query(*a, pa, *b, pb, request);
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-  for (const Contact& c : got.contacts) pairs.emplace_back(c.tri_a, c.tri_b);
-  EXPECT_EQ(pairs, want);
+  EXPECT_EQ(test::pair_ids(got.contacts), want);
   EXPECT_GE(want.size(), 1u);
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "fans");
 }
