@@ -75,7 +75,7 @@ void record_plan(const plans::Plan& plan, ScheduleRecord& record) {
 }
 
 /// Pair i, cut into pieces, finalized from what `start` seeds and every current worker's slots
-/// (`count` candidates in all): a contact query without a limit reads them where they are
+/// (`count`: the workers' candidates): a contact query without a limit reads them where they are
 /// (narrow::finalize_contacts: its reduction keeps few), any other gathers them into one list.
 void finalize_split(StepState& state, const std::vector<WorkerSlots*>& slots, std::size_t i,
                     const std::function<void(std::size_t, std::vector<narrow::Candidate>&, QueryStats&)>& start,

@@ -171,7 +171,7 @@ TEST(NearbyLook, ListsKeepWhatTheirConcatenationKeeps) {
   };
   std::mt19937_64 rng(11);
   for (int split = 0; split < 6; ++split) {
-    // Up to five lists (an empty one among them), cut at random places.
+    // Up to seven lists cut at random places (empty ones where two cuts meet), and an empty last one.
     std::vector<std::size_t> cuts = {0, all.size()};
     std::uniform_int_distribution<std::size_t> at(0, all.size());
     for (int k = 0; k < split; ++k) cuts.push_back(at(rng));
