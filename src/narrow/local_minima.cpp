@@ -4,9 +4,9 @@
 #include "narrow/local_minima.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 
 #include "narrow/nearby_look.h"
@@ -33,18 +33,19 @@ std::uint32_t tri_b(std::uint64_t key) { return static_cast<std::uint32_t>(key);
 /// `closer` on entries: the same order.
 bool closer(const Entry& x, const Entry& y) { return x.distance != y.distance ? x.distance < y.distance : x.key < y.key; }
 
-/// Below this many candidates the reduction's entries and table are made on the calling thread:
-/// a parallel pass over a few thousand costs more in waking threads (and, for the table, in
-/// compare-and-swaps on lines both threads write) than it saves.
+/// Below this many candidates the reduction's entries are made on the calling thread: a parallel
+/// pass over a few thousand costs more in waking threads than it saves. (Made by the thread that
+/// fills the table, while the others run the look, they took as long on two threads.)
 constexpr std::size_t kParallelFill = std::size_t{1} << 15;
 
 /// Where each entry sits, by its key: open addressing with linear probing, at most half full, four
 /// bytes a slot (the table of a pair's 70,000 candidates fits in 1 MiB, so that filling it stays
-/// in cache). Filled in parallel from kParallelFill entries (a slot claimed by compare-and-swap;
-/// which slot an entry gets may vary, what a lookup finds does not), else in order; then only read.
+/// in cache). Filled in order on one thread (the reduction runs the list's look meanwhile: filled
+/// by several threads, each slot claimed by compare-and-swap, it took longer on two threads than
+/// this on one), then only read.
 class EntryTable {
  public:
-  EntryTable(const std::vector<Entry>& entries, std::size_t grain) : mEntries(entries) {
+  explicit EntryTable(const std::vector<Entry>& entries) : mEntries(entries) {
     std::size_t capacity = 16;
     mShift = 60;
     while (capacity < 2 * entries.size()) {
@@ -53,25 +54,13 @@ class EntryTable {
     }
     mMask = capacity - 1;
     mSlots.assign(capacity, kEmpty);
-    if (entries.size() < kParallelFill) {
-      for (std::size_t i = 0; i < entries.size(); ++i) {
-        std::size_t h = slot(entries[i].key);
-        while (mSlots[h] != kEmpty) h = (h + 1) & mMask;
-        mSlots[h] = static_cast<std::uint32_t>(i);
-      }
-      return;
+    constexpr std::size_t kAhead = 16;  // the slot of the entry this many places on, prefetched
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      if (i + kAhead < entries.size()) __builtin_prefetch(&mSlots[slot(entries[i + kAhead].key)], 1);
+      std::size_t h = slot(entries[i].key);
+      while (mSlots[h] != kEmpty) h = (h + 1) & mMask;
+      mSlots[h] = static_cast<std::uint32_t>(i);
     }
-    parallel::parallel_for(0, entries.size(), grain, [&](std::size_t lo, std::size_t hi) {
-      for (std::size_t i = lo; i != hi; ++i) {
-        for (std::size_t h = slot(entries[i].key);; h = (h + 1) & mMask) {
-          std::uint32_t expected = kEmpty;
-          if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
-                                                                                std::memory_order_relaxed)) {
-            break;
-          }
-        }
-      }
-    });
   }
 
   void prefetch(std::uint64_t key) const { __builtin_prefetch(&mSlots[slot(key)]); }
@@ -208,49 +197,89 @@ struct Reduction {
   }
 };
 
-/// local_minima on the candidates `candidates` (a vector or CandidateLists: size and operator[]).
+/// Reads candidate g of a list (reader(list)(g)): a vector's by index; the lists' by a
+/// CandidateLists::Reader, one per run read in order (no search a candidate).
+struct VectorReader {
+  const Candidate* data;
+  const Candidate& operator()(std::size_t g) const { return data[g]; }
+};
+VectorReader reader(const std::vector<Candidate>& list) { return VectorReader{list.data()}; }
+CandidateLists::Reader reader(const CandidateLists& lists) { return CandidateLists::Reader(lists); }
+
+/// The list's look at candidates [lo, hi): keep[i] = 1 where a neighbour in the list dominates
+/// candidate i (null also before the library's constants are made: a query from another
+/// constant's constructor). Its columns are made here, a run at a time, in the thread's own (made
+/// once: no allocation a call), not for the whole list first.
 template <class List>
-std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, std::size_t grain) {
-  std::vector<Entry> entries(candidates.size());
-  const auto fill = [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t i = lo; i != hi; ++i) {
-      const Candidate& c = candidates[i];
-      entries[i] = {key_of(c.tri_a, c.tri_b), c.distance};
-    }
-  };
-  if (candidates.size() < kParallelFill) {
-    fill(0, candidates.size());
-  } else {
-    parallel::parallel_for(0, candidates.size(), grain, fill);
-  }
-  const EntryTable table(entries, grain);
-  // The hubs' groups, where a model has a hub (none on most meshes, a few on a sphere's poles).
-  const bool any_hub = ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree;
-  const std::unique_ptr<const Hubs> hubs = any_hub ? std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries) : nullptr;
-  const Reduction reduction{ctx.a(), ctx.b(), entries, table, hubs.get()};
-  // The list's look first, for a chunk at a time (null also before the library's constants are
-  // made: a query from another constant's constructor), then the lookups of what it left.
+void look_at(const PairContext& ctx, const List& candidates, std::size_t lo, std::size_t hi, char* keep) {
   const detail::NearbyLook look = kNearbyLook != nullptr ? kNearbyLook : detail::nearby_look_portable;
-  const auto candidate = [&](std::size_t g) {
-    const Candidate& c = candidates[g];
+  thread_local detail::NearbyColumns columns(kLookRun);
+  auto read = reader(candidates);
+  const auto nearby = [&](std::size_t g) {
+    const Candidate& c = read(g);
     return detail::NearbyCandidate{c.tri_a, c.tri_b, c.distance, ctx.a().welded_corners(c.tri_a),
                                    ctx.b().welded_corners(c.tri_b)};
   };
-  std::vector<char> keep(candidates.size(), 0);
-  parallel::parallel_for(0, candidates.size(), grain, [&](std::size_t lo, std::size_t hi) {
-    // The look's columns made here, by each chunk for its runs (not for the whole list first), in
-    // the thread's own (made once: no allocation a chunk).
-    thread_local detail::NearbyColumns columns(kLookRun);
-    for (std::size_t at = lo; at < hi; at += kLookRun) {
-      const std::size_t count = std::min(hi - at, kLookRun);
-      columns.load(at, count, candidates.size(), candidate);
-      look(columns, 0, count, keep.data() + at);  // 1 where a neighbour in the list dominates
+  for (std::size_t at = lo; at < hi; at += kLookRun) {
+    const std::size_t count = std::min(hi - at, kLookRun);
+    columns.load(at, count, candidates.size(), nearby);
+    look(columns, 0, count, keep + at);
+  }
+}
+
+/// local_minima on the candidates `candidates` (a vector or CandidateLists: size and reader).
+/// The list's look needs no table: it runs while one thread fills the table and makes the hubs'
+/// groups (where a model has a hub: none on most meshes, a few on a sphere's poles); then the
+/// lookups of what the look left.
+template <class List>
+std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, std::size_t grain) {
+  const std::size_t n = candidates.size();
+  const bool serial = grain >= n;  // then here, not through parallel_for's std::function
+  std::vector<Entry> entries(n);
+  const auto fill = [&](std::size_t lo, std::size_t hi) {
+    auto read = reader(candidates);
+    for (std::size_t i = lo; i != hi; ++i) {
+      const Candidate& c = read(i);
+      entries[i] = {key_of(c.tri_a, c.tri_b), c.distance};
     }
+  };
+  if (n < kParallelFill) {
+    fill(0, n);
+  } else {
+    parallel::parallel_for(0, n, grain, fill);
+  }
+  std::optional<EntryTable> table;
+  std::unique_ptr<const Hubs> hubs;
+  const auto index = [&] {
+    table.emplace(entries);
+    if (ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree) {
+      hubs = std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries);
+    }
+  };
+  std::vector<char> keep(n, 0);
+  const auto look = [&](std::size_t lo, std::size_t hi) { look_at(ctx, candidates, lo, hi, keep.data()); };
+  if (serial) {
+    index();
+    look(0, n);
+  } else {
+    parallel::JobGroup group;
+    group.run(index);
+    parallel::parallel_for(0, n, grain, look);
+    group.wait();
+  }
+  const Reduction reduction{ctx.a(), ctx.b(), entries, *table, hubs.get()};
+  const auto verdicts = [&](std::size_t lo, std::size_t hi) {
     for (std::size_t i = lo; i != hi; ++i) keep[i] = keep[i] == 0 && !reduction.dominated(i) ? 1 : 0;
-  });
+  };
+  if (serial) {
+    verdicts(0, n);
+  } else {
+    parallel::parallel_for(0, n, grain, verdicts);
+  }
   std::vector<Candidate> kept;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (keep[i]) kept.push_back(candidates[i]);
+  auto read = reader(candidates);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (keep[i]) kept.push_back(read(i));
   }
   return kept;
 }

@@ -30,11 +30,37 @@ class CandidateLists {
   [[nodiscard]] std::size_t size() const { return mEnd.empty() ? 0 : mEnd.back(); }
   /// Candidate g of the concatenation.
   [[nodiscard]] const Candidate& operator[](std::size_t g) const {
-    const auto k = static_cast<std::size_t>(std::upper_bound(mEnd.begin(), mEnd.end(), g) - mEnd.begin());
-    return (*mLists[k])[k == 0 ? g : g - mEnd[k - 1]];
+    const std::size_t k = list_of(g);
+    return (*mLists[k])[g - begin_of(k)];
   }
 
+  /// Reads the concatenation by position with no search while the positions stay in one list (a
+  /// run read in order searches once a list).
+  class Reader {
+   public:
+    explicit Reader(const CandidateLists& lists) : mLists(lists) {}
+    const Candidate& operator()(std::size_t g) {
+      if (g - mBegin >= mCount) {  // (also below mBegin: the difference wraps)
+        const std::size_t k = mLists.list_of(g);
+        mBegin = mLists.begin_of(k);
+        mCount = mLists.mLists[k]->size();
+        mData = mLists.mLists[k]->data();
+      }
+      return mData[g - mBegin];
+    }
+
+   private:
+    const CandidateLists& mLists;
+    const Candidate* mData = nullptr;
+    std::size_t mBegin = 0, mCount = 0;
+  };
+
  private:
+  [[nodiscard]] std::size_t list_of(std::size_t g) const {
+    return static_cast<std::size_t>(std::upper_bound(mEnd.begin(), mEnd.end(), g) - mEnd.begin());
+  }
+  [[nodiscard]] std::size_t begin_of(std::size_t k) const { return k == 0 ? 0 : mEnd[k - 1]; }
+
   std::vector<const std::vector<Candidate>*> mLists;
   std::vector<std::size_t> mEnd;  ///< where each list ends in the concatenation
 };

@@ -17,6 +17,7 @@
 #include "narrow/local_minima.h"
 #include "narrow/nearby_look.h"
 #include "narrow/traversal.h"
+#include "parallel/executor.h"
 #include "support/local_minima_oracle.h"
 #include "support/random_poses.h"
 
@@ -185,6 +186,42 @@ TEST(NearbyLook, ListsKeepWhatTheirConcatenationKeeps) {
     for (const std::size_t grain : {std::size_t{128}, all.size()}) {
       EXPECT_EQ(ids(local_minima(ctx, lists, grain)), ids(want)) << split << " cuts, grain " << grain;
     }
+    // On threads: the table filled by one job while the look's chunks run.
+    parallel::Executor executor(2);
+    executor.execute([&] {
+      for (const std::size_t grain : {std::size_t{16}, std::size_t{128}}) {
+        EXPECT_EQ(ids(local_minima(ctx, lists, grain)), ids(want)) << split << " cuts, grain " << grain << ", 2 threads";
+      }
+    });
+  }
+}
+
+/// A reader of the lists gives the candidate operator[] gives, wherever it is sent next: on to the
+/// next place, across a list's end, back, far ahead, past empty lists.
+TEST(NearbyLook, ListReaderFindsEachCandidate) {
+  std::vector<std::vector<Candidate>> parts(6);
+  const std::size_t sizes[] = {3, 0, 1, 0, 5, 2};
+  std::uint32_t id = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    for (std::size_t j = 0; j < sizes[k]; ++j) {
+      Candidate c;
+      c.tri_a = id++;
+      parts[k].push_back(c);
+    }
+  }
+  CandidateLists lists;
+  for (const std::vector<Candidate>& p : parts) lists.add(p);
+  ASSERT_EQ(lists.size(), 11u);
+  CandidateLists::Reader read(lists);
+  std::vector<std::size_t> order;
+  for (std::size_t g = 0; g < lists.size(); ++g) order.push_back(g);  // in order
+  for (std::size_t g = lists.size(); g-- > 0;) order.push_back(g);    // backwards
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::size_t> any(0, lists.size() - 1);
+  for (int k = 0; k < 200; ++k) order.push_back(any(rng));
+  for (const std::size_t g : order) {
+    EXPECT_EQ(&read(g), &lists[g]) << g;
+    EXPECT_EQ(read(g).tri_a, g);
   }
 }
 

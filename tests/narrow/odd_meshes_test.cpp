@@ -6,6 +6,8 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +15,9 @@
 #include "caliber/model.h"
 #include "caliber/procedural.h"
 #include "caliber/query.h"
+#include "narrow/local_minima.h"
+#include "narrow/traversal.h"
+#include "parallel/executor.h"
 #include "support/local_minima_oracle.h"
 #include "support/random_poses.h"
 
@@ -177,6 +182,21 @@ TEST(OddMeshes, ContactsAroundAHubAreTheLocalMinima) {
   EXPECT_EQ(test::pair_ids(got.contacts), want);
   EXPECT_GE(want.size(), 1u);
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "fans");
+  // On two threads, the hubs' groups made by the job that fills the table, the look's chunks beside it.
+  const narrow::PairContext ctx(*a, pa, *b, pb, request);
+  narrow::TraversalScratch scratch;
+  std::vector<narrow::Candidate> all;
+  QueryStats stats;
+  narrow::traverse(ctx, narrow::NodePair{0, 0}, scratch, all, stats);
+  const auto ids = [](const std::vector<narrow::Candidate>& c) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+    for (const narrow::Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
+    return out;
+  };
+  const auto serial = ids(narrow::local_minima(ctx, all, all.size()));
+  ASSERT_EQ(serial.size(), want.size());
+  parallel::Executor executor(2);
+  executor.execute([&] { EXPECT_EQ(ids(narrow::local_minima(ctx, all, 16)), serial); });
 }
 
 }  // namespace
