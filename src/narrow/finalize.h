@@ -17,8 +17,8 @@ namespace caliber::narrow {
 /// Below this many candidates a pair is finalized serially; above, its local-minimum test, sort
 /// and world transform run in chunks of this many on several threads (one heavy pair's
 /// finalization would otherwise be serial work). But an interference result's keys are sorted
-/// serially below kParallelSortKeys, and a contact reduction's hash index is filled serially below
-/// local_minima's own threshold (32,768 candidates).
+/// serially below kParallelSortKeys, and a contact reduction's hash index is filled by one thread
+/// (while the others run the list's look: local_minima).
 inline constexpr std::size_t kFinalizeGrain = 128;
 /// From this many, an interference result's keys are sorted on the engine's threads. Below, the
 /// serial radix sort: on 2 threads it was the faster on a few thousand keys (TBB's parallel sort
