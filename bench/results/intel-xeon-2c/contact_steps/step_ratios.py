@@ -6,19 +6,10 @@ rounds' ratios.
 
     python3 step_ratios.py CALIBER[,CALIBER...] SCENE STEPS ROUNDS   (from the repository root)
 """
-import json
 import statistics
-import subprocess
 import sys
-import tempfile
 
-
-def step_ms(binary, scene, steps, method, threads):
-    with tempfile.NamedTemporaryFile(suffix=".json") as f:
-        subprocess.run([binary, "run", f"scenes/{scene}.json", "--method", method, "--threads", str(threads),
-                        "--steps", str(steps), "--json", f.name], check=True, stdout=subprocess.DEVNULL,
-                       stderr=subprocess.DEVNULL)
-        return statistics.median(s["step_ms"] for s in json.load(open(f.name))["steps"])
+from compare_steps import step_ms  # (this folder's: each run's median step)
 
 
 def main():
