@@ -18,7 +18,7 @@ namespace caliber::narrow {
 /// and world transform run in chunks of this many on several threads (one heavy pair's
 /// finalization would otherwise be serial work). But an interference result's keys are sorted
 /// serially below kParallelSortKeys, and a contact reduction's hash index is filled by one thread
-/// (while the others run the list's look: local_minima).
+/// while the others run the list's look, on fewer than six threads (local_minima).
 inline constexpr std::size_t kFinalizeGrain = 128;
 /// From this many, an interference result's keys are sorted on the engine's threads. Below, the
 /// serial radix sort: on 2 threads it was the faster on a few thousand keys (TBB's parallel sort

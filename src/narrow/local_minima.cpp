@@ -4,6 +4,7 @@
 #include "narrow/local_minima.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -34,18 +35,25 @@ std::uint32_t tri_b(std::uint64_t key) { return static_cast<std::uint32_t>(key);
 bool closer(const Entry& x, const Entry& y) { return x.distance != y.distance ? x.distance < y.distance : x.key < y.key; }
 
 /// Below this many candidates the reduction's entries are made on the calling thread: a parallel
-/// pass over a few thousand costs more in waking threads than it saves. (Made by the thread that
-/// fills the table, while the others run the look, they took as long on two threads.)
+/// pass over a few thousand costs more in waking threads than it saves.
 constexpr std::size_t kParallelFill = std::size_t{1} << 15;
+
+/// From this many threads, the table of kParallelFill entries or more is filled by all of them
+/// before the look (each slot claimed by compare-and-swap), not by one beside it. On two threads
+/// (two_large, 71,000 entries) the shared fill took 0.54 ms, the fill in order 0.27 on one: four
+/// times the cost an entry, so that one thread's fill holds up a look shared by about six or more
+/// (a model of those figures; not measured beyond two threads).
+constexpr int kSharedFillThreads = 6;
 
 /// Where each entry sits, by its key: open addressing with linear probing, at most half full, four
 /// bytes a slot (the table of a pair's 70,000 candidates fits in 1 MiB, so that filling it stays
-/// in cache). Filled in order on one thread (the reduction runs the list's look meanwhile: filled
-/// by several threads, each slot claimed by compare-and-swap, it took longer on two threads than
-/// this on one), then only read.
+/// in cache). Filled in order on this thread (the reduction runs the list's look meanwhile), or,
+/// given a grain, in chunks of it on the executor's threads (a slot claimed by compare-and-swap;
+/// which slot an entry gets may vary, what a lookup finds does not); then only read.
 class EntryTable {
  public:
-  explicit EntryTable(const std::vector<Entry>& entries) : mEntries(entries) {
+  /// `shared_grain`: 0 to fill in order here, else the chunks of the shared fill.
+  explicit EntryTable(const std::vector<Entry>& entries, std::size_t shared_grain = 0) : mEntries(entries) {
     std::size_t capacity = 16;
     mShift = 60;
     while (capacity < 2 * entries.size()) {
@@ -54,6 +62,20 @@ class EntryTable {
     }
     mMask = capacity - 1;
     mSlots.assign(capacity, kEmpty);
+    if (shared_grain != 0) {
+      parallel::parallel_for(0, entries.size(), shared_grain, [&](std::size_t lo, std::size_t hi) {
+        for (std::size_t i = lo; i != hi; ++i) {
+          for (std::size_t h = slot(entries[i].key);; h = (h + 1) & mMask) {
+            std::uint32_t expected = kEmpty;
+            if (std::atomic_ref<std::uint32_t>(mSlots[h]).compare_exchange_strong(expected, static_cast<std::uint32_t>(i),
+                                                                                  std::memory_order_relaxed)) {
+              break;
+            }
+          }
+        }
+      });
+      return;
+    }
     constexpr std::size_t kAhead = 16;  // the slot of the entry this many places on, prefetched
     for (std::size_t i = 0; i < entries.size(); ++i) {
       if (i + kAhead < entries.size()) __builtin_prefetch(&mSlots[slot(entries[i + kAhead].key)], 1);
@@ -229,8 +251,9 @@ void look_at(const PairContext& ctx, const List& candidates, std::size_t lo, std
 
 /// local_minima on the candidates `candidates` (a vector or CandidateLists: size and reader).
 /// The list's look needs no table: it runs while one thread fills the table and makes the hubs'
-/// groups (where a model has a hub: none on most meshes, a few on a sphere's poles); then the
-/// lookups of what the look left.
+/// groups (where a model has a hub: none on most meshes, a few on a sphere's poles), but where
+/// many threads share a large table's fill first (kSharedFillThreads); then the lookups of what
+/// the look left.
 template <class List>
 std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, std::size_t grain) {
   const std::size_t n = candidates.size();
@@ -248,10 +271,12 @@ std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, st
   } else {
     parallel::parallel_for(0, n, grain, fill);
   }
+  // Many threads: the table filled by all of them first (kSharedFillThreads).
+  const bool shared_fill = !serial && n >= kParallelFill && parallel::concurrency() >= kSharedFillThreads;
   std::optional<EntryTable> table;
   std::unique_ptr<const Hubs> hubs;
   const auto index = [&] {
-    table.emplace(entries);
+    table.emplace(entries, shared_fill ? std::max<std::size_t>(grain, 1) : 0);
     if (ctx.a().largest_degree > kHubDegree || ctx.b().largest_degree > kHubDegree) {
       hubs = std::make_unique<const Hubs>(ctx.a(), ctx.b(), entries);
     }
@@ -261,6 +286,9 @@ std::vector<Candidate> reduce(const PairContext& ctx, const List& candidates, st
   if (serial) {
     index();
     look(0, n);
+  } else if (shared_fill) {
+    index();
+    parallel::parallel_for(0, n, grain, look);
   } else {
     parallel::JobGroup group;
     group.run(index);

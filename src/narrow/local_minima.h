@@ -9,6 +9,7 @@
 #include "narrow/candidate.h"
 #include "narrow/nearby_look.h"
 #include "narrow/pair_context.h"
+#include "util/assert.h"
 
 namespace caliber::narrow {
 
@@ -57,6 +58,7 @@ class CandidateLists {
 
  private:
   [[nodiscard]] std::size_t list_of(std::size_t g) const {
+    CALIBER_ASSERT(g < size(), "a position in the lists");
     return static_cast<std::size_t>(std::upper_bound(mEnd.begin(), mEnd.end(), g) - mEnd.begin());
   }
   [[nodiscard]] std::size_t begin_of(std::size_t k) const { return k == 0 ? 0 : mEnd[k - 1]; }
@@ -71,8 +73,8 @@ class CandidateLists {
 /// their order, so they need no sorting first; the kept ones are returned in the input's order.
 /// Linear in the candidates times the adjacency's degree, that degree taken at most 32 a vertex
 /// (a vertex with more corners at it answers for its candidates by their closest); in
-/// chunks of `grain` on the current executor (a grain as large as the input keeps it on this
-/// thread). Both models need adjacency.
+/// chunks of `grain` (0 read as 1) on the current executor (a grain as large as the input keeps it
+/// on this thread). Both models need adjacency.
 std::vector<Candidate> local_minima(const PairContext& ctx, const std::vector<Candidate>& candidates, std::size_t grain);
 /// The same on the concatenation of `lists`.
 std::vector<Candidate> local_minima(const PairContext& ctx, const CandidateLists& lists, std::size_t grain);

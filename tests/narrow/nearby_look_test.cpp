@@ -19,6 +19,7 @@
 #include "narrow/traversal.h"
 #include "parallel/executor.h"
 #include "support/local_minima_oracle.h"
+#include "support/pool_host.h"
 #include "support/random_poses.h"
 
 namespace caliber::narrow {
@@ -147,29 +148,51 @@ TEST(NearbyLook, ContactsAreTheLocalMinimaOfTheProximityPairs) {
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "torus and sphere");
 }
 
+/// A contact query's candidates between a torus and a sphere (their segments given), as a
+/// traversal of the pair from its root gathers them.
+struct TorusAndSphere {
+  TorusAndSphere(int torus_u, int torus_v, int sphere_u, int sphere_v)
+      : a(build_model(make_torus(1.0, 0.35, torus_u, torus_v))),
+        b(build_model(make_sphere(0.6, sphere_u, sphere_v))),
+        pb(Pose::from_values(1.05, 0.1, 0.2, 1, 0.1, 0.05, 0.02)),
+        request(contact_request()),
+        ctx(*a, pa, *b, pb, request) {
+    TraversalScratch scratch;
+    QueryStats stats;
+    traverse(ctx, NodePair{0, 0}, scratch, all, stats);
+  }
+  static QueryRequest contact_request() {
+    QueryRequest r;
+    r.kind = QueryKind::contact;
+    r.tolerance = 0.15;
+    r.angle_deg = 180.0;
+    return r;
+  }
+
+  decltype(build_model(Mesh{})) a, b;
+  Pose pa, pb;
+  QueryRequest request;
+  PairContext ctx;
+  std::vector<Candidate> all;
+};
+
+/// The triangle pairs of `c`, in order.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_of(const std::vector<Candidate>& c) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  for (const Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
+  return out;
+}
+
 /// The reduction of a pair's candidates read where they are, in lists (CandidateLists: the
 /// workers' of a cut pair), keeps what it keeps of them gathered into one list, in that order.
 TEST(NearbyLook, ListsKeepWhatTheirConcatenationKeeps) {
-  const auto a = build_model(make_torus(1.0, 0.35, 48, 24));
-  const auto b = build_model(make_sphere(0.6, 16, 24));
-  QueryRequest request;
-  request.kind = QueryKind::contact;
-  request.tolerance = 0.15;
-  request.angle_deg = 180.0;
-  const Pose pa, pb = Pose::from_values(1.05, 0.1, 0.2, 1, 0.1, 0.05, 0.02);
-  const PairContext ctx(*a, pa, *b, pb, request);
-  TraversalScratch scratch;
-  std::vector<Candidate> all;
-  QueryStats stats;
-  traverse(ctx, NodePair{0, 0}, scratch, all, stats);
+  const TorusAndSphere pair(48, 24, 16, 24);
+  const PairContext& ctx = pair.ctx;
+  const std::vector<Candidate>& all = pair.all;
   ASSERT_GT(all.size(), 2000u) << "runs of the look across lists and chunks";
   const std::vector<Candidate> want = local_minima(ctx, all, 128);
   ASSERT_GT(want.size(), 2u);
-  const auto ids = [](const std::vector<Candidate>& c) {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-    for (const Candidate& x : c) out.emplace_back(x.tri_a, x.tri_b);
-    return out;
-  };
+  const auto ids = pairs_of;
   std::mt19937_64 rng(11);
   for (int split = 0; split < 6; ++split) {
     // Up to seven lists cut at random places (empty ones where two cuts meet), and an empty last one.
@@ -196,8 +219,23 @@ TEST(NearbyLook, ListsKeepWhatTheirConcatenationKeeps) {
   }
 }
 
+/// A list of more than 32,768 candidates reduced on eight threads, where they fill the table
+/// together before the look (compare-and-swap), keeps what the serial reduction keeps.
+TEST(NearbyLook, ALargeListOnEightThreadsKeepsWhatOneKeeps) {
+  const TorusAndSphere pair(192, 96, 64, 96);
+  ASSERT_GE(pair.all.size(), std::size_t{1} << 15);
+  const auto want = pairs_of(local_minima(pair.ctx, pair.all, pair.all.size()));
+  ASSERT_GT(want.size(), 2u);
+  test::PoolHost host(8);  // (eight whatever the cores: the engine's own pool has at most one a core)
+  parallel::Executor eight(8, &host);
+  eight.execute([&] {
+    ASSERT_EQ(parallel::concurrency(), 8);
+    EXPECT_EQ(pairs_of(local_minima(pair.ctx, pair.all, 128)), want);
+  });
+}
+
 /// A reader of the lists gives the candidate operator[] gives, wherever it is sent next: on to the
-/// next place, across a list's end, back, far ahead, past empty lists.
+/// next place, across a list's end, back, far ahead (lists added empty are not among them).
 TEST(NearbyLook, ListReaderFindsEachCandidate) {
   std::vector<std::vector<Candidate>> parts(6);
   const std::size_t sizes[] = {3, 0, 1, 0, 5, 2};

@@ -19,6 +19,7 @@
 #include "narrow/traversal.h"
 #include "parallel/executor.h"
 #include "support/local_minima_oracle.h"
+#include "support/pool_host.h"
 #include "support/random_poses.h"
 
 namespace caliber {
@@ -182,7 +183,8 @@ TEST(OddMeshes, ContactsAroundAHubAreTheLocalMinima) {
   EXPECT_EQ(test::pair_ids(got.contacts), want);
   EXPECT_GE(want.size(), 1u);
   test::expect_identical(got, query_brute_force(*a, pa, *b, pb, request), "fans");
-  // On two threads, the hubs' groups made by the job that fills the table, the look's chunks beside it.
+  // On two threads, the hubs' groups made by the job that fills the table, the look's chunks beside
+  // it; on eight, the table filled by all of them first.
   const narrow::PairContext ctx(*a, pa, *b, pb, request);
   narrow::TraversalScratch scratch;
   std::vector<narrow::Candidate> all;
@@ -195,8 +197,15 @@ TEST(OddMeshes, ContactsAroundAHubAreTheLocalMinima) {
   };
   const auto serial = ids(narrow::local_minima(ctx, all, all.size()));
   ASSERT_EQ(serial.size(), want.size());
-  parallel::Executor executor(2);
-  executor.execute([&] { EXPECT_EQ(ids(narrow::local_minima(ctx, all, 16)), serial); });
+  ASSERT_GE(all.size(), std::size_t{1} << 15) << "a table that eight threads fill together";
+  parallel::Executor two(2);
+  two.execute([&] { EXPECT_EQ(ids(narrow::local_minima(ctx, all, 16)), serial) << "2 threads"; });
+  test::PoolHost host(8);  // (eight whatever the cores: the engine's own pool has at most one a core)
+  parallel::Executor eight(8, &host);
+  eight.execute([&] {
+    ASSERT_EQ(parallel::concurrency(), 8);
+    EXPECT_EQ(ids(narrow::local_minima(ctx, all, 16)), serial) << "8 threads";
+  });
 }
 
 }  // namespace
