@@ -12,8 +12,14 @@ const detail::WideTest kWideTest =
 const WideLoop kWideLoop = detail::wide_loop_form(true) != nullptr ? detail::wide_loop_form(true) : detail::wide_loop_form(false);
 const detail::SlotOrderKeys kSlotOrderKeys = detail::slot_order_keys_avx2_if_supported();
 
+void wide_lanes(const PairContext& ctx, detail::WideLanes& out) {
+  detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale(), ctx.a(), ctx.b(), out);
+}
+
 detail::WideLanes wide_lanes(const PairContext& ctx) {
-  return detail::make_wide_lanes(ctx.node_test_frame(), ctx.lanes_scale(), ctx.a(), ctx.b());
+  detail::WideLanes l;
+  wide_lanes(ctx, l);
+  return l;
 }
 
 bool root_test(const PairContext& ctx, NodePair n, RootTest how) {

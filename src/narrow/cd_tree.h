@@ -131,7 +131,8 @@ inline int cd_children(const PairContext& ctx, NodePair n, NodePair out[kMaxChil
 }
 
 /// The lanes of the wide node test for ctx's pose (detail::make_wide_lanes, with the scale of
-/// PairContext::node_lanes): made once by a traversal.
+/// PairContext::node_lanes): made once by a traversal, in place (`out`) or returned.
+void wide_lanes(const PairContext& ctx, detail::WideLanes& out);
 detail::WideLanes wide_lanes(const PairContext& ctx);
 
 /// The vector form of the wide node test where this CPU has one (built for AVX-512VL, else for

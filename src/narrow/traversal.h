@@ -68,7 +68,7 @@ inline void traverse_depth_first(const PairContext& ctx, NodePair root, Traversa
   LeafBuffer own;
   LeafBuffer& buffer = carried ? scratch.piece_leaves(ctx, out) : own;
   if (top != base && wide_cd_tree(ctx)) {
-    if (piece == nullptr) wide = wide_lanes(ctx);
+    if (piece == nullptr) wide_lanes(ctx, wide);
     lanes.wide = piece != nullptr ? piece : &wide;
     lanes.staying = &scratch.staying_for(carried ? piece : nullptr);
   } else if (top != base) {

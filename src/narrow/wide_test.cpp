@@ -57,8 +57,7 @@ void fill_side(double m[3][3], double abs_m[3][3], const double t[3], WideSide& 
 
 }  // namespace
 
-WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b) {
-  WideLanes l;
+void make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b, WideLanes& l) {
   l.staying_wide[0] = b.wide.data();
   l.staying_wide[1] = a.wide.data();
   double m[3][3], abs_m[3][3], t[3];
@@ -88,7 +87,6 @@ WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData&
   const double slack = kShare * scale * l.unit;
   l.reach_f = static_cast<float>(f.reach * l.unit + slack);
   l.slab_f = static_cast<float>(f.slab_reach * l.unit + slack);
-  return l;
 }
 
 namespace {

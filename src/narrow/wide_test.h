@@ -241,9 +241,11 @@ inline void make_staying_floats(const NodeTestFrame& f, const WideLanes& l, bool
   kept.has_floats = true;
 }
 
-/// The lanes of frame f (its pose, reach and slab reach) between models a and b. `scale`: a bound
-/// on every coordinate, extent, reach and slab bound the test computes with, which sets the slack.
-WideLanes make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b);
+/// The lanes of frame f (its pose, reach and slab reach) between models a and b, written to `l`
+/// (made in place: a traversal's lanes are 1,728 bytes, too many to copy for a query that stops
+/// early). `scale`: a bound on every coordinate, extent, reach and slab bound the test computes
+/// with, which sets the slack.
+void make_wide_lanes(const NodeTestFrame& f, double scale, const ModelData& a, const ModelData& b, WideLanes& l);
 
 /// The test of the children of a visit whose side `a_descends` says (true: A's node descends, B's
 /// node `stay` stays; sn: its BvhNode) against the descending node's wide node w: bit k set where

@@ -124,7 +124,7 @@ struct PairLanes {
 
   narrow::VisitLanes of(const narrow::PairContext& ctx) {
     if (narrow::wide_cd_tree(ctx)) {
-      wide = narrow::wide_lanes(ctx);
+      narrow::wide_lanes(ctx, wide);
       return narrow::VisitLanes{nullptr, &wide};
     }
     binary = ctx.node_lanes();
