@@ -22,6 +22,7 @@ const QueryRequest& validated(const Model& a, const Pose& pose_a, const Model& b
   check_contact_models(request, a, b, "model A", "model B");
   return request;
 }
+bool intersect_in_batches();
 }  // namespace
 
 PairContext::PairContext(const Model& a, const Pose& pose_a, const Model& b, const Pose& pose_b, const QueryRequest& request)
@@ -59,6 +60,7 @@ void PairContext::ask(const QueryRequest& request) {
   mDescendAlone = request.kind == QueryKind::distance ? kDescendAloneRatioDistance : kDescendAloneRatio;
   mReach = reach_for(reach(request));
   mSlabReach = mReach * (1.0 + 1e-6);
+  mIntersectWaits = request.kind == QueryKind::interference && request.groups == nullptr && intersect_in_batches();
   mNodeFrame.reach = mReach;
   mNodeFrame.slab_reach = mSlabReach;
   // The angle is read by the contact kind's tests alone (cones_can_face, normals_allow): the
@@ -176,26 +178,6 @@ int PairContext::node_tests_2x2_scalar(std::uint32_t a0, std::uint32_t a1, std::
   return pass;
 }
 
-void PairContext::gaps_2x2(const NearA& a0, const NearA& a1, const NearB& b0, const NearB& b1, double reach,
-                           double out[4]) const {
-  static const detail::Gaps2x2 lanes =
-      detail::gaps_2x2_form(true) != nullptr ? detail::gaps_2x2_form(true) : detail::gaps_2x2_form(false);
-  const NearA* as[2] = {&a0, &a1};
-  const NearB* bs[2] = {&b0, &b1};
-  if (lanes == nullptr) {
-    for (int k = 0; k < 4; ++k) out[k] = gap(*as[k / 2], *bs[k % 2], reach);
-    return;
-  }
-  lanes(detail::BoundConstants{kRotationHair, kApartShrink}, a0, a1, b0, b1, reach, out);
-  // What gap adds to the geometry: groups that forbid every pair below.
-  if (mGroups == nullptr) return;
-  for (int k = 0; k < 4; ++k) {
-    if (out[k] <= reach && !groups_can_touch(mA.group_mask(as[k / 2]->index), mB.group_mask(bs[k % 2]->index))) {
-      out[k] = std::numeric_limits<double>::infinity();
-    }
-  }
-}
-
 void PairContext::corners(std::uint32_t ta, std::uint32_t tb, Eigen::Vector3d a[3], Eigen::Vector3d b[3]) const {
   const auto& tri_a = mA.mesh.triangles[ta];
   for (int k = 0; k < 3; ++k) {
@@ -278,7 +260,7 @@ bool PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
   return true;
 }
 
-void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
+void PairContext::wait_or_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
   if (mKind == QueryKind::interference) {
     if (!intersect_in_batches()) {
       leaf_test(ta, tb, out);
@@ -286,7 +268,7 @@ void PairContext::leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Cand
     }
     // leaf_test's steps up to the exact test, which waits for the batch; the corners are read
     // when it is full (gather_corners), eight pairs' at once.
-    if (mGroups != nullptr && !groups_allow(ta, tb)) return;
+    if (!groups_allow(ta, tb)) return;
     BufferedPairs& waiting = buffer.refusal;
     waiting.ta[waiting.batch.size] = ta;
     waiting.tb[waiting.batch.size] = tb;

@@ -168,22 +168,8 @@ class PairContext {
     OrientedBox computed;
     s.frame = own_frame(mA, ia, computed);
   }
-  /// Prepares node ib of B for the distance bound, in s.
-  void near(std::uint32_t ib, NearB& s) const {
-    fill_box_b(ib, s);
-    OrientedBox computed;
-    const OrientedBox& own = own_frame(mB, ib, computed);
-    for (int i = 0; i < 3; ++i) {
-      s.frame.center[i] =
-          mRot(i, 0) * own.center[0] + mRot(i, 1) * own.center[1] + mRot(i, 2) * own.center[2] + mNodeFrame.trans[i];
-    }
-    for (int k = 0; k < 3; ++k) {
-      s.frame.half[k] = own.half[k];
-      for (int i = 0; i < 3; ++i) {
-        s.frame.axis[k][i] = mRot(i, 0) * own.axis[k][0] + mRot(i, 1) * own.axis[k][1] + mRot(i, 2) * own.axis[k][2];
-      }
-    }
-  }
+  /// Prepares node ib of B for the distance bound, in s (its frame brought into A's).
+  void near(std::uint32_t ib, NearB& s) const;
 
   /// A lower bound on the distance between any triangles below two nodes, before the safety
   /// margin, when it is at most `reach` (reach_for of a distance); otherwise some number above
@@ -221,8 +207,17 @@ class PairContext {
   /// Returns whether it did.
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
   /// The same, the pair waiting in `buffer` for the batch kernels: once they run (a full batch, or
-  /// flush_leaves), `out` has what leaf_test would have appended, in the same order.
-  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
+  /// flush_leaves), `out` has what leaf_test would have appended, in the same order (interference
+  /// without groups inlined here: the pair waits, its triangles' corner ids asked of memory).
+  void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
+    if (!mIntersectWaits) return wait_or_test(ta, tb, out, buffer);
+    BufferedPairs& waiting = buffer.refusal;
+    waiting.ta[waiting.batch.size] = ta;
+    waiting.tb[waiting.batch.size] = tb;
+    __builtin_prefetch(&mA.mesh.triangles[ta]);
+    __builtin_prefetch(&mB.mesh.triangles[tb]);
+    if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
+  }
   /// Finishes the pairs waiting in `buffer` (their candidates appended to `out`) and empties it.
   void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const;
   /// The same within `bound` (not the tolerance): leaf_distance's verdicts and candidates, in the
@@ -369,12 +364,15 @@ class PairContext {
 
   /// Sets what depends on the request: its kind, reach, angle and group table.
   void ask(const QueryRequest& request);
+  /// leaf_test with a buffer where the inlined steps do not apply.
+  void wait_or_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
 
   const ModelData& mA;
   const ModelData& mB;
   Pose mPoseA;
   QueryRequest mRequest;
   QueryKind mKind;
+  bool mIntersectWaits;  ///< interference without groups, its pairs waiting for the batch kernels
   const GroupCompatibility* mGroups;
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;           ///< |mRot|, grown by a relative hair (rounding in the rotation)
