@@ -56,7 +56,19 @@ struct LetGoOnExit {
   }
 };
 
-/// Appends an entry's answer to the batch's.
+/// Makes room in the batch's contacts for `adding` more, `done` of its `n` entries answered:
+/// schedule::batch_capacity where they do not fit (as push_back grows where that much is refused).
+void make_room(std::vector<Contact>& contacts, std::size_t adding, std::size_t done, std::size_t n) {
+  const std::size_t need = contacts.size() + adding;
+  if (need <= contacts.capacity()) return;
+  try {
+    contacts.reserve(schedule::batch_capacity(need, done, n, contacts.max_size()));
+  } catch (const std::bad_alloc&) {
+    contacts.reserve(std::max(need, std::min(2 * need, contacts.max_size())));  // (or throws, as push_back would)
+  }
+}
+
+/// Appends an entry's answer to the batch's (its room made: make_room).
 void append(BatchResult& out, const QueryResult& r) {
   out.contacts.insert(out.contacts.end(), r.contacts.begin(), r.contacts.end());
   out.offsets.push_back(out.contacts.size());
@@ -109,6 +121,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
         if (in_order) {
           for (std::size_t i = 0; i != count; ++i) {
             narrow::query_whole(context(i), results[0]);
+            make_room(out.contacts, results[0].contacts.size(), first + i + 1, n);
             append(out, results[0]);
           }
           return;
@@ -125,10 +138,9 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
       const auto make = [&](std::size_t i, void* where) { new (where) narrow::PairContext(context(i)); };
       mImpl->run_pairs(options, mOptions.method, chunk_pairs, request, no_history, make, results, record);
     }
-    std::size_t total = out.contacts.size();
-    for (const QueryResult& r : results) total += r.contacts.size();
-    // Geometric growth: reserving the exact new size at every chunk copied every contact so far.
-    if (total > out.contacts.capacity()) out.contacts.reserve(std::max(total, 2 * out.contacts.capacity()));
+    std::size_t adding = 0;
+    for (const QueryResult& r : results) adding += r.contacts.size();
+    make_room(out.contacts, adding, first + count, n);
     for (QueryResult& r : results) {
       append(out, r);
       let_go_if_large(r);

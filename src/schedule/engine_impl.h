@@ -6,6 +6,7 @@
 /// Engine::sweep_many (schedule/engine_sweep.cpp) run sweeps through run_sweeps, which splits a
 /// heavy sweep's distance queries through run_pairs.
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <functional>
@@ -105,6 +106,19 @@ inline int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
        pieces *= 4)
     ++depth;
   return depth;
+}
+
+/// The capacity a batch's contacts grow to where `need` of them do not fit, `done` of its `n`
+/// entries answered (those included; at least 1): what the entries are on course to give (need
+/// over done, times n, and a quarter more), at least twice and at most eight times `need`, and at
+/// most `most` (never below need). Each reallocation of a large batch copies its contacts and
+/// touches new pages, what it pays beside its queries (bench_batch's interference on every pair);
+/// room reserved and never filled costs address space, not memory.
+inline std::size_t batch_capacity(std::size_t need, std::size_t done, std::size_t n, std::size_t most) {
+  const double at = static_cast<double>(need);
+  const double on_course = at * (static_cast<double>(n) / static_cast<double>(std::max<std::size_t>(done, 1))) * 1.25;
+  const double want = std::min(std::clamp(on_course, 2.0 * at, 8.0 * at), static_cast<double>(most));
+  return std::max(need, static_cast<std::size_t>(want));
 }
 
 /// Distance queries of sweeps that went through the method (split across threads), counted over

@@ -17,6 +17,7 @@
 #include "caliber/procedural.h"
 #include "caliber/query.h"
 #include "caliber/sweep.h"
+#include "schedule/engine_impl.h"
 #include "support/random_poses.h"
 #include "support/torus_sphere.h"
 
@@ -165,6 +166,46 @@ TEST(Batch, ManyEntriesAcrossChunksAndEitherSideFixed) {
   const BatchResult empty = engine.query_many(*shapes().torus, one, *shapes().sphere, {}, request);
   EXPECT_EQ(empty.size(), 0u);
   EXPECT_TRUE(empty.contacts.empty());
+}
+
+TEST(Batch, ContactsGrowTowardWhatTheEntriesAreOnCourseToGive) {
+  constexpr std::size_t kMost = std::size_t{1} << 40;
+  // A tenth of the entries done: ten times as many to come, a quarter more (within 8 times need).
+  EXPECT_EQ(schedule::batch_capacity(1000, 500, 2000, kMost), 5000u);
+  EXPECT_EQ(schedule::batch_capacity(1000, 1000, 10000, kMost), 8000u);
+  // Near the end, or at it: at least twice what is needed (growth stays geometric).
+  EXPECT_EQ(schedule::batch_capacity(1000, 9900, 10000, kMost), 2000u);
+  EXPECT_EQ(schedule::batch_capacity(1000, 10000, 10000, kMost), 2000u);
+  // Within what a vector may hold, and never below what is needed.
+  EXPECT_EQ(schedule::batch_capacity(1000, 1, 1000000, 3000), 3000u);
+  EXPECT_EQ(schedule::batch_capacity(1000, 1, 1000000, 500), 1000u);
+  // No entry done yet counts as one.
+  EXPECT_EQ(schedule::batch_capacity(10, 0, 3, kMost), 37u);  // 37.5, cut
+}
+
+TEST(Batch, ContactsComeLateOrEarlyAndTheBatchGrowsToHoldThem) {
+  // A batch's contacts grow toward what its entries are on course to give (make_room): here that
+  // guess is wrong both ways, the contacts coming after many entries without any, or before them;
+  // across a chunk on two threads, entry by entry on one.
+  const Pose far = Pose::from_values(10.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0);
+  const std::vector<Pose> touching = poses_near(300, 23, 0.4);
+  std::vector<Pose> late(8192, far);
+  late.insert(late.end(), touching.begin(), touching.end());
+  std::vector<Pose> early = touching;
+  early.insert(early.end(), 8192, far);
+  early.insert(early.end(), touching.begin(), touching.begin() + 20);
+  const std::vector<Pose> one{Pose{}};
+  QueryRequest request;  // interference: every pair, tens of contacts an entry that touches
+  for (const int threads : {1, 2}) {
+    EngineOptions options;
+    options.threads = threads;
+    Engine engine(options);
+    for (const auto& [poses, name] : {std::pair{&late, "late"}, std::pair{&early, "early"}}) {
+      const BatchResult batch = engine.query_many(*shapes().torus, one, *shapes().sphere, *poses, request);
+      ASSERT_GT(batch.contacts.size(), 1000u) << name;
+      expect_queries(batch, one, *poses, request, std::string(name) + ", " + std::to_string(threads) + " threads");
+    }
+  }
 }
 
 TEST(Batch, TheHookBetweenChunksIsCalledAndMayStopTheCall) {
