@@ -208,7 +208,8 @@ class PairContext {
   bool leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out) const;
   /// The same, the pair waiting in `buffer` for the batch kernels: once they run (a full batch, or
   /// flush_leaves), `out` has what leaf_test would have appended, in the same order (interference
-  /// without groups inlined here: the pair waits, its triangles' corner ids asked of memory).
+  /// without groups, where the CPU has the batch kernels, inlined here: the pair waits, its
+  /// triangles' corner ids asked of memory).
   void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
     if (!mIntersectWaits) return wait_or_test(ta, tb, out, buffer);
     BufferedPairs& waiting = buffer.refusal;
@@ -372,7 +373,7 @@ class PairContext {
   Pose mPoseA;
   QueryRequest mRequest;
   QueryKind mKind;
-  bool mIntersectWaits;  ///< interference without groups, its pairs waiting for the batch kernels
+  bool mIntersectWaits;  ///< interference without groups where the CPU has the batch kernels: its pairs wait for them
   const GroupCompatibility* mGroups;
   Eigen::Matrix3d mRot;
   Eigen::Matrix3d mAbsRot;           ///< |mRot|, grown by a relative hair (rounding in the rotation)

@@ -56,16 +56,22 @@ struct LetGoOnExit {
   }
 };
 
-/// Makes room in the batch's contacts for `adding` more, `done` of its `n` entries answered:
-/// schedule::batch_capacity where they do not fit (as push_back grows where that much is refused).
-void make_room(std::vector<Contact>& contacts, std::size_t adding, std::size_t done, std::size_t n) {
+/// Makes room in the batch's contacts for `adding` more, `done` of its `n` entries answered, `last`
+/// their growth before (updated): schedule::batch_capacity where they do not fit; where that much
+/// is refused, twice what is needed, else exactly that (which throws where refused too).
+void make_room(std::vector<Contact>& contacts, std::size_t adding, std::size_t done, std::size_t n, schedule::BatchGrowth& last) {
   const std::size_t need = contacts.size() + adding;
   if (need <= contacts.capacity()) return;
   try {
-    contacts.reserve(schedule::batch_capacity(need, done, n, contacts.max_size()));
+    contacts.reserve(schedule::batch_capacity(need, done, n, contacts.max_size(), last));
   } catch (const std::bad_alloc&) {
-    contacts.reserve(std::max(need, std::min(2 * need, contacts.max_size())));  // (or throws, as push_back would)
+    try {
+      contacts.reserve(need <= contacts.max_size() / 2 ? 2 * need : need);
+    } catch (const std::bad_alloc&) {
+      contacts.reserve(need);
+    }
   }
+  last = schedule::BatchGrowth{need, done};
 }
 
 /// Appends an entry's answer to the batch's (its room made: make_room).
@@ -101,6 +107,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
   std::vector<QueryResult>& results = mImpl->batch_results;
   const LetGoOnExit let_go{results};
   mImpl->timeline.begin(false);
+  schedule::BatchGrowth growth;
   for (std::size_t first = 0; first < n; first += kChunk) {
     if (first > 0 && mOptions.between_chunks) mOptions.between_chunks();
     const std::size_t count = std::min(kChunk, n - first);
@@ -121,7 +128,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
         if (in_order) {
           for (std::size_t i = 0; i != count; ++i) {
             narrow::query_whole(context(i), results[0]);
-            make_room(out.contacts, results[0].contacts.size(), first + i + 1, n);
+            make_room(out.contacts, results[0].contacts.size(), first + i + 1, n, growth);
             append(out, results[0]);
           }
           return;
@@ -140,7 +147,7 @@ BatchResult Engine::query_many(const Model& a, std::span<const Pose> poses_a, co
     }
     std::size_t adding = 0;
     for (const QueryResult& r : results) adding += r.contacts.size();
-    make_room(out.contacts, adding, first + count, n);
+    make_room(out.contacts, adding, first + count, n, growth);
     for (QueryResult& r : results) {
       append(out, r);
       let_go_if_large(r);

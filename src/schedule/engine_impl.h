@@ -108,17 +108,29 @@ inline int stealing_cutoff(std::size_t n, int threads, int stealing_depth) {
   return depth;
 }
 
+/// A batch's contacts and entries answered when its contacts last grew (zeros before they did).
+struct BatchGrowth {
+  std::size_t contacts = 0;
+  std::size_t entries = 0;
+};
+
 /// The capacity a batch's contacts grow to where `need` of them do not fit, `done` of its `n`
-/// entries answered (those included; at least 1): what the entries are on course to give (need
-/// over done, times n, and a quarter more), at least twice and at most eight times `need`, and at
-/// most `most` (never below need). Each reallocation of a large batch copies its contacts and
-/// touches new pages, what it pays beside its queries (bench_batch's interference on every pair);
-/// room reserved and never filled costs address space, not memory.
-inline std::size_t batch_capacity(std::size_t need, std::size_t done, std::size_t n, std::size_t most) {
+/// entries answered (those included), `last` their growth before: what the entries are on course
+/// to give (need, and for each entry left what each gave since `last`: contacts come in runs, a
+/// sweep's free poses before its colliding ones; a quarter more), at least twice and at most eight
+/// times `need`, and at most `most` (never below need). Each reallocation of a large batch copies
+/// its contacts and touches new pages, what it pays beside its queries (bench_batch's interference
+/// on every pair); room reserved and never filled is address space no page backs (where the
+/// system limits that, the batch keeps what it reserved while it lives).
+inline std::size_t batch_capacity(std::size_t need, std::size_t done, std::size_t n, std::size_t most, BatchGrowth last = {}) {
+  if (need >= most / 8) return std::max(need, most);  // (compared in integers: most may not be a double)
   const double at = static_cast<double>(need);
-  const double on_course = at * (static_cast<double>(n) / static_cast<double>(std::max<std::size_t>(done, 1))) * 1.25;
-  const double want = std::min(std::clamp(on_course, 2.0 * at, 8.0 * at), static_cast<double>(most));
-  return std::max(need, static_cast<std::size_t>(want));
+  const double since = static_cast<double>(done > last.entries ? done - last.entries : 1);
+  const double rate = static_cast<double>(need - std::min(last.contacts, need)) / since;
+  const double on_course = (at + rate * static_cast<double>(n > done ? n - done : 0)) * 1.25;
+  // Below 8 need < most: the double converts back within size_t (rounded, at most a step off).
+  const auto want = static_cast<std::size_t>(std::clamp(on_course, 2.0 * at, 8.0 * at));
+  return std::clamp(want, need, most);
 }
 
 /// Distance queries of sweeps that went through the method (split across threads), counted over

@@ -2,6 +2,7 @@
 // method and thread count, with max_pairs, across the batch's internal chunks, with one side fixed
 // or both moving; poses from raw arrays; bad batches refused naming the pose.
 
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
@@ -170,17 +171,28 @@ TEST(Batch, ManyEntriesAcrossChunksAndEitherSideFixed) {
 
 TEST(Batch, ContactsGrowTowardWhatTheEntriesAreOnCourseToGive) {
   constexpr std::size_t kMost = std::size_t{1} << 40;
-  // A tenth of the entries done: ten times as many to come, a quarter more (within 8 times need).
-  EXPECT_EQ(schedule::batch_capacity(1000, 500, 2000, kMost), 5000u);
+  // A fifth of the entries done: five times as many to come, a quarter more (within 8 times need).
+  EXPECT_EQ(schedule::batch_capacity(1000, 800, 2000, kMost), 3125u);
   EXPECT_EQ(schedule::batch_capacity(1000, 1000, 10000, kMost), 8000u);
   // Near the end, or at it: at least twice what is needed (growth stays geometric).
   EXPECT_EQ(schedule::batch_capacity(1000, 9900, 10000, kMost), 2000u);
   EXPECT_EQ(schedule::batch_capacity(1000, 10000, 10000, kMost), 2000u);
-  // Within what a vector may hold, and never below what is needed.
+  // Within what a vector may hold, and never below what is needed; near that, no double in the way.
   EXPECT_EQ(schedule::batch_capacity(1000, 1, 1000000, 3000), 3000u);
   EXPECT_EQ(schedule::batch_capacity(1000, 1, 1000000, 500), 1000u);
+  const std::size_t most = std::vector<Contact>().max_size();
+  EXPECT_EQ(schedule::batch_capacity(most / 2, 1, 1000, most), most);
+  const std::size_t below = schedule::batch_capacity(most / 8 - 1, 1, 1000, most);  // 8 need, within rounding
+  EXPECT_LE(below, most);
+  EXPECT_GE(below, most - 64);
+  const std::size_t huge = std::numeric_limits<std::size_t>::max();
+  EXPECT_EQ(schedule::batch_capacity(huge / 2, 1, 1000, huge), huge);
+  // What each entry gave since the growth before: 1,000 contacts over the last 1,000 entries, 5,000
+  // entries to come.
+  EXPECT_EQ(schedule::batch_capacity(2000, 5000, 10000, kMost, {1000, 4000}), 8750u);
+  EXPECT_EQ(schedule::batch_capacity(2000, 9000, 10000, kMost, {1000, 8000}), 4000u);  // 3,000 * 1.25
   // No entry done yet counts as one.
-  EXPECT_EQ(schedule::batch_capacity(10, 0, 3, kMost), 37u);  // 37.5, cut
+  EXPECT_EQ(schedule::batch_capacity(10, 0, 3, kMost), 50u);
 }
 
 TEST(Batch, ContactsComeLateOrEarlyAndTheBatchGrowsToHoldThem) {
@@ -203,6 +215,8 @@ TEST(Batch, ContactsComeLateOrEarlyAndTheBatchGrowsToHoldThem) {
     for (const auto& [poses, name] : {std::pair{&late, "late"}, std::pair{&early, "early"}}) {
       const BatchResult batch = engine.query_many(*shapes().torus, one, *shapes().sphere, *poses, request);
       ASSERT_GT(batch.contacts.size(), 1000u) << name;
+      // Room for what the entries were on course to give, never more than 8 times what they gave.
+      EXPECT_LE(batch.contacts.capacity(), 8 * batch.contacts.size()) << name;
       expect_queries(batch, one, *poses, request, std::string(name) + ", " + std::to_string(threads) + " threads");
     }
   }
