@@ -268,14 +268,7 @@ void PairContext::wait_or_test(std::uint32_t ta, std::uint32_t tb, std::vector<C
     }
     // leaf_test's steps up to the exact test, which waits for the batch; the corners are read
     // when it is full (gather_corners), eight pairs' at once.
-    if (!groups_allow(ta, tb)) return;
-    BufferedPairs& waiting = buffer.refusal;
-    waiting.ta[waiting.batch.size] = ta;
-    waiting.tb[waiting.batch.size] = tb;
-    // Their corners' ids asked of memory now, read when the batch is full (gather_corners).
-    __builtin_prefetch(&mA.mesh.triangles[ta]);
-    __builtin_prefetch(&mB.mesh.triangles[tb]);
-    if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
+    if (groups_allow(ta, tb)) wait_to_intersect(ta, tb, out, buffer.refusal);
     return;
   }
   // leaf_within's steps up to the refusal, which waits for the batch; the corners are read when it

@@ -212,12 +212,7 @@ class PairContext {
   /// triangles' corner ids asked of memory).
   void leaf_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const {
     if (!mIntersectWaits) return wait_or_test(ta, tb, out, buffer);
-    BufferedPairs& waiting = buffer.refusal;
-    waiting.ta[waiting.batch.size] = ta;
-    waiting.tb[waiting.batch.size] = tb;
-    __builtin_prefetch(&mA.mesh.triangles[ta]);
-    __builtin_prefetch(&mB.mesh.triangles[tb]);
-    if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
+    wait_to_intersect(ta, tb, out, buffer.refusal);
   }
   /// Finishes the pairs waiting in `buffer` (their candidates appended to `out`) and empties it.
   void flush_leaves(LeafBuffer& buffer, std::vector<Candidate>& out) const;
@@ -365,6 +360,15 @@ class PairContext {
 
   /// Sets what depends on the request: its kind, reach, angle and group table.
   void ask(const QueryRequest& request);
+  /// An interference pair waiting for the batch kernels (its triangles' corner ids asked of memory,
+  /// read when the batch is full: gather_corners).
+  void wait_to_intersect(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, BufferedPairs& waiting) const {
+    waiting.ta[waiting.batch.size] = ta;
+    waiting.tb[waiting.batch.size] = tb;
+    __builtin_prefetch(&mA.mesh.triangles[ta]);
+    __builtin_prefetch(&mB.mesh.triangles[tb]);
+    if (++waiting.batch.size == geometry::TriangleBatch::kLanes) intersect_buffered(waiting, out);
+  }
   /// leaf_test with a buffer where the inlined steps do not apply.
   void wait_or_test(std::uint32_t ta, std::uint32_t tb, std::vector<Candidate>& out, LeafBuffer& buffer) const;
 
