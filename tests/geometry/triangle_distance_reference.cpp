@@ -1,8 +1,7 @@
-// The closest-point kernel as it was at 2a20389 (per-query edge terms, a square root per feature pair,
-// every corner's and crossing point's nearest point on the other triangle), kept verbatim as the
-// reference: the kernel in src/geometry/triangle_distance.cpp returns the same bits (points and
-// distance) on most inputs, and elsewhere the same distance but for rounding
-// (TriangleDistance.EveryFormSameBitsAndTheReferenceDistance says where).
+// The closest-point kernel as it was at 2a20389 (per-query edge terms, a square root per feature pair),
+// kept verbatim as the reference: the optimized kernel in src/geometry/triangle_distance.cpp must
+// return the same bits (points and distance) on every input, so that every contact stays
+// byte-identical to the results of earlier versions.
 
 #include "geometry/triangle_distance_reference.h"
 
