@@ -16,8 +16,19 @@
 #include "caliber/query.h"
 using namespace caliber;
 static Pose place(const Mesh& a, const Mesh& b, double deg, Eigen::Vector3d axis, Eigen::Vector3d off) {
-  auto bc = [](const Mesh& m, Eigen::Vector3d& c, double& d) { Eigen::Vector3d lo = m.vertices[0], hi = lo; for (auto& v : m.vertices) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v);} c = 0.5*(lo+hi); d = (hi-lo).norm(); };
-  Eigen::Vector3d ca, cb; double da, db; bc(a, ca, da); bc(b, cb, db);
+  auto bc = [](const Mesh& m, Eigen::Vector3d& c, double& d) {
+    Eigen::Vector3d lo = m.vertices[0], hi = lo;
+    for (auto& v : m.vertices) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    c = 0.5 * (lo + hi);
+    d = (hi - lo).norm();
+  };
+  Eigen::Vector3d ca, cb;
+  double da, db;
+  bc(a, ca, da);
+  bc(b, cb, db);
   Eigen::Quaterniond q(Eigen::AngleAxisd(deg * std::numbers::pi / 180.0, axis.normalized()));
   Eigen::Vector3d t = ca + off * da - q * cb;
   return Pose::from_values(t.x(), t.y(), t.z(), q.w(), q.x(), q.y(), q.z());
@@ -32,7 +43,10 @@ int main(int argc, char** argv) {
   std::vector<double> same, cross;
   // Mode: each thread pinned; turn passes 0 -> 1 -> 0 ... ; "same" runs: thread 0 runs twice in a row.
   auto run = [&](int me) {
-    cpu_set_t set; CPU_ZERO(&set); CPU_SET(me, &set); sched_setaffinity(0, sizeof set, &set);
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(me, &set);
+    sched_setaffinity(0, sizeof set, &set);
     for (int i = 0; i < reps; ++i) {
       // phase: 0: t0 query (after t1's: cross), 1: t0 query again (same), 2: t1 query (cross)
       for (int phase = 0; phase < 3; ++phase) {
@@ -47,7 +61,10 @@ int main(int argc, char** argv) {
       }
     }
   };
-  std::thread t1(run, 1); run(0); t1.join();
-  std::sort(same.begin(), same.end()); std::sort(cross.begin(), cross.end());
-  std::printf("same core again %.3f ms, after the other core %.3f ms\n", same[same.size()/2], cross[cross.size()/2]);
+  std::thread t1(run, 1);
+  run(0);
+  t1.join();
+  std::sort(same.begin(), same.end());
+  std::sort(cross.begin(), cross.end());
+  std::printf("same core again %.3f ms, after the other core %.3f ms\n", same[same.size() / 2], cross[cross.size() / 2]);
 }
