@@ -78,9 +78,9 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   const __m256d b = dot(d1, d2);
   const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero);
   // a > 0 and e > 0: the general case.
-  const __m256d denom = _mm256_sub_pd(_mm256_mul_pd(a, e), _mm256_mul_pd(b, b));
-  const __m256d s_general =
-      _mm256_and_pd(gt(denom, zero), clamp01x4(_mm256_div_pd(_mm256_sub_pd(_mm256_mul_pd(b, f), _mm256_mul_pd(c, e)), denom)));
+  const __m256d inv_e = _mm256_div_pd(one, e);
+  const Pack3 h = d1 - _mm256_mul_pd(b, inv_e) * d2, u = r - _mm256_mul_pd(f, inv_e) * d2;
+  const __m256d hh = dot(h, h), s_general = _mm256_and_pd(gt(hh, zero), clamp01x4(_mm256_div_pd(negate(dot(u, h)), hh)));
   const __m256d t_general = _mm256_div_pd(_mm256_add_pd(_mm256_mul_pd(b, s_general), f), e);
   const __m256d s_at_0 = clamp01x4(_mm256_div_pd(negate(c), a));            // clamp01(-c / a)
   const __m256d s_at_1 = clamp01x4(_mm256_div_pd(_mm256_sub_pd(b, c), a));  // clamp01((b - c) / a)

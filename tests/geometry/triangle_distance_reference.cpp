@@ -1,7 +1,5 @@
-// The closest-point kernel as it was at 2a20389 (per-query edge terms, a square root per feature pair),
-// kept verbatim as the reference: the optimized kernel in src/geometry/triangle_distance.cpp must
-// return the same bits (points and distance) on every input, so that every contact stays
-// byte-identical to the results of earlier versions.
+// The closest point on a triangle as it was at 2a20389, kept verbatim as the reference: the kernel's
+// region test in src/geometry/triangle_distance.cpp must return the same bits on every input.
 
 #include "geometry/triangle_distance_reference.h"
 
@@ -16,22 +14,6 @@ using Vec3 = Eigen::Vector3d;
 double clamp01(double t) {
   // NaN (from 0/0 on a degenerate input) falls to 0 as well.
   return t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;
-}
-
-/// Keeps the closer of the current best pair and (p, q).
-void consider(ClosestPoints& best, const Vec3& p, const Vec3& q) {
-  const double d = (q - p).norm();
-  if (d < best.distance) best = ClosestPoints{p, q, d};
-}
-
-/// Where segment pq crosses the plane through a with normal n (floating point), if it does.
-bool crossing_point(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& n, Vec3& out) {
-  const double sp = n.dot(p - a);
-  const double sq = n.dot(q - a);
-  if ((sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) || sp == sq) return false;
-  const double t = clamp01(sp / (sp - sq));
-  out = p + t * (q - p);
-  return true;
 }
 
 Vec3 closest_point_on_segment(const Vec3& x, const Vec3& p, const Vec3& q) {
@@ -79,62 +61,6 @@ Vec3 closest_point_on_triangle(const Vec3& x, const Vec3& a, const Vec3& b, cons
       best = y;
       best_d = d;
     }
-  }
-  return best;
-}
-
-void closest_points_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1, Vec3& c2) {
-  // Ericson 5.1.9, with the parameters always clamped to [0, 1].
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0.0, t = 0.0;
-  if (!(a > 0.0) && !(e > 0.0)) {
-    s = t = 0.0;
-  } else if (!(a > 0.0)) {
-    t = clamp01(f / e);
-  } else {
-    const double c = d1.dot(r);
-    if (!(e > 0.0)) {
-      s = clamp01(-c / a);
-    } else {
-      const double b = d1.dot(d2);
-      const double denom = a * e - b * b;
-      s = denom > 0.0 ? clamp01((b * f - c * e) / denom) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0.0) {
-        t = 0.0;
-        s = clamp01(-c / a);
-      } else if (t > 1.0) {
-        t = 1.0;
-        s = clamp01((b - c) / a);
-      }
-      t = clamp01(t);
-    }
-  }
-  c1 = p1 + s * d1;
-  c2 = p2 + t * d2;
-}
-
-ClosestPoints closest_points_triangles(const Vec3 a[3], const Vec3 b[3]) {
-  ClosestPoints best{a[0], b[0], (b[0] - a[0]).norm()};
-  Vec3 c1, c2;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      closest_points_segments(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3], c1, c2);
-      consider(best, c1, c2);
-    }
-  }
-  for (int i = 0; i < 3; ++i) {
-    consider(best, a[i], closest_point_on_triangle(a[i], b[0], b[1], b[2]));
-    consider(best, closest_point_on_triangle(b[i], a[0], a[1], a[2]), b[i]);
-  }
-  // Intersecting triangles: an edge of one pierces the other; its crossing point, on both triangles, is a feature pair.
-  const Vec3 na = (a[1] - a[0]).cross(a[2] - a[0]);
-  const Vec3 nb = (b[1] - b[0]).cross(b[2] - b[0]);
-  Vec3 x;
-  for (int i = 0; i < 3; ++i) {
-    if (crossing_point(a[i], a[(i + 1) % 3], b[0], nb, x)) consider(best, x, closest_point_on_triangle(x, b[0], b[1], b[2]));
-    if (crossing_point(b[i], b[(i + 1) % 3], a[0], na, x)) consider(best, closest_point_on_triangle(x, a[0], a[1], a[2]), x);
   }
   return best;
 }

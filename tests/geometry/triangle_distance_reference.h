@@ -1,13 +1,11 @@
 #pragma once
 /// \file
-/// The closest-point kernel of 2a20389, the bit-for-bit reference of geometry/triangle_distance.h.
+/// The closest point on a triangle of 2a20389, the bit-for-bit reference of
+/// geometry/triangle_distance.h's closest_point_on_triangle.
 
 #include "geometry/triangle_distance.h"
 
 namespace caliber::geometry::reference {
-
-/// closest_points_triangles as of 2a20389.
-ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
 /// closest_point_on_triangle as of 2a20389.
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
