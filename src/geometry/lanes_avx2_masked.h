@@ -62,9 +62,6 @@ CALIBER_AVX2 inline bool none(M m) { return bits(m) == 0; }
 CALIBER_AVX2 inline bool all_set(M m) { return bits(m) == 0xF; }
 CALIBER_AVX2 inline M not_lanes(M m) { return ~m; }
 CALIBER_AVX2 inline D clamp01(D t) { return lanes4::clamp01x4(t); }
-CALIBER_AVX2 __attribute__((always_inline)) inline P3 add_where(M m, const P3& base, const P3& step) {
-  return pick(m, base + step, base);
-}
 
 /// lanes8::Triangle8 for half `half` of a batch's triangles of one side: the same values. (Not
 /// built on BatchHalf: that form, with ab2, ac2 and normal2 as members beside len2, took 1.8 %

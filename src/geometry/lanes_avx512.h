@@ -74,11 +74,6 @@ CALIBER_AVX512 inline bool all_set(M m) { return m == 0xFF; }
 CALIBER_AVX512 inline M not_lanes(M m) { return static_cast<M>(~m); }
 /// u where the mask is set, else 0.
 CALIBER_AVX512 inline D keep(M m, D u) { return _mm512_maskz_mov_pd(m, u); }
-/// base + step where the mask is set, else base.
-CALIBER_AVX512 inline P3 add_where(M m, const P3& base, const P3& step) {
-  return {_mm512_mask_add_pd(base.x, m, base.x, step.x), _mm512_mask_add_pd(base.y, m, base.y, step.y),
-          _mm512_mask_add_pd(base.z, m, base.z, step.z)};
-}
 
 CALIBER_AVX512 inline P3 load(const double (&c)[3][TriangleBatch::kLanes]) {
   return {_mm512_load_pd(c[0]), _mm512_load_pd(c[1]), _mm512_load_pd(c[2])};

@@ -95,6 +95,22 @@ Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t) {
   return best;
 }
 
+bool face_projection(const Vec3& x, const TriangleFrame& t, Vec3& out) {
+  if (!t.solid) return false;
+  const Vec3& a = t.v[0];
+  const Vec3 ax = x - a, bx = x - t.v[1], cx = x - t.v[2];
+  const double d1 = t.ab.dot(ax), d2 = t.ac.dot(ax);
+  const double d3 = t.ab.dot(bx), d4 = t.ac.dot(bx);
+  const double d5 = t.ab.dot(cx), d6 = t.ac.dot(cx);
+  const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+  if (!(va >= 0.0 && vb >= 0.0 && vc >= 0.0 && va + vb + vc > 0.0)) return false;
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  if (!(v >= 0.0 && w >= 0.0 && v + w <= 1.0)) return false;
+  out = a + v * t.ab + w * t.ac;
+  return true;
+}
+
 void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1,
                           Vec3& c2) {
   // Ericson 5.1.9, with the parameters always clamped to [0, 1]. In the general case s minimizes
@@ -155,12 +171,13 @@ struct EdgeVectors {
 };
 
 /// The last feature pairs of the triangle kernel, in its order. Intersecting triangles: an edge of
-/// one pierces the other; its crossing point, on both triangles, is a feature pair.
+/// one pierces the other; its crossing point, where it projects into the other's face, and that
+/// projection are a feature pair (face_projection).
 void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
-  Vec3 x;
+  Vec3 x, y;
   for (int i = 0; i < 3; ++i) {
-    if (crossing_point(a[i], a[(i + 1) % 3], b[0], fb.normal, x)) nearest.consider(x, closest_point_on_frame(x, fb));
-    if (crossing_point(b[i], b[(i + 1) % 3], a[0], fa.normal, x)) nearest.consider(closest_point_on_frame(x, fa), x);
+    if (crossing_point(a[i], a[(i + 1) % 3], b[0], fb.normal, x) && face_projection(x, fb, y)) nearest.consider(x, y);
+    if (crossing_point(b[i], b[(i + 1) % 3], a[0], fa.normal, x) && face_projection(x, fa, y)) nearest.consider(y, x);
   }
 }
 
@@ -195,13 +212,15 @@ bool edge_pairs(const Vec3 a[3], const Vec3 b[3], kernel::Nearest& nearest) {
   return kernel::slab_clear(a, b, nearest.best.on_a, nearest.best.on_b);
 }
 
-/// The kernel's other feature pairs, taken into `nearest` after the edge pairs.
+/// The kernel's other feature pairs, taken into `nearest` after the edge pairs: each corner with its
+/// projection into the other's face, where it has one (kernel::face_projection), then the crossings.
 void face_pairs(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa, const kernel::TriangleFrame& fb,
                 kernel::Nearest& nearest) {
-  using kernel::closest_point_on_frame;
+  using kernel::face_projection;
+  Vec3 y;
   for (int i = 0; i < 3; ++i) {
-    nearest.consider(a[i], closest_point_on_frame(a[i], fb));
-    nearest.consider(closest_point_on_frame(b[i], fa), b[i]);
+    if (face_projection(a[i], fb, y)) nearest.consider(a[i], y);
+    if (face_projection(b[i], fa, y)) nearest.consider(y, b[i]);
   }
   kernel::consider_crossings(a, b, fa, fb, nearest);
 }

@@ -35,8 +35,10 @@ struct ClosestPoints {
 /// it, have A on one side and B on the other (up to rounding), it is the nearest pair and the kernel
 /// stops there. Of several pairs at the same distance, the first in the kernel's order is
 /// reported: edge i of A against edge j of B in the order (i, j) = (0, 0), (0, 1), ..., (2, 2)
-/// (edge i runs from corner i to corner i + 1), then, if not stopped, corner i of A onto B and
-/// corner i of B onto A for i = 0, 1, 2, then the crossings. Its distance is the triangles' within
+/// (edge i runs from corner i to corner i + 1), then, if not stopped, corner i of A onto B's face
+/// and corner i of B onto A's face for i = 0, 1, 2, then the crossings, each where it projects into
+/// the face (a point nearest an edge or corner of the other lies on an edge of its own: an edge pair
+/// is as near). Its distance is the triangles' within
 /// rounding: at most about 2^-46 of the triangles' extent above it where the kernel stops early.
 /// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);

@@ -95,24 +95,15 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   out.store(p1 + s * d1, p2 + t * d2);
 }
 
-/// A triangle in four lanes (one triangle or several), with what closest_point_on_frame reads.
+/// A triangle in four lanes (one triangle or several), with what face_projection reads.
 struct Frame4 {
   Pack3 a, b, c, ab, ac;
   __m256d solid;  ///< all ones where the lane's triangle is solid
 };
 
-/// closest_point_on_segment in four lanes, and the squared distance to x.
-CALIBER_AVX2 Pack3 closest_point_on_segment_x4(const Pack3& x, const Pack3& p, const Pack3& q, __m256d& dist2) {
-  const Pack3 d = q - p;
-  const __m256d len2 = dot(d, d);
-  const Pack3 y = pick(gt(len2, _mm256_setzero_pd()), p + clamp01x4(_mm256_div_pd(dot(x - p, d), len2)) * d, p);
-  dist2 = dot(y - x, y - x);
-  return y;
-}
-
-/// closest_point_on_frame in four lanes: its regions in its order, the first that holds wins; the
-/// nearest edge point where none does or the triangle is not solid.
-CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
+/// kernel::face_projection in four lanes: the projections, and `inside`, the lanes where x projects
+/// into the face of a solid triangle (elsewhere the lane's values are not used).
+CALIBER_AVX2 Pack3 face_projection_x4(const Pack3& x, const Frame4& t, __m256d& inside) {
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
   const Pack3 ax = x - t.a, bx = x - t.b, cx = x - t.c;
   const __m256d d1 = dot(t.ab, ax), d2 = dot(t.ac, ax);
@@ -121,41 +112,12 @@ CALIBER_AVX2 Pack3 closest_point_on_frame_x4(const Pack3& x, const Frame4& t) {
   const __m256d vc = _mm256_sub_pd(_mm256_mul_pd(d1, d4), _mm256_mul_pd(d3, d2));
   const __m256d vb = _mm256_sub_pd(_mm256_mul_pd(d5, d2), _mm256_mul_pd(d1, d6));
   const __m256d va = _mm256_sub_pd(_mm256_mul_pd(d3, d6), _mm256_mul_pd(d5, d4));
-  const __m256d d1_d3 = _mm256_sub_pd(d1, d3), d2_d6 = _mm256_sub_pd(d2, d6);
-  const __m256d d4_d3 = _mm256_sub_pd(d4, d3), d5_d6 = _mm256_sub_pd(d5, d6);
-  const __m256d bc_sum = _mm256_add_pd(d4_d3, d5_d6);
   const __m256d vsum = _mm256_add_pd(_mm256_add_pd(va, vb), vc);
   const __m256d denom = _mm256_div_pd(one, vsum);
   const __m256d v = _mm256_mul_pd(vb, denom), w = _mm256_mul_pd(vc, denom);
-
-  const __m256d in_a = all(le(d1, zero), le(d2, zero));
-  const __m256d in_b = all(ge(d3, zero), le(d4, d3));
-  const __m256d in_ab = all(le(vc, zero), ge(d1, zero), le(d3, zero), gt(d1_d3, zero));
-  const __m256d in_c = all(ge(d6, zero), le(d5, d6));
-  const __m256d in_ac = all(le(vb, zero), ge(d2, zero), le(d6, zero), gt(d2_d6, zero));
-  const __m256d in_bc = all(le(va, zero), ge(d4_d3, zero), ge(d5_d6, zero), gt(bc_sum, zero));
-  const __m256d in_face =
-      all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero), le(_mm256_add_pd(v, w), one));
-  const __m256d settled = all(t.solid, any(in_a, in_b, in_ab, in_c, in_ac, in_bc, in_face));
-
-  Pack3 y = x;  // every lane is overwritten below
-  if (_mm256_movemask_pd(settled) != 0xF) {
-    __m256d best_d, d;
-    y = closest_point_on_segment_x4(x, t.a, t.b, best_d);
-    Pack3 e = closest_point_on_segment_x4(x, t.b, t.c, d);
-    const __m256d closer_bc = lt(d, best_d);
-    y = pick(closer_bc, e, y);
-    best_d = pick(closer_bc, d, best_d);
-    e = closest_point_on_segment_x4(x, t.c, t.a, d);
-    y = pick(lt(d, best_d), e, y);
-  }
-  y = pick(all(t.solid, in_face), t.a + v * t.ab + w * t.ac, y);
-  y = pick(all(t.solid, in_bc), t.b + _mm256_div_pd(d4_d3, bc_sum) * (t.c - t.b), y);
-  y = pick(all(t.solid, in_ac), t.a + _mm256_div_pd(d2, d2_d6) * t.ac, y);
-  y = pick(all(t.solid, in_c), t.c, y);
-  y = pick(all(t.solid, in_ab), t.a + _mm256_div_pd(d1, d1_d3) * t.ab, y);
-  y = pick(all(t.solid, in_b), t.b, y);
-  return pick(all(t.solid, in_a), t.a, y);
+  inside = all(t.solid, all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero),
+                            le(_mm256_add_pd(v, w), one)));
+  return t.a + v * t.ab + w * t.ac;
 }
 
 /// One triangle's frame in all four lanes.
@@ -169,7 +131,7 @@ CALIBER_AVX2 Frame4 pick(__m256d mask, const Frame4& u, const Frame4& v) {
           pick(mask, u.ab, v.ab), pick(mask, u.ac, v.ac), pick(mask, u.solid, v.solid)};
 }
 
-/// The points the kernel projects onto the other triangle, in the portable order: a[0], b[0],
+/// The points the kernel projects into the other triangle's face, in the portable order: a[0], b[0],
 /// a[1], b[1], a[2], b[2], then the crossing points of the edges that cross the other's plane
 /// (edge 0 of A, of B, edge 1 of A, ...). A point of A goes onto B, a point of B onto A; the
 /// feature pair is (point, its projection) for A's, (projection, point) for B's.
@@ -192,17 +154,20 @@ struct Projections {
   }
 };
 
-/// Each projection of `points`, four at a time: batch k of `out` holds points 4k to 4k + 3 with
-/// their projections (the caller offers them to Nearest in that order).
+/// Each projection of `points` into the other's face, four at a time: batch k of `out` holds points
+/// 4k to 4k + 3 with their projections, and bit l of inside[k] is set where point 4k + l has one
+/// (the caller offers those to Nearest in that order).
 CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb,
-                          FeaturePairs4 out[Projections::kMost / 4]) {
+                          FeaturePairs4 out[Projections::kMost / 4], int inside[Projections::kMost / 4]) {
   const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
   for (int first = 0; first < points.count; first += 4) {
     const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
     const __m256d of_a = _mm256_castsi256_pd(_mm256_load_si256(reinterpret_cast<const __m256i*>(points.of_a + first)));
-    const Pack3 y = closest_point_on_frame_x4(x, pick(of_a, onto_b, onto_a));
+    __m256d in_face;
+    const Pack3 y = face_projection_x4(x, pick(of_a, onto_b, onto_a), in_face);
     // A's point with its projection on B; B's point's projection on A with the point.
     out[first / 4].store(x, y, ~_mm256_movemask_pd(of_a) & 0xF);
+    inside[first / 4] = _mm256_movemask_pd(in_face);
   }
 }
 
@@ -291,7 +256,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline bool edge_pairs(const Triangl
 CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangle4& ta, const Triangle4& tb,
                                                                    const TriangleFrame& fa, const TriangleFrame& fb, __m256d sa,
                                                                    __m256d sb, Nearest& nearest) {
-  // Vertex-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
+  // Corner-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
   Projections points;
   const Pack3 corners01 = interleave<0, 1>(ta.v, tb.v), corners2 = interleave<2, 2>(ta.v, tb.v);
@@ -307,10 +272,12 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangl
   add_crossings(corners2, interleave<2, 2>(ta.e, tb.e), interleave<2, 2>(sa, sb), interleave<0, 0>(sa, sb), 2, points);
   points.pad();
   FeaturePairs4 projected[Projections::kMost / 4];
-  project(points, fa, fb, projected);
+  int inside[Projections::kMost / 4];
+  project(points, fa, fb, projected, inside);
 
   for (int first = 0; first < points.count; first += 4) {
-    take(projected[first / 4], points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1, nearest);
+    const int lanes = points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1;
+    take(projected[first / 4], lanes & inside[first / 4], nearest);
   }
 }
 

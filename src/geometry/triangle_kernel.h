@@ -119,6 +119,13 @@ inline bool slab_clear(const Vec3 a[3], const Vec3 b[3], const Vec3& p, const Ve
 /// Closest point to x on the triangle of `t`.
 Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t);
 
+/// Where x projects into the face of a solid triangle `t` (closest_point_on_frame's face region,
+/// tested alone): true, and `out` the projection, as closest_point_on_frame makes it there. Else
+/// false. The kernel's corner-face and crossing feature pairs: a point nearest an edge or a corner
+/// of the other triangle lies on an edge of its own, so an edge pair is at least as near (up to
+/// rounding), and the kernel takes no pair for it.
+bool face_projection(const Vec3& x, const TriangleFrame& t, Vec3& out);
+
 /// Closest points c1 on p1 + s d1 and c2 on p2 + t d2 (s, t in [0, 1]), given a = |d1|^2 and
 /// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
 void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& p2, const Vec3& d2, double e, Vec3& c1, Vec3& c2);
