@@ -41,9 +41,8 @@ struct ClosestPoints {
 /// is as near). Its distance is the triangles' within rounding (at most about 2^-46 of the
 /// triangles' extent above it where the kernel stops early), but for one known gap: where a point
 /// of one lies over the face of a thin triangle (a cap or a needle) of the other, the face region's
-/// test loses precision and the distance can be above the true one by more (never below but for
-/// rounding)
-/// (bench/results/amd-epyc-2c/kernels/hostile_accuracy/).
+/// test loses precision and the distance can be above the true one by more, never below but for
+/// rounding (bench/results/amd-epyc-2c/kernels/hostile_accuracy/).
 /// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
