@@ -118,7 +118,8 @@ void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& 
   // computed: s = -(u . h) / |h|^2. Ericson's (b f - c e) / (a e - b^2) loses the difference of
   // nearly parallel edges' directions to rounding (a e - b^2 cancels to about 2^-53 a e), and its
   // point wanders along the edges, some 2^26 units of rounding farther; from h and u the error
-  // stays a few units of rounding of the edges' and r's lengths at any angle.
+  // stays a few units of rounding of the edges' and r's lengths at any angle (where |h|^2 is a
+  // normal number).
   const Vec3 r = p1 - p2;
   const double f = d2.dot(r);
   double s = 0.0, t = 0.0;
@@ -128,7 +129,7 @@ void closest_points_edges(const Vec3& p1, const Vec3& d1, double a, const Vec3& 
     t = clamp01(f / e);
   } else {
     const double c = d1.dot(r);
-    if (!(e > 0.0)) {
+    if (!(e >= 0x1p-1022)) {  // zero, or so short that 1 / e overflows: the edge is taken at p2
       s = clamp01(-c / a);
     } else {
       const double b = d1.dot(d2);

@@ -76,7 +76,7 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   const __m256d f = dot(d2, r);
   const __m256d c = dot(d1, r);
   const __m256d b = dot(d1, d2);
-  const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero);
+  const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero), e_ok = ge(e, _mm256_set1_pd(0x1p-1022));
   // a > 0 and e > 0: the general case.
   const __m256d inv_e = _mm256_div_pd(one, e);
   const Pack3 h = d1 - _mm256_mul_pd(b, inv_e) * d2, u = r - _mm256_mul_pd(f, inv_e) * d2;
@@ -87,9 +87,9 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   const __m256d t_below = lt(t_general, zero), t_above = gt(t_general, one);
   __m256d s = pick(t_below, s_at_0, pick(t_above, s_at_1, s_general));
   __m256d t = clamp01x4(pick(t_below, zero, pick(t_above, one, t_general)));
-  // a > 0, e not: t = 0, s = clamp01(-c / a). a not, e > 0: s = 0, t = clamp01(f / e). Neither: 0, 0.
-  s = pick(e_pos, s, s_at_0);
-  t = _mm256_and_pd(e_pos, t);
+  // a > 0, e below 2^-1022: t = 0, s = clamp01(-c / a). a not, e > 0: s = 0, t = clamp01(f / e). Neither: 0, 0.
+  s = pick(e_ok, s, s_at_0);
+  t = _mm256_and_pd(e_ok, t);
   s = _mm256_and_pd(a_pos, s);
   t = pick(a_pos, t, _mm256_and_pd(e_pos, clamp01x4(_mm256_div_pd(f, e))));
   out.store(p1 + s * d1, p2 + t * d2);

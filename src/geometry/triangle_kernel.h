@@ -24,7 +24,7 @@ struct TriangleFrame {
   Vec3 normal;      ///< ab x ac
   double normal2;   ///< |normal|^2
   double ab2, ac2;  ///< |ab|^2, |ac|^2
-  bool solid;       ///< far enough from degenerate for the region test (else: nearest edge point)
+  bool solid;       ///< far enough from degenerate for the region test (else: nearest edge point; no face pair)
 
   explicit TriangleFrame(const Vec3 corners[3])
       : v(corners),

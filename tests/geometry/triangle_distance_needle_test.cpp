@@ -1,8 +1,9 @@
-// A needle beside a nearly parallel edge: the edge pairs' routine (closest_points_edges) is
-// ill-conditioned there, and every edge pair through the needle's nearest corner is; the nearest
-// pair is that corner with its nearest point on the other triangle (Ericson's edge region), which
-// the kernel must take. A kernel that took a corner only where it projects into the other's face
-// gave 0.0010000006 for a distance of 0.001, and a proximity query at 0.0010000001 kept no contact.
+// A needle beside a nearly parallel edge: every edge pair through the needle's nearest corner is
+// nearly parallel, and the nearest pair is that corner with its nearest point on the other
+// triangle's edge, which the kernel leaves to the edge pairs (it takes a corner only into the
+// other's face). With Ericson's parameter for the edge pairs, which cancels for nearly parallel
+// edges, a kernel that did so gave 0.0010000006 for a distance of 0.001, and a proximity query at
+// 0.0010000001 kept no contact.
 
 #include "geometry/triangle_distance.h"
 
@@ -92,6 +93,37 @@ TEST(TriangleDistanceNeedle, QueriesKeepThePairAtItsDistance) {
     ASSERT_EQ(nearest.contacts.size(), 1u);
     EXPECT_NEAR(nearest.contacts[0].distance, 0.001, 1e-18);
   }
+}
+
+}  // namespace
+}  // namespace caliber::geometry
+
+namespace caliber::geometry {
+namespace {
+
+/// An edge shorter than about 1.5e-154 has a subnormal squared length e, and 1 / e overflows: the
+/// edge pairs take such an edge at its first corner (the nearest point on it is within its length).
+/// A kernel that divided by it anyway kept the other edge's point at its start.
+TEST(TriangleDistanceShortEdge, SegmentsAndEveryFormKeepTheNearestPoint) {
+  Eigen::Vector3d c1, c2;
+  closest_points_segments({0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, 1, 1e-155}, c1, c2);
+  EXPECT_EQ(c1, Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_NEAR((c2 - c1).norm(), 1.0, 1e-15);
+
+  const Eigen::Vector3d a[3] = {{0, 1, -1}, {0, 1, 1}, {0, 5, 0}};
+  const Eigen::Vector3d b[3] = {{0, 0, 0}, {1e-155, 0, 0}, {0, 1e-155, 1e-155}};
+  EXPECT_NEAR(closest_points_triangles(a, b).distance, 1.0, 1e-15);
+  EXPECT_NEAR(detail::closest_points_triangles_portable(a, b).distance, 1.0, 1e-15);
+  ClosestPoints within{};
+  ASSERT_TRUE(closest_points_triangles_within(a, b, 1.2, within));
+  EXPECT_NEAR(within.distance, 1.0, 1e-15);
+  TriangleBatch batch;
+  batch.add(a, b);
+  batch.add(b, a);
+  ClosestPointsBatch lanes;
+  closest_points_triangles_batch(batch, lanes);
+  EXPECT_NEAR(lanes.get(0).distance, 1.0, 1e-15);
+  EXPECT_NEAR(lanes.get(1).distance, 1.0, 1e-15);
 }
 
 }  // namespace

@@ -10,8 +10,10 @@ namespace {
 
 #if defined(__SIZEOF_FLOAT128__)
 using Real = __float128;
+const Real kFar = __builtin_inff128();
 #else
 using Real = long double;
+const Real kFar = HUGE_VALL;
 #endif
 
 struct V {
@@ -55,15 +57,15 @@ Real segment_segment2(const V& p1, const V& d1, const V& p2, const V& d2) {
 }
 
 /// Squared distance from x to the plane of triangle t where x projects inside it (barycentric
-/// signs), else "infinity": the edges cover the rest.
+/// signs), else infinity: the edges cover the rest.
 Real point_face2(const V& x, const V t[3]) {
   const V n = cross(t[1] - t[0], t[2] - t[0]);
   const Real nn = dot(n, n);
-  if (!(nn > 0)) return Real(1e300);
+  if (!(nn > 0)) return kFar;
   const Real h = dot(x - t[0], n);
   const V y = x - (h / nn) * n;  // the projection onto the plane
   for (int i = 0; i < 3; ++i) {
-    if (dot(cross(t[(i + 1) % 3] - t[i], y - t[i]), n) < 0) return Real(1e300);
+    if (dot(cross(t[(i + 1) % 3] - t[i], y - t[i]), n) < 0) return kFar;
   }
   return h * h / nn;
 }
@@ -77,7 +79,7 @@ double triangles_distance(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]
     ta[i] = {Real(a[i].x()), Real(a[i].y()), Real(a[i].z())};
     tb[i] = {Real(b[i].x()), Real(b[i].y()), Real(b[i].z())};
   }
-  Real best = Real(1e300);
+  Real best = kFar;
   for (int i = 0; i < 3; ++i) {
     best = std::min({best, point_face2(ta[i], tb), point_face2(tb[i], ta)});
     for (int j = 0; j < 3; ++j) {

@@ -10,7 +10,9 @@
 namespace caliber::geometry::oracle {
 
 /// The distance between the closed triangles a and b (either may be degenerate), to within about
-/// 2^-100 of their coordinates' magnitude (2^-60 with long double), rounded to the nearest double.
+/// 2^-100 of their coordinates' magnitude (2^-60 with long double), rounded to a double (through
+/// long double's square root). Squared distances are kept: the square of any double is within
+/// __float128's range (and long double's).
 double triangles_distance(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
 }  // namespace caliber::geometry::oracle

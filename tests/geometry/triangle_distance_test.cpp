@@ -229,7 +229,7 @@ TEST(TriangleDistance, EveryFormSameBitsAndTheOracleDistance) {
 }
 
 /// The batch kernel, every form, against the portable kernel bit for bit: the same pairs as
-/// EveryFormSameBitsAndTheReferenceDistance, in batches of every size from 1 to 8 (a lane of a partial batch
+/// EveryFormSameBitsAndTheOracleDistance, in batches of every size from 1 to 8 (a lane of a partial batch
 /// must not depend on the padding), each pair's kind in different lanes from batch to batch.
 TEST(TriangleDistance, BatchSameBitsAsThePortableKernel) {
   std::mt19937_64 rng(20261123);
