@@ -77,7 +77,7 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   const __m256d c = dot(d1, r);
   const __m256d b = dot(d1, d2);
   const __m256d a_pos = gt(a, zero), e_pos = gt(e, zero), e_ok = ge(e, _mm256_set1_pd(0x1p-1022));
-  // a > 0 and e > 0: the general case.
+  // a > 0 and e_ok (e at least 2^-1022, so that 1 / e is finite): the general case.
   const __m256d inv_e = _mm256_div_pd(one, e);
   const Pack3 h = d1 - _mm256_mul_pd(b, inv_e) * d2, u = r - _mm256_mul_pd(f, inv_e) * d2;
   const __m256d hh = dot(h, h), s_general = _mm256_and_pd(gt(hh, zero), clamp01x4(_mm256_div_pd(negate(dot(u, h)), hh)));
