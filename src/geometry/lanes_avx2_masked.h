@@ -53,6 +53,8 @@ CALIBER_AVX2 inline D all_lanes(double v) { return _mm256_set1_pd(v); }
 /// u where the mask is set, else 0 (_mm512_maskz_mov_pd).
 CALIBER_AVX2 inline D keep(M m, D u) { return _mm256_and_pd(m.m, u); }
 CALIBER_AVX2 inline D root(D u) { return _mm256_sqrt_pd(u); }
+/// u v + w, rounded once (the caller enables "fma").
+__attribute__((target("avx2,fma"))) inline D fmadd(D u, D v, D w) { return _mm256_fmadd_pd(u, v, w); }
 CALIBER_AVX2 inline D min_lanes(D u, D v) { return _mm256_min_pd(u, v); }
 CALIBER_AVX2 inline D max_lanes(D u, D v) { return _mm256_max_pd(u, v); }
 CALIBER_AVX2 inline M no_lane() { return _mm256_setzero_pd(); }
@@ -63,14 +65,11 @@ CALIBER_AVX2 inline bool all_set(M m) { return bits(m) == 0xF; }
 CALIBER_AVX2 inline M not_lanes(M m) { return ~m; }
 CALIBER_AVX2 inline D clamp01(D t) { return lanes4::clamp01x4(t); }
 
-/// lanes8::Triangle8 for half `half` of a batch's triangles of one side: the same values. (Not
-/// built on BatchHalf: that form, with ab2, ac2 and normal2 as members beside len2, took 1.8 %
-/// more instructions in the closest-points batch than these locals.)
+/// What the closest-points batch reads of lanes8::Triangle8 (the corners, the edges and their
+/// squared lengths), for half `half` of a batch's triangles of one side: the same values.
 struct Tri {
   P3 v[3], e[3];
   D len2[3];
-  P3 ab, ac, normal;
-  M solid;
 
   CALIBER_AVX2 Tri(const double (&c)[3][3][TriangleBatch::kLanes], int half) {
     for (int k = 0; k < 3; ++k) v[k] = lanes4::load_half(c[k], half);
@@ -78,12 +77,6 @@ struct Tri {
       e[i] = v[(i + 1) % 3] - v[i];
       len2[i] = dot(e[i], e[i]);
     }
-    ab = e[0];
-    ac = v[2] - v[0];
-    normal = cross(ab, ac);
-    const D ab2 = len2[0], ac2 = dot(ac, ac), normal2 = dot(normal, normal);
-    const D scale2 = _mm256_max_pd(ac2, ab2);
-    solid = gt(normal2, mul(mul(all_lanes(1e-24), scale2), scale2));
   }
 };
 

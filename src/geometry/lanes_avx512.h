@@ -60,6 +60,8 @@ CALIBER_AVX512 inline P3 pick(M mask, const P3& u, const P3& v) {
 CALIBER_AVX512 inline D clamp01(D t) { return _mm512_min_pd(_mm512_max_pd(t, _mm512_setzero_pd()), all_lanes(1.0)); }
 
 CALIBER_AVX512 inline D root(D u) { return _mm512_sqrt_pd(u); }
+/// u v + w, rounded once.
+CALIBER_AVX512 inline D fmadd(D u, D v, D w) { return _mm512_fmadd_pd(u, v, w); }
 CALIBER_AVX512 inline D magnitude(D u) {
   return _mm512_castsi512_pd(_mm512_andnot_si512(_mm512_set1_epi64(INT64_MIN), _mm512_castpd_si512(u)));
 }
@@ -86,7 +88,6 @@ struct Triangle8 {
   D len2[3];
   P3 ab, ac, normal;    ///< v1 - v0, v2 - v0, ab x ac
   D ab2, ac2, normal2;  ///< their squared lengths
-  M solid;
 
   CALIBER_AVX512 explicit Triangle8(const double (&c)[3][3][TriangleBatch::kLanes]) : v{load(c[0]), load(c[1]), load(c[2])} {
     for (int i = 0; i < 3; ++i) {
@@ -99,9 +100,6 @@ struct Triangle8 {
     ab2 = len2[0];
     ac2 = dot(ac, ac);
     normal2 = dot(normal, normal);
-    // std::max(ab2, ac2) is ab2 < ac2 ? ac2 : ab2; vmaxpd(ac2, ab2) is ac2 > ab2 ? ac2 : ab2.
-    const D scale2 = _mm512_max_pd(ac2, ab2);
-    solid = gt(normal2, mul(mul(all_lanes(1e-24), scale2), scale2));
   }
 };
 

@@ -95,19 +95,12 @@ Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t) {
   return best;
 }
 
-bool face_projection(const Vec3& x, const TriangleFrame& t, Vec3& out) {
-  if (!t.solid) return false;
-  const Vec3& a = t.v[0];
-  const Vec3 ax = x - a, bx = x - t.v[1], cx = x - t.v[2];
-  const double d1 = t.ab.dot(ax), d2 = t.ac.dot(ax);
-  const double d3 = t.ab.dot(bx), d4 = t.ac.dot(bx);
-  const double d5 = t.ab.dot(cx), d6 = t.ac.dot(cx);
-  const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
-  if (!(va >= 0.0 && vb >= 0.0 && vc >= 0.0 && va + vb + vc > 0.0)) return false;
-  const double denom = 1.0 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  if (!(v >= 0.0 && w >= 0.0 && v + w <= 1.0)) return false;
-  out = a + v * t.ab + w * t.ac;
+bool face_projection(const Vec3& x, const TriangleFrame& t, const FacePlane& f, Vec3& out) {
+  if (!f.solid) return false;
+  const Vec3 ax = x - t.v[0];
+  const double s0 = f.inward[0].dot(ax), s1 = f.inward[1].dot(Vec3(x - t.v[1])), s2 = f.inward[2].dot(Vec3(x - t.v[2]));
+  if (!(s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0)) return false;
+  out = x - (f.n.dot(ax) * f.inv2) * f.n;
   return true;
 }
 
@@ -174,11 +167,12 @@ struct EdgeVectors {
 /// The last feature pairs of the triangle kernel, in its order. Intersecting triangles: an edge of
 /// one pierces the other; its crossing point, where it projects into the other's face, and that
 /// projection are a feature pair (face_projection).
-void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb, Nearest& nearest) {
+void consider_crossings(const Vec3 a[3], const Vec3 b[3], const TriangleFrame& fa, const TriangleFrame& fb, const FacePlane& pa,
+                        const FacePlane& pb, Nearest& nearest) {
   Vec3 x, y;
   for (int i = 0; i < 3; ++i) {
-    if (crossing_point(a[i], a[(i + 1) % 3], b[0], fb.normal, x) && face_projection(x, fb, y)) nearest.consider(x, y);
-    if (crossing_point(b[i], b[(i + 1) % 3], a[0], fa.normal, x) && face_projection(x, fa, y)) nearest.consider(y, x);
+    if (crossing_point(a[i], a[(i + 1) % 3], b[0], pb.n, x) && face_projection(x, fb, pb, y)) nearest.consider(x, y);
+    if (crossing_point(b[i], b[(i + 1) % 3], a[0], pa.n, x) && face_projection(x, fa, pa, y)) nearest.consider(y, x);
   }
 }
 
@@ -218,12 +212,13 @@ bool edge_pairs(const Vec3 a[3], const Vec3 b[3], kernel::Nearest& nearest) {
 void face_pairs(const Vec3 a[3], const Vec3 b[3], const kernel::TriangleFrame& fa, const kernel::TriangleFrame& fb,
                 kernel::Nearest& nearest) {
   using kernel::face_projection;
+  const kernel::FacePlane pa(fa), pb(fb);
   Vec3 y;
   for (int i = 0; i < 3; ++i) {
-    if (face_projection(a[i], fb, y)) nearest.consider(a[i], y);
-    if (face_projection(b[i], fa, y)) nearest.consider(y, b[i]);
+    if (face_projection(a[i], fb, pb, y)) nearest.consider(a[i], y);
+    if (face_projection(b[i], fa, pa, y)) nearest.consider(y, b[i]);
   }
-  kernel::consider_crossings(a, b, fa, fb, nearest);
+  kernel::consider_crossings(a, b, fa, fb, pa, pb, nearest);
 }
 
 }  // namespace

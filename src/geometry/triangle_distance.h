@@ -39,11 +39,12 @@ struct ClosestPoints {
 /// and corner i of B onto A's face for i = 0, 1, 2, then the crossings, each where it projects into
 /// the face (a point nearest an edge or corner of the other lies on an edge of its own: an edge pair
 /// is as near). Its distance is the triangles' within rounding (at most about 2^-46 of the
-/// triangles' extent above it where the kernel stops early), but for one known gap: where a point
-/// of one lies over the face of a thin triangle (a cap or a needle) of the other, the face region's
-/// test loses precision and the distance can be above the true one by more, never below but for
-/// rounding (bench/results/amd-epyc-2c/kernels/hostile_accuracy/).
-/// Runs on AVX2 where the CPU has it (x86-64), else portable code: the same bits either way.
+/// triangles' extent above it where the kernel stops early), thin triangles (caps, needles) too: a
+/// face's normal is computed to more than double precision from the corners (kernel::FacePlane), and
+/// a point is over the face where it is inside its three edges' planes across it. A triangle whose
+/// normal is shorter than 1e-15 of its longer side at corner 0 squared is taken by its edges alone
+/// (bench/results/amd-epyc-2c/kernels/hostile_accuracy/: an oracle's distance on hostile pairs).
+/// Runs on AVX2 and FMA where the CPU has them (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
 /// Up to kLanes triangle pairs for closest_points_triangles_batch, corner by corner, coordinate by

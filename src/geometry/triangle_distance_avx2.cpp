@@ -16,9 +16,10 @@ using kernel::Nearest;
 using kernel::TriangleFrame;
 using kernel::Vec3;
 
-// The same kernel, four feature pairs at a time in AVX2 registers (x86-64, chosen at run time where the CPU has AVX2). Each lane
-// computes exactly what the portable code computes for its feature pair: the same IEEE operations in the same order (no FMA: this
-// file is built with -ffp-contract=off and only "avx2" is enabled here, not "fma"), every region and case of the branches
+// The same kernel, four feature pairs at a time in AVX2 registers (x86-64, chosen at run time where the CPU has AVX2 and FMA). Each lane
+// computes exactly what the portable code computes for its feature pair: the same IEEE operations in the same order (a fused
+// multiply-add only where the portable code calls std::fma: this file is built with -ffp-contract=off, so the compiler fuses
+// nothing itself, and enables "avx2" and "fma", where the CPU has both), every region and case of the branches
 // evaluated and the one the branches would take selected by masks. Comparisons are the ordered, quiet ones (false on NaN, as in
 // C++), and clamp01 is max then min with the operands in the order of the scalar maxsd/minsd of clamp01
 // (triangle_distance.cpp), so NaN falls to 0 in every lane as it does there. The feature pairs are then taken by the same Nearest
@@ -26,7 +27,7 @@ using kernel::Vec3;
 // dot() (lanes_avx2.h; tests/geometry/triangle_distance_test.cpp compares both paths bit for bit).
 namespace {
 
-#define CALIBER_AVX2 __attribute__((target("avx2")))
+#define CALIBER_AVX2 __attribute__((target("avx2,fma")))
 
 using namespace lanes4;
 using lanes4::broadcast;  // beside broadcast and pick on Frame4 below, which would hide them
@@ -95,40 +96,43 @@ CALIBER_AVX2 void closest_points_edges_x4(const Pack3& p1, const Pack3& d1, __m2
   out.store(p1 + s * d1, p2 + t * d2);
 }
 
-/// A triangle in four lanes (one triangle or several), with what face_projection reads.
+/// A triangle in four lanes (one triangle or several), with what face_projection reads: its
+/// corners and its kernel::FacePlane.
 struct Frame4 {
-  Pack3 a, b, c, ab, ac;
+  Pack3 v[3], inward[3], n;
+  __m256d inv2;
   __m256d solid;  ///< all ones where the lane's triangle is solid
 };
 
 /// kernel::face_projection in four lanes: the projections, and `inside`, the lanes where x projects
 /// into the face of a solid triangle (elsewhere the lane's values are not used).
 CALIBER_AVX2 Pack3 face_projection_x4(const Pack3& x, const Frame4& t, __m256d& inside) {
-  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
-  const Pack3 ax = x - t.a, bx = x - t.b, cx = x - t.c;
-  const __m256d d1 = dot(t.ab, ax), d2 = dot(t.ac, ax);
-  const __m256d d3 = dot(t.ab, bx), d4 = dot(t.ac, bx);
-  const __m256d d5 = dot(t.ab, cx), d6 = dot(t.ac, cx);
-  const __m256d vc = _mm256_sub_pd(_mm256_mul_pd(d1, d4), _mm256_mul_pd(d3, d2));
-  const __m256d vb = _mm256_sub_pd(_mm256_mul_pd(d5, d2), _mm256_mul_pd(d1, d6));
-  const __m256d va = _mm256_sub_pd(_mm256_mul_pd(d3, d6), _mm256_mul_pd(d5, d4));
-  const __m256d vsum = _mm256_add_pd(_mm256_add_pd(va, vb), vc);
-  const __m256d denom = _mm256_div_pd(one, vsum);
-  const __m256d v = _mm256_mul_pd(vb, denom), w = _mm256_mul_pd(vc, denom);
-  inside = all(t.solid, all(ge(va, zero), ge(vb, zero), ge(vc, zero), gt(vsum, zero), ge(v, zero), ge(w, zero),
-                            le(_mm256_add_pd(v, w), one)));
-  return t.a + v * t.ab + w * t.ac;
+  const __m256d zero = _mm256_setzero_pd();
+  const Pack3 ax = x - t.v[0];
+  const __m256d s0 = dot(t.inward[0], ax), s1 = dot(t.inward[1], x - t.v[1]), s2 = dot(t.inward[2], x - t.v[2]);
+  inside = all(t.solid, all(ge(s0, zero), ge(s1, zero), ge(s2, zero)));
+  return x - _mm256_mul_pd(dot(t.n, ax), t.inv2) * t.n;
 }
 
 /// One triangle's frame in all four lanes.
-CALIBER_AVX2 Frame4 broadcast(const TriangleFrame& f) {
-  return {broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2]),
-          broadcast(f.ab),   broadcast(f.ac),   _mm256_castsi256_pd(_mm256_set1_epi64x(f.solid ? -1 : 0))};
+CALIBER_AVX2 Frame4 broadcast(const TriangleFrame& f, const kernel::FacePlane& p) {
+  return {{broadcast(f.v[0]), broadcast(f.v[1]), broadcast(f.v[2])},
+          {broadcast(p.inward[0]), broadcast(p.inward[1]), broadcast(p.inward[2])},
+          broadcast(p.n),
+          _mm256_set1_pd(p.inv2),
+          _mm256_castsi256_pd(_mm256_set1_epi64x(p.solid ? -1 : 0))};
 }
 
 CALIBER_AVX2 Frame4 pick(__m256d mask, const Frame4& u, const Frame4& v) {
-  return {pick(mask, u.a, v.a),   pick(mask, u.b, v.b),   pick(mask, u.c, v.c),
-          pick(mask, u.ab, v.ab), pick(mask, u.ac, v.ac), pick(mask, u.solid, v.solid)};
+  Frame4 w;
+  for (int i = 0; i < 3; ++i) {
+    w.v[i] = pick(mask, u.v[i], v.v[i]);
+    w.inward[i] = pick(mask, u.inward[i], v.inward[i]);
+  }
+  w.n = pick(mask, u.n, v.n);
+  w.inv2 = pick(mask, u.inv2, v.inv2);
+  w.solid = pick(mask, u.solid, v.solid);
+  return w;
 }
 
 /// The points the kernel projects into the other triangle's face, in the portable order: a[0], b[0],
@@ -157,9 +161,8 @@ struct Projections {
 /// Each projection of `points` into the other's face, four at a time: batch k of `out` holds points
 /// 4k to 4k + 3 with their projections, and bit l of inside[k] is set where point 4k + l has one
 /// (the caller offers those to Nearest in that order).
-CALIBER_AVX2 void project(const Projections& points, const TriangleFrame& fa, const TriangleFrame& fb,
+CALIBER_AVX2 void project(const Projections& points, const Frame4& onto_a, const Frame4& onto_b,
                           FeaturePairs4 out[Projections::kMost / 4], int inside[Projections::kMost / 4]) {
-  const Frame4 onto_a = broadcast(fa), onto_b = broadcast(fb);
   for (int first = 0; first < points.count; first += 4) {
     const Pack3 x{_mm256_load_pd(points.x + first), _mm256_load_pd(points.y + first), _mm256_load_pd(points.z + first)};
     const __m256d of_a = _mm256_castsi256_pd(_mm256_load_si256(reinterpret_cast<const __m256i*>(points.of_a + first)));
@@ -250,12 +253,14 @@ CALIBER_AVX2 __attribute__((always_inline)) inline bool edge_pairs(const Triangl
   return slab_clear_x4(ta.v, tb.v, nearest.best.on_a, nearest.best.on_b);
 }
 
-/// The kernel's other feature pairs, taken into `nearest` after the edge pairs, once the frames,
-/// the corners' lanes and their signed distances along the other's normal (sa: A's corners against
-/// B's plane, sb: B's against A's) are known.
+/// The kernel's other feature pairs, taken into `nearest` after the edge pairs, given the frames,
+/// the corners' lanes, and the corners less the other's first (wa: A's less B's, wb: B's less A's).
 CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangle4& ta, const Triangle4& tb,
-                                                                   const TriangleFrame& fa, const TriangleFrame& fb, __m256d sa,
-                                                                   __m256d sb, Nearest& nearest) {
+                                                                   const TriangleFrame& fa, const TriangleFrame& fb,
+                                                                   const Pack3& wa, const Pack3& wb, Nearest& nearest) {
+  const kernel::FacePlane pa(fa), pb(fb);
+  // Each corner's signed distance along the other's normal, as crossing_point computes it.
+  const __m256d sa = dot(broadcast(pb.n), wa), sb = dot(broadcast(pa.n), wb);
   // Corner-face feature pairs, then edge-plane crossings (edge i of A and of B against the other's
   // plane: normal n through its first corner), as Projections lists them.
   Projections points;
@@ -273,7 +278,7 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangl
   points.pad();
   FeaturePairs4 projected[Projections::kMost / 4];
   int inside[Projections::kMost / 4];
-  project(points, fa, fb, projected, inside);
+  project(points, broadcast(fa, pa), broadcast(fb, pb), projected, inside);
 
   for (int first = 0; first < points.count; first += 4) {
     const int lanes = points.count - first >= 4 ? 0xF : (1 << (points.count - first)) - 1;
@@ -281,24 +286,14 @@ CALIBER_AVX2 __attribute__((always_inline)) inline void face_pairs(const Triangl
   }
 }
 
-/// A triangle pair's lanes, frames and signed distances: what the plane test and the feature
-/// pairs share. Each corner's signed distance along the other's normal is computed as crossing_point and
-/// beyond_plane compute it.
+/// A triangle pair's lanes and frames: what the plane test and the feature pairs share.
 struct Pair4 {
   Triangle4 ta, tb;
   TriangleFrame fa, fb;
   Pack3 wa, wb;  ///< A's corners less B's first, B's less A's
-  __m256d sa, sb;
 
   CALIBER_AVX2 Pair4(const Vec3 a[3], const Vec3 b[3])
-      : ta(load(a)),
-        tb(load(b)),
-        fa(a),
-        fb(b),
-        wa(ta.v - broadcast(b[0])),
-        wb(tb.v - broadcast(a[0])),
-        sa(dot(broadcast(fb.normal), wa)),
-        sb(dot(broadcast(fa.normal), wb)) {}
+      : ta(load(a)), tb(load(b)), fa(a), fb(b), wa(ta.v - broadcast(b[0])), wb(tb.v - broadcast(a[0])) {}
 };
 
 #undef CALIBER_AVX2
@@ -307,36 +302,38 @@ struct Pair4 {
 
 namespace detail {
 
-__attribute__((target("avx2"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
+__attribute__((target("avx2,fma"))) ClosestPoints closest_points_triangles_avx2(const Vec3 a[3], const Vec3 b[3]) {
   const Pair4 p(a, b);
   Nearest nearest(a[0], b[0]);
-  if (!edge_pairs(p.ta, p.tb, nearest)) face_pairs(p.ta, p.tb, p.fa, p.fb, p.sa, p.sb, nearest);
+  if (!edge_pairs(p.ta, p.tb, nearest)) face_pairs(p.ta, p.tb, p.fa, p.fb, p.wa, p.wb, nearest);
   return nearest.best;
 }
 
-/// The plane tests of the refusal on the pair's lanes. Both planes' lengths and uv in one square
-/// root of four lanes (correctly rounded, as std::sqrt).
-__attribute__((target("avx2"), always_inline)) inline bool planes_apart(const Pair4& p, double reach) {
+/// The plane tests of the refusal on the pair's lanes: each corner's signed distance along the
+/// other's normal as beyond_plane computes it; both planes' lengths and uv in one square root of four
+/// lanes (correctly rounded, as std::sqrt).
+__attribute__((target("avx2,fma"), always_inline)) inline bool planes_apart(const Pair4& p, double reach) {
+  const __m256d sa = dot(broadcast(p.fb.normal), p.wa), sb = dot(broadcast(p.fa.normal), p.wb);
   alignas(32) double roots[4];
   _mm256_store_pd(roots, _mm256_sqrt_pd(lanes(p.fb.normal2, p.fa.normal2, p.fb.ab2 * p.fb.ac2, p.fa.ab2 * p.fa.ac2)));
-  return beyond_plane_x4(p.wa, p.sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, p.sb, roots[1], roots[3], reach);
+  return beyond_plane_x4(p.wa, sa, roots[0], roots[2], reach) || beyond_plane_x4(p.wb, sb, roots[1], roots[3], reach);
 }
 
 /// closest_points_triangles_within_portable's steps in its order, on the pair's lanes.
-__attribute__((target("avx2"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
-                                                                          ClosestPoints& out) {
+__attribute__((target("avx2,fma"))) bool closest_points_triangles_within_avx2(const Vec3 a[3], const Vec3 b[3], double reach,
+                                                                              ClosestPoints& out) {
   const Pair4 p(a, b);
   if (planes_apart(p, reach)) return false;
   Nearest nearest(a[0], b[0]);
   if (!edge_pairs(p.ta, p.tb, nearest)) {
     if (edges_apart_x4(p.fa, b, p.ta, p.tb, reach)) return false;
-    face_pairs(p.ta, p.tb, p.fa, p.fb, p.sa, p.sb, nearest);
+    face_pairs(p.ta, p.tb, p.fa, p.fb, p.wa, p.wb, nearest);
   }
   out = nearest.best;
   return true;
 }
 
-__attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const Vec3 b[3], double reach) {
+__attribute__((target("avx2,fma"))) bool triangles_apart_avx2(const Vec3 a[3], const Vec3 b[3], double reach) {
   const Pair4 p(a, b);
   return planes_apart(p, reach) || edges_apart_x4(p.fa, b, p.ta, p.tb, reach);
 }
@@ -344,7 +341,7 @@ __attribute__((target("avx2"))) bool triangles_apart_avx2(const Vec3 a[3], const
 template <class Form>
 Form where_avx2(Form form) {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? form : nullptr;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? form : nullptr;
 }
 
 ApartTest triangles_apart_avx2_if_supported() { return where_avx2<ApartTest>(&triangles_apart_avx2); }

@@ -10,14 +10,14 @@
 namespace caliber::geometry {
 
 // The triangle kernel on a batch's pairs four at a time, one pair per AVX2 lane (x86-64, chosen at
-// run time where the CPU has AVX2 but not AVX-512F): triangle_batch_kernel.inc's body, the AVX-512
+// run time where the CPU has AVX2 and FMA but not AVX-512F): triangle_batch_kernel.inc's body, the AVX-512
 // form's, on __m256d lanes with vector masks (that file says how each lane's bits are the portable
 // kernel's).
 namespace {
 
 using namespace lanes4::masked;
 
-#define CALIBER_AVX2 __attribute__((target("avx2")))
+#define CALIBER_AVX2 __attribute__((target("avx2,fma")))
 
 #define CALIBER_LANES CALIBER_AVX2
 #include "geometry/triangle_batch_kernel.inc"
@@ -48,7 +48,7 @@ namespace detail {
 
 BatchKernel closest_points_triangles_batch_avx2_if_supported() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? &batch_avx2 : nullptr;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? &batch_avx2 : nullptr;
 }
 
 }  // namespace detail

@@ -24,7 +24,7 @@ struct TriangleFrame {
   Vec3 normal;      ///< ab x ac
   double normal2;   ///< |normal|^2
   double ab2, ac2;  ///< |ab|^2, |ac|^2
-  bool solid;       ///< far enough from degenerate for the region test (else: nearest edge point; no face pair)
+  bool solid;       ///< far enough from degenerate for closest_point_on_frame's region test (else: nearest edge point)
 
   explicit TriangleFrame(const Vec3 corners[3])
       : v(corners),
@@ -36,6 +36,57 @@ struct TriangleFrame {
         ac2(ac.squaredNorm()) {
     const double scale2 = std::max(ab2, ac2);
     solid = normal2 > 1e-24 * scale2 * scale2;
+  }
+};
+
+/// b - a as hi + lo exactly (Knuth's two-sum of b and -a): hi the rounded difference.
+inline void two_diff(double b, double a, double& hi, double& lo) {
+  hi = b - a;
+  const double bv = hi - b;
+  lo = (b - (hi - bv)) - (a + bv);
+}
+
+/// p q - r s where each factor is a difference carried as hi + lo (two_diff): Kahan's difference of
+/// products on the high parts (r1 s1's rounding error exact by FMA, so only the last addition
+/// rounds where p1 q1 and r1 s1 cancel), plus the low parts' first-order terms. Within a few units
+/// of rounding of the result itself, less about 2^-104 |p| |q|: the cross product of a thin
+/// triangle's edges keeps its direction, which the rounded products lose (and the rounded edges).
+inline double cross_term(double p1, double p2, double q1, double q2, double r1, double r2, double s1, double s2) {
+  const double w = r1 * s1;
+  const double e = std::fma(-r1, s1, w);
+  const double f = std::fma(p1, q1, -w);
+  const double lo = std::fma(p1, q2, p2 * q1) - std::fma(r1, s2, r2 * s1);
+  return (f + e) + lo;
+}
+
+/// What the kernel's face pairs read of a triangle (frame t): its normal ab x ac from the
+/// corners to a few units of rounding of itself (cross_term), whatever the triangle's angles; the
+/// edges' inward directions n x e_i (e_i = v[i + 1] - v[i]); and 1 / |n|^2. A point lies over the
+/// face when it is on the inner side of the three edges, and projects along n (face_projection).
+/// The face is taken where |n| exceeds 1e-15 of the longer of ab and ac squared (about the sine of
+/// the angle at corner 0): n is then within half a unit of rounding of its direction.
+struct FacePlane {
+  Vec3 n;
+  Vec3 inward[3];
+  double inv2;
+  bool solid;
+
+  explicit FacePlane(const TriangleFrame& t) {
+    double u[3][2], w[3][2];  // ab and ac, each coordinate as hi, lo
+    for (int k = 0; k < 3; ++k) {
+      two_diff(t.v[1][k], t.v[0][k], u[k][0], u[k][1]);
+      two_diff(t.v[2][k], t.v[0][k], w[k][0], w[k][1]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      n[k] = cross_term(u[i][0], u[i][1], w[j][0], w[j][1], u[j][0], u[j][1], w[i][0], w[i][1]);
+    }
+    inward[0] = n.cross(t.ab);
+    inward[1] = n.cross(Vec3(t.v[2] - t.v[1]));
+    inward[2] = n.cross(Vec3(t.v[0] - t.v[2]));
+    const double n2 = n.squaredNorm(), scale2 = std::max(t.ab2, t.ac2);
+    inv2 = 1.0 / n2;
+    solid = n2 > 1e-30 * scale2 * scale2;
   }
 };
 
@@ -119,12 +170,14 @@ inline bool slab_clear(const Vec3 a[3], const Vec3 b[3], const Vec3& p, const Ve
 /// Closest point to x on the triangle of `t`.
 Vec3 closest_point_on_frame(const Vec3& x, const TriangleFrame& t);
 
-/// Where x projects into the face of a solid triangle `t` (closest_point_on_frame's face region,
-/// tested alone): true, and `out` the projection, as closest_point_on_frame makes it there. Else
-/// false. The kernel's corner-face and crossing feature pairs: a point nearest an edge or a corner
+/// Where x projects into the face of triangle `t` (plane f, solid): true, and `out` the projection,
+/// x less its height along f.n, where x lies on the inner side of the three edges (each
+/// (x - v_i) . inward_i >= 0). Else false. Unlike closest_point_on_frame's barycentric region test,
+/// this keeps its precision on a thin triangle, whose products of edges' dot products cancel. The
+/// kernel's corner-face and crossing feature pairs: a point nearest an edge or a corner
 /// of the other triangle lies on an edge of its own, so an edge pair is at least as near (up to
 /// rounding), and the kernel takes no pair for it.
-bool face_projection(const Vec3& x, const TriangleFrame& t, Vec3& out);
+bool face_projection(const Vec3& x, const TriangleFrame& t, const FacePlane& f, Vec3& out);
 
 /// Closest points c1 on p1 + s d1 and c2 on p2 + t d2 (s, t in [0, 1]), given a = |d1|^2 and
 /// e = |d2|^2: the body of closest_points_segments with the edge terms computed by the caller.
