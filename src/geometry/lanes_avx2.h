@@ -3,9 +3,10 @@
 /// Three-vectors in four AVX2 lanes for the triangle kernel (triangle_distance_avx2.cpp: a lane
 /// per feature pair) and the batched tests (triangle_intersect_avx2.cpp, triangle_apart_avx2.cpp,
 /// triangle_distance_batch_avx2.cpp: a lane per triangle pair, the last two through
-/// lanes_avx2_masked.h), each operation the IEEE operation the portable code does (no FMA), so
-/// that every lane computes its bits. Included only by code built for x86-64 with GNU C++; every
-/// function is compiled for AVX2 alone, chosen at run time.
+/// lanes_avx2_masked.h), each operation the IEEE operation the portable code does (no fused
+/// multiply-add here: the kernel's FMA is explicit, kernel::cross_term and fmadd), so that every
+/// lane computes its bits. Included only by code built for x86-64 with GNU C++; these functions are
+/// compiled for AVX2 (the kernel and the batch that call them also enable FMA), chosen at run time.
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>

@@ -42,8 +42,9 @@ struct ClosestPoints {
 /// triangles' extent above it where the kernel stops early), thin triangles (caps, needles) too: a
 /// face's normal is computed to more than double precision from the corners (kernel::FacePlane), and
 /// a point is over the face where it is inside its three edges' planes across it. A triangle whose
-/// normal is shorter than 1e-15 of its longer side at corner 0 squared is taken by its edges alone
-/// (bench/results/amd-epyc-2c/kernels/hostile_accuracy/: an oracle's distance on hostile pairs).
+/// normal is shorter than 1e-15 of its longer side at corner 0 squared, or whose sides are beyond
+/// about 1e77 or below 1e-77 (the squared normal or its inverse overflows), is taken by its edges
+/// alone (bench/results/amd-epyc-2c/kernels/hostile_accuracy/: an oracle's distance on hostile pairs).
 /// Runs on AVX2 and FMA where the CPU has them (x86-64), else portable code: the same bits either way.
 ClosestPoints closest_points_triangles(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3]);
 
@@ -104,8 +105,8 @@ void closest_points_triangles_batch(TriangleBatch& batch, ClosestPointsBatch& ou
 /// closest_points_triangles for a caller that wants only pairs within `reach`: false (and `out`
 /// untouched) when a direction certifiably puts the triangles farther apart than `reach`, else true
 /// with `out` exactly what closest_points_triangles returns. The directions: a plane of one
-/// triangle with the whole other triangle beyond it (tested first, sharing the kernel's normals
-/// and signed distances), then, unless the kernel's edge pairs settle the pair (its early stop:
+/// triangle with the whole other triangle beyond it (tested first, on the normal ab x ac; the
+/// face pairs use kernel::FacePlane's), then, unless the kernel's edge pairs settle the pair (its early stop:
 /// then true, whatever the distance), the cross product of an edge of each with the corners'
 /// projections apart (edge_axes.h). It may return true for pairs farther apart than `reach`.
 bool closest_points_triangles_within(const Eigen::Vector3d a[3], const Eigen::Vector3d b[3], double reach, ClosestPoints& out);

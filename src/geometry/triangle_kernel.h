@@ -63,8 +63,10 @@ inline double cross_term(double p1, double p2, double q1, double q2, double r1, 
 /// corners to a few units of rounding of itself (cross_term), whatever the triangle's angles; the
 /// edges' inward directions n x e_i (e_i = v[i + 1] - v[i]); and 1 / |n|^2. A point lies over the
 /// face when it is on the inner side of the three edges, and projects along n (face_projection).
-/// The face is taken where |n| exceeds 1e-15 of the longer of ab and ac squared (about the sine of
-/// the angle at corner 0): n is then within half a unit of rounding of its direction.
+/// The face is taken where |n| exceeds 1e-15 of the longer of ab and ac squared (so the sine of the
+/// angle at corner 0 exceeds 1e-15; the terms cross_term leaves out are then below half a unit of
+/// rounding of n, whose direction stays within a few), and |n|^2 and its inverse are finite (sides
+/// between about 1e-77 and 1e77): else the kernel takes the triangle by its edges alone.
 struct FacePlane {
   Vec3 n;
   Vec3 inward[3];
@@ -86,7 +88,7 @@ struct FacePlane {
     inward[2] = n.cross(Vec3(t.v[0] - t.v[2]));
     const double n2 = n.squaredNorm(), scale2 = std::max(t.ab2, t.ac2);
     inv2 = 1.0 / n2;
-    solid = n2 > 1e-30 * scale2 * scale2;
+    solid = (n2 > 1e-30 * scale2 * scale2) & (n2 <= 0x1.fffffffffffffp+1023) & (inv2 <= 0x1.fffffffffffffp+1023);
   }
 };
 

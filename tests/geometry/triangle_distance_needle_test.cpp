@@ -18,6 +18,7 @@
 #include "caliber/mesh.h"
 #include "caliber/model.h"
 #include "caliber/query.h"
+#include "geometry/triangle_distance_oracle.h"
 
 namespace caliber::geometry {
 namespace {
@@ -124,6 +125,33 @@ TEST(TriangleDistanceShortEdge, SegmentsAndEveryFormKeepTheNearestPoint) {
   closest_points_triangles_batch(batch, lanes);
   EXPECT_NEAR(lanes.get(0).distance, 1.0, 1e-15);
   EXPECT_NEAR(lanes.get(1).distance, 1.0, 1e-15);
+}
+
+/// A face whose sides are near 1e80: |ab x ac|^2 overflows. The face pair then has no plane to
+/// project along (1 / |n|^2 is 0, and a kernel that took the face anyway projected x onto itself:
+/// distance 0), so the kernel takes such a triangle by its edges alone, never nearer than it is.
+TEST(TriangleDistanceHugeFace, TakenByItsEdgesNeverBelowTheDistance) {
+  const Eigen::Vector3d x(9e79, 7.5e72, 1e78);
+  const Eigen::Vector3d b[3] = {{0, 0, 0}, {1e80, 0, 0}, {0, 1.5e74, 0}};
+  const Eigen::Vector3d tilted[3] = {x, x + Eigen::Vector3d(2e80, 3e74, -2e78), x + Eigen::Vector3d(2e80, 4.5e74, -2e78)};
+  const Eigen::Vector3d upright[3] = {x, x + Eigen::Vector3d(0, 0, 1e80), x + Eigen::Vector3d(1e78, 0, 1e80)};
+  for (const auto* a : {tilted, upright}) {
+    const double truth = oracle::triangles_distance(a, b);
+    const ClosestPoints want = detail::closest_points_triangles_portable(a, b);
+    EXPECT_GE(want.distance, truth * (1 - 0x1p-50));
+    EXPECT_LE(want.distance, truth * (1 + 1e-9));
+    EXPECT_EQ(closest_points_triangles(a, b).distance, want.distance);
+    TriangleBatch batch;
+    batch.add(a, b);
+    batch.add(b, a);
+    ClosestPointsBatch lanes;
+    closest_points_triangles_batch(batch, lanes);
+    EXPECT_EQ(lanes.get(0).distance, want.distance);
+    EXPECT_EQ(lanes.get(1).distance, want.distance);
+    ClosestPoints within{};
+    ASSERT_TRUE(closest_points_triangles_within(a, b, 2 * truth, within));
+    EXPECT_EQ(within.distance, want.distance);
+  }
 }
 
 }  // namespace
