@@ -49,7 +49,7 @@ inline void two_diff(double b, double a, double& hi, double& lo) {
 /// p q - r s where each factor is a difference carried as hi + lo (two_diff): Kahan's difference of
 /// products on the high parts (r1 s1's rounding error exact by FMA, so only the last addition
 /// rounds where p1 q1 and r1 s1 cancel), plus the low parts' first-order terms. Within a few units
-/// of rounding of the result itself, less about 2^-104 |p| |q|: the cross product of a thin
+/// of rounding of the result itself, plus about 2^-104 |p| |q|: the cross product of a thin
 /// triangle's edges keeps its direction, which the rounded products lose (and the rounded edges).
 inline double cross_term(double p1, double p2, double q1, double q2, double r1, double r2, double s1, double s2) {
   const double w = r1 * s1;
