@@ -6,6 +6,7 @@ packages=(
   build-essential cmake pkg-config python3
   libeigen3-dev libtbb-dev libassimp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libgmp-dev      # tests only: exact rationals, the oracle of the exact predicates' test
   libfcl-dev      # benchmarks only: the peer comparison against FCL
   libembree-dev   # benchmarks only: the narrow phase against Embree's rtcCollide
   libbullet-dev   # benchmarks only: the broad phase against Bullet's dynamic AABB tree

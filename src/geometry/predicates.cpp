@@ -17,12 +17,10 @@ constexpr double kSplitter = 134217729.0;            // 2^27 + 1
 constexpr double kO3dErrBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 constexpr double kCcwErrBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 
-/// A nonoverlapping expansion: the exact value is the sum of v[0..n), smallest magnitude first.
-struct Expansion {
-  static constexpr int kCapacity = 256;
-  double v[kCapacity];
-  int n = 0;
-};
+// An expansion is a nonoverlapping sequence of doubles whose exact sum is the value, smallest
+// magnitude first, in an array the caller sizes for the most terms it can have (each function says
+// how many), with its length beside it: no copies of unused room (an exact sign costs tens of
+// operations where its terms are few, as they are where the coordinates' differences are exact).
 
 inline void two_sum(double a, double b, double& x, double& y) {
   x = a + b;
@@ -56,100 +54,125 @@ inline void two_product(double a, double b, double& x, double& y) {
   y = alo * blo - err3;
 }
 
-/// The exact difference a - b as an expansion of up to two terms.
-Expansion diff(double a, double b) {
-  Expansion e;
+/// The exact difference a - b in h (room for 2 terms); returns its length.
+int diff(double a, double b, double* h) {
   double x, y;
   two_diff(a, b, x, y);
-  if (y != 0.0) e.v[e.n++] = y;
-  if (x != 0.0) e.v[e.n++] = x;
-  return e;
+  int n = 0;
+  if (y != 0.0) h[n++] = y;
+  if (x != 0.0) h[n++] = x;
+  return n;
 }
 
-/// h = e + b (Shewchuk's grow-expansion with zero elimination).
-void grow(const Expansion& e, double b, Expansion& h) {
+/// h = h + b in place (Shewchuk's grow-expansion with zero elimination; room for n + 1 terms):
+/// returns the new length.
+int grow(double* h, int n, double b) {
   double q = b;
-  h.n = 0;
-  for (int i = 0; i < e.n; ++i) {
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
     double sum, err;
-    two_sum(q, e.v[i], sum, err);
+    two_sum(q, h[i], sum, err);
     q = sum;
-    if (err != 0.0) h.v[h.n++] = err;
+    if (err != 0.0) h[k++] = err;
   }
-  if (q != 0.0 || h.n == 0) h.v[h.n++] = q;
+  if (q != 0.0 || k == 0) h[k++] = q;
+  return k;
 }
 
-/// e + f, by growing e with each component of f.
-Expansion add(const Expansion& e, const Expansion& f) {
-  Expansion buffers[2];
-  const Expansion* current = &e;
-  int next = 0;
-  for (int i = 0; i < f.n; ++i) {
-    grow(*current, f.v[i], buffers[next]);
-    current = &buffers[next];
-    next ^= 1;
-  }
-  Expansion result;
-  result.n = current->n;
-  for (int i = 0; i < current->n; ++i) result.v[i] = current->v[i];
-  return result;
+/// h = h + f in place, by growing h with each component of f (room for n + fn terms): returns
+/// the new length.
+int grow_by(double* h, int n, const double* f, int fn) {
+  for (int i = 0; i < fn; ++i) n = grow(h, n, f[i]);
+  return n;
 }
 
-Expansion negate(Expansion e) {
-  for (int i = 0; i < e.n; ++i) e.v[i] = -e.v[i];
-  return e;
+/// h = e + f (room for en + fn terms): returns h's length.
+int add(const double* e, int en, const double* f, int fn, double* h) {
+  for (int i = 0; i < en; ++i) h[i] = e[i];
+  return grow_by(h, en, f, fn);
 }
 
-/// h = e * b (Shewchuk's scale-expansion with zero elimination).
-void scale(const Expansion& e, double b, Expansion& h) {
-  h.n = 0;
-  if (e.n == 0 || b == 0.0) return;
+/// e negated, in place.
+void negate(double* e, int n) {
+  for (int i = 0; i < n; ++i) e[i] = -e[i];
+}
+
+/// h = e * b (Shewchuk's scale-expansion with zero elimination; room for 2 en terms): returns
+/// h's length.
+int scale(const double* e, int en, double b, double* h) {
+  int n = 0;
+  if (en == 0 || b == 0.0) return 0;
   double q, hh;
-  two_product(e.v[0], b, q, hh);
-  if (hh != 0.0) h.v[h.n++] = hh;
-  for (int i = 1; i < e.n; ++i) {
+  two_product(e[0], b, q, hh);
+  if (hh != 0.0) h[n++] = hh;
+  for (int i = 1; i < en; ++i) {
     double p1, p0, sum;
-    two_product(e.v[i], b, p1, p0);
+    two_product(e[i], b, p1, p0);
     two_sum(q, p0, sum, hh);
-    if (hh != 0.0) h.v[h.n++] = hh;
+    if (hh != 0.0) h[n++] = hh;
     two_sum(p1, sum, q, hh);  // p1 and sum do not overlap badly: fast-two-sum would do, two-sum is safe
-    if (hh != 0.0) h.v[h.n++] = hh;
+    if (hh != 0.0) h[n++] = hh;
   }
-  if (q != 0.0 || h.n == 0) h.v[h.n++] = q;
+  if (q != 0.0 || n == 0) h[n++] = q;
+  return n;
 }
 
-Expansion multiply(const Expansion& e, const Expansion& f) {
-  Expansion result;
-  Expansion term;
-  for (int i = 0; i < f.n; ++i) {
-    scale(e, f.v[i], term);
-    result = add(result, term);
+/// h = e * f, the sum of e scaled by each component of f (room for 2 en fn terms; kMostE bounds
+/// en): returns h's length.
+template <int kMostE>
+int multiply(const double* e, int en, const double* f, int fn, double* h) {
+  double term[2 * kMostE];
+  int n = 0;
+  for (int i = 0; i < fn; ++i) {
+    const int tn = scale(e, en, f[i], term);
+    n = grow_by(h, n, term, tn);
   }
-  return result;
+  return n;
 }
 
-int sign(const Expansion& e) {
-  for (int i = e.n - 1; i >= 0; --i) {
-    if (e.v[i] > 0.0) return 1;
-    if (e.v[i] < 0.0) return -1;
+int sign(const double* e, int n) {
+  for (int i = n - 1; i >= 0; --i) {
+    if (e[i] > 0.0) return 1;
+    if (e[i] < 0.0) return -1;
   }
   return 0;
 }
 
-int orient2d_exact(const double* a, const double* b, const double* c) {
-  const Expansion acx = diff(a[0], c[0]), acy = diff(a[1], c[1]);
-  const Expansion bcx = diff(b[0], c[0]), bcy = diff(b[1], c[1]);
-  return sign(add(multiply(acx, bcy), negate(multiply(acy, bcx))));
+/// a d - b c for expansions of at most two terms each (room for 16 terms): returns its length.
+int cross(const double* a, int an, const double* d, int dn, const double* b, int bn, const double* c, int cn, double* h) {
+  double ad[8], bc[8];
+  const int adn = multiply<2>(a, an, d, dn, ad);
+  const int bcn = multiply<2>(b, bn, c, cn, bc);
+  negate(bc, bcn);
+  return add(ad, adn, bc, bcn, h);
 }
 
-int orient3d_exact(const double* a, const double* b, const double* c, const double* d) {
-  const Expansion adx = diff(a[0], d[0]), ady = diff(a[1], d[1]), adz = diff(a[2], d[2]);
-  const Expansion bdx = diff(b[0], d[0]), bdy = diff(b[1], d[1]), bdz = diff(b[2], d[2]);
-  const Expansion cdx = diff(c[0], d[0]), cdy = diff(c[1], d[1]), cdz = diff(c[2], d[2]);
-  const Expansion m1 = add(multiply(bdx, cdy), negate(multiply(cdx, bdy)));
-  const Expansion m2 = add(multiply(cdx, ady), negate(multiply(adx, cdy)));
-  const Expansion m3 = add(multiply(adx, bdy), negate(multiply(bdx, ady)));
-  return sign(add(add(multiply(adz, m1), multiply(bdz, m2)), multiply(cdz, m3)));
+// The exact forms are kept out of line: the filters that call them stay small.
+[[gnu::noinline]] int orient2d_exact(const double* a, const double* b, const double* c) {
+  double acx[2], acy[2], bcx[2], bcy[2], det[16];
+  const int acxn = diff(a[0], c[0], acx), acyn = diff(a[1], c[1], acy);
+  const int bcxn = diff(b[0], c[0], bcx), bcyn = diff(b[1], c[1], bcy);
+  return sign(det, cross(acx, acxn, bcy, bcyn, acy, acyn, bcx, bcxn, det));
+}
+
+[[gnu::noinline]] int orient3d_exact(const double* a, const double* b, const double* c, const double* d) {
+  double ad[3][2], bd[3][2], cd[3][2];
+  int adn[3], bdn[3], cdn[3];
+  for (int i = 0; i < 3; ++i) {
+    adn[i] = diff(a[i], d[i], ad[i]);
+    bdn[i] = diff(b[i], d[i], bd[i]);
+    cdn[i] = diff(c[i], d[i], cd[i]);
+  }
+  double m1[16], m2[16], m3[16];
+  const int m1n = cross(bd[0], bdn[0], cd[1], cdn[1], cd[0], cdn[0], bd[1], bdn[1], m1);
+  const int m2n = cross(cd[0], cdn[0], ad[1], adn[1], ad[0], adn[0], cd[1], cdn[1], m2);
+  const int m3n = cross(ad[0], adn[0], bd[1], bdn[1], bd[0], bdn[0], ad[1], adn[1], m3);
+  double t1[64], t2[64], t3[64], t12[128], det[192];
+  const int t1n = multiply<2>(ad[2], adn[2], m1, m1n, t1);
+  const int t2n = multiply<2>(bd[2], bdn[2], m2, m2n, t2);
+  const int t3n = multiply<2>(cd[2], cdn[2], m3, m3n, t3);
+  const int t12n = add(t1, t1n, t2, t2n, t12);
+  return sign(det, add(t12, t12n, t3, t3n, det));
 }
 
 }  // namespace

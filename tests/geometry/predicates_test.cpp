@@ -4,6 +4,7 @@
 #include <array>
 #include <random>
 
+#include <gmp.h>
 #include <gtest/gtest.h>
 
 namespace caliber::geometry {
@@ -103,6 +104,93 @@ TEST(Predicates, Orient2dMatchesIntegerArithmetic) {
     const double fc[2] = {static_cast<double>(c[0]) * 0.125, static_cast<double>(c[1]) * 0.125};
     ASSERT_EQ(orient2d(fa, fb, fc), want) << "iteration " << iter;
   }
+}
+
+/// A rational of GMP's, freed with its scope.
+struct Rational {
+  mpq_t q;
+  Rational() { mpq_init(q); }
+  explicit Rational(double x) {
+    mpq_init(q);
+    mpq_set_d(q, x);  // exact: every finite double is a rational
+  }
+  Rational(const Rational&) = delete;
+  Rational& operator=(const Rational&) = delete;
+  ~Rational() { mpq_clear(q); }
+};
+
+/// u - w into out.
+void sub(const Rational& u, const Rational& w, Rational& out) { mpq_sub(out.q, u.q, w.q); }
+
+/// The exact sign of det[a-d; b-d; c-d] (three coordinates each), in rationals.
+int orient3d_rational(const double* a, const double* b, const double* c, const double* d) {
+  Rational m[3][3], t, u, det;
+  for (int k = 0; k < 3; ++k) {
+    const Rational ak(a[k]), bk(b[k]), ck(c[k]), dk(d[k]);
+    sub(ak, dk, m[0][k]);
+    sub(bk, dk, m[1][k]);
+    sub(ck, dk, m[2][k]);
+  }
+  // det = sum over the columns j of m[0][j] times its cofactor.
+  for (int j = 0; j < 3; ++j) {
+    const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    mpq_mul(t.q, m[1][j1].q, m[2][j2].q);
+    mpq_mul(u.q, m[1][j2].q, m[2][j1].q);
+    mpq_sub(t.q, t.q, u.q);
+    mpq_mul(t.q, t.q, m[0][j].q);
+    mpq_add(det.q, det.q, t.q);
+  }
+  return mpq_sgn(det.q);
+}
+
+/// The exact sign of det[a-c; b-c] (two coordinates each), in rationals.
+int orient2d_rational(const double* a, const double* b, const double* c) {
+  const Rational a0(a[0]), a1(a[1]), b0(b[0]), b1(b[1]), c0(c[0]), c1(c[1]);
+  Rational acx, acy, bcx, bcy, l, r;
+  sub(a0, c0, acx);
+  sub(a1, c1, acy);
+  sub(b0, c0, bcx);
+  sub(b1, c1, bcy);
+  mpq_mul(l.q, acx.q, bcy.q);
+  mpq_mul(r.q, acy.q, bcx.q);
+  return mpq_cmp(l.q, r.q) > 0 ? 1 : (mpq_cmp(l.q, r.q) < 0 ? -1 : 0);
+}
+
+/// Random doubles of magnitudes 2^-40 to 2^40 (some 0), and points within rounding of the plane
+/// (or line) through others, so that the differences round and the filter cannot decide: every
+/// sign as GMP's rationals give it.
+TEST(Predicates, EverySignIsTheRationalOneWhereDifferencesRound) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-40, 40);
+  const auto coordinate = [&] { return rng() % 16 == 0 ? 0.0 : std::ldexp(unit(rng), exponent(rng)); };
+  int signs3[3] = {}, signs2[3] = {};
+  for (int iter = 0; iter < 20000; ++iter) {
+    double a[3], b[3], c[3], d[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = coordinate();
+      b[k] = coordinate();
+      c[k] = coordinate();
+    }
+    // d on the plane through a, b, c, rounded, and sometimes nudged by an ulp in one coordinate.
+    const double s = unit(rng), t = unit(rng);
+    for (int k = 0; k < 3; ++k) d[k] = a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]);
+    if (iter % 3 == 0) d[iter % 9 / 3] = std::nextafter(d[iter % 9 / 3], iter % 2 == 0 ? 1e300 : -1e300);
+    const int want3 = orient3d_rational(a, b, c, d);
+    ASSERT_EQ(orient3d(a, b, c, d), want3) << "iteration " << iter;
+    ++signs3[want3 + 1];
+    // c2 on the line through a and b (x, y), rounded.
+    const double c2[2] = {a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])};
+    const int want2 = orient2d_rational(a, b, c2);
+    ASSERT_EQ(orient2d(a, b, c2), want2) << "iteration " << iter;
+    ++signs2[want2 + 1];
+  }
+  // Both signs many times, and some exact zeros.
+  EXPECT_GT(signs3[0], 2000);
+  EXPECT_GT(signs3[2], 2000);
+  EXPECT_GT(signs2[0], 2000);
+  EXPECT_GT(signs2[2], 2000);
+  EXPECT_GT(signs2[1] + signs3[1], 100);
 }
 
 TEST(Predicates, ExactWhereDifferencesAreInexact) {
