@@ -147,8 +147,28 @@ int cross(const double* a, int an, const double* d, int dn, const double* b, int
   return add(ad, adn, bc, bcn, h);
 }
 
+/// Whether the three 2-D points share a coordinate, or two of them coincide: their determinant has
+/// a zero row or column, so it is 0 exactly (most exact zeros of meshes on a grid; the expansions'
+/// answer, at once).
+bool degenerate2d(const double* a, const double* b, const double* c) {
+  for (int i = 0; i < 2; ++i) {
+    if (a[i] == c[i] && b[i] == c[i]) return true;
+  }
+  return (a[0] == c[0] && a[1] == c[1]) || (b[0] == c[0] && b[1] == c[1]);
+}
+
+/// orient3d's degenerate2d: the four points share a coordinate, or one of a, b, c is d.
+bool degenerate3d(const double* a, const double* b, const double* c, const double* d) {
+  for (int i = 0; i < 3; ++i) {
+    if (a[i] == d[i] && b[i] == d[i] && c[i] == d[i]) return true;
+  }
+  const auto same = [d](const double* p) { return p[0] == d[0] && p[1] == d[1] && p[2] == d[2]; };
+  return same(a) || same(b) || same(c);
+}
+
 // The exact forms are kept out of line: the filters that call them stay small.
 [[gnu::noinline]] int orient2d_exact(const double* a, const double* b, const double* c) {
+  if (degenerate2d(a, b, c)) return 0;
   double acx[2], acy[2], bcx[2], bcy[2], det[16];
   const int acxn = diff(a[0], c[0], acx), acyn = diff(a[1], c[1], acy);
   const int bcxn = diff(b[0], c[0], bcx), bcyn = diff(b[1], c[1], bcy);
@@ -156,6 +176,7 @@ int cross(const double* a, int an, const double* d, int dn, const double* b, int
 }
 
 [[gnu::noinline]] int orient3d_exact(const double* a, const double* b, const double* c, const double* d) {
+  if (degenerate3d(a, b, c, d)) return 0;
   double ad[3][2], bd[3][2], cd[3][2];
   int adn[3], bdn[3], cdn[3];
   for (int i = 0; i < 3; ++i) {

@@ -193,6 +193,37 @@ TEST(Predicates, EverySignIsTheRationalOneWhereDifferencesRound) {
   EXPECT_GT(signs2[1] + signs3[1], 100);
 }
 
+/// Points on a small grid (coordinates -1, 0, 1, 2 times a random scale, some nonzero ones moved
+/// by an ulp):
+/// shared coordinates, repeated points, collinear and coplanar sets at every turn, where the
+/// expansions' shortcuts for a zero row or column apply; every sign as GMP's rationals give it.
+TEST(Predicates, EverySignIsTheRationalOneOnAGrid) {
+  std::mt19937_64 rng(12);
+  std::uniform_int_distribution<int> step(-1, 2);
+  std::uniform_real_distribution<double> scale(0.1, 10.0);
+  int signs[3] = {};
+  for (int iter = 0; iter < 20000; ++iter) {
+    const double s = scale(rng);
+    double p[4][3];
+    for (auto& point : p) {
+      for (double& x : point) {
+        x = step(rng) * s;
+        // (Not a zero: an ulp from 0 is far below the predicates' range, predicates.h.)
+        if (x != 0.0 && rng() % 8 == 0) x = std::nextafter(x, rng() % 2 == 0 ? 1e300 : -1e300);
+      }
+    }
+    const int want3 = orient3d_rational(p[0], p[1], p[2], p[3]);
+    ASSERT_EQ(orient3d(p[0], p[1], p[2], p[3]), want3) << "iteration " << iter;
+    const int want2 = orient2d_rational(p[0], p[1], p[2]);
+    ASSERT_EQ(orient2d(p[0], p[1], p[2]), want2) << "iteration " << iter;
+    ++signs[want3 + 1];
+    ++signs[want2 + 1];
+  }
+  EXPECT_GT(signs[0], 5000);
+  EXPECT_GT(signs[1], 5000);
+  EXPECT_GT(signs[2], 5000);
+}
+
 TEST(Predicates, ExactWhereDifferencesAreInexact) {
   // Coordinates whose differences are not representable: 1 and 1e-20 apart (the difference rounds).
   const double a[3] = {1.0, 0.0, 0.0}, b[3] = {0.0, 1.0, 0.0}, c[3] = {0.0, 0.0, 1.0};
