@@ -25,8 +25,12 @@ bool within_bounds(const P2& x, const P2& a, const P2& b) {
   return true;
 }
 
-/// Closed 2-D segments pq and rs meet; exact, degenerate segments (points) included.
+/// Closed 2-D segments pq and rs meet; exact, degenerate segments (points) included. Segments
+/// whose bounding boxes do not meet are apart without an orientation (the comparisons are exact).
 bool segments_intersect_2d(const P2& p, const P2& q, const P2& r, const P2& s) {
+  for (int k = 0; k < 2; ++k) {
+    if (std::max(p.v[k], q.v[k]) < std::min(r.v[k], s.v[k]) || std::max(r.v[k], s.v[k]) < std::min(p.v[k], q.v[k])) return false;
+  }
   const int o1 = orient2d(p.v, q.v, r.v);
   const int o2 = orient2d(p.v, q.v, s.v);
   const int o3 = orient2d(r.v, s.v, p.v);
@@ -39,8 +43,13 @@ bool segments_intersect_2d(const P2& p, const P2& q, const P2& r, const P2& s) {
   return false;
 }
 
-/// Point p lies in the closed 2-D triangle t (which may be degenerate).
+/// Point p lies in the closed 2-D triangle t (which may be degenerate); outside its bounding box,
+/// not, without an orientation.
 bool point_in_triangle_2d(const P2& p, const P2 t[3]) {
+  for (int k = 0; k < 2; ++k) {
+    if (p.v[k] < std::min({t[0].v[k], t[1].v[k], t[2].v[k]}) || p.v[k] > std::max({t[0].v[k], t[1].v[k], t[2].v[k]}))
+      return false;
+  }
   if (orient2d(t[0].v, t[1].v, t[2].v) != 0) {
     const int o1 = orient2d(t[0].v, t[1].v, p.v);
     const int o2 = orient2d(t[1].v, t[2].v, p.v);
@@ -67,7 +76,13 @@ bool triangles_intersect_2d(const P2 a[3], const P2 b[3]) {
 
 /// For point sets that lie in one common plane: their convex hulls meet iff they meet in all three
 /// axis projections (one projection is injective on that plane, and projections keep meetings).
+/// Hulls whose bounding boxes do not meet are apart at once (exact comparisons).
 bool coplanar_hulls_intersect(const Vec3 a[3], const Vec3 b[3]) {
+  for (int k = 0; k < 3; ++k) {
+    const double a_lo = std::min({a[0][k], a[1][k], a[2][k]}), a_hi = std::max({a[0][k], a[1][k], a[2][k]});
+    const double b_lo = std::min({b[0][k], b[1][k], b[2][k]}), b_hi = std::max({b[0][k], b[1][k], b[2][k]});
+    if (a_hi < b_lo || b_hi < a_lo) return false;
+  }
   for (int drop = 0; drop < 3; ++drop) {
     const int u = (drop + 1) % 3, v = (drop + 2) % 3;
     P2 pa[3], pb[3];

@@ -1,6 +1,8 @@
 #include "geometry/triangle_intersect.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 
@@ -230,6 +232,61 @@ TEST(TriangleIntersect, PlanesCrossingTestAgreesWithEdgeTestsOnRandomPairs) {
   }
   EXPECT_GT(crossing_yes, 1000);
   EXPECT_GT(crossing_no, 1000);
+}
+
+/// Whether closed 2-D triangles (integer corners, possibly degenerate) meet, by separating axes:
+/// their Minkowski difference, a convex polygon, segment or point, misses the origin exactly where
+/// one of the axes separates them, the edges' directions and normals and the two coordinate axes.
+bool triangles_meet_by_axes(const std::int64_t a[3][2], const std::int64_t b[3][2]) {
+  std::int64_t axes[14][2] = {{1, 0}, {0, 1}};
+  int count = 2;
+  for (const auto* t : {a, b}) {
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t dx = t[(i + 1) % 3][0] - t[i][0], dy = t[(i + 1) % 3][1] - t[i][1];
+      axes[count][0] = dx, axes[count++][1] = dy;
+      axes[count][0] = -dy, axes[count++][1] = dx;
+    }
+  }
+  for (int k = 0; k < count; ++k) {
+    std::int64_t lo[2] = {INT64_MAX, INT64_MAX}, hi[2] = {INT64_MIN, INT64_MIN};
+    for (int side = 0; side < 2; ++side) {
+      for (int i = 0; i < 3; ++i) {
+        const auto* p = side == 0 ? a[i] : b[i];
+        const std::int64_t x = axes[k][0] * p[0] + axes[k][1] * p[1];
+        lo[side] = std::min(lo[side], x);
+        hi[side] = std::max(hi[side], x);
+      }
+    }
+    if (hi[0] < lo[1] || hi[1] < lo[0]) return false;
+  }
+  return true;
+}
+
+/// Coplanar pairs: triangles of a small integer grid (shared corners, touching edges, degenerate
+/// ones) placed in three planes (z = 2; x + y + z = 0; x = y, where one axis projection flattens
+/// both onto a line): every answer, in every order, is that of the separating axes in the plane.
+TEST(TriangleIntersect, CoplanarPairsMeetAsTheirSeparatingAxesSay) {
+  std::mt19937_64 rng(31);
+  std::uniform_int_distribution<int> u(-3, 3);
+  int yes = 0, no = 0;
+  for (int iter = 0; iter < 4000; ++iter) {
+    std::int64_t a[3][2], b[3][2];
+    for (auto& p : a) p[0] = u(rng), p[1] = u(rng);
+    for (auto& p : b) p[0] = u(rng), p[1] = u(rng);
+    const bool want = triangles_meet_by_axes(a, b);
+    const auto place = [](const std::int64_t p[2], int plane) {
+      const double x = static_cast<double>(p[0]), y = static_cast<double>(p[1]);
+      return plane == 0 ? Vec3(x, y, 2.0) : plane == 1 ? Vec3(x, y, -x - y) : Vec3(x, x, y);
+    };
+    for (int plane = 0; plane < 3; ++plane) {
+      const Vec3 ta[3] = {place(a[0], plane), place(a[1], plane), place(a[2], plane)};
+      const Vec3 tb[3] = {place(b[0], plane), place(b[1], plane), place(b[2], plane)};
+      ASSERT_EQ(consistent_answer(ta, tb), want) << "iteration " << iter << ", plane " << plane;
+    }
+    (want ? yes : no) += 1;
+  }
+  EXPECT_GT(yes, 1000);
+  EXPECT_GT(no, 1000);
 }
 
 // certainly_separated may skip triangles_intersect only where it would say false: it must never
