@@ -166,6 +166,10 @@ bool degenerate3d(const double* a, const double* b, const double* c, const doubl
   return same(a) || same(b) || same(c);
 }
 
+}  // namespace
+
+namespace detail {
+
 // The exact forms are kept out of line: the filters that call them stay small.
 [[gnu::noinline]] int orient2d_exact(const double* a, const double* b, const double* c) {
   if (degenerate2d(a, b, c)) return 0;
@@ -196,7 +200,7 @@ bool degenerate3d(const double* a, const double* b, const double* c, const doubl
   return sign(det, add(t12, t12n, t3, t3n, det));
 }
 
-}  // namespace
+}  // namespace detail
 
 int orient2d(const double* a, const double* b, const double* c) {
   const double detleft = (a[0] - c[0]) * (b[1] - c[1]);
@@ -205,7 +209,7 @@ int orient2d(const double* a, const double* b, const double* c) {
   const double errbound = kCcwErrBound * (std::fabs(detleft) + std::fabs(detright));
   if (det > errbound) return 1;
   if (-det > errbound) return -1;
-  return orient2d_exact(a, b, c);
+  return detail::orient2d_exact(a, b, c);
 }
 
 int orient3d(const double* a, const double* b, const double* c, const double* d) {
@@ -222,7 +226,7 @@ int orient3d(const double* a, const double* b, const double* c, const double* d)
   const double errbound = kO3dErrBound * permanent;
   if (det > errbound) return 1;
   if (-det > errbound) return -1;
-  return orient3d_exact(a, b, c, d);
+  return detail::orient3d_exact(a, b, c, d);
 }
 
 }  // namespace caliber::geometry
